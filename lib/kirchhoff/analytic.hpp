@@ -1,0 +1,99 @@
+// Closed-form (and closed-form-up-to-one-root) results for elastic rods, kept apart from the
+// numerical solvers so that the solvers can be checked against them.
+//
+// Contents:
+//   * PinnedElastica: the first mode of the pinned-pinned planar Elastica in Jacobi elliptic
+//     functions (Love, "A Treatise on the Mathematical Theory of Elasticity", ch. XIX).
+//   * eq54_*: the maximum curvature and deflection of the same rod read off the Noether
+//     invariant H = 1/2 EI kappa^2 - P cos(theta) (eq. 54 of the reference paper).
+//   * euler_critical_load: Euler buckling loads for the four classical end conditions.
+//   * StraightTwistedRod and clamped_twisted_critical_moment: the straight twisted rod under
+//     tension and its Greenhill instability for clamped ends.
+//
+// Conventions shared with the planar solver (planar_equations.cpp): theta is the angle of the
+// tangent d3 = (cos theta, sin theta) above the x axis, kappa = theta', the internal force n acts
+// on [0, s] from (s, L], and m' = (n x r') . e_z, so a rod compressed by P (n = -P e_x) obeys
+//   EI theta'' = -P sin(theta).
+//
+// Every function checks its arguments and throws std::invalid_argument, naming the argument and
+// the reason, when they are outside the stated domain (non-finite values included).
+#pragma once
+
+namespace kirchhoff::analytic {
+
+// Planar Elastica, pinned at both ends, first (one half-wave) mode; Love's classical solution.
+// The rod starts at the origin heading at angle theta0 above the x axis, ends on the x axis at
+// x = end_to_end(), and bulges towards +y; both supports carry the compressive end load P along
+// the chord and no moment.
+//
+// With k = sin(theta0 / 2) (elliptic modulus), lambda = sqrt(P / EI) and K = K(k):
+//   sin(theta / 2) = k sn(K - lambda s, k),   lambda L = 2 K(k),   so  P = 4 K(k)^2 EI / L^2.
+//
+// Sign convention: the arch turns clockwise, so kappa(s) = theta'(s) <= 0 on [0, L] and
+// kappa(L / 2) = -kappa_max(); kappa_max() and y_max() are magnitudes.
+//
+// Domain: L > 0, EI > 0, theta0 in (0, pi) (theta0 -> pi is the closed loop, K -> infinity);
+// arclengths s in [0, L].
+struct PinnedElastica {
+  double L;       // length
+  double EI;      // bending stiffness
+  double theta0;  // tangent angle at s = 0; theta(L) = -theta0
+
+  double k() const;           // elliptic modulus sin(theta0 / 2)
+  double lambda() const;      // sqrt(P / EI) = 2 K(k) / L
+  double load() const;        // P = 4 K(k)^2 EI / L^2
+  double y_max() const;       // mid-span deflection 2 k / lambda
+  double kappa_max() const;   // |curvature| at mid-span, 2 k lambda
+  double end_to_end() const;  // chord between the supports, L (2 E(k) / K(k) - 1)
+
+  double theta(double s) const;  // 2 asin(k sn(K - lambda s, k))
+  double kappa(double s) const;  // theta'(s) = -2 k lambda cn(K - lambda s, k)
+  double x(double s) const;      // (2 / lambda) (E(k) - E(am(K - lambda s), k)) - s
+  double y(double s) const;      // (2 k / lambda) cn(K - lambda s, k)
+  // The invariant H(s) = 1/2 EI kappa^2 - P cos(theta); equals -P cos(theta0) for every s.
+  double hamiltonian(double s) const;
+};
+
+// Eq. (54) of the reference paper: equate H = 1/2 EI kappa^2 - P cos(theta) at a support
+// (kappa = 0, theta = theta0) and at mid-span (theta = 0), and use EI kappa = -P y:
+//   kappa_max = sqrt(2 P / EI (1 - cos theta0)),   y_max = sqrt(2 EI / P (1 - cos theta0)).
+// Exact for the Elastica with any P > 0, EI > 0, theta0 in (0, pi).
+double eq54_kappa_max(double P, double EI, double theta0);
+double eq54_y_max(double P, double EI, double theta0);
+
+// Euler buckling of a straight column, P_cr = x_n^2 EI / L^2 = (n pi)^2 EI / (K_eff L)^2.
+enum class EulerEnds { PinnedPinned, ClampedFree, ClampedPinned, ClampedClamped };
+
+// x_n for mode n >= 1, in increasing order:
+//   PinnedPinned   n pi
+//   ClampedFree    (2n - 1) pi / 2
+//   ClampedPinned  n-th positive root of tan x = x (4.4934094579..., 7.7252518369..., ...)
+//   ClampedClamped 2 pi, 2 x_1, 4 pi, 2 x_2, ... : symmetric modes 2 j pi alternate with the
+//                  antisymmetric ones 2 x_j (x_j the roots of tan x = x, i.e. tan(x/2) = x/2).
+double euler_load_parameter(EulerEnds ends, int mode = 1);
+double euler_critical_load(EulerEnds ends, double EI, double L, int mode = 1);
+
+// n-th positive root (n >= 1) of tan x = x; it lies in (n pi, n pi + pi / 2).
+double tan_x_equals_x_root(int n);
+
+// A straight rod along e3, twisted by an end rotation phi and pulled by a tension T.
+// Isotropic bending stiffness B, twist stiffness C; m = (C phi / L) e3, n = T e3, and the
+// Hamiltonian H = 1/2 m . K^-1 m + n . d3 = 1/2 m3^2 / C + T.
+// Domain: B > 0, C > 0, L > 0, phi and T finite.
+struct StraightTwistedRod {
+  double B, C, L, phi, T;
+  double twisting_moment() const;  // m3 = C phi / L
+  double hamiltonian() const;      // 1/2 m3^2 / C + T
+};
+
+// Greenhill instability of a straight twisted isotropic rod clamped at both ends (the far end
+// slides axially under the dead tension T; lateral position and orientation fixed): the smallest
+// twisting moment M > 0 for which the linearised equations have a nontrivial solution.
+//   T = 0:        M L / B = 2 x_1 = 8.98681891581813...
+//   L -> infinity: M -> 2 sqrt(B T) (Greenhill); more precisely
+//                  M = 2 sqrt(B T + pi^2 B^2 / L^2) (1 + O((B / (T L^2))^2)).
+// Domain: B > 0, L > 0, T > -4 pi^2 B / L^2 (compression below the clamped-clamped Euler load;
+// at that load the straight rod buckles with no twist at all). The derivation is in analytic.cpp.
+double clamped_twisted_critical_moment(double B, double T, double L);
+
+}  // namespace kirchhoff::analytic

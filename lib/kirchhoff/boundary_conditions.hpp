@@ -1,0 +1,88 @@
+// Boundary conditions as composable pieces. An end of the rod imposes, along chosen lab
+// directions, one of each work-conjugate pair: position or force, orientation or moment.
+// Presets (clamped, pinned, free, loaded, sliding) are just particular choices of directions.
+//
+// Loads are the *applied* force/moment at that end: at s = L the internal force is n(L) = F,
+// at s = 0 it is n(0) = -F (n is the force exerted by the part s+ on the part s-).
+//
+// Extra conditions (e.g. the end slope theta0 of the simply supported Elastica, Fig. 3) are
+// imposed on top of a complete set; each one must be balanced by an unknown parameter (there
+// the load P), which the shooting problem checks.
+#pragma once
+
+#include <Eigen/Dense>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "kirchhoff/parameters.hpp"
+#include "kirchhoff/rod_equations.hpp"
+
+namespace kirchhoff {
+
+using VectorTarget = std::function<Vec3(const Parameters&)>;
+using OrientationFunction = std::function<OrientationTarget(const Parameters&)>;
+
+// How the constrained directions of a slot are chosen; resolved against the equations'
+// admissible directions (so the same condition works in 3D and in the plane).
+enum class Directions {
+  All,             // every admissible direction
+  AlongAxis,       // the axis only
+  LateralToAxis,   // the admissible directions orthogonal to the axis
+};
+
+struct SlotCondition {
+  Slot slot = Slot::Position;
+  Directions directions = Directions::All;
+  Vec3 axis = Vec3::UnitZ();   // for AlongAxis / LateralToAxis
+  VectorTarget value;          // position / applied force / applied moment (unused for orientation)
+  OrientationFunction orientation;  // orientation target (Slot::Orientation only)
+  bool track_turns = false;    // orientation: count whole turns about the target axis
+  bool extra = false;          // an extra condition balanced by an unknown parameter
+
+  // Orthonormal 3 x k basis of the constrained lab directions.
+  Eigen::MatrixXd basis(const RodEquations& eq) const;
+};
+
+class EndCondition {
+ public:
+  // Position and frame imposed.
+  static EndCondition clamped(VectorTarget position, OrientationFunction orientation, bool track_turns = false);
+  // Position imposed, no applied moment.
+  static EndCondition pinned(VectorTarget position);
+  // No applied force or moment.
+  static EndCondition free();
+  // Dead force and moment applied, position and frame free.
+  static EndCondition loaded(VectorTarget force, VectorTarget moment);
+  // Position imposed across `axis`, free along it under the applied force's axial component; the
+  // frame is imposed when `orientation` is given, otherwise the end carries no moment.
+  static EndCondition sliding(Vec3 axis, VectorTarget position, VectorTarget force,
+                              OrientationFunction orientation = {}, bool track_turns = false);
+
+  EndCondition& add(SlotCondition condition);
+  // Extra condition: the frame's rotation about `axis` equals `angle` (e.g. theta(0) = theta0).
+  EndCondition& impose_orientation_angle(Vec3 axis, std::function<double(const Parameters&)> angle);
+
+  const std::vector<SlotCondition>& conditions() const { return conditions_; }
+  int extra_count() const;
+
+  // Checks that each work-conjugate pair is imposed exactly once along every admissible
+  // direction. Returns the reason when not (e.g. "position and force both imposed along
+  // (1, 0, 0)"), empty when complete.
+  std::string check(const RodEquations& eq) const;
+
+  // Residuals and their Jacobian with respect to the state y at this end.
+  void append_residuals(const RodEquations& eq, bool at_start, const Eigen::VectorXd& y, const Parameters& p,
+                        std::vector<double>* residual, std::vector<Eigen::RowVectorXd>* jacobian) const;
+
+  // A state satisfying the imposed values (used to complete an initial guess).
+  void impose_on(const RodEquations& eq, bool at_start, const Parameters& p, RodPoint* point) const;
+
+ private:
+  std::vector<SlotCondition> conditions_;
+};
+
+VectorTarget constant(const Vec3& v);
+OrientationFunction constant_orientation(const OrientationTarget& t);
+
+}  // namespace kirchhoff

@@ -1,0 +1,40 @@
+// Integration of the rod equations in arclength with Boost.Odeint, with or without the
+// variational equations (state-transition matrix Phi = dy(s1)/dy(s0)).
+#pragma once
+
+#include <Eigen/Dense>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace kirchhoff {
+
+struct IntegratorOptions {
+  enum class Stepper {
+    Dopri5,        // Dormand-Prince 5(4): cheap steps, dense output for profiles
+    RungeKutta78,  // Runge-Kutta-Fehlberg 7(8): fewer steps at the tight tolerances we default to
+  };
+  // Default: RK78 at 1e-12, tight enough that H is flat to ~1e-10 of its scale on the test cases.
+  Stepper stepper = Stepper::RungeKutta78;
+  double abs_tol = 1e-12;   // absolute error per step (odeint's error checker)
+  double rel_tol = 1e-12;   // relative error per step
+  double initial_step = 1e-2;  // first trial step as a fraction of the segment length
+  long max_steps = 200000;     // per segment; beyond this the integration is reported as failed
+
+  // Returns an empty string when valid, else the reason.
+  std::string validate() const;
+};
+
+// Thrown by the integrators; the shooting layer turns it into a status, never lets it escape.
+struct IntegrationError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct SegmentFlow {
+  Eigen::VectorXd y;    // state at the end of the segment
+  Eigen::MatrixXd Phi;  // dy(s1)/dy(s0); empty unless sensitivities were requested
+  long rhs_evaluations = 0;
+  long steps = 0;
+};
+
+}  // namespace kirchhoff

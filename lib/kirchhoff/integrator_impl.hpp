@@ -1,0 +1,123 @@
+// Internal: the odeint plumbing shared by the spatial and planar equations. A right-hand side
+// is any object with `template <class T> void operator()(const T* y, T* dyds, double s) const`,
+// evaluated on double for the state and on Dual<N> for the variational equations.
+#pragma once
+
+#include <array>
+#include <boost/numeric/odeint.hpp>
+#include <cmath>
+
+#include "kirchhoff/dual.hpp"
+#include "kirchhoff/integrator.hpp"
+
+namespace kirchhoff::detail {
+
+namespace odeint = boost::numeric::odeint;
+
+// Arclength marching with an odeint controlled stepper. We drive try_step ourselves (rather
+// than integrate_adaptive) to cap the number of steps and to land exactly on s1.
+template <class State, class System>
+long march(State& x, double s0, double s1, const System& system, const IntegratorOptions& opt) {
+  const double span = s1 - s0;
+  if (span == 0.0) return 0;
+  double s = s0;
+  double ds = opt.initial_step * span;
+  long steps = 0;
+  auto advance = [&](auto stepper) {
+    while ((span > 0) ? (s < s1) : (s > s1)) {
+      if ((span > 0) ? (s + ds > s1) : (s + ds < s1)) ds = s1 - s;
+      if (stepper.try_step(system, x, s, ds) == odeint::success) ++steps;
+      if (steps + 1 > opt.max_steps) throw IntegrationError("more than max_steps integration steps");
+      if (!std::isfinite(ds) || std::abs(ds) < 1e-14 * std::abs(span))
+        throw IntegrationError("step size underflow near s = " + std::to_string(s));
+    }
+  };
+  if (opt.stepper == IntegratorOptions::Stepper::Dopri5)
+    advance(odeint::make_controlled(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_dopri5<State>()));
+  else
+    advance(odeint::make_controlled(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_fehlberg78<State>()));
+  for (double v : x)
+    if (!std::isfinite(v)) throw IntegrationError("non-finite state");
+  return steps;
+}
+
+// Integrates the state alone.
+template <int N, class Rhs>
+SegmentFlow flow_state(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                       const IntegratorOptions& opt) {
+  using State = std::array<double, N>;
+  State x;
+  for (int i = 0; i < N; ++i) x[i] = y0[i];
+  long evaluations = 0;
+  auto system = [&](const State& y, State& dy, double s) {
+    ++evaluations;
+    rhs(y.data(), dy.data(), s);
+  };
+  SegmentFlow out;
+  out.steps = march(x, s0, s1, system, opt);
+  out.y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
+  out.rhs_evaluations = evaluations;
+  return out;
+}
+
+// Integrates the state together with the variational equations Phi' = (df/dy) Phi, Phi(s0) = I,
+// by evaluating the right-hand side on Dual<N> seeded with the columns of Phi.
+template <int N, class Rhs>
+SegmentFlow flow_with_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                    const IntegratorOptions& opt) {
+  using State = std::array<double, N + N * N>;  // y, then Phi row-major
+  State x{};
+  for (int i = 0; i < N; ++i) {
+    x[i] = y0[i];
+    x[N + i * N + i] = 1.0;
+  }
+  long evaluations = 0;
+  auto system = [&](const State& y, State& dy, double s) {
+    ++evaluations;
+    std::array<Dual<N>, N> yd, dyd;
+    for (int i = 0; i < N; ++i) {
+      yd[i].v = y[i];
+      for (int j = 0; j < N; ++j) yd[i].d[j] = y[N + i * N + j];
+    }
+    rhs(yd.data(), dyd.data(), s);
+    for (int i = 0; i < N; ++i) {
+      dy[i] = dyd[i].v;
+      for (int j = 0; j < N; ++j) dy[N + i * N + j] = dyd[i].d[j];
+    }
+  };
+  SegmentFlow out;
+  out.steps = march(x, s0, s1, system, opt);
+  out.y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
+  out.Phi = Eigen::Map<const Eigen::Matrix<double, N, N, Eigen::RowMajor>>(x.data() + N);
+  out.rhs_evaluations = evaluations;
+  return out;
+}
+
+// States at the requested arclengths (sorted). Dopri5 uses its dense output (interpolation
+// between steps); RK78 steps onto each sample point so profiles keep its accuracy.
+template <int N, class Rhs>
+std::vector<Eigen::VectorXd> sample_states(const Rhs& rhs, const Eigen::VectorXd& y0,
+                                           const std::vector<double>& s_values,
+                                           const IntegratorOptions& opt) {
+  using State = std::array<double, N>;
+  State x;
+  for (int i = 0; i < N; ++i) x[i] = y0[i];
+  std::vector<Eigen::VectorXd> out;
+  if (s_values.empty()) return out;
+  auto system = [&](const State& y, State& dy, double s) { rhs(y.data(), dy.data(), s); };
+  auto observer = [&](const State& y, double) {
+    out.push_back(Eigen::Map<const Eigen::Matrix<double, N, 1>>(y.data()));
+  };
+  const double span = s_values.back() - s_values.front();
+  const double ds = opt.initial_step * (span > 0 ? span : 1.0);
+  if (opt.stepper == IntegratorOptions::Stepper::Dopri5) {
+    auto stepper = odeint::make_dense_output(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_dopri5<State>());
+    odeint::integrate_times(stepper, system, x, s_values.begin(), s_values.end(), ds, observer);
+  } else {
+    auto stepper = odeint::make_controlled(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_fehlberg78<State>());
+    odeint::integrate_times(stepper, system, x, s_values.begin(), s_values.end(), ds, observer);
+  }
+  return out;
+}
+
+}  // namespace kirchhoff::detail

@@ -1,0 +1,183 @@
+#include "kirchhoff/newton.hpp"
+
+#include <cmath>
+#include <nlopt.hpp>
+#include <sstream>
+
+namespace kirchhoff {
+
+const char* to_string(SolverStatus status) {
+  switch (status) {
+    case SolverStatus::Converged: return "converged";
+    case SolverStatus::MaxIterations: return "max_iterations";
+    case SolverStatus::SingularJacobian: return "singular_jacobian";
+    case SolverStatus::IntegrationFailed: return "integration_failed";
+    case SolverStatus::LineSearchFailed: return "line_search_failed";
+  }
+  return "unknown";
+}
+
+std::string NewtonOptions::validate() const {
+  if (max_iterations < 1) return "max_iterations must be >= 1";
+  if (!(residual_tolerance > 0)) return "residual_tolerance must be > 0";
+  if (!(finite_difference_step > 0)) return "finite_difference_step must be > 0";
+  if (max_backtracks < 0) return "max_backtracks must be >= 0";
+  return {};
+}
+
+std::string NewtonSummary::brief_report() const {
+  std::ostringstream os;
+  os << to_string(status) << " after " << iterations << " iterations, residual " << residual_norm;
+  if (used_fallback_search) os << " (starting point from NLopt search)";
+  if (!message.empty()) os << ": " << message;
+  return os.str();
+}
+
+bool finite_difference_jacobian(const NonlinearSystem& system, const Eigen::VectorXd& x, double step,
+                                Eigen::MatrixXd* J) {
+  const int n = system.size();
+  J->resize(n, n);
+  Eigen::VectorXd xp = x, Fp, Fm;
+  std::string failure;
+  for (int j = 0; j < n; ++j) {
+    const double h = step * (1.0 + std::abs(x[j]));
+    xp[j] = x[j] + h;
+    if (!system.evaluate(xp, &Fp, nullptr, &failure)) return false;
+    xp[j] = x[j] - h;
+    if (!system.evaluate(xp, &Fm, nullptr, &failure)) return false;
+    xp[j] = x[j];
+    J->col(j) = (Fp - Fm) / (2.0 * h);
+  }
+  return true;
+}
+
+NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options) {
+  NewtonSummary summary;
+  Eigen::VectorXd F, F_trial;
+  Eigen::MatrixXd J;
+  std::string failure;
+  auto evaluate = [&](const Eigen::VectorXd& at, Eigen::VectorXd* f, Eigen::MatrixXd* jac) {
+    ++summary.evaluations;
+    if (jac && options.finite_difference_jacobian) {
+      if (!system.evaluate(at, f, nullptr, &failure)) return false;
+      return finite_difference_jacobian(system, at, options.finite_difference_step, jac);
+    }
+    return system.evaluate(at, f, jac, &failure);
+  };
+
+  if (!evaluate(x, &F, &J)) {
+    summary.status = SolverStatus::IntegrationFailed;
+    summary.residual_norm = INFINITY;
+    summary.message = failure;
+    return summary;
+  }
+  double norm = F.lpNorm<Eigen::Infinity>();
+  for (int it = 0; it < options.max_iterations; ++it) {
+    summary.residual_norm = norm;
+    if (norm <= options.residual_tolerance) {
+      summary.status = SolverStatus::Converged;
+      return summary;
+    }
+    Eigen::PartialPivLU<Eigen::MatrixXd> lu(J);
+    if (!(lu.rcond() > options.singular_rcond)) {
+      summary.status = SolverStatus::SingularJacobian;
+      summary.message = "reciprocal condition number " + std::to_string(lu.rcond());
+      return summary;
+    }
+    const Eigen::VectorXd dx = -lu.solve(F);
+    // Backtracking on |F|_2: accept the first step length that decreases it (sufficient
+    // decrease with the usual 1e-4 slope fraction).
+    const double merit = F.squaredNorm();
+    double alpha = 1.0;
+    bool accepted = false;
+    Eigen::VectorXd x_trial;
+    for (int k = 0; k <= options.max_backtracks; ++k, alpha *= 0.5) {
+      x_trial = x + alpha * dx;
+      if (evaluate(x_trial, &F_trial, nullptr) && F_trial.squaredNorm() <= (1.0 - 1e-4 * alpha) * merit) {
+        accepted = true;
+        break;
+      }
+    }
+    ++summary.iterations;
+    if (!accepted) {
+      summary.status = SolverStatus::LineSearchFailed;
+      summary.message = "no step length decreased the residual";
+      return summary;
+    }
+    x = x_trial;
+    if (!evaluate(x, &F, &J)) {
+      summary.status = SolverStatus::IntegrationFailed;
+      summary.message = failure;
+      return summary;
+    }
+    norm = F.lpNorm<Eigen::Infinity>();
+    summary.history.push_back(norm);
+    const bool stalled = alpha * dx.lpNorm<Eigen::Infinity>() <=
+                         options.step_tolerance * (1.0 + x.lpNorm<Eigen::Infinity>());
+    if (stalled && norm <= 1e3 * options.residual_tolerance) {
+      summary.residual_norm = norm;
+      summary.status = SolverStatus::Converged;
+      summary.message = "step at round-off";
+      return summary;
+    }
+  }
+  summary.residual_norm = norm;
+  summary.status = norm <= options.residual_tolerance ? SolverStatus::Converged : SolverStatus::MaxIterations;
+  return summary;
+}
+
+namespace {
+
+struct SearchContext {
+  const NonlinearSystem* system;
+  long evaluations = 0;
+};
+
+// Objective |F|^2 / 2 with gradient J^T F; an unevaluable point is a large value, so the
+// search backs away from regions where the integrator fails.
+double least_squares_objective(unsigned n, const double* x, double* grad, void* data) {
+  auto* ctx = static_cast<SearchContext*>(data);
+  ++ctx->evaluations;
+  Eigen::Map<const Eigen::VectorXd> xv(x, n);
+  Eigen::VectorXd F;
+  Eigen::MatrixXd J;
+  std::string failure;
+  if (!ctx->system->evaluate(xv, &F, grad ? &J : nullptr, &failure)) {
+    if (grad) std::fill(grad, grad + n, 0.0);
+    return 1e300;
+  }
+  if (grad) Eigen::Map<Eigen::VectorXd>(grad, n) = J.transpose() * F;
+  return 0.5 * F.squaredNorm();
+}
+
+}  // namespace
+
+NewtonSummary solve_with_fallback(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options) {
+  const Eigen::VectorXd guess = x;
+  NewtonSummary summary = newton_solve(system, x, options);
+  if (summary.converged() || !options.fallback_search) return summary;
+
+  SearchContext ctx{&system};
+  nlopt::opt search(nlopt::LD_LBFGS, static_cast<unsigned>(system.size()));
+  search.set_min_objective(least_squares_objective, &ctx);
+  search.set_maxeval(options.fallback_evaluations);
+  search.set_ftol_abs(0.5 * options.residual_tolerance * options.residual_tolerance);
+  std::vector<double> start(guess.data(), guess.data() + guess.size());
+  double value = 0.0;
+  try {
+    search.optimize(start, value);
+  } catch (const std::exception&) {
+    // NLopt stops with roundoff_limited or similar: the point reached is still a candidate.
+  }
+  Eigen::VectorXd candidate = Eigen::Map<Eigen::VectorXd>(start.data(), start.size());
+  NewtonSummary second = newton_solve(system, candidate, options);
+  second.used_fallback_search = true;
+  second.evaluations += summary.evaluations + ctx.evaluations;
+  if (second.converged() || second.residual_norm < summary.residual_norm) {
+    x = candidate;
+    return second;
+  }
+  return summary;
+}
+
+}  // namespace kirchhoff

@@ -1,0 +1,71 @@
+// Damped Newton for small dense square systems F(x) = 0 (the shooting residuals), with a
+// summary that says why it stopped, a finite-difference Jacobian as a checked fallback, and an
+// NLopt least-squares search for a starting point when Newton from the user's guess fails.
+#pragma once
+
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
+
+namespace kirchhoff {
+
+class NonlinearSystem {
+ public:
+  virtual ~NonlinearSystem() = default;
+  virtual int size() const = 0;  // number of unknowns = number of residuals
+  // Fills F (and J when non-null). Returns false when the residual cannot be evaluated (the
+  // integrator gave up), with the reason in *failure.
+  virtual bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
+                        std::string* failure) const = 0;
+};
+
+enum class SolverStatus {
+  Converged,          // max_i |F_i| <= residual_tolerance
+  MaxIterations,      // max_iterations Newton steps without converging
+  SingularJacobian,   // reciprocal condition number of J below singular_rcond
+  IntegrationFailed,  // the residual could not be evaluated at the current iterate
+  LineSearchFailed,   // no step length in [2^-max_backtracks, 1] decreased |F|
+};
+const char* to_string(SolverStatus status);
+
+struct NewtonOptions {
+  int max_iterations = 50;
+  double residual_tolerance = 1e-10;  // on max_i |F_i|; the integrator is run at 1e-12
+  // Converged as well when the Newton step is this small relative to x and |F| is within
+  // 1e3 x residual_tolerance: the iterate has stopped moving at round-off.
+  double step_tolerance = 1e-14;
+  int max_backtracks = 20;
+  double singular_rcond = 1e-15;  // below this LU's estimate, J is treated as singular
+  bool finite_difference_jacobian = false;  // fallback; the default is the variational Jacobian
+  double finite_difference_step = 1e-6;     // central differences: error ~ h^2 ~ 1e-12
+  bool fallback_search = true;  // run an NLopt least-squares search when Newton fails
+  int fallback_evaluations = 2000;
+
+  std::string validate() const;  // empty when valid
+};
+
+struct NewtonSummary {
+  SolverStatus status = SolverStatus::MaxIterations;
+  int iterations = 0;
+  double residual_norm = 0.0;  // max_i |F_i| at the returned x (the best one seen)
+  std::string message;
+  std::vector<double> history;  // residual norm after each iteration
+  long evaluations = 0;
+  bool used_fallback_search = false;
+
+  bool converged() const { return status == SolverStatus::Converged; }
+  std::string brief_report() const;
+};
+
+// Solves F(x) = 0 starting from x; on return x holds the best iterate found.
+NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options);
+
+// Newton, and when it fails and options.fallback_search is set, an NLopt minimisation of
+// |F|^2 / 2 from the original guess followed by Newton again.
+NewtonSummary solve_with_fallback(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options);
+
+// Central-difference Jacobian; returns false when an evaluation fails.
+bool finite_difference_jacobian(const NonlinearSystem& system, const Eigen::VectorXd& x, double step,
+                                Eigen::MatrixXd* J);
+
+}  // namespace kirchhoff

@@ -1,0 +1,107 @@
+// The description of an elastic rod: stiffnesses, natural strains and external conservative
+// fields. Immutable once built; the equations and solvers read it, never write it.
+//
+// Notation follows the reference paper (Noether invariants for elastic rods), section 3:
+// bending/twist stiffnesses B1, B2, B3 (eq. 12), shear/stretch stiffnesses A1, A2, A3 (eq. 13),
+// natural curvatures/twist u_hat and natural shear/stretch v_hat, external potential W_ext (eq. 14).
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <functional>
+#include <memory>
+#include <string>
+
+namespace kirchhoff {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+
+// A scalar material property as a function of the arclength s. Constant profiles skip the
+// function call, which matters because the right-hand side evaluates six of them per call.
+class Profile {
+ public:
+  Profile(double constant = 0.0) : constant_(constant) {}  // NOLINT: a number is a constant profile
+  Profile(std::function<double(double)> f, std::function<double(double)> derivative = {})
+      : function_(std::move(f)), derivative_(std::move(derivative)) {}
+
+  double operator()(double s) const { return function_ ? function_(s) : constant_; }
+  bool is_constant() const { return !function_; }
+  // d/ds of the profile; central differences when no derivative was supplied (used only for
+  // reporting identities such as eq. 57, never inside the equations).
+  double derivative(double s) const;
+
+ private:
+  double constant_ = 0.0;
+  std::function<double(double)> function_;
+  std::function<double(double)> derivative_;
+};
+
+// A conservative external field per unit length: potential W_ext(r), force f = -dW/dr and the
+// force's gradient df/dr, which the variational equations need.
+class ExternalField {
+ public:
+  virtual ~ExternalField() = default;
+  virtual double potential(const Vec3& r) const = 0;
+  virtual Vec3 force(const Vec3& r) const = 0;
+  virtual Mat3 force_gradient(const Vec3& r) const = 0;
+};
+
+// Weight per unit length w acting along -up: W_ext = w r.up (section 3.1, rho S g r.e_z).
+class UniformGravity final : public ExternalField {
+ public:
+  UniformGravity(double weight_per_length, Vec3 up);
+  double potential(const Vec3& r) const override { return weight_ * r.dot(up_); }
+  Vec3 force(const Vec3&) const override { return -weight_ * up_; }
+  Mat3 force_gradient(const Vec3&) const override { return Mat3::Zero(); }
+
+ private:
+  double weight_;
+  Vec3 up_;
+};
+
+// Soft-wall barrier of eq. (64): W_ext = b / (a - r.normal), repelling the rod from the plane
+// r.normal = a it must stay below.
+class BarrierWall final : public ExternalField {
+ public:
+  BarrierWall(double range_b, double height_a, Vec3 normal);
+  double potential(const Vec3& r) const override;
+  Vec3 force(const Vec3& r) const override;
+  Mat3 force_gradient(const Vec3& r) const override;
+
+ private:
+  double b_, a_;
+  Vec3 normal_;
+};
+
+// Several fields acting together.
+class FieldSum final : public ExternalField {
+ public:
+  void add(std::shared_ptr<const ExternalField> f) { fields_.push_back(std::move(f)); }
+  bool empty() const { return fields_.empty(); }
+  double potential(const Vec3& r) const override;
+  Vec3 force(const Vec3& r) const override;
+  Mat3 force_gradient(const Vec3& r) const override;
+
+ private:
+  std::vector<std::shared_ptr<const ExternalField>> fields_;
+};
+
+struct RodModel {
+  double length = 1.0;
+  std::array<Profile, 3> B{Profile(1.0), Profile(1.0), Profile(1.0)};  // bend 1, bend 2, twist
+  // Kirchhoff limit: inextensible and unshearable, v = v_hat exactly (no large stiffness).
+  bool extensible = false;
+  std::array<Profile, 3> A{Profile(1.0), Profile(1.0), Profile(1.0)};  // shear 1, shear 2, stretch
+  std::array<Profile, 3> u_hat{Profile(0.0), Profile(0.0), Profile(0.0)};
+  std::array<Profile, 3> v_hat{Profile(0.0), Profile(0.0), Profile(1.0)};
+  std::shared_ptr<const ExternalField> field;  // null: no external field
+
+  // Throws std::invalid_argument naming the offending property (non-positive length or
+  // stiffness at any sampled s).
+  void validate() const;
+  // True when no property depends on s, so the Lagrangian has no explicit s and H is conserved.
+  bool is_uniform() const;
+};
+
+}  // namespace kirchhoff

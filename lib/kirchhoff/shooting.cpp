@@ -1,0 +1,209 @@
+#include "kirchhoff/shooting.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace kirchhoff {
+namespace {
+
+// Central-difference step for parameter columns, relative to 1 + |p|: the truncation error
+// ~h^2 and round-off ~eps/h balance near 1e-6 for the smooth closed-form targets.
+constexpr double kParameterStep = 1e-6;
+
+struct ConditionRows {
+  std::vector<double> values;
+  std::vector<Eigen::RowVectorXd> jacobian;
+};
+
+}  // namespace
+
+std::string ShootingOptions::validate() const {
+  if (segments < 1) return "segments must be >= 1";
+  if (std::string e = integrator.validate(); !e.empty()) return e;
+  return newton.validate();
+}
+
+std::string IntegratorOptions::validate() const {
+  if (!(abs_tol > 0) || !(rel_tol >= 0)) return "integrator tolerances must be > 0";
+  if (!(initial_step > 0) || initial_step > 1) return "initial_step must be in (0, 1]";
+  if (max_steps < 1) return "max_steps must be >= 1";
+  return {};
+}
+
+ShootingProblem::ShootingProblem(ProblemDefinition definition) : definition_(std::move(definition)) {
+  if (std::string e = definition_.options.validate(); !e.empty()) throw std::invalid_argument(e);
+  if (!definition_.model) throw std::invalid_argument("no rod model given");
+  const auto eq = equations(definition_.parameters);
+  state_size_ = eq->state_size();
+  if (std::string e = definition_.start.check(*eq); !e.empty()) throw std::invalid_argument("start: " + e);
+  if (std::string e = definition_.end.check(*eq); !e.empty()) throw std::invalid_argument("end: " + e);
+  for (const auto& name : definition_.unknown_parameters) {
+    const int i = definition_.parameters.index_of(name);
+    if (i < 0) throw std::invalid_argument("unknown parameter '" + name + "' is not among the parameters");
+    unknown_index_.push_back(i);
+  }
+  const int extras = definition_.start.extra_count() + definition_.end.extra_count();
+  if (extras != static_cast<int>(unknown_index_.size()))
+    throw std::invalid_argument(std::to_string(extras) + " extra condition(s) but " +
+                                std::to_string(unknown_index_.size()) +
+                                " unknown parameter(s): each unknown parameter needs exactly one extra condition");
+  // Count residual rows once, at the guess, to make sure the system is square.
+  std::vector<double> rows;
+  const Eigen::VectorXd y = eq->state(RodPoint{});
+  residual_count_ = static_cast<int>(eq->gauge_residual(y, nullptr).size());
+  definition_.start.append_residuals(*eq, true, y, definition_.parameters, &rows, nullptr);
+  definition_.end.append_residuals(*eq, false, y, definition_.parameters, &rows, nullptr);
+  residual_count_ += static_cast<int>(rows.size()) + (segments() - 1) * state_size_;
+  if (residual_count_ != size())
+    throw std::invalid_argument("boundary conditions give " + std::to_string(residual_count_) +
+                                " equations for " + std::to_string(size()) + " unknowns");
+}
+
+int ShootingProblem::size() const { return segments() * state_size_ + static_cast<int>(unknown_index_.size()); }
+
+std::shared_ptr<const RodEquations> ShootingProblem::equations(const Parameters& p) const {
+  std::vector<double> key;
+  for (const auto& name : definition_.model_parameters)
+    if (p.contains(name)) key.push_back(p.get(name));
+  if (!cached_equations_ || key != cached_model_values_) {
+    RodModel model = definition_.model(p);
+    cached_equations_ = definition_.kind == RodKind::Planar ? make_planar_equations(std::move(model))
+                                                            : make_spatial_equations(std::move(model));
+    cached_model_values_ = key;
+  }
+  return cached_equations_;
+}
+
+Parameters ShootingProblem::parameters_at(const Eigen::VectorXd& x) const {
+  Parameters p = definition_.parameters;
+  const int offset = segments() * state_size_;
+  for (size_t j = 0; j < unknown_index_.size(); ++j) p.value_at(unknown_index_[j]) = x[offset + j];
+  return p;
+}
+
+void ShootingProblem::set_parameter(const std::string& name, double value) {
+  definition_.parameters.set(name, value);
+}
+
+bool ShootingProblem::depends_on_model(int unknown) const {
+  return definition_.model_parameters.count(definition_.parameters.names()[unknown_index_[unknown]]) > 0;
+}
+
+bool ShootingProblem::evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
+                               std::string* failure) const {
+  const Parameters p = parameters_at(x);
+  if (!residual(x, p, F, J, failure)) return false;
+  if (!J) return true;
+  // Parameter columns by central differences (see the header for why this is accurate enough).
+  const int offset = segments() * state_size_;
+  for (size_t j = 0; j < unknown_index_.size(); ++j) {
+    const double h = kParameterStep * (1.0 + std::abs(x[offset + j]));
+    Eigen::VectorXd xp = x, xm = x, Fp, Fm;
+    xp[offset + j] += h;
+    xm[offset + j] -= h;
+    if (!residual(xp, parameters_at(xp), &Fp, nullptr, failure)) return false;
+    if (!residual(xm, parameters_at(xm), &Fm, nullptr, failure)) return false;
+    J->col(offset + j) = (Fp - Fm) / (2.0 * h);
+  }
+  return true;
+}
+
+bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
+                               Eigen::MatrixXd* J, std::string* failure) const {
+  const auto eq = equations(p);
+  const int n = state_size_, M = segments();
+  const double L = eq->model().length;
+  F->resize(residual_count_);
+  if (J) J->setZero(residual_count_, size());
+  int row = 0;
+
+  const Eigen::VectorXd y0 = x.head(n);
+  Eigen::MatrixXd Jg;
+  const Eigen::VectorXd g = eq->gauge_residual(y0, J ? &Jg : nullptr);
+  F->segment(row, g.size()) = g;
+  if (J) J->block(row, 0, g.size(), n) = Jg;
+  row += static_cast<int>(g.size());
+
+  ConditionRows start;
+  definition_.start.append_residuals(*eq, true, y0, p, &start.values, J ? &start.jacobian : nullptr);
+  for (size_t k = 0; k < start.values.size(); ++k, ++row) {
+    (*F)[row] = start.values[k];
+    if (J) J->block(row, 0, 1, n) = start.jacobian[k];
+  }
+
+  SegmentFlow last;
+  try {
+    for (int i = 0; i < M; ++i) {
+      const double s0 = L * i / M, s1 = L * (i + 1) / M;
+      SegmentFlow flow = eq->flow(x.segment(i * n, n), s0, s1, J != nullptr, definition_.options.integrator);
+      rhs_evaluations_ += flow.rhs_evaluations;
+      if (i + 1 < M) {
+        F->segment(row, n) = flow.y - x.segment((i + 1) * n, n);
+        if (J) {
+          J->block(row, i * n, n, n) = flow.Phi;
+          J->block(row, (i + 1) * n, n, n) = -Eigen::MatrixXd::Identity(n, n);
+        }
+        row += n;
+      } else {
+        last = std::move(flow);
+      }
+    }
+  } catch (const IntegrationError& e) {
+    if (failure) *failure = e.what();
+    return false;
+  }
+
+  ConditionRows end;
+  definition_.end.append_residuals(*eq, false, last.y, p, &end.values, J ? &end.jacobian : nullptr);
+  for (size_t k = 0; k < end.values.size(); ++k, ++row) {
+    (*F)[row] = end.values[k];
+    if (J) J->block(row, (M - 1) * n, 1, n) = end.jacobian[k] * last.Phi;
+  }
+  return true;
+}
+
+Eigen::VectorXd ShootingProblem::initial_unknowns(const RodPoint& start_guess) const {
+  const auto eq = equations(definition_.parameters);
+  RodPoint p0 = start_guess;
+  definition_.start.impose_on(*eq, true, definition_.parameters, &p0);
+  const int n = state_size_, M = segments();
+  Eigen::VectorXd x(size());
+  Eigen::VectorXd y = eq->state(p0);
+  const double L = eq->model().length;
+  for (int i = 0; i < M; ++i) {
+    x.segment(i * n, n) = y;
+    if (i + 1 < M) y = eq->flow(y, L * i / M, L * (i + 1) / M, false, definition_.options.integrator).y;
+  }
+  for (size_t j = 0; j < unknown_index_.size(); ++j)
+    x[M * n + j] = definition_.parameters.values()[unknown_index_[j]];
+  return x;
+}
+
+std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const std::vector<double>& s) const {
+  const Parameters p = parameters_at(x);
+  const auto eq = equations(p);
+  const int n = state_size_, M = segments();
+  const double L = eq->model().length;
+  std::vector<RodPoint> out;
+  out.reserve(s.size());
+  size_t k = 0;
+  for (int i = 0; i < M; ++i) {
+    const double s0 = L * i / M, s1 = L * (i + 1) / M;
+    std::vector<double> local{s0};
+    while (k < s.size() && (s[k] < s1 || (i + 1 == M && s[k] <= s1))) local.push_back(s[k++]);
+    if (local.size() == 1) continue;
+    const auto states = eq->sample(x.segment(i * n, n), local, definition_.options.integrator);
+    for (size_t j = 1; j < states.size(); ++j) out.push_back(eq->point(states[j], local[j]));
+  }
+  return out;
+}
+
+ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) {
+  ShootingResult result;
+  result.x = x0;
+  result.summary = solve_with_fallback(problem, result.x, problem.definition().options.newton);
+  result.parameters = problem.parameters_at(result.x);
+  return result;
+}
+
+}  // namespace kirchhoff

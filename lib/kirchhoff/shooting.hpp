@@ -1,0 +1,106 @@
+// Shooting for rod equilibria: single or multiple shooting on the rod equations, with boundary
+// conditions at both ends and unknown parameters balanced by extra conditions.
+//
+// Unknowns x = [y(s_0), ..., y(s_{M-1}), p_unknown] for M segments s_0 = 0 < ... < s_M = L.
+// Residuals, in order: the equations' gauge conditions at s = 0, the start conditions, the
+// continuity y(s_{i+1}^-) - y(s_{i+1}) for interior nodes, the end conditions. Extra conditions
+// sit with the conditions of their end. The Jacobian comes from the variational equations
+// (state-transition matrices); parameters that enter the rod model are differentiated by
+// central differences of the flow, those that enter only the boundary conditions by central
+// differences of the (closed-form) conditions.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "kirchhoff/boundary_conditions.hpp"
+#include "kirchhoff/integrator.hpp"
+#include "kirchhoff/newton.hpp"
+#include "kirchhoff/parameters.hpp"
+#include "kirchhoff/rod_equations.hpp"
+
+namespace kirchhoff {
+
+enum class RodKind { Spatial, Planar };
+
+using ModelFunction = std::function<RodModel(const Parameters&)>;
+
+struct ShootingOptions {
+  int segments = 1;  // multiple shooting when > 1 (long or strongly loaded rods)
+  IntegratorOptions integrator;
+  NewtonOptions newton;
+  std::string validate() const;
+};
+
+// Everything needed to state a problem; ShootingProblem checks it on construction.
+struct ProblemDefinition {
+  RodKind kind = RodKind::Spatial;
+  ModelFunction model;                     // the rod for given parameter values
+  std::set<std::string> model_parameters;  // parameters the model depends on
+  EndCondition start, end;
+  Parameters parameters;                   // current values (guesses for the unknown ones)
+  std::vector<std::string> unknown_parameters;
+  ShootingOptions options;
+};
+
+class ShootingProblem final : public NonlinearSystem {
+ public:
+  // Throws std::invalid_argument with the reason for an inconsistent definition (bad options,
+  // incomplete or doubly imposed boundary conditions, unknown parameters without extra
+  // conditions, non-physical model).
+  explicit ShootingProblem(ProblemDefinition definition);
+
+  int size() const override;
+  bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
+                std::string* failure) const override;
+
+  // Unknown vector from a state guess at s = 0 (completed with the start conditions) by
+  // integrating across the segments; throws IntegrationError when that integration fails.
+  Eigen::VectorXd initial_unknowns(const RodPoint& start_guess) const;
+
+  // Parameters with the unknown ones taken from x.
+  Parameters parameters_at(const Eigen::VectorXd& x) const;
+  void set_parameter(const std::string& name, double value);
+  const Parameters& parameters() const { return definition_.parameters; }
+  const ProblemDefinition& definition() const { return definition_; }
+
+  // Equations for the given parameters (rebuilt when a model parameter changes).
+  std::shared_ptr<const RodEquations> equations(const Parameters& p) const;
+  double length(const Parameters& p) const { return equations(p)->model().length; }
+  int state_size() const { return state_size_; }
+  int segments() const { return definition_.options.segments; }
+  // State at s = 0 stored in x.
+  Eigen::VectorXd start_state(const Eigen::VectorXd& x) const { return x.head(state_size_); }
+  // Solution sampled at the given arclengths (sorted, within [0, L]).
+  std::vector<RodPoint> sample(const Eigen::VectorXd& x, const std::vector<double>& s) const;
+
+  long rhs_evaluations() const { return rhs_evaluations_; }
+
+ private:
+  bool residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F, Eigen::MatrixXd* J,
+                std::string* failure) const;
+  bool depends_on_model(int unknown) const;
+
+  ProblemDefinition definition_;
+  int state_size_ = 0;
+  int residual_count_ = 0;
+  std::vector<int> unknown_index_;  // index of each unknown parameter in Parameters
+  mutable std::vector<double> cached_model_values_;
+  mutable std::shared_ptr<const RodEquations> cached_equations_;
+  mutable long rhs_evaluations_ = 0;
+};
+
+// A solved problem: the unknowns, how the solve went, and the parameters at the solution.
+struct ShootingResult {
+  Eigen::VectorXd x;
+  NewtonSummary summary;
+  Parameters parameters;
+};
+
+// Newton (with the NLopt fallback when enabled) from the unknowns x0.
+ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0);
+
+}  // namespace kirchhoff
