@@ -318,9 +318,10 @@ double StraightTwistedRod::hamiltonian() const {
 //   w1 + w2 = m,  w1 w2 = t,  w1,2 = m/2 +- beta,  beta = sqrt(m^2/4 - t).
 // An energy argument fixes the regime. The equation is the Euler-Lagrange equation of the second
 // variation Q[w] = int B|w''|^2 + T|w'|^2 - M Im(conj(w') w'') ds, and a clamped solution has
-// Q = 0. By Cauchy-Schwarz and AM-GM, |M int Im(conj(w') w'')| <= M |w'| |w''|
-// <= M / (2 sqrt(B T)) (B |w''|^2 + T |w'|^2), so Q > 0 for w != 0 while M < 2 sqrt(B T): the
-// critical moment has m^2 >= 4 t, beta is real and w1, w2 are real helical wavenumbers.
+// Q = 0. For T > 0, Cauchy-Schwarz and AM-GM (|.| the L2 norm) give |M int Im(conj(w') w'')|
+// <= M |w'| |w''| <= M / (2 sqrt(B T)) (B |w''|^2 + T |w'|^2), so Q > 0 for w != 0 while
+// M < 2 sqrt(B T): the critical moment has m^2 >= 4 t. With T <= 0 that holds trivially. So beta
+// is real and w1, w2 are real helical wavenumbers.
 // With w = a + b xi + c e^(i w1 xi) + d e^(i w2 xi), w(0) = w'(0) = 0 eliminate a and b, and
 // w(1) = w'(1) = 0 leave a 2x2 system whose determinant, multiplied by e^(-i m/2), is
 //   D = -2i F,  F = 4 [u2 sin(u2) g(u1) - u1 sin(u1) g(u2)],  u_j = w_j / 2,

@@ -1,0 +1,57 @@
+#include "result_json.hpp"
+
+#include <cmath>
+
+namespace kirchhoff::cli {
+namespace {
+
+nlohmann::json vec(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+nlohmann::json stats_json(const InvariantStats& s) {
+  return {{"mean", s.mean}, {"min", s.min}, {"max", s.max}, {"spread", s.spread},
+          {"relative_spread", s.relative_spread()}, {"applies", s.applies}};
+}
+nlohmann::json vector_stats_json(const VectorInvariantStats& s) {
+  return {{"mean", vec(s.mean)}, {"spread", s.spread}, {"applies", s.applies}};
+}
+nlohmann::json end_json(const RodPoint& p) { return {{"s", p.s}, {"r", vec(p.r)}, {"n", vec(p.n)}, {"m", vec(p.m)}}; }
+
+// JSON has no infinity; a residual that could not be evaluated is null.
+nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+
+}  // namespace
+
+nlohmann::json parameters_json(const Parameters& p) {
+  nlohmann::json out = nlohmann::json::object();
+  for (int i = 0; i < p.size(); ++i) out[p.names()[i]] = p.values()[i];
+  return out;
+}
+
+nlohmann::json solution_json(const Case& c, const ShootingProblem& problem, const Solution& sol) {
+  nlohmann::json j;
+  j["case"] = c.path;
+  j["status"] = to_string(sol.result.summary.status);
+  j["iterations"] = sol.result.summary.iterations;
+  j["residual"] = sol.result.summary.residual_norm;
+  j["parameters"] = parameters_json(sol.result.parameters);
+  j["derived"] = nlohmann::json::object();
+  for (const auto& [name, value] : sol.derived) j["derived"][name] = value;
+  j["invariants"] = {{"H", stats_json(sol.invariants.H)},
+                     {"m3", stats_json(sol.invariants.m3)},
+                     {"n_dot_m", stats_json(sol.invariants.n_dot_m)},
+                     {"n", vector_stats_json(sol.invariants.n)},
+                     {"r_cross_n_plus_m", vector_stats_json(sol.invariants.moment_about_origin)}};
+  j["ends"] = {{"start", end_json(sol.profile.front())}, {"end", end_json(sol.profile.back())}};
+  j["rhs_evaluations"] = problem.rhs_evaluations();
+  if (sol.result.summary.used_fallback_search) j["note"] = "starting point from the NLopt fallback search";
+  return j;
+}
+
+nlohmann::json failure_json(const Case& c, const std::string& status, int iterations, double residual,
+                            const std::string& message) {
+  return {{"case", c.path}, {"status", status}, {"iterations", iterations},
+          {"residual", number_or_null(residual)}, {"message", message},
+          {"parameters", parameters_json(c.definition.parameters)}};
+}
+
+}  // namespace kirchhoff::cli

@@ -1,0 +1,97 @@
+#include "solve_command.hpp"
+
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "kirchhoff/case_file.hpp"
+#include "kirchhoff/solution.hpp"
+#include "result_json.hpp"
+
+namespace kirchhoff::cli {
+namespace {
+
+ParameterOverrides parse_overrides(const std::vector<std::string>& texts) {
+  ParameterOverrides out;
+  for (const auto& t : texts) {
+    try {
+      out.push_back(parse_override(t));
+    } catch (const std::invalid_argument& e) {
+      throw CaseError(std::string("--set: ") + e.what());
+    }
+  }
+  return out;
+}
+
+void print_human(const Case& c, const Solution& sol) {
+  std::cout << (c.title.empty() ? c.path : c.title) << "\n";
+  std::cout << "  " << sol.result.summary.brief_report() << "\n";
+  std::cout.precision(12);
+  for (const auto& name : c.derived) std::cout << "  " << name << " = " << sol.derived.at(name) << "\n";
+  const auto& H = sol.invariants.H;
+  std::cout << "  H = " << H.mean << " (spread " << H.spread << ", " << H.relative_spread() << " of its scale"
+            << (H.applies ? "" : "; not invariant for this rod") << ")\n";
+  if (sol.invariants.m3.applies)
+    std::cout << "  m3 = " << sol.invariants.m3.mean << " (spread " << sol.invariants.m3.spread << ")\n";
+  if (sol.invariants.n_dot_m.applies)
+    std::cout << "  n.m = " << sol.invariants.n_dot_m.mean << " (spread " << sol.invariants.n_dot_m.spread << ")\n";
+}
+
+}  // namespace
+
+int run_solve(const SolveArguments& args) {
+  Case c;
+  try {
+    c = load_case(args.case_path, parse_overrides(args.overrides));
+  } catch (const CaseError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  const ShootingProblem problem(c.definition);
+  Eigen::VectorXd x0;
+  try {
+    x0 = problem.initial_unknowns(c.start_guess);
+  } catch (const IntegrationError& e) {
+    std::cerr << "error: " << c.path << ": the initial guess cannot be integrated: " << e.what() << "\n";
+    if (args.json) std::cout << failure_json(c, "integration_failed", 0, INFINITY, e.what()).dump(2) << "\n";
+    return kExitNotConverged;
+  }
+  ShootingResult result = solve(problem, x0);
+  if (!result.summary.converged()) {
+    std::cerr << "error: " << c.path << ": not converged: " << result.summary.brief_report() << "\n";
+    if (args.json)
+      std::cout << failure_json(c, to_string(result.summary.status), result.summary.iterations,
+                                result.summary.residual_norm, result.summary.message)
+                       .dump(2)
+                << "\n";
+    return kExitNotConverged;
+  }
+  const Solution sol = make_solution(problem, std::move(result), c.samples, c.derived);
+  if (!args.profile_path.empty()) {
+    try {
+      write_profile_csv(args.profile_path, problem.equations(sol.result.parameters)->model(), sol.profile);
+    } catch (const std::runtime_error& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+  }
+  if (args.json)
+    std::cout << solution_json(c, problem, sol).dump(2) << "\n";
+  else
+    print_human(c, sol);
+  return kExitOk;
+}
+
+int run_check(const std::string& case_path, const std::vector<std::string>& overrides) {
+  try {
+    const Case c = load_case(case_path, parse_overrides(overrides));
+    const ShootingProblem problem(c.definition);
+    std::cout << case_path << ": ok (" << (c.definition.kind == RodKind::Planar ? "planar" : "spatial") << ", "
+              << problem.size() << " unknowns, " << c.definition.options.segments << " segment(s))\n";
+    return kExitOk;
+  } catch (const CaseError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+}
+
+}  // namespace kirchhoff::cli

@@ -1,0 +1,479 @@
+#include "kirchhoff/case_file.hpp"
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+#include <toml.hpp>
+
+#include "kirchhoff/expression.hpp"
+#include "kirchhoff/solution.hpp"
+
+namespace kirchhoff {
+namespace {
+
+// Material properties are checked for positivity at this many points along the rod.
+constexpr int kPositivitySamples = 101;
+
+using Value = toml::value;
+
+std::string join(const std::set<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+// Reads typed values out of the TOML tree, turning every problem into a CaseError that names
+// the file, the line, the key and the reason.
+class Reader {
+ public:
+  Reader(std::string path, std::vector<std::string> parameter_names)
+      : path_(std::move(path)), parameter_names_(std::move(parameter_names)) {}
+
+  [[noreturn]] void fail(const Value& v, const std::string& key, const std::string& reason) const {
+    std::ostringstream os;
+    os << path_;
+    const auto line = v.location().line();
+    if (line > 0) os << ":" << line;
+    os << ": key '" << key << "': " << reason;
+    throw CaseError(os.str());
+  }
+  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
+    throw CaseError(path_ + ": key '" + key + "': " + reason);
+  }
+
+  void allow_keys(const Value& table, const std::string& name, const std::set<std::string>& allowed) const {
+    if (!table.is_table()) fail(table, name, "must be a table");
+    for (const auto& [key, value] : table.as_table())
+      if (!allowed.count(key))
+        fail(value, qualified(name, key), "unknown key (expected one of: " + join(allowed) + ")");
+  }
+
+  static std::string qualified(const std::string& table, const std::string& key) {
+    return table.empty() ? key : table + "." + key;
+  }
+
+  static const Value* find(const Value& table, const std::string& key) {
+    if (!table.is_table()) return nullptr;
+    const auto& t = table.as_table();
+    const auto it = t.find(key);
+    return it == t.end() ? nullptr : &it->second;
+  }
+
+  double number(const Value& v, const std::string& key) const {
+    if (v.is_floating()) return v.as_floating();
+    if (v.is_integer()) return static_cast<double>(v.as_integer());
+    fail(v, key, "must be a number, got " + type_name(v));
+  }
+  long integer(const Value& v, const std::string& key) const {
+    if (v.is_integer()) return static_cast<long>(v.as_integer());
+    fail(v, key, "must be an integer, got " + type_name(v));
+  }
+  bool boolean(const Value& v, const std::string& key) const {
+    if (v.is_boolean()) return v.as_boolean();
+    fail(v, key, "must be true or false, got " + type_name(v));
+  }
+  std::string string(const Value& v, const std::string& key) const {
+    if (v.is_string()) return v.as_string().str;
+    fail(v, key, "must be a string, got " + type_name(v));
+  }
+  std::vector<std::string> strings(const Value& v, const std::string& key) const {
+    if (!v.is_array()) fail(v, key, "must be an array of strings, got " + type_name(v));
+    std::vector<std::string> out;
+    for (const auto& e : v.as_array()) out.push_back(string(e, key));
+    return out;
+  }
+
+  Expression expression(const Value& v, const std::string& key, bool uses_s = false) const {
+    if (v.is_floating() || v.is_integer()) return Expression::constant(number(v, key));
+    if (!v.is_string()) fail(v, key, "must be a number or an expression string, got " + type_name(v));
+    try {
+      return Expression(v.as_string().str, parameter_names_, uses_s);
+    } catch (const std::invalid_argument& e) {
+      fail(v, key, e.what());
+    }
+  }
+
+  std::array<Expression, 3> vector(const Value& v, const std::string& key, bool uses_s = false) const {
+    if (!v.is_array() || (v.as_array().size() != 3 && v.as_array().size() != 2))
+      fail(v, key, "must be an array of 2 or 3 numbers/expressions");
+    const auto& a = v.as_array();
+    return {expression(a[0], key, uses_s), expression(a[1], key, uses_s),
+            a.size() == 3 ? expression(a[2], key, uses_s) : Expression::constant(0.0)};
+  }
+
+  Vec3 unit_vector(const Value& v, const std::string& key) const {
+    if (!v.is_array() || v.as_array().size() != 3) fail(v, key, "must be an array of 3 numbers");
+    const auto& a = v.as_array();
+    const Vec3 out(number(a[0], key), number(a[1], key), number(a[2], key));
+    if (!(out.norm() > 0)) fail(v, key, "must be a non-zero vector");
+    return out.normalized();
+  }
+
+  const std::string& path() const { return path_; }
+
+ private:
+  static std::string type_name(const Value& v) {
+    std::ostringstream os;
+    os << v.type();
+    return os.str();
+  }
+  std::string path_;
+  std::vector<std::string> parameter_names_;
+};
+
+VectorTarget vector_target(const std::array<Expression, 3>& e) {
+  return [e](const Parameters& p) { return Vec3(e[0](p), e[1](p), e[2](p)); };
+}
+
+// An orientation table {axis = [..], angle = expr}.
+OrientationFunction orientation_target(const Reader& reader, const Value& v, const std::string& key) {
+  reader.allow_keys(v, key, {"axis", "angle"});
+  const Value* axis_value = Reader::find(v, "axis");
+  const Vec3 axis = axis_value ? reader.unit_vector(*axis_value, key + ".axis") : Vec3::UnitZ();
+  const Value* angle_value = Reader::find(v, "angle");
+  const Expression angle = angle_value ? reader.expression(*angle_value, key + ".angle") : Expression::constant(0.0);
+  return [axis, angle](const Parameters& p) { return OrientationTarget{axis, angle(p)}; };
+}
+
+EndCondition read_end(const Reader& reader, const Value& root, const std::string& name) {
+  const Value* table = Reader::find(root, name);
+  if (!table) reader.fail(name, "missing table [" + name + "] (the boundary condition at that end)");
+  const Value* type_value = Reader::find(*table, "type");
+  if (!type_value) reader.fail(*table, name + ".type", "missing (clamped, pinned, free, loaded or sliding)");
+  const std::string type = reader.string(*type_value, name + ".type");
+  static const std::map<std::string, std::set<std::string>> keys_for_type = {
+      {"clamped", {"position", "orientation", "track_turns"}},
+      {"pinned", {"position"}},
+      {"free", {}},
+      {"loaded", {"force", "moment"}},
+      {"sliding", {"axis", "position", "force", "orientation", "track_turns"}},
+  };
+  const auto it = keys_for_type.find(type);
+  if (it == keys_for_type.end())
+    reader.fail(*type_value, name + ".type", "'" + type + "' is not one of: clamped, pinned, free, loaded, sliding");
+  std::set<std::string> allowed = it->second;
+  allowed.insert({"type", "extra_angle", "extra_angle_axis"});
+  for (const auto& [key, value] : table->as_table())
+    if (!allowed.count(key))
+      reader.fail(value, name + "." + key,
+                  it->second.count(key) ? "" : "does not apply to a " + type + " end (allowed: " + join(allowed) + ")");
+
+  auto vec = [&](const std::string& key) -> VectorTarget {
+    const Value* v = Reader::find(*table, key);
+    return v ? vector_target(reader.vector(*v, name + "." + key)) : constant(Vec3::Zero());
+  };
+  auto orientation = [&]() -> OrientationFunction {
+    const Value* v = Reader::find(*table, "orientation");
+    return v ? orientation_target(reader, *v, name + ".orientation") : OrientationFunction{};
+  };
+  const Value* turns_value = Reader::find(*table, "track_turns");
+  const bool track_turns = turns_value ? reader.boolean(*turns_value, name + ".track_turns") : false;
+
+  EndCondition end;
+  if (type == "clamped") {
+    OrientationFunction o = orientation();
+    end = EndCondition::clamped(vec("position"), o ? o : constant_orientation({}), track_turns);
+  } else if (type == "pinned") {
+    end = EndCondition::pinned(vec("position"));
+  } else if (type == "free") {
+    end = EndCondition::free();
+  } else if (type == "loaded") {
+    end = EndCondition::loaded(vec("force"), vec("moment"));
+  } else {
+    const Value* axis = Reader::find(*table, "axis");
+    if (!axis) reader.fail(*table, name + ".axis", "a sliding end needs the axis it slides along");
+    end = EndCondition::sliding(reader.unit_vector(*axis, name + ".axis"), vec("position"), vec("force"),
+                                orientation(), track_turns);
+  }
+  if (const Value* angle = Reader::find(*table, "extra_angle")) {
+    const Value* axis = Reader::find(*table, "extra_angle_axis");
+    const Vec3 a = axis ? reader.unit_vector(*axis, name + ".extra_angle_axis") : Vec3::UnitZ();
+    const Expression e = reader.expression(*angle, name + ".extra_angle");
+    end.impose_orientation_angle(a, [e](const Parameters& p) { return e(p); });
+  }
+  return end;
+}
+
+// A material profile: the expression, checked positive along the rod when required.
+struct ProfileSpec {
+  Expression expression = Expression::constant(0.0);
+  const Value* source = nullptr;
+  std::string key;
+  Profile build(const Parameters& p) const {
+    return expression.depends_on_s() ? Profile(expression.bind(p)) : Profile(expression(p));
+  }
+};
+
+}  // namespace
+
+std::pair<std::string, double> parse_override(const std::string& text) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw std::invalid_argument("'" + text + "' is not NAME=VALUE");
+  const std::string name = text.substr(0, eq), value = text.substr(eq + 1);
+  size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(value, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != value.size()) throw std::invalid_argument("'" + value + "' in '" + text + "' is not a number");
+  return {name, v};
+}
+
+Case load_case(const std::string& path, const ParameterOverrides& overrides) {
+  Value root;
+  try {
+    root = toml::parse(path);
+  } catch (const toml::syntax_error& e) {
+    throw CaseError(path + ": TOML syntax error: " + e.what());
+  } catch (const std::runtime_error& e) {
+    throw CaseError(path + ": " + e.what());
+  }
+
+  Case c;
+  c.path = path;
+  // Parameters first: every expression may use them.
+  Parameters parameters;
+  const Reader plain(path, {});
+  plain.allow_keys(root, "", {"title", "description", "model", "parameters", "rod", "start", "end", "guess",
+                              "solver", "output"});
+  if (const Value* table = Reader::find(root, "parameters")) {
+    if (!table->is_table()) plain.fail(*table, "parameters", "must be a table of named numbers");
+    for (const auto& [name, value] : table->as_table()) {
+      if (name == "s") plain.fail(value, "parameters.s", "'s' is reserved for the arclength");
+      parameters.set(name, plain.number(value, "parameters." + name));
+    }
+  }
+  for (const auto& [name, value] : overrides) {
+    if (!parameters.contains(name)) {
+      std::set<std::string> names(parameters.names().begin(), parameters.names().end());
+      throw CaseError(path + ": --set " + name + ": no parameter '" + name + "' in [parameters] (have: " +
+                      join(names) + ")");
+    }
+    parameters.set(name, value);
+  }
+  const Reader reader(path, parameters.names());
+  if (const Value* v = Reader::find(root, "title")) c.title = reader.string(*v, "title");
+  if (const Value* v = Reader::find(root, "description")) c.description = reader.string(*v, "description");
+  ProblemDefinition& d = c.definition;
+  d.parameters = parameters;
+  if (const Value* v = Reader::find(root, "model")) {
+    const std::string kind = reader.string(*v, "model");
+    if (kind == "planar") d.kind = RodKind::Planar;
+    else if (kind == "spatial") d.kind = RodKind::Spatial;
+    else reader.fail(*v, "model", "'" + kind + "' is not 'planar' or 'spatial'");
+  } else {
+    reader.fail(root, "model", "missing ('planar' or 'spatial')");
+  }
+
+  // [rod]
+  const Value* rod = Reader::find(root, "rod");
+  if (!rod) reader.fail("rod", "missing table [rod]");
+  reader.allow_keys(*rod, "rod", {"length", "B", "B1", "B2", "B3", "extensible", "A1", "A2", "A3", "u_hat",
+                                  "v_hat", "gravity", "barrier"});
+  const Value* length_value = Reader::find(*rod, "length");
+  if (!length_value) reader.fail(*rod, "rod.length", "missing");
+  const Expression length = reader.expression(*length_value, "rod.length");
+  std::array<ProfileSpec, 3> B, A, u_hat, v_hat;
+  const char* bend_keys[3] = {"B1", "B2", "B3"};
+  const char* shear_keys[3] = {"A1", "A2", "A3"};
+  const double natural_v[3] = {0.0, 0.0, 1.0};
+  for (int i = 0; i < 3; ++i) {
+    B[i] = {Expression::constant(1.0), nullptr, std::string("rod.") + bend_keys[i]};
+    A[i] = {Expression::constant(1.0), nullptr, std::string("rod.") + shear_keys[i]};
+    u_hat[i] = {Expression::constant(0.0), nullptr, "rod.u_hat"};
+    v_hat[i] = {Expression::constant(natural_v[i]), nullptr, "rod.v_hat"};
+  }
+  if (const Value* v = Reader::find(*rod, "B"))  // isotropic bending: B1 = B2
+    for (int i = 0; i < 2; ++i) B[i] = {reader.expression(*v, "rod.B", true), v, "rod.B"};
+  for (int i = 0; i < 3; ++i) {
+    if (const Value* v = Reader::find(*rod, bend_keys[i])) {
+      if (i < 2 && Reader::find(*rod, "B")) reader.fail(*v, B[i].key, "give either B or B1/B2, not both");
+      B[i] = {reader.expression(*v, B[i].key, true), v, B[i].key};
+    }
+    if (const Value* v = Reader::find(*rod, shear_keys[i])) A[i] = {reader.expression(*v, A[i].key, true), v, A[i].key};
+  }
+  const Value* extensible_value = Reader::find(*rod, "extensible");
+  const bool extensible = extensible_value ? reader.boolean(*extensible_value, "rod.extensible") : false;
+  if (!extensible)
+    for (int i = 0; i < 3; ++i)
+      if (A[i].source) reader.fail(*A[i].source, A[i].key, "shear/stretch stiffness given but rod.extensible is false");
+  for (auto [key, spec] : {std::pair{"u_hat", &u_hat}, std::pair{"v_hat", &v_hat}}) {
+    if (const Value* v = Reader::find(*rod, key)) {
+      const auto e = reader.vector(*v, std::string("rod.") + key, true);
+      for (int i = 0; i < 3; ++i) (*spec)[i] = {e[i], v, std::string("rod.") + key};
+    }
+  }
+  // External fields.
+  std::function<void(const Parameters&, FieldSum*)> add_fields = [](const Parameters&, FieldSum*) {};
+  std::set<std::string> field_parameters;
+  if (const Value* g = Reader::find(*rod, "gravity")) {
+    reader.allow_keys(*g, "rod.gravity", {"weight", "up"});
+    const Value* w = Reader::find(*g, "weight");
+    if (!w) reader.fail(*g, "rod.gravity.weight", "missing (weight per unit length)");
+    const Expression weight = reader.expression(*w, "rod.gravity.weight");
+    const Value* up_value = Reader::find(*g, "up");
+    const Vec3 up = up_value ? reader.unit_vector(*up_value, "rod.gravity.up") : Vec3::UnitY();
+    for (const auto& n : weight.used_parameters()) field_parameters.insert(n);
+    add_fields = [prev = add_fields, weight, up](const Parameters& p, FieldSum* f) {
+      prev(p, f);
+      f->add(std::make_shared<UniformGravity>(weight(p), up));
+    };
+  }
+  if (const Value* bw = Reader::find(*rod, "barrier")) {
+    reader.allow_keys(*bw, "rod.barrier", {"b", "a", "normal"});
+    const Value* b = Reader::find(*bw, "b");
+    const Value* a = Reader::find(*bw, "a");
+    if (!b || !a) reader.fail(*bw, "rod.barrier", "needs b (range) and a (wall height)");
+    const Expression range = reader.expression(*b, "rod.barrier.b"), height = reader.expression(*a, "rod.barrier.a");
+    const Value* normal_value = Reader::find(*bw, "normal");
+    const Vec3 normal = normal_value ? reader.unit_vector(*normal_value, "rod.barrier.normal") : Vec3::UnitY();
+    if (!(range(parameters) > 0)) reader.fail(*b, "rod.barrier.b", "must be > 0");
+    for (const auto& e : {range, height})
+      for (const auto& n : e.used_parameters()) field_parameters.insert(n);
+    add_fields = [prev = add_fields, range, height, normal](const Parameters& p, FieldSum* f) {
+      prev(p, f);
+      f->add(std::make_shared<BarrierWall>(range(p), height(p), normal));
+    };
+  }
+
+  // Physical checks at the case's parameter values, naming the key.
+  const double L = length(parameters);
+  if (!(L > 0)) reader.fail(*length_value, "rod.length", "must be > 0, got " + std::to_string(L));
+  for (const auto* group : {&B, &A}) {
+    if (group == &A && !extensible) continue;
+    for (const auto& spec : *group) {
+      for (int k = 0; k < kPositivitySamples; ++k) {
+        const double s = L * k / (kPositivitySamples - 1);
+        const double value = spec.expression(parameters, s);
+        if (!(value > 0)) {
+          const std::string reason = "stiffness must be > 0, got " + std::to_string(value) + " at s = " + std::to_string(s);
+          if (spec.source) reader.fail(*spec.source, spec.key, reason);
+          reader.fail(spec.key, reason);
+        }
+        if (!spec.expression.depends_on_s()) break;
+      }
+    }
+  }
+
+  for (const auto* e : {&length})
+    for (const auto& n : e->used_parameters()) d.model_parameters.insert(n);
+  for (const auto* group : {&B, &A, &u_hat, &v_hat})
+    for (const auto& spec : *group)
+      for (const auto& n : spec.expression.used_parameters()) d.model_parameters.insert(n);
+  d.model_parameters.insert(field_parameters.begin(), field_parameters.end());
+  d.model = [length, B, A, u_hat, v_hat, extensible, add_fields](const Parameters& p) {
+    RodModel m;
+    m.length = length(p);
+    m.extensible = extensible;
+    for (int i = 0; i < 3; ++i) {
+      m.B[i] = B[i].build(p);
+      m.A[i] = A[i].build(p);
+      m.u_hat[i] = u_hat[i].build(p);
+      m.v_hat[i] = v_hat[i].build(p);
+    }
+    auto fields = std::make_shared<FieldSum>();
+    add_fields(p, fields.get());
+    if (!fields->empty()) m.field = fields;
+    return m;
+  };
+
+  d.start = read_end(reader, root, "start");
+  d.end = read_end(reader, root, "end");
+
+  // [solver]
+  if (const Value* s = Reader::find(root, "solver")) {
+    reader.allow_keys(*s, "solver", {"unknowns", "segments", "stepper", "abs_tol", "rel_tol", "tolerance",
+                                     "max_iterations", "jacobian", "fallback_search"});
+    ShootingOptions& o = d.options;
+    if (const Value* v = Reader::find(*s, "unknowns")) {
+      d.unknown_parameters = reader.strings(*v, "solver.unknowns");
+      for (const auto& name : d.unknown_parameters)
+        if (!parameters.contains(name))
+          reader.fail(*v, "solver.unknowns", "'" + name + "' is not in [parameters] (give it there with a guess)");
+    }
+    if (const Value* v = Reader::find(*s, "segments")) {
+      o.segments = static_cast<int>(reader.integer(*v, "solver.segments"));
+      if (o.segments < 1) reader.fail(*v, "solver.segments", "must be >= 1");
+    }
+    if (const Value* v = Reader::find(*s, "stepper")) {
+      const std::string name = reader.string(*v, "solver.stepper");
+      if (name == "rk78") o.integrator.stepper = IntegratorOptions::Stepper::RungeKutta78;
+      else if (name == "dopri5") o.integrator.stepper = IntegratorOptions::Stepper::Dopri5;
+      else reader.fail(*v, "solver.stepper", "'" + name + "' is not 'rk78' or 'dopri5'");
+    }
+    auto positive = [&](const char* key, double* target) {
+      if (const Value* v = Reader::find(*s, key)) {
+        *target = reader.number(*v, std::string("solver.") + key);
+        if (!(*target > 0)) reader.fail(*v, std::string("solver.") + key, "must be > 0");
+      }
+    };
+    positive("abs_tol", &o.integrator.abs_tol);
+    positive("rel_tol", &o.integrator.rel_tol);
+    positive("tolerance", &o.newton.residual_tolerance);
+    if (const Value* v = Reader::find(*s, "max_iterations")) {
+      o.newton.max_iterations = static_cast<int>(reader.integer(*v, "solver.max_iterations"));
+      if (o.newton.max_iterations < 1) reader.fail(*v, "solver.max_iterations", "must be >= 1");
+    }
+    if (const Value* v = Reader::find(*s, "jacobian")) {
+      const std::string name = reader.string(*v, "solver.jacobian");
+      if (name == "finite_differences") o.newton.finite_difference_jacobian = true;
+      else if (name != "variational") reader.fail(*v, "solver.jacobian", "'" + name + "' is not 'variational' or 'finite_differences'");
+    }
+    if (const Value* v = Reader::find(*s, "fallback_search")) o.newton.fallback_search = reader.boolean(*v, "solver.fallback_search");
+  }
+
+  // [guess]: the state at s = 0 before the start conditions are imposed on it.
+  c.start_guess.R = d.kind == RodKind::Planar ? planar_reference_frame() : Mat3::Identity();
+  if (const Value* g = Reader::find(root, "guess")) {
+    reader.allow_keys(*g, "guess", {"position", "orientation", "force", "moment"});
+    auto vec = [&](const char* key, Vec3* target) {
+      if (const Value* v = Reader::find(*g, key)) *target = vector_target(reader.vector(*v, std::string("guess.") + key))(parameters);
+    };
+    vec("position", &c.start_guess.r);
+    vec("force", &c.start_guess.n);
+    vec("moment", &c.start_guess.m);
+    if (const Value* v = Reader::find(*g, "orientation")) {
+      const OrientationTarget t = orientation_target(reader, *v, "guess.orientation")(parameters);
+      c.start_guess.R = Eigen::AngleAxisd(t.angle, t.axis).toRotationMatrix() * c.start_guess.R;
+      c.start_guess.turn_angle = t.angle;
+    }
+  }
+
+  // [output]
+  if (const Value* o = Reader::find(root, "output")) {
+    reader.allow_keys(*o, "output", {"derived", "samples"});
+    if (const Value* v = Reader::find(*o, "derived")) {
+      c.derived = reader.strings(*v, "output.derived");
+      for (const auto& name : c.derived)
+        if (!derived_catalogue().count(name)) {
+          std::set<std::string> names;
+          for (const auto& [n, meaning] : derived_catalogue()) names.insert(n);
+          reader.fail(*v, "output.derived", "'" + name + "' is not a derived quantity (known: " + join(names) + ")");
+        }
+    }
+    if (const Value* v = Reader::find(*o, "samples")) {
+      c.samples = static_cast<int>(reader.integer(*v, "output.samples"));
+      if (c.samples < 2) reader.fail(*v, "output.samples", "must be >= 2");
+    }
+  }
+
+  // Consistency of the boundary conditions, checked by the problem itself.
+  try {
+    ShootingProblem check(d);
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    const std::string table = what.rfind("start:", 0) == 0 ? "start" : what.rfind("end:", 0) == 0 ? "end" : "solver";
+    const Value* v = Reader::find(root, table);
+    if (v) reader.fail(*v, table, what);
+    reader.fail(table, what);
+  }
+  return c;
+}
+
+}  // namespace kirchhoff

@@ -1,0 +1,36 @@
+// A solved equilibrium as users see it: the sampled profile, the invariants along it, the
+// derived quantities a case asks for, and the solver's summary.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "kirchhoff/invariants.hpp"
+#include "kirchhoff/shooting.hpp"
+
+namespace kirchhoff {
+
+struct Solution {
+  ShootingResult result;
+  std::vector<RodPoint> profile;  // equally spaced in s, ends included
+  InvariantReport invariants;
+  std::map<std::string, double> derived;
+};
+
+// Samples (n_samples >= 2 points), computes invariants and the requested derived quantities.
+Solution make_solution(const ShootingProblem& problem, ShootingResult result, int n_samples,
+                       const std::vector<std::string>& derived_names);
+
+// Names accepted in a case's derived list, with a one-line meaning each.
+const std::map<std::string, std::string>& derived_catalogue();
+
+// -dV/ds at fixed state: the explicit arclength dependence that makes H vary (eq. 57 for a
+// tapered rod, H' = -1/2 EI'(s) theta'^2).
+double explicit_s_derivative_of_energy(const RodModel& model, const RodPoint& p);
+
+// Writes one row per profile point: s, r, d1, d2, d3, n, m, u, H, m3, n.m, dH/ds predicted by
+// the explicit-s identity. Throws std::runtime_error when the file cannot be written.
+void write_profile_csv(const std::string& path, const RodModel& model, const std::vector<RodPoint>& profile);
+
+}  // namespace kirchhoff
