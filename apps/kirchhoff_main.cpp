@@ -28,6 +28,12 @@ int main(int argc, char** argv) {
   solve_cmd->add_option("--profile", solve.profile_path,
                         "Write the solution along the rod as CSV: s, r, d1, d2, d3, n, m, u, H, m3, n.m, dH/ds");
 
+  solve_cmd
+      ->add_option("--phase-condition", solve.phase_condition,
+                   "Override [solver] phase_condition: 'axial' selects one buckled solution of an isotropic\n"
+                   "twisted rod out of its circle of rotated copies (singular on the straight rod)")
+      ->check(CLI::IsMember({"none", "axial"}));
+
   std::string check_path;
   std::vector<std::string> check_overrides;
   auto* check_cmd = app.add_subcommand("check", "Validate a case file without solving");

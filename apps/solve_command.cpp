@@ -41,7 +41,7 @@ void print_human(const Case& c, const Solution& sol) {
 int run_solve(const SolveArguments& args) {
   Case c;
   try {
-    c = load_case(args.case_path, parse_overrides(args.overrides));
+    c = load_case(args.case_path, parse_overrides(args.overrides), args.phase_condition);
   } catch (const CaseError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;

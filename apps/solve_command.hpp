@@ -16,6 +16,7 @@ struct SolveArguments {
   std::vector<std::string> overrides;  // NAME=VALUE
   bool json = false;
   std::string profile_path;
+  std::string phase_condition;  // empty: as in the case file
 };
 
 int run_solve(const SolveArguments& args);

@@ -225,7 +225,20 @@ std::pair<std::string, double> parse_override(const std::string& text) {
   return {name, v};
 }
 
-Case load_case(const std::string& path, const ParameterOverrides& overrides) {
+namespace {
+void apply_phase_condition(const Reader& reader, const Value* where, const std::string& name, ProblemDefinition& d) {
+  if (name == "axial") {
+    if (d.kind != RodKind::Spatial) reader.fail(*where, "solver.phase_condition", "'axial' is for spatial rods");
+    if (d.parameters.contains("unfolding"))
+      reader.fail(*where, "solver.phase_condition", "needs the parameter name 'unfolding' free");
+    add_axial_phase_condition(d);
+  } else if (name != "none") {
+    reader.fail(*where, "solver.phase_condition", "'" + name + "' is not 'none' or 'axial'");
+  }
+}
+}  // namespace
+
+Case load_case(const std::string& path, const ParameterOverrides& overrides, const std::string& phase_condition) {
   Value root;
   try {
     root = toml::parse(path);
@@ -389,7 +402,7 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides) {
   // [solver]
   if (const Value* s = Reader::find(root, "solver")) {
     reader.allow_keys(*s, "solver", {"unknowns", "segments", "stepper", "abs_tol", "rel_tol", "tolerance",
-                                     "max_iterations", "jacobian", "fallback_search"});
+                                     "max_iterations", "jacobian", "fallback_search", "phase_condition"});
     ShootingOptions& o = d.options;
     if (const Value* v = Reader::find(*s, "unknowns")) {
       d.unknown_parameters = reader.strings(*v, "solver.unknowns");
@@ -426,7 +439,11 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides) {
       else if (name != "variational") reader.fail(*v, "solver.jacobian", "'" + name + "' is not 'variational' or 'finite_differences'");
     }
     if (const Value* v = Reader::find(*s, "fallback_search")) o.newton.fallback_search = reader.boolean(*v, "solver.fallback_search");
+    if (const Value* v = Reader::find(*s, "phase_condition"); v && phase_condition.empty())
+      apply_phase_condition(reader, v, reader.string(*v, "solver.phase_condition"), d);
   }
+
+  if (!phase_condition.empty()) apply_phase_condition(reader, &root, phase_condition, d);
 
   // [guess]: the state at s = 0 before the start conditions are imposed on it.
   c.start_guess.R = d.kind == RodKind::Planar ? planar_reference_frame() : Mat3::Identity();

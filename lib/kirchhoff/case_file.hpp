@@ -33,7 +33,9 @@ using ParameterOverrides = std::vector<std::pair<std::string, double>>;
 // Reads, validates and builds the case (including a ShootingProblem construction, so that
 // inconsistent boundary conditions are reported here). Overrides replace [parameters] values
 // and must name existing parameters.
-Case load_case(const std::string& path, const ParameterOverrides& overrides = {});
+// phase_condition, when non-empty, replaces [solver] phase_condition ("none" or "axial").
+Case load_case(const std::string& path, const ParameterOverrides& overrides = {},
+               const std::string& phase_condition = "");
 
 // Parses "NAME=VALUE"; throws std::invalid_argument with the reason.
 std::pair<std::string, double> parse_override(const std::string& text);

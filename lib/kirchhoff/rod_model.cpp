@@ -73,6 +73,7 @@ void RodModel::validate() const {
 }
 
 bool RodModel::is_uniform() const {
+  if (symmetry_unfolding != 0.0) return false;
   for (int i = 0; i < 3; ++i) {
     if (!B[i].is_constant() || !u_hat[i].is_constant() || !v_hat[i].is_constant()) return false;
     if (extensible && !A[i].is_constant()) return false;

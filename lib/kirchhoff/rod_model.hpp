@@ -96,6 +96,10 @@ struct RodModel {
   std::array<Profile, 3> u_hat{Profile(0.0), Profile(0.0), Profile(0.0)};
   std::array<Profile, 3> v_hat{Profile(0.0), Profile(0.0), Profile(1.0)};
   std::shared_ptr<const ExternalField> field;  // null: no external field
+  // Unfolding parameter mu of the axial phase condition (see add_axial_phase_condition): a
+  // fictitious distributed couple l = mu (e3 - d3), m' = n x r' - l. Every solution of a
+  // well-posed problem drives it to zero; while it is non-zero H is not reported invariant.
+  double symmetry_unfolding = 0.0;
 
   // Throws std::invalid_argument naming the offending property (non-positive length or
   // stiffness at any sampled s).

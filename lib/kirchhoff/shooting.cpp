@@ -198,6 +198,26 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
   return out;
 }
 
+void add_axial_phase_condition(ProblemDefinition& d) {
+  if (d.kind != RodKind::Spatial) throw std::invalid_argument("the axial phase condition is for spatial rods");
+  const std::string name = "unfolding";
+  d.parameters.set(name, 0.0);
+  d.model = [inner = d.model, name](const Parameters& p) {
+    RodModel m = inner(p);
+    m.symmetry_unfolding = p.get(name);
+    return m;
+  };
+  d.model_parameters.insert(name);
+  SlotCondition phase;
+  phase.slot = Slot::Moment;
+  phase.directions = Directions::AlongAxis;
+  phase.axis = Vec3::UnitY();
+  phase.value = constant(Vec3::Zero());
+  phase.extra = true;
+  d.start.add(phase);
+  d.unknown_parameters.push_back(name);
+}
+
 ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) {
   ShootingResult result;
   result.x = x0;

@@ -93,6 +93,18 @@ class ShootingProblem final : public NonlinearSystem {
   mutable long rhs_evaluations_ = 0;
 };
 
+// Breaks the rotational symmetry of an isotropic (B1 = B2) spatial rod whose ends both lie on
+// the e3 axis with d3 = e3 there (e.g. the twisted clamped rod). Rotating a solution about e3
+// while turning its cross-sections back about d3 gives another solution, so buckled solutions
+// come in circles and Newton's matrix is singular along them. We add
+//   - a phase condition m(0).e2 = 0 that picks one solution on each circle, and
+//   - an unknown unfolding parameter mu (named "unfolding") entering as a distributed couple
+//     l = mu (e3 - d3), which changes the first integral J = (m + r x n).e3 - m.d3 at the rate
+//     J' = -mu |e3 - d3|^2. The end conditions give J(0) = J(L) = 0, so every solution that is
+//     not straight has mu = 0. (On the straight rod the circle of solutions shrinks to a point
+//     and the phase condition is degenerate: solve the straight rod without it.)
+void add_axial_phase_condition(ProblemDefinition& definition);
+
 // A solved problem: the unknowns, how the solve went, and the parameters at the solution.
 struct ShootingResult {
   Eigen::VectorXd x;

@@ -90,6 +90,12 @@ class SpatialEquations final : public RodEquations {
     dy[kM] = n[1] * dr[2] - n[2] * dr[1];
     dy[kM + 1] = n[2] * dr[0] - n[0] * dr[2];
     dy[kM + 2] = n[0] * dr[1] - n[1] * dr[0];
+    if (model_.symmetry_unfolding != 0.0) {
+      const double mu = model_.symmetry_unfolding;
+      dy[kM] = dy[kM] + mu * R[0][2];
+      dy[kM + 1] = dy[kM + 1] + mu * R[1][2];
+      dy[kM + 2] = dy[kM + 2] - mu * (1.0 - R[2][2]);
+    }
     // chi = 2 atan2(qz, w)  =>  chi' = 2 (w qz' - qz w') / (w^2 + qz^2).
     dy[kChi] = 2.0 * (w * dy[kQ + 3] - qz * dy[kQ]) / (w * w + qz * qz);
   }
@@ -185,7 +191,10 @@ class SpatialEquations final : public RodEquations {
     Eigen::VectorXd g(2);
     g[0] = q.squaredNorm() - 1.0;
     const double w = q[0], qz = q[3], d = w * w + qz * qz;
-    g[1] = y[kChi] - 2.0 * std::atan2(qz, w);
+    // chi(0) is the twist of R(0) in (-pi, pi]: taken from q or -q alike (both are R(0)), so the
+    // turn count cannot jump by a whole turn through the sign of the quaternion.
+    const double sign = w < 0 ? -1.0 : 1.0;
+    g[1] = y[kChi] - 2.0 * std::atan2(sign * qz, sign * w);
     if (jacobian) {
       jacobian->setZero(2, kStateSize);
       jacobian->block<1, 4>(0, kQ) = 2.0 * q.transpose();
