@@ -13,6 +13,7 @@ const char* to_string(SolverStatus status) {
     case SolverStatus::SingularJacobian: return "singular_jacobian";
     case SolverStatus::IntegrationFailed: return "integration_failed";
     case SolverStatus::LineSearchFailed: return "line_search_failed";
+    case SolverStatus::UnfoldingNotZero: return "unfolding_not_zero";
   }
   return "unknown";
 }

@@ -25,6 +25,8 @@ enum class SolverStatus {
   SingularJacobian,   // reciprocal condition number of J below singular_rcond
   IntegrationFailed,  // the residual could not be evaluated at the current iterate
   LineSearchFailed,   // no step length in [2^-max_backtracks, 1] decreased |F|
+  UnfoldingNotZero,   // converged, but the symmetry-unfolding parameter is not 0 (|mu| >
+                      // kUnfoldingTolerance): a solution of the unfolded system, not an equilibrium
 };
 const char* to_string(SolverStatus status);
 

@@ -223,6 +223,12 @@ ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) 
   result.x = x0;
   result.summary = solve_with_fallback(problem, result.x, problem.definition().options.newton);
   result.parameters = problem.parameters_at(result.x);
+  if (result.summary.converged() && result.parameters.contains("unfolding") &&
+      std::abs(result.parameters.get("unfolding")) > kUnfoldingTolerance) {
+    result.summary.status = SolverStatus::UnfoldingNotZero;
+    result.summary.message = "unfolding = " + std::to_string(result.parameters.get("unfolding")) +
+                             ": not an equilibrium (on the straight rod the axial phase condition is degenerate)";
+  }
   return result;
 }
 

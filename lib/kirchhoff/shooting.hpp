@@ -105,6 +105,11 @@ class ShootingProblem final : public NonlinearSystem {
 //     and the phase condition is degenerate: solve the straight rod without it.)
 void add_axial_phase_condition(ProblemDefinition& definition);
 
+// |mu| above this at a converged point means the unfolded system was solved with a non-zero
+// couple (an artefact, not an equilibrium). At true solutions mu is zero to the Newton
+// tolerance times the conditioning, far below this.
+constexpr double kUnfoldingTolerance = 1e-7;
+
 // A solved problem: the unknowns, how the solve went, and the parameters at the solution.
 struct ShootingResult {
   Eigen::VectorXd x;
