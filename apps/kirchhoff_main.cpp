@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "reproduce_command.hpp"
 #include "solve_command.hpp"
 
 int main(int argc, char** argv) {
@@ -15,7 +16,8 @@ int main(int argc, char** argv) {
       "Examples:\n"
       "  kirchhoff solve cases/simply_supported.toml --set theta0=2.0\n"
       "  kirchhoff solve cases/twisted_clamped.toml --json --profile rod.csv\n"
-      "  kirchhoff check cases/tapered.toml\n\n"
+      "  kirchhoff check cases/tapered.toml\n"
+      "  kirchhoff reproduce --out out\n\n"
       "Exit status: 0 solved, 1 solver failure (status and best residual reported), 2 input refused."};
   app.require_subcommand(1);
 
@@ -40,6 +42,13 @@ int main(int argc, char** argv) {
   check_cmd->add_option("case", check_path, "Case file (TOML)")->required()->check(CLI::ExistingFile);
   check_cmd->add_option("--set", check_overrides, "Override a parameter: NAME=VALUE (repeatable)");
 
+  std::string out_dir = "out";
+  std::string cases_dir = KIRCHHOFF_DEFAULT_CASES_DIR;
+  auto* reproduce_cmd = app.add_subcommand(
+      "reproduce", "Recompute the paper's results the toolkit covers: DIR/report.md, DIR/report.json, DIR/profiles/*.csv");
+  reproduce_cmd->add_option("--out", out_dir, "Output folder (created)")->capture_default_str();
+  reproduce_cmd->add_option("--cases", cases_dir, "Folder of the case files")->capture_default_str()->check(CLI::ExistingDirectory);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -48,5 +57,6 @@ int main(int argc, char** argv) {
   }
   if (*solve_cmd) return run_solve(solve);
   if (*check_cmd) return run_check(check_path, check_overrides);
+  if (*reproduce_cmd) return run_reproduce(out_dir, cases_dir);
   return kExitBadInput;
 }

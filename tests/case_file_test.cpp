@@ -1,0 +1,530 @@
+// The case-file loader refuses every class of bad input with a message that names the file, the
+// key (with its line where the TOML parser knows it) and the reason. Each bad case is a small
+// TOML file derived from a valid one (the simply supported Elastica) by changing one thing.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "kirchhoff/case_file.hpp"
+#include "kirchhoff/shooting.hpp"
+
+namespace kirchhoff {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+// A valid planar case (cases/simply_supported.toml without comments), the base of every
+// bad case below. Keep one statement per line: the tests locate keys by line.
+const char* const kBase = R"(title = "simply supported, base of the bad cases"
+model = "planar"
+
+[parameters]
+theta0 = 1.0
+L = 1.0
+EI = 1.0
+P = 12.0
+
+[rod]
+length = "L"
+B = "EI"
+
+[start]
+type = "pinned"
+position = [0, 0]
+extra_angle = "theta0"
+
+[end]
+type = "sliding"
+axis = [1, 0, 0]
+position = [0, 0]
+force = ["-P", 0]
+
+[solver]
+unknowns = ["P"]
+
+[guess]
+force = ["-P", 0]
+
+[output]
+derived = ["P", "y_max"]
+)";
+
+// A spatial case (twisted clamped rod), for the checks that only apply to spatial rods.
+const char* const kSpatialBase = R"(model = "spatial"
+
+[parameters]
+phi = 6.0
+L = 1.0
+
+[rod]
+length = "L"
+B = 1.0
+B3 = 0.8
+
+[start]
+type = "clamped"
+position = [0, 0, 0]
+
+[end]
+type = "sliding"
+axis = [0, 0, 1]
+position = [0, 0, 0]
+force = [0, 0, 0]
+orientation = { axis = [0, 0, 1], angle = "phi" }
+track_turns = true
+
+[guess]
+moment = [0, 0, "0.8*phi/L"]
+)";
+
+// 1-based line of the first line containing needle, 0 when absent.
+int line_of(const std::string& text, const std::string& needle) {
+  const auto at = text.find(needle);
+  if (at == std::string::npos) return 0;
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
+}
+
+// text with `from` replaced by `to`; fails the test when `from` is not in the text (so that a
+// mutation that silently does nothing cannot make a test pass).
+std::string replaced(const std::string& text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "'" << from << "' is not in the base case";
+  if (at == std::string::npos) return text;
+  EXPECT_EQ(text.find(from, at + 1), std::string::npos) << "'" << from << "' is ambiguous in the base case";
+  std::string out = text;
+  out.replace(at, from.size(), to);
+  return out;
+}
+
+class CaseFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "kirchhoff_case_file_test_XXXXXX").string();
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override {
+    std::error_code ignored;
+    fs::remove_all(dir_, ignored);
+  }
+
+  std::string write(const std::string& text) {
+    const std::string path = (dir_ / ("case_" + std::to_string(++count_) + ".toml")).string();
+    std::ofstream(path) << text;
+    return path;
+  }
+
+  // Loads text and expects a CaseError naming the file, the key (as 'key'), every reason
+  // fragment and, when line > 0, "FILE:LINE:" at the start of the message.
+  void expect_refused(const std::string& text, const std::string& key, std::initializer_list<std::string> reason,
+                      int line = 0, const ParameterOverrides& overrides = {}, const std::string& phase = "") {
+    const std::string path = write(text);
+    std::string message;
+    EXPECT_THROW(
+        {
+          try {
+            load_case(path, overrides, phase);
+          } catch (const CaseError& e) {
+            message = e.what();
+            throw;
+          }
+        },
+        CaseError)
+        << "accepted:\n"
+        << text;
+    EXPECT_THAT(message, HasSubstr(path));
+    EXPECT_THAT(message, HasSubstr("key '" + key + "'"));
+    for (const auto& r : reason) EXPECT_THAT(message, HasSubstr(r));
+    if (line > 0) {
+      EXPECT_EQ(message.rfind(path + ":" + std::to_string(line) + ":", 0), 0u)
+          << "expected line " << line << " in: " << message;
+    }
+  }
+
+  fs::path dir_;
+  int count_ = 0;
+};
+
+// ---- the bases are valid: every refusal below is due to the one change -------------------
+
+TEST_F(CaseFileTest, BaseCasesLoad) {
+  const Case c = load_case(write(kBase));
+  EXPECT_EQ(c.definition.kind, RodKind::Planar);
+  EXPECT_EQ(c.definition.unknown_parameters, std::vector<std::string>{"P"});
+  EXPECT_EQ(c.definition.parameters.get("P"), 12.0);
+  EXPECT_EQ(c.derived, (std::vector<std::string>{"P", "y_max"}));
+  EXPECT_NO_THROW(ShootingProblem{c.definition});
+
+  const Case s = load_case(write(kSpatialBase));
+  EXPECT_EQ(s.definition.kind, RodKind::Spatial);
+  EXPECT_NO_THROW(ShootingProblem{s.definition});
+}
+
+TEST_F(CaseFileTest, OverridesReplaceParameters) {
+  const Case c = load_case(write(kBase), {{"theta0", 2.0}, {"P", 30.0}});
+  EXPECT_EQ(c.definition.parameters.get("theta0"), 2.0);
+  EXPECT_EQ(c.definition.parameters.get("P"), 30.0);
+  EXPECT_EQ(c.definition.parameters.get("EI"), 1.0);
+}
+
+// ---- typo'd keys ---------------------------------------------------------------------------
+
+TEST_F(CaseFileTest, TypoInRodKey) {
+  const std::string text = replaced(kBase, "length = \"L\"", "lenght = \"L\"");
+  expect_refused(text, "rod.lenght", {"unknown key", "length"}, line_of(text, "lenght"));
+}
+
+TEST_F(CaseFileTest, TypoInEndTypeKey) {
+  // The misspelt key itself should be named, not only the missing 'type'.
+  const std::string text = replaced(kBase, "type = \"sliding\"", "typ = \"sliding\"");
+  expect_refused(text, "end.typ", {}, line_of(text, "typ = "));
+}
+
+TEST_F(CaseFileTest, TypoInEndKeyBesideType) {
+  const std::string text = replaced(kBase, "axis = [1, 0, 0]", "axis = [1, 0, 0]\naxsi = [1, 0, 0]");
+  expect_refused(text, "end.axsi", {"does not apply to a sliding end", "axis"}, line_of(text, "axsi"));
+}
+
+TEST_F(CaseFileTest, UnknownTopLevelTable) {
+  const std::string text = replaced(kBase, "[solver]", "[solvr]");
+  expect_refused(text, "solvr", {"unknown key", "solver"});
+}
+
+TEST_F(CaseFileTest, TypoInSolverKey) {
+  const std::string text = replaced(kBase, "unknowns = [\"P\"]", "unknowns = [\"P\"]\nmax_iteration = 3");
+  expect_refused(text, "solver.max_iteration", {"unknown key", "max_iterations"}, line_of(text, "max_iteration"));
+}
+
+// ---- wrong types ---------------------------------------------------------------------------
+
+TEST_F(CaseFileTest, LengthIsBoolean) {
+  const std::string text = replaced(kBase, "length = \"L\"", "length = true");
+  expect_refused(text, "rod.length", {"must be a number or an expression", "boolean"}, line_of(text, "length = "));
+}
+
+TEST_F(CaseFileTest, StiffnessIsArray) {
+  const std::string text = replaced(kBase, "B = \"EI\"", "B = [1, 2]");
+  expect_refused(text, "rod.B", {"must be a number or an expression", "array"}, line_of(text, "B = "));
+}
+
+TEST_F(CaseFileTest, SegmentsIsFloat) {
+  const std::string text = replaced(kBase, "unknowns = [\"P\"]", "unknowns = [\"P\"]\nsegments = 1.5");
+  expect_refused(text, "solver.segments", {"must be an integer", "floating"}, line_of(text, "segments"));
+}
+
+TEST_F(CaseFileTest, UnknownsIsString) {
+  const std::string text = replaced(kBase, "unknowns = [\"P\"]", "unknowns = \"P\"");
+  expect_refused(text, "solver.unknowns", {"must be an array of strings", "string"}, line_of(text, "unknowns"));
+}
+
+TEST_F(CaseFileTest, ModelIsMisspelt) {
+  const std::string text = replaced(kBase, "model = \"planar\"", "model = \"planer\"");
+  expect_refused(text, "model", {"'planer'", "not 'planar' or 'spatial'"}, line_of(text, "model"));
+}
+
+TEST_F(CaseFileTest, ParameterIsString) {
+  const std::string text = replaced(kBase, "EI = 1.0", "EI = \"one\"");
+  expect_refused(text, "parameters.EI", {"must be a number", "string"}, line_of(text, "EI = \"one\""));
+}
+
+// ---- non-physical values -------------------------------------------------------------------
+
+TEST_F(CaseFileTest, ZeroLength) {
+  const std::string text = replaced(kBase, "length = \"L\"", "length = 0");
+  expect_refused(text, "rod.length", {"must be > 0"}, line_of(text, "length = "));
+}
+
+TEST_F(CaseFileTest, ZeroLengthThroughParameter) {
+  // The check applies at the parameter values, overrides included.
+  expect_refused(kBase, "rod.length", {"must be > 0"}, line_of(kBase, "length = "), {{"L", -1.0}});
+}
+
+TEST_F(CaseFileTest, NegativeStiffness) {
+  const std::string text = replaced(kBase, "B = \"EI\"", "B = -1");
+  expect_refused(text, "rod.B", {"stiffness must be > 0", "-1"}, line_of(text, "B = "));
+}
+
+TEST_F(CaseFileTest, NegativeStiffnessThroughOverride) {
+  expect_refused(kBase, "rod.B", {"stiffness must be > 0"}, line_of(kBase, "B = "), {{"EI", -2.0}});
+}
+
+TEST_F(CaseFileTest, TaperedStiffnessGoesNegative) {
+  // 1 - 2 s is positive at s = 0 and reaches 0 at s = 0.5: only a check along the rod sees it.
+  const std::string text = replaced(kBase, "B = \"EI\"", "B = \"1 - 2*s\"");
+  expect_refused(text, "rod.B", {"stiffness must be > 0", "at s = 0.5"}, line_of(text, "B = "));
+}
+
+TEST_F(CaseFileTest, TaperedStiffnessPositiveIsAccepted) {
+  const std::string text = replaced(kBase, "B = \"EI\"", "B = \"1 + 2*s\"");
+  EXPECT_NO_THROW(load_case(write(text)));
+}
+
+TEST_F(CaseFileTest, BarrierRangeNotPositive) {
+  for (const char* b : {"0", "-0.1"}) {
+    const std::string text =
+        replaced(kBase, "B = \"EI\"", std::string("B = \"EI\"\nbarrier = { b = ") + b + ", a = 1 }");
+    SCOPED_TRACE(b);
+    expect_refused(text, "rod.barrier.b", {"must be > 0"}, line_of(text, "barrier"));
+  }
+  // ... while a positive range is accepted.
+  const std::string ok = replaced(kBase, "B = \"EI\"", "B = \"EI\"\nbarrier = { b = 0.1, a = 1 }");
+  EXPECT_NO_THROW(load_case(write(ok)));
+}
+
+TEST_F(CaseFileTest, ShearStiffnessWithoutExtensible) {
+  const std::string text = replaced(kBase, "B = \"EI\"", "B = \"EI\"\nA3 = 50");
+  expect_refused(text, "rod.A3", {"rod.extensible is false"}, line_of(text, "A3"));
+}
+
+TEST_F(CaseFileTest, BothIsotropicAndDirectionalStiffness) {
+  const std::string text = replaced(kBase, "B = \"EI\"", "B = \"EI\"\nB1 = 2");
+  expect_refused(text, "rod.B1", {"either B or B1/B2"}, line_of(text, "B1"));
+}
+
+// ---- impossible or inconsistent boundary conditions ----------------------------------------
+
+TEST_F(CaseFileTest, UnknownParameterWithoutExtraCondition) {
+  const std::string text = replaced(kBase, "extra_angle = \"theta0\"\n", "");
+  expect_refused(text, "solver", {"0 extra condition(s) but 1 unknown parameter(s)"});
+}
+
+TEST_F(CaseFileTest, ExtraConditionWithoutUnknownParameter) {
+  const std::string text = replaced(kBase, "[solver]\nunknowns = [\"P\"]\n", "");
+  expect_refused(text, "solver", {"1 extra condition(s) but 0 unknown parameter(s)"});
+}
+
+TEST_F(CaseFileTest, SlidingEndWithoutAxis) {
+  const std::string text = replaced(kBase, "axis = [1, 0, 0]\n", "");
+  expect_refused(text, "end.axis", {"sliding end needs the axis"});
+}
+
+TEST_F(CaseFileTest, SlidingAxisOutOfThePlane) {
+  // The planar rod cannot carry a force along e_z.
+  const std::string text = replaced(kBase, "axis = [1, 0, 0]", "axis = [0, 0, 1]");
+  expect_refused(text, "end", {"end:", "planar"});
+}
+
+TEST_F(CaseFileTest, BogusEndType) {
+  const std::string text = replaced(kBase, "type = \"sliding\"", "type = \"bogus\"");
+  expect_refused(text, "end.type", {"'bogus' is not one of", "clamped, pinned, free, loaded, sliding"},
+                 line_of(text, "bogus"));
+}
+
+TEST_F(CaseFileTest, KeyDoesNotApplyToEndType) {
+  const std::string text = replaced(kBase, "type = \"pinned\"", "type = \"clamped\"\nforce = [0, 1]");
+  expect_refused(text, "start.force", {"does not apply to a clamped end"}, line_of(text, "force = [0, 1]"));
+}
+
+TEST_F(CaseFileTest, FreeStartLeavesTheSystemUnderdetermined) {
+  const std::string text =
+      replaced(kBase, "type = \"pinned\"\nposition = [0, 0]\nextra_angle = \"theta0\"", "type = \"free\"");
+  expect_refused(text, "start", {"start:", "neither"});
+}
+
+TEST_F(CaseFileTest, UnknownsNameMissingParameter) {
+  const std::string text = replaced(kBase, "unknowns = [\"P\"]", "unknowns = [\"Q\"]");
+  expect_refused(text, "solver.unknowns", {"'Q' is not in [parameters]"}, line_of(text, "unknowns"));
+}
+
+TEST_F(CaseFileTest, TurnTrackingAboutAnotherAxisNamesTheEnd) {
+  // Turn counting works about e3 only; the refusal must point at the end that asks for it.
+  const std::string text =
+      replaced(kSpatialBase, "orientation = { axis = [0, 0, 1]", "orientation = { axis = [1, 0, 0]");
+  expect_refused(text, "end", {"turn"});
+}
+
+TEST_F(CaseFileTest, AxialPhaseConditionOnPlanarRod) {
+  expect_refused(kBase, "solver.phase_condition", {"'axial' is for spatial rods"}, 0, {}, "axial");
+  const std::string text = replaced(kBase, "unknowns = [\"P\"]", "unknowns = [\"P\"]\nphase_condition = \"axial\"");
+  expect_refused(text, "solver.phase_condition", {"'axial' is for spatial rods"}, line_of(text, "phase_condition"));
+}
+
+TEST_F(CaseFileTest, BogusPhaseCondition) {
+  const std::string text =
+      replaced(kSpatialBase, "[guess]", "[solver]\nphase_condition = \"radial\"\n\n[guess]");
+  expect_refused(text, "solver.phase_condition", {"'radial' is not 'none' or 'axial'"},
+                 line_of(text, "phase_condition"));
+  // The spatial base accepts the real one.
+  EXPECT_NO_THROW(load_case(write(kSpatialBase), {}, "axial"));
+}
+
+TEST_F(CaseFileTest, UnknownDerivedQuantity) {
+  const std::string text = replaced(kBase, "derived = [\"P\", \"y_max\"]", "derived = [\"P\", \"ymax\"]");
+  expect_refused(text, "output.derived", {"'ymax' is not a derived quantity", "y_max"}, line_of(text, "derived"));
+}
+
+// ---- bad expressions -----------------------------------------------------------------------
+
+TEST_F(CaseFileTest, ExpressionWithUnknownVariable) {
+  const std::string text = replaced(kBase, "force = [\"-P\", 0]\n\n[solver]", "force = [\"-Q\", 0]\n\n[solver]");
+  expect_refused(text, "end.force", {"cannot read expression '-Q'", "Q"}, line_of(text, "\"-Q\""));
+}
+
+TEST_F(CaseFileTest, ExpressionWithSyntaxError) {
+  const std::string text = replaced(kBase, "length = \"L\"", "length = \"L*\"");
+  expect_refused(text, "rod.length", {"cannot read expression 'L*'"}, line_of(text, "length = "));
+}
+
+TEST_F(CaseFileTest, ArclengthOutsideMaterialProperties) {
+  const std::string text = replaced(kBase, "axis = [1, 0, 0]\nposition = [0, 0]", "axis = [1, 0, 0]\nposition = [\"s\", 0]");
+  expect_refused(text, "end.position", {"cannot read expression 's'", "s is only allowed in material properties"},
+                 line_of(text, "\"s\""));
+}
+
+TEST_F(CaseFileTest, ArclengthCannotBeAParameter) {
+  const std::string text = replaced(kBase, "EI = 1.0", "EI = 1.0\ns = 0.5");
+  expect_refused(text, "parameters.s", {"reserved for the arclength"}, line_of(text, "s = 0.5"));
+}
+
+// ---- --set overrides -----------------------------------------------------------------------
+
+TEST_F(CaseFileTest, OverrideOfUnknownParameter) {
+  const std::string path = write(kBase);
+  try {
+    load_case(path, {{"Q", 1.0}});
+    FAIL() << "override of a parameter that does not exist was accepted";
+  } catch (const CaseError& e) {
+    const std::string message = e.what();
+    EXPECT_THAT(message, HasSubstr(path));
+    EXPECT_THAT(message, HasSubstr("--set Q"));
+    EXPECT_THAT(message, HasSubstr("no parameter 'Q'"));
+    EXPECT_THAT(message, HasSubstr("theta0"));  // the names it has
+  }
+}
+
+TEST(ParseOverride, AcceptsNameEqualsNumber) {
+  EXPECT_EQ(parse_override("theta0=2.5"), (std::pair<std::string, double>{"theta0", 2.5}));
+  EXPECT_EQ(parse_override("P=-1e-3"), (std::pair<std::string, double>{"P", -1e-3}));
+}
+
+TEST(ParseOverride, RefusesNonNumericValue) {
+  try {
+    parse_override("P=abc");
+    FAIL() << "'P=abc' was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr("'abc'"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("not a number"));
+  }
+  EXPECT_THROW(parse_override("P=1.5x"), std::invalid_argument);
+  EXPECT_THROW(parse_override("P="), std::invalid_argument);
+  EXPECT_THROW(parse_override("P=1e999"), std::invalid_argument);
+}
+
+TEST(ParseOverride, RefusesMissingEquals) {
+  try {
+    parse_override("noequals");
+    FAIL() << "'noequals' was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr("'noequals'"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("NAME=VALUE"));
+  }
+  EXPECT_THROW(parse_override("=3"), std::invalid_argument);
+}
+
+TEST_F(CaseFileTest, NonFiniteOverrideIsRefused) {
+  // stod reads "nan" and "inf"; neither is a usable parameter value. Either parse_override or
+  // load_case must refuse it (theta0 has no physical range check of its own).
+  const std::string path = write(kBase);
+  for (const char* text : {"theta0=nan", "theta0=inf"}) {
+    SCOPED_TRACE(text);
+    EXPECT_ANY_THROW({
+      const auto o = parse_override(text);
+      load_case(path, {o});
+    });
+  }
+}
+
+// ---- TOML syntax and files -----------------------------------------------------------------
+
+TEST_F(CaseFileTest, TomlSyntaxError) {
+  const std::string text = replaced(kBase, "length = \"L\"", "length = ");
+  const std::string path = write(text);
+  try {
+    load_case(path);
+    FAIL() << "a TOML syntax error was accepted";
+  } catch (const CaseError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind(path + ": TOML syntax error", 0), 0u) << message;
+    // toml11 shows the offending line as " NN | text".
+    EXPECT_THAT(message, HasSubstr(std::to_string(line_of(text, "length = ")) + " | length ="));
+  }
+}
+
+TEST_F(CaseFileTest, DuplicateKeyIsASyntaxError) {
+  const std::string text = replaced(kBase, "B = \"EI\"", "B = \"EI\"\nB = 2");
+  const std::string path = write(text);
+  try {
+    load_case(path);
+    FAIL() << "a duplicate key was accepted";
+  } catch (const CaseError& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr(path + ": TOML syntax error"));
+  }
+}
+
+TEST_F(CaseFileTest, MissingFile) {
+  const std::string path = (dir_ / "does_not_exist.toml").string();
+  try {
+    load_case(path);
+    FAIL() << "a missing file was accepted";
+  } catch (const CaseError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind(path + ":", 0), 0u) << message;
+    EXPECT_THAT(message, HasSubstr("open"));
+  }
+}
+
+TEST_F(CaseFileTest, MissingTables) {
+  expect_refused(replaced(kBase, "model = \"planar\"\n", ""), "model", {"missing"});
+  const std::string no_rod = replaced(kBase, "[rod]\nlength = \"L\"\nB = \"EI\"\n", "");
+  expect_refused(no_rod, "rod", {"missing table [rod]"});
+  const std::string no_end = replaced(
+      kBase, "[end]\ntype = \"sliding\"\naxis = [1, 0, 0]\nposition = [0, 0]\nforce = [\"-P\", 0]\n", "");
+  expect_refused(no_end, "end", {"missing table [end]"});
+}
+
+// ---- every shipped case loads and its problem constructs -----------------------------------
+
+TEST(ShippedCases, EveryCaseLoadsAndConstructs) {
+  std::set<std::string> seen;
+  for (const auto& entry : fs::directory_iterator(KIRCHHOFF_CASES_DIR)) {
+    if (entry.path().extension() != ".toml") continue;
+    const std::string path = entry.path().string();
+    SCOPED_TRACE(path);
+    seen.insert(entry.path().stem().string());
+    Case c;
+    ASSERT_NO_THROW(c = load_case(path)) << path;
+    EXPECT_EQ(c.path, path);
+    EXPECT_FALSE(c.title.empty());
+    EXPECT_FALSE(c.derived.empty());
+    EXPECT_GE(c.samples, 2);
+    std::unique_ptr<ShootingProblem> problem;
+    ASSERT_NO_THROW(problem = std::make_unique<ShootingProblem>(c.definition));
+    EXPECT_GT(problem->size(), static_cast<int>(c.definition.unknown_parameters.size()));
+  }
+  for (const char* name :
+       {"simply_supported", "euler_column", "tapered", "twisted_clamped", "heavy_cantilever", "reissner"})
+    EXPECT_TRUE(seen.count(name)) << name << ".toml missing from " << KIRCHHOFF_CASES_DIR;
+}
+
+TEST(ShippedCases, TwistedClampedAcceptsTheAxialPhaseCondition) {
+  const Case c = load_case(std::string(KIRCHHOFF_CASES_DIR) + "/twisted_clamped.toml", {{"phi", 11.58}}, "axial");
+  EXPECT_TRUE(c.definition.parameters.contains("unfolding"));
+  EXPECT_NE(std::find(c.definition.unknown_parameters.begin(), c.definition.unknown_parameters.end(), "unfolding"),
+            c.definition.unknown_parameters.end());
+  EXPECT_NO_THROW(ShootingProblem{c.definition});
+}
+
+}  // namespace
+}  // namespace kirchhoff
