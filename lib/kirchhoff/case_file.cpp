@@ -138,9 +138,23 @@ OrientationFunction orientation_target(const Reader& reader, const Value& v, con
   return [axis, angle](const Parameters& p) { return OrientationTarget{axis, angle(p)}; };
 }
 
-EndCondition read_end(const Reader& reader, const Value& root, const std::string& name) {
+// The frame angles the equations can impose: in the plane, rotations about e_z; turn tracking in
+// 3D counts turns about e3.
+void check_rotation_axis(const Reader& reader, const Value& where, const std::string& key, const Vec3& axis,
+                         RodKind kind, bool track_turns) {
+  const bool along_z = std::abs(std::abs(axis.z()) - 1.0) < 1e-12;
+  if (kind == RodKind::Planar && !along_z)
+    reader.fail(where, key, "a planar rod only turns about e_z = [0, 0, 1]");
+  if (kind == RodKind::Spatial && track_turns && (axis - Vec3::UnitZ()).norm() > 1e-12)
+    reader.fail(where, key, "turns are tracked about e3 = [0, 0, 1] only");
+}
+
+EndCondition read_end(const Reader& reader, const Value& root, const std::string& name, RodKind kind,
+                      const Parameters& parameters) {
   const Value* table = Reader::find(root, name);
   if (!table) reader.fail(name, "missing table [" + name + "] (the boundary condition at that end)");
+  reader.allow_keys(*table, name, {"type", "position", "orientation", "track_turns", "force", "moment", "axis",
+                                   "extra_angle", "extra_angle_axis"});
   const Value* type_value = Reader::find(*table, "type");
   if (!type_value) reader.fail(*table, name + ".type", "missing (clamped, pinned, free, loaded or sliding)");
   const std::string type = reader.string(*type_value, name + ".type");
@@ -158,19 +172,31 @@ EndCondition read_end(const Reader& reader, const Value& root, const std::string
   allowed.insert({"type", "extra_angle", "extra_angle_axis"});
   for (const auto& [key, value] : table->as_table())
     if (!allowed.count(key))
-      reader.fail(value, name + "." + key,
-                  it->second.count(key) ? "" : "does not apply to a " + type + " end (allowed: " + join(allowed) + ")");
+      reader.fail(value, name + "." + key, "does not apply to a " + type + " end (allowed: " + join(allowed) + ")");
 
   auto vec = [&](const std::string& key) -> VectorTarget {
     const Value* v = Reader::find(*table, key);
-    return v ? vector_target(reader.vector(*v, name + "." + key)) : constant(Vec3::Zero());
-  };
-  auto orientation = [&]() -> OrientationFunction {
-    const Value* v = Reader::find(*table, "orientation");
-    return v ? orientation_target(reader, *v, name + ".orientation") : OrientationFunction{};
+    if (!v) return constant(Vec3::Zero());
+    const auto e = reader.vector(*v, name + "." + key);
+    if (kind == RodKind::Planar) {
+      // Positions and forces live in the plane, moments along e_z.
+      const Vec3 value(e[0](parameters), e[1](parameters), e[2](parameters));
+      if (key == "moment" && (value.x() != 0.0 || value.y() != 0.0))
+        reader.fail(*v, name + "." + key, "a planar rod only carries moments about e_z: give [0, 0, M]");
+      if (key != "moment" && value.z() != 0.0)
+        reader.fail(*v, name + "." + key, "a planar rod has no z component: give [x, y]");
+    }
+    return vector_target(e);
   };
   const Value* turns_value = Reader::find(*table, "track_turns");
   const bool track_turns = turns_value ? reader.boolean(*turns_value, name + ".track_turns") : false;
+  auto orientation = [&]() -> OrientationFunction {
+    const Value* v = Reader::find(*table, "orientation");
+    if (!v) return OrientationFunction{};
+    OrientationFunction f = orientation_target(reader, *v, name + ".orientation");
+    check_rotation_axis(reader, *v, name + ".orientation.axis", f(parameters).axis, kind, track_turns);
+    return f;
+  };
 
   EndCondition end;
   if (type == "clamped") {
@@ -191,6 +217,7 @@ EndCondition read_end(const Reader& reader, const Value& root, const std::string
   if (const Value* angle = Reader::find(*table, "extra_angle")) {
     const Value* axis = Reader::find(*table, "extra_angle_axis");
     const Vec3 a = axis ? reader.unit_vector(*axis, name + ".extra_angle_axis") : Vec3::UnitZ();
+    if (axis) check_rotation_axis(reader, *axis, name + ".extra_angle_axis", a, kind, true);
     const Expression e = reader.expression(*angle, name + ".extra_angle");
     end.impose_orientation_angle(a, [e](const Parameters& p) { return e(p); });
   }
@@ -222,6 +249,7 @@ std::pair<std::string, double> parse_override(const std::string& text) {
     used = 0;
   }
   if (used == 0 || used != value.size()) throw std::invalid_argument("'" + value + "' in '" + text + "' is not a number");
+  if (!std::isfinite(v)) throw std::invalid_argument("'" + value + "' in '" + text + "' is not finite");
   return {name, v};
 }
 
@@ -259,7 +287,9 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
     if (!table->is_table()) plain.fail(*table, "parameters", "must be a table of named numbers");
     for (const auto& [name, value] : table->as_table()) {
       if (name == "s") plain.fail(value, "parameters.s", "'s' is reserved for the arclength");
-      parameters.set(name, plain.number(value, "parameters." + name));
+      const double v = plain.number(value, "parameters." + name);
+      if (!std::isfinite(v)) plain.fail(value, "parameters." + name, "must be a finite number");
+      parameters.set(name, v);
     }
   }
   for (const auto& [name, value] : overrides) {
@@ -306,8 +336,9 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
     for (int i = 0; i < 2; ++i) B[i] = {reader.expression(*v, "rod.B", true), v, "rod.B"};
   for (int i = 0; i < 3; ++i) {
     if (const Value* v = Reader::find(*rod, bend_keys[i])) {
-      if (i < 2 && Reader::find(*rod, "B")) reader.fail(*v, B[i].key, "give either B or B1/B2, not both");
-      B[i] = {reader.expression(*v, B[i].key, true), v, B[i].key};
+      const std::string key = std::string("rod.") + bend_keys[i];
+      if (i < 2 && Reader::find(*rod, "B")) reader.fail(*v, key, "give either B or B1/B2, not both");
+      B[i] = {reader.expression(*v, key, true), v, key};
     }
     if (const Value* v = Reader::find(*rod, shear_keys[i])) A[i] = {reader.expression(*v, A[i].key, true), v, A[i].key};
   }
@@ -396,8 +427,8 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
     return m;
   };
 
-  d.start = read_end(reader, root, "start");
-  d.end = read_end(reader, root, "end");
+  d.start = read_end(reader, root, "start", d.kind, parameters);
+  d.end = read_end(reader, root, "end", d.kind, parameters);
 
   // [solver]
   if (const Value* s = Reader::find(root, "solver")) {

@@ -2,6 +2,7 @@
 
 #include <muParser.h>
 
+#include <algorithm>
 #include <functional>
 #include <stdexcept>
 
@@ -24,10 +25,18 @@ Expression::Expression(const std::string& text, const std::vector<std::string>& 
     for (size_t i = 0; i < parameter_names.size(); ++i) c.parser.DefineVar(parameter_names[i], &c.storage[i]);
     if (uses_s) c.parser.DefineVar("s", &c.storage.back());
     c.parser.SetExpr(text);
+    // muParser lists undefined names here too, so every name is checked against ours.
     for (const auto& [name, address] : c.parser.GetUsedVar()) {
       (void)address;
-      if (name == "s") depends_on_s_ = true;
-      else used_.push_back(name);
+      if (name == "s" && uses_s) {
+        depends_on_s_ = true;
+      } else if (std::find(parameter_names.begin(), parameter_names.end(), name) != parameter_names.end()) {
+        used_.push_back(name);
+      } else {
+        throw std::invalid_argument("cannot read expression '" + text + "': " +
+                                    (name == "s" ? std::string("s is only allowed in material properties (it is the arclength)")
+                                                 : "unknown variable '" + name + "' (not in [parameters])"));
+      }
     }
   } catch (const mu::Parser::exception_type& e) {
     throw std::invalid_argument("cannot read expression '" + text + "': " + e.GetMsg() +

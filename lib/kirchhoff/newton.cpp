@@ -34,6 +34,13 @@ std::string NewtonSummary::brief_report() const {
   return os.str();
 }
 
+double reciprocal_condition(const Eigen::PartialPivLU<Eigen::MatrixXd>& lu) {
+  const Eigen::VectorXd pivots = lu.matrixLU().diagonal().cwiseAbs();
+  const double largest = pivots.maxCoeff();
+  if (!(largest > 0)) return 0.0;
+  return std::min(lu.rcond(), pivots.minCoeff() / largest);
+}
+
 bool finite_difference_jacobian(const NonlinearSystem& system, const Eigen::VectorXd& x, double step,
                                 Eigen::MatrixXd* J) {
   const int n = system.size();
@@ -66,23 +73,30 @@ NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, co
     return system.evaluate(at, f, jac, &failure);
   };
 
-  if (!evaluate(x, &F, &J)) {
+  // F alone first: a converged guess (or iterate) never pays for a Jacobian.
+  if (!evaluate(x, &F, nullptr)) {
     summary.status = SolverStatus::IntegrationFailed;
     summary.residual_norm = INFINITY;
     summary.message = failure;
     return summary;
   }
   double norm = F.lpNorm<Eigen::Infinity>();
+  summary.residual_norm = norm;
   for (int it = 0; it < options.max_iterations; ++it) {
-    summary.residual_norm = norm;
     if (norm <= options.residual_tolerance) {
       summary.status = SolverStatus::Converged;
       return summary;
     }
+    if (!evaluate(x, &F, &J)) {
+      summary.status = SolverStatus::IntegrationFailed;
+      summary.message = failure;
+      return summary;
+    }
     Eigen::PartialPivLU<Eigen::MatrixXd> lu(J);
-    if (!(lu.rcond() > options.singular_rcond)) {
+    const double rcond = reciprocal_condition(lu);
+    if (!(rcond > options.singular_rcond)) {
       summary.status = SolverStatus::SingularJacobian;
-      summary.message = "reciprocal condition number " + std::to_string(lu.rcond());
+      summary.message = "reciprocal condition number " + std::to_string(rcond);
       return summary;
     }
     const Eigen::VectorXd dx = -lu.solve(F);
@@ -106,23 +120,18 @@ NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, co
       return summary;
     }
     x = x_trial;
-    if (!evaluate(x, &F, &J)) {
-      summary.status = SolverStatus::IntegrationFailed;
-      summary.message = failure;
-      return summary;
-    }
+    F = F_trial;
     norm = F.lpNorm<Eigen::Infinity>();
+    summary.residual_norm = norm;
     summary.history.push_back(norm);
     const bool stalled = alpha * dx.lpNorm<Eigen::Infinity>() <=
                          options.step_tolerance * (1.0 + x.lpNorm<Eigen::Infinity>());
     if (stalled && norm <= 1e3 * options.residual_tolerance) {
-      summary.residual_norm = norm;
       summary.status = SolverStatus::Converged;
       summary.message = "step at round-off";
       return summary;
     }
   }
-  summary.residual_norm = norm;
   summary.status = norm <= options.residual_tolerance ? SolverStatus::Converged : SolverStatus::MaxIterations;
   return summary;
 }

@@ -66,6 +66,10 @@ NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, co
 // |F|^2 / 2 from the original guess followed by Newton again.
 NewtonSummary solve_with_fallback(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options);
 
+// Reciprocal condition estimate of an LU factorisation that also sees exactly zero pivots
+// (Eigen's estimate alone does not when a whole column vanishes): min(rcond, min|U_ii|/max|U_ii|).
+double reciprocal_condition(const Eigen::PartialPivLU<Eigen::MatrixXd>& lu);
+
 // Central-difference Jacobian; returns false when an evaluation fails.
 bool finite_difference_jacobian(const NonlinearSystem& system, const Eigen::VectorXd& x, double step,
                                 Eigen::MatrixXd* J);

@@ -223,11 +223,23 @@ ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) 
   result.x = x0;
   result.summary = solve_with_fallback(problem, result.x, problem.definition().options.newton);
   result.parameters = problem.parameters_at(result.x);
-  if (result.summary.converged() && result.parameters.contains("unfolding") &&
-      std::abs(result.parameters.get("unfolding")) > kUnfoldingTolerance) {
+  if (!result.summary.converged() || !result.parameters.contains("unfolding")) return result;
+  if (std::abs(result.parameters.get("unfolding")) > kUnfoldingTolerance) {
     result.summary.status = SolverStatus::UnfoldingNotZero;
     result.summary.message = "unfolding = " + std::to_string(result.parameters.get("unfolding")) +
                              ": not an equilibrium (on the straight rod the axial phase condition is degenerate)";
+    return result;
+  }
+  // A guess that is already a straight solution converges in zero iterations; the phase
+  // condition is degenerate there, which shows as a singular Jacobian.
+  Eigen::VectorXd F;
+  Eigen::MatrixXd J;
+  std::string failure;
+  if (problem.evaluate(result.x, &F, &J, &failure) &&
+      !(reciprocal_condition(J.partialPivLu()) > problem.definition().options.newton.singular_rcond * 1e3)) {
+    result.summary.status = SolverStatus::SingularJacobian;
+    result.summary.message =
+        "the axial phase condition is degenerate here (a straight rod): solve it without the phase condition";
   }
   return result;
 }

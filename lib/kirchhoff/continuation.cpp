@@ -1,0 +1,462 @@
+#include "kirchhoff/continuation.hpp"
+
+#include <algorithm>
+#include <boost/math/tools/minima.hpp>
+#include <cmath>
+
+#include "kirchhoff/solution.hpp"
+
+namespace kirchhoff {
+namespace {
+
+// Central-difference step for F_lambda relative to 1 + |lambda| (see shooting.cpp).
+constexpr double kLambdaStep = 1e-6;
+// Step growth and shrink factors: the usual choices for predictor-corrector continuation.
+constexpr double kGrow = 1.5, kShrink = 0.5;
+// A corrector that needs at most this many iterations lets the step grow; at least kSlow, shrink.
+constexpr int kFast = 3, kSlow = 6;
+// Secant/Brent location stops when the step interval is this small relative to the step.
+constexpr double kLocateTolerance = 1e-12;
+constexpr int kLocateIterations = 60;
+// H is flagged as not flat above this fraction of its scale (the standard).
+constexpr double kFlatH = 1e-9;
+
+double sign_of(double v) { return v < 0 ? -1.0 : 1.0; }
+
+}  // namespace
+
+const char* to_string(PointType type) {
+  switch (type) {
+    case PointType::Start: return "start";
+    case PointType::Regular: return "regular";
+    case PointType::Fold: return "fold";
+    case PointType::BranchPoint: return "branch_point";
+    case PointType::Event: return "event";
+    case PointType::Endpoint: return "endpoint";
+  }
+  return "?";
+}
+
+const char* to_string(StopReason reason) {
+  switch (reason) {
+    case StopReason::ReachedTarget: return "reached_target";
+    case StopReason::MaxPoints: return "max_points";
+    case StopReason::ParameterBounds: return "parameter_bounds";
+    case StopReason::StepTooSmall: return "step_too_small";
+    case StopReason::EventStop: return "event";
+    case StopReason::StartFailed: return "start_failed";
+  }
+  return "?";
+}
+
+std::string ContinuationOptions::validate() const {
+  if (parameter.empty()) return "no continuation parameter given";
+  if (!(initial_step > 0) || !(min_step > 0) || !(max_step >= min_step)) return "steps must satisfy 0 < min_step <= max_step, initial_step > 0";
+  if (max_points < 1) return "max_points must be >= 1";
+  if (!(parameter_min < parameter_max)) return "parameter_min must be < parameter_max";
+  if (corrector_max_iterations < 1 || !(corrector_tolerance > 0)) return "corrector settings must be positive";
+  if (samples < 2) return "samples must be >= 2";
+  return {};
+}
+
+Continuation::Continuation(const ShootingProblem& problem, ContinuationOptions options)
+    : problem_(problem), options_(std::move(options)) {
+  if (std::string e = options_.validate(); !e.empty()) throw std::invalid_argument(e);
+  if (!problem_.parameters().contains(options_.parameter))
+    throw std::invalid_argument("continuation parameter '" + options_.parameter + "' is not a parameter of the problem");
+  for (const auto& u : problem_.definition().unknown_parameters)
+    if (u == options_.parameter)
+      throw std::invalid_argument("'" + options_.parameter + "' is solved for (an unknown); continue in another parameter");
+  for (const auto& e : options_.events)
+    if (std::find(options_.derived.begin(), options_.derived.end(), e.quantity) == options_.derived.end())
+      options_.derived.push_back(e.quantity);
+  n_ = problem_.size();
+}
+
+Eigen::VectorXd Continuation::join(const Eigen::VectorXd& x, double lambda) const {
+  Eigen::VectorXd z(n_ + 1);
+  z << x, lambda;
+  return z;
+}
+
+bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure) {
+  const double lambda = z[n_];
+  const Eigen::VectorXd x = z.head(n_);
+  problem_.set_parameter(options_.parameter, lambda);
+  Eigen::MatrixXd J;
+  if (!problem_.evaluate(x, F, A ? &J : nullptr, failure)) return false;
+  if (!A) return true;
+  const double h = kLambdaStep * (1.0 + std::abs(lambda));
+  Eigen::VectorXd Fp, Fm;
+  problem_.set_parameter(options_.parameter, lambda + h);
+  const bool ok_p = problem_.evaluate(x, &Fp, nullptr, failure);
+  problem_.set_parameter(options_.parameter, lambda - h);
+  const bool ok_m = ok_p && problem_.evaluate(x, &Fm, nullptr, failure);
+  problem_.set_parameter(options_.parameter, lambda);
+  if (!ok_m) return false;
+  A->resize(n_, n_ + 1);
+  A->leftCols(n_) = J;
+  A->col(n_) = (Fp - Fm) / (2.0 * h);
+  return true;
+}
+
+bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
+                           int* iterations) {
+  Eigen::VectorXd F, G(n_ + 1);
+  Eigen::MatrixXd A, M(n_ + 1, n_ + 1);
+  std::string failure;
+  for (int it = 0; it <= options_.corrector_max_iterations; ++it) {
+    if (!evaluate(z, &F, &A, &failure)) return false;
+    G << F, normal.dot(z - z_predicted);
+    if (!G.allFinite()) return false;
+    if (G.lpNorm<Eigen::Infinity>() <= options_.corrector_tolerance) {
+      *iterations = it;
+      return true;
+    }
+    if (it == options_.corrector_max_iterations) break;
+    M << A, normal.transpose();
+    Eigen::PartialPivLU<Eigen::MatrixXd> lu(M);
+    if (!(reciprocal_condition(lu) > 1e-15)) return false;
+    z -= lu.solve(G);
+  }
+  return false;
+}
+
+bool Continuation::tangent_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous, Eigen::VectorXd* t,
+                              double* determinant, double* smallest_singular, int* small_count) {
+  Eigen::VectorXd F;
+  Eigen::MatrixXd A;
+  std::string failure;
+  if (!evaluate(z, &F, &A, &failure)) return false;
+  Eigen::MatrixXd M(n_ + 1, n_ + 1);
+  M << A, previous.transpose();
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n_ + 1);
+  rhs[n_] = 1.0;
+  *t = M.partialPivLu().solve(rhs);
+  if (!t->allFinite() || t->norm() == 0.0) return false;
+  t->normalize();
+  M.row(n_) = t->transpose();
+  *determinant = M.partialPivLu().determinant();
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(M).singularValues();
+  *smallest_singular = sv[n_] / sv[0];
+  *small_count = 0;
+  for (int i = 0; i <= n_; ++i) *small_count += sv[i] / sv[0] < options_.branch_point_tolerance ? 1 : 0;
+  return true;
+}
+
+ContinuationPoint Continuation::make_point(const Eigen::VectorXd& z, const Eigen::VectorXd& t, PointType type,
+                                           int index, double arclength, int iterations) {
+  ContinuationPoint p;
+  p.index = index;
+  p.x = z.head(n_);
+  p.parameter = z[n_];
+  p.tangent = t;
+  p.type = type;
+  p.arclength = arclength;
+  p.newton_iterations = iterations;
+  if (options_.compute_invariants || !options_.derived.empty()) {
+    problem_.set_parameter(options_.parameter, p.parameter);
+    ShootingResult r;
+    r.x = p.x;
+    r.summary.status = SolverStatus::Converged;
+    r.parameters = problem_.parameters_at(p.x);
+    const Solution s = make_solution(problem_, std::move(r), options_.samples, options_.derived);
+    p.derived = s.derived;
+    p.invariants = s.invariants;
+    p.H_flat = !s.invariants.H.applies || s.invariants.H.spread <= kFlatH * std::max(1.0, s.invariants.H.scale);
+  }
+  return p;
+}
+
+std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint& from, double h, PointType type) {
+  const Eigen::VectorXd z0 = join(from.x, from.parameter);
+  const Eigen::VectorXd z_pred = z0 + h * from.tangent;
+  Eigen::VectorXd z = z_pred, t;
+  int iterations = 0;
+  if (!correct(z, z_pred, from.tangent, &iterations)) return std::nullopt;
+  Monitors m;
+  if (!tangent_at(z, from.tangent, &t, &m.determinant, &m.smallest_singular, &m.small_count)) return std::nullopt;
+  m.tangent_lambda = t[n_];
+  ContinuationPoint p = make_point(z, t, type, from.index + 1, from.arclength + (z - z0).norm(), iterations);
+  monitors_[-1] = m;  // scratch slot for the most recent trial
+  return p;
+}
+
+std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& from, double h_max,
+                                                      const std::function<double(const ContinuationPoint&)>& monitor,
+                                                      bool minimise, PointType type) {
+  std::optional<ContinuationPoint> best;
+  if (minimise) {
+    auto f = [&](double h) {
+      auto p = step_from(from, h, type);
+      return p ? monitor(*p) : INFINITY;
+    };
+    const auto [h, value] = boost::math::tools::brent_find_minima(f, 0.0, h_max, 40);
+    (void)value;
+    best = step_from(from, h, type);
+  } else {
+    // Illinois (modified regula falsi) on h: brackets the root and converges superlinearly.
+    double a = 0.0, fa = monitor(from), b = h_max;
+    auto pb = step_from(from, b, type);
+    if (!pb) return std::nullopt;
+    double fb = monitor(*pb);
+    best = pb;
+    int side = 0;
+    for (int it = 0; it < kLocateIterations && std::abs(b - a) > kLocateTolerance * h_max; ++it) {
+      const double c = (a * fb - b * fa) / (fb - fa);
+      auto pc = step_from(from, c, type);
+      if (!pc) return std::nullopt;
+      const double fc = monitor(*pc);
+      best = pc;
+      if (fc == 0.0) break;
+      if (sign_of(fc) == sign_of(fb)) {
+        b = c;
+        fb = fc;
+        if (side == -1) fa *= 0.5;
+        side = -1;
+      } else {
+        a = c;
+        fa = fc;
+        if (side == +1) fb *= 0.5;
+        side = +1;
+      }
+      if (std::abs(fc) < 1e-15) break;
+    }
+  }
+  if (best) best->type = type;
+  return best;
+}
+
+ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink& sink) {
+  ContinuationResult result;
+  const double lambda0 = problem_.parameters().get(options_.parameter);
+  // Correct at fixed lambda (normal = e_lambda).
+  Eigen::VectorXd z = join(x0, lambda0), e = Eigen::VectorXd::Zero(n_ + 1);
+  e[n_] = 1.0;
+  int iterations = 0;
+  if (!correct(z, z, e, &iterations)) {
+    result.reason = StopReason::StartFailed;
+    result.message = "the starting point does not converge at " + options_.parameter + " = " + std::to_string(lambda0);
+    return result;
+  }
+  const double direction = std::isnan(options_.target) ? sign_of(options_.direction) : sign_of(options_.target - lambda0);
+  Eigen::VectorXd t;
+  Monitors m;
+  if (!tangent_at(z, direction * e, &t, &m.determinant, &m.smallest_singular, &m.small_count)) {
+    result.reason = StopReason::StartFailed;
+    result.message = "no tangent at the starting point";
+    return result;
+  }
+  if (t[n_] * direction < 0) t = -t;
+  m.tangent_lambda = t[n_];
+  ContinuationPoint start = make_point(z, t, PointType::Start, 0, 0.0, iterations);
+  start.step = options_.initial_step;
+  monitors_.clear();
+  monitors_[0] = m;
+  return march(start, sink);
+}
+
+ContinuationResult Continuation::resume(const ContinuationPoint& last, const PointSink& sink) {
+  Monitors m;
+  Eigen::VectorXd t;
+  ContinuationPoint start = last;
+  if (!tangent_at(join(last.x, last.parameter), last.tangent, &t, &m.determinant, &m.smallest_singular,
+                  &m.small_count)) {
+    ContinuationResult result;
+    result.reason = StopReason::StartFailed;
+    result.message = "cannot resume: no tangent at the last point";
+    return result;
+  }
+  m.tangent_lambda = t[n_];
+  start.tangent = t;
+  if (!(start.step > 0)) start.step = options_.initial_step;
+  monitors_.clear();
+  monitors_[start.index] = m;
+  ContinuationResult r = march(start, {});
+  // march reports the start point first; a resumed run already has it.
+  if (!r.points.empty()) r.points.erase(r.points.begin());
+  if (sink)
+    for (const auto& p : r.points) sink(p);
+  return r;
+}
+
+Eigen::MatrixXd Continuation::bifurcation_directions(const ContinuationPoint& point, int count) {
+  Eigen::VectorXd F;
+  Eigen::MatrixXd A;
+  std::string failure;
+  if (!evaluate(join(point.x, point.parameter), &F, &A, &failure)) throw std::runtime_error(failure);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
+  // The last count + 1 right singular vectors span the null space (tangent included).
+  Eigen::MatrixXd N = svd.matrixV().rightCols(count + 1);
+  N -= point.tangent * (point.tangent.transpose() * N);
+  Eigen::JacobiSVD<Eigen::MatrixXd> basis(N, Eigen::ComputeThinU);
+  return basis.matrixU().leftCols(count);
+}
+
+ContinuationResult Continuation::run_along(const Eigen::VectorXd& x, double lambda, const Eigen::VectorXd& direction,
+                                           PointType start_type, const PointSink& sink) {
+  ContinuationResult result;
+  const Eigen::VectorXd z_bp = join(x, lambda);
+  const Eigen::VectorXd d = direction.normalized();
+  ContinuationPoint origin = make_point(z_bp, d, start_type, 0, 0.0, 0);
+  const Eigen::VectorXd z_pred = z_bp + options_.initial_step * d;
+  Eigen::VectorXd z = z_pred, t;
+  int iterations = 0;
+  Monitors m;
+  if (!correct(z, z_pred, d, &iterations) || !tangent_at(z, d, &t, &m.determinant, &m.smallest_singular, &m.small_count)) {
+    result.reason = StopReason::StartFailed;
+    result.message = "no solution along the switching direction";
+    return result;
+  }
+  m.tangent_lambda = t[n_];
+  if (sink) sink(origin);
+  ContinuationPoint first = make_point(z, t, PointType::Regular, 1, (z - z_bp).norm(), iterations);
+  first.step = options_.initial_step;
+  monitors_.clear();
+  monitors_[1] = m;
+  result = march(first, sink);
+  result.points.insert(result.points.begin(), origin);
+  return result;
+}
+
+ContinuationResult Continuation::switch_branch(const ContinuationPoint& bp, const PointSink& sink, double sign) {
+  const Eigen::VectorXd d = bifurcation_directions(bp, 1).col(0) * sign_of(sign);
+  return run_along(bp.x, bp.parameter, d, PointType::BranchPoint, sink);
+}
+
+ContinuationResult Continuation::march(ContinuationPoint current, const PointSink& sink) {
+  ContinuationResult result;
+  result.points.push_back(current);
+  if (sink) sink(current);
+  double ds = current.step > 0 ? current.step : options_.initial_step;
+  std::optional<ContinuationPoint> before_current;  // the point before `current`, for minima
+  double previous_h = 0.0;
+  const bool has_target = !std::isnan(options_.target);
+
+  auto accept = [&](ContinuationPoint p) {
+    p.index = result.points.back().index + 1;
+    p.step = ds;
+    result.points.push_back(p);
+    if (sink) sink(result.points.back());
+  };
+
+  while (static_cast<int>(result.points.size()) < options_.max_points) {
+    auto candidate = step_from(current, ds, PointType::Regular);
+    if (!candidate) {
+      ds *= kShrink;
+      if (ds < options_.min_step) {
+        result.reason = StopReason::StepTooSmall;
+        result.message = "the corrector failed down to the minimum step";
+        return result;
+      }
+      continue;
+    }
+    const Monitors m_new = monitors_[-1];
+    const double angle = std::acos(std::clamp(current.tangent.dot(candidate->tangent), -1.0, 1.0));
+    if (angle > options_.max_tangent_angle && ds > options_.min_step) {
+      ds = std::max(ds * kShrink, options_.min_step);
+      continue;
+    }
+    const Monitors m_old = monitors_[current.index];
+
+    // Special points inside this step, each with its position h along it.
+    std::vector<std::pair<double, ContinuationPoint>> special;
+    bool stop = false;
+    StopReason stop_reason = StopReason::MaxPoints;
+    auto crossed = [](double a, double b) { return (a < 0) != (b < 0) && a != 0.0; };
+    if (has_target && crossed(current.parameter - options_.target, candidate->parameter - options_.target)) {
+      auto p = locate(current, ds, [&](const ContinuationPoint& q) { return q.parameter - options_.target; }, false,
+                      PointType::Endpoint);
+      if (p) {
+        special.push_back({(p->arclength - current.arclength), *p});
+        stop = true;
+        stop_reason = StopReason::ReachedTarget;
+      }
+    }
+    for (double bound : {options_.parameter_min, options_.parameter_max}) {
+      if (std::isfinite(bound) && crossed(current.parameter - bound, candidate->parameter - bound)) {
+        auto p = locate(current, ds, [&](const ContinuationPoint& q) { return q.parameter - bound; }, false,
+                        PointType::Endpoint);
+        if (p) {
+          special.push_back({p->arclength - current.arclength, *p});
+          stop = true;
+          stop_reason = StopReason::ParameterBounds;
+        }
+      }
+    }
+    if (options_.detect_folds && crossed(m_old.tangent_lambda, m_new.tangent_lambda)) {
+      auto p = locate(current, ds, [&](const ContinuationPoint& q) { return q.tangent[n_]; }, false, PointType::Fold);
+      if (p) special.push_back({p->arclength - current.arclength, *p});
+    }
+    bool simple_bp = false;
+    if (options_.detect_branch_points && crossed(m_old.determinant, m_new.determinant)) {
+      auto p = locate(current, ds, [&](const ContinuationPoint&) { return monitors_[-1].determinant; }, false,
+                      PointType::BranchPoint);
+      if (p) {
+        p->multiplicity = std::max(1, monitors_[-1].small_count);
+        special.push_back({p->arclength - current.arclength, *p});
+        simple_bp = true;
+      }
+    }
+    // Branch points that keep the determinant's sign (even multiplicity): a local minimum of
+    // the smallest singular value over the last two steps that is, once located, tiny.
+    if (options_.detect_branch_points && !simple_bp && before_current &&
+        m_old.smallest_singular < monitors_[before_current->index].smallest_singular &&
+        m_old.smallest_singular < m_new.smallest_singular) {
+      auto p = locate(*before_current, previous_h + ds,
+                      [&](const ContinuationPoint&) { return monitors_[-1].smallest_singular; }, true,
+                      PointType::BranchPoint);
+      if (p && monitors_[-1].smallest_singular < options_.branch_point_tolerance) {
+        p->multiplicity = std::max(1, monitors_[-1].small_count - 1);
+        // Found behind `current` or ahead of it: record it in order with a consistent index.
+        special.push_back({p->arclength - current.arclength, *p});
+      }
+    }
+    for (const auto& e : options_.events) {
+      const double a = current.derived.count(e.quantity) ? current.derived.at(e.quantity) - e.value : NAN;
+      const double b = candidate->derived.count(e.quantity) ? candidate->derived.at(e.quantity) - e.value : NAN;
+      if (std::isfinite(a) && std::isfinite(b) && crossed(a, b)) {
+        auto p = locate(current, ds, [&](const ContinuationPoint& q) { return q.derived.at(e.quantity) - e.value; },
+                        false, PointType::Event);
+        if (p) {
+          p->event = e.quantity + "=" + std::to_string(e.value);
+          special.push_back({p->arclength - current.arclength, *p});
+          if (e.stop) {
+            stop = true;
+            stop_reason = StopReason::EventStop;
+          }
+        }
+      }
+    }
+    std::sort(special.begin(), special.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (auto& [h, p] : special) {
+      accept(p);
+      if (stop && (p.type == PointType::Endpoint || p.type == PointType::Event)) {
+        if (p.type == PointType::Event && stop_reason == StopReason::EventStop) {
+          result.reason = stop_reason;
+          result.message = "event " + p.event;
+          return result;
+        }
+        if (p.type == PointType::Endpoint) {
+          result.reason = stop_reason;
+          return result;
+        }
+      }
+    }
+
+    const int iterations = candidate->newton_iterations;
+    before_current = current;
+    previous_h = ds;
+    monitors_[result.points.back().index + 1] = m_new;
+    accept(*candidate);
+    current = result.points.back();
+    if (iterations <= kFast) ds = std::min(ds * kGrow, options_.max_step);
+    if (iterations >= kSlow) ds = std::max(ds * kShrink, options_.min_step);
+    result.points.back().step = ds;
+    current.step = ds;
+  }
+  result.reason = StopReason::MaxPoints;
+  return result;
+}
+
+}  // namespace kirchhoff

@@ -1,0 +1,150 @@
+// Pseudo-arclength continuation of shooting problems in one named parameter, with fold and
+// branch-point detection and location, branch switching, events and resumable runs.
+//
+// The branch is a curve z(sigma) = (x, lambda) of solutions of F(x; lambda) = 0, where x are the
+// shooting unknowns and lambda the continued parameter. Each step predicts along the tangent t,
+// then corrects with Newton on the bordered system
+//     [ F_x  F_lambda ] dz = -[ F                  ]
+//     [      t^T      ]      [ t.(z - z_predicted) ],
+// and the new tangent solves [F_x F_lambda; t_old^T] t = [0; 1]. Along the way:
+//   - folds: the lambda component of t changes sign;
+//   - simple branch points: det [F_x F_lambda; t^T] changes sign;
+//   - branch points of any multiplicity (e.g. the double one of the isotropic twisted rod, where
+//     the determinant keeps its sign): a local minimum of the smallest singular value of the
+//     bordered matrix that, located, falls below branch_point_tolerance; the count of such small
+//     singular values is the multiplicity;
+//   - events: a derived quantity crosses a given value.
+#pragma once
+
+#include <functional>
+#include <limits>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kirchhoff/invariants.hpp"
+#include "kirchhoff/shooting.hpp"
+
+namespace kirchhoff {
+
+// A derived quantity crossing a value: recorded as a point, and the run stops when `stop`.
+struct ContinuationEvent {
+  std::string quantity;  // a name from derived_catalogue()
+  double value = 0.0;
+  bool stop = true;
+};
+
+struct ContinuationOptions {
+  std::string parameter;                                      // the continued parameter
+  double target = std::numeric_limits<double>::quiet_NaN();   // stop on reaching it (NaN: no target)
+  double direction = 1.0;           // initial direction of lambda (+1/-1), used when there is no target
+  double initial_step = 0.05;       // pseudo-arclength step
+  double min_step = 1e-7;           // below this the run stops (step_too_small)
+  double max_step = 0.5;
+  double max_tangent_angle = 0.35;  // rad; a step turning the tangent more is retried shorter
+  int max_points = 500;
+  double parameter_min = -std::numeric_limits<double>::infinity();
+  double parameter_max = std::numeric_limits<double>::infinity();
+  int corrector_max_iterations = 8;
+  double corrector_tolerance = 1e-10;   // max |F| and |arclength condition|
+  bool detect_folds = true;
+  bool detect_branch_points = true;
+  // Located branch point: smallest singular value of the bordered matrix below this times the
+  // largest one. Away from branch points it is O(1e-2) or more on rod problems; located
+  // points reach ~1e-12.
+  double branch_point_tolerance = 1e-7;
+  std::vector<ContinuationEvent> events;
+  std::vector<std::string> derived;   // computed at every point (and available to events)
+  int samples = 101;                  // profile points for invariants and derived quantities
+  bool compute_invariants = true;     // false skips sampling (derived from events need it)
+
+  std::string validate() const;
+};
+
+enum class PointType { Start, Regular, Fold, BranchPoint, Event, Endpoint };
+const char* to_string(PointType type);
+
+struct ContinuationPoint {
+  int index = 0;
+  double parameter = 0.0;
+  double arclength = 0.0;
+  Eigen::VectorXd x;        // shooting unknowns
+  Eigen::VectorXd tangent;  // (dx, dlambda), unit
+  PointType type = PointType::Regular;
+  int multiplicity = 0;     // branch points: number of small singular values
+  int newton_iterations = 0;
+  std::string event;        // events: the quantity that crossed
+  std::map<std::string, double> derived;
+  InvariantReport invariants;
+  bool H_flat = true;       // false flags a point whose H spread exceeds 1e-9 of its scale
+  double step = 0.0;        // step size after this point
+};
+
+enum class StopReason { ReachedTarget, MaxPoints, ParameterBounds, StepTooSmall, EventStop, StartFailed };
+const char* to_string(StopReason reason);
+
+struct ContinuationResult {
+  std::vector<ContinuationPoint> points;
+  StopReason reason = StopReason::MaxPoints;
+  std::string message;
+};
+
+// Called for every accepted point, in order, as soon as it is known (CSV writers, progress).
+using PointSink = std::function<void(const ContinuationPoint&)>;
+
+class Continuation {
+ public:
+  // The problem is copied; its value of options.parameter is the starting one.
+  Continuation(const ShootingProblem& problem, ContinuationOptions options);
+
+  // Starts from unknowns x0 (corrected at fixed lambda first).
+  ContinuationResult run(const Eigen::VectorXd& x0, const PointSink& sink = {});
+  // Resumes from a point of an earlier run (its x, parameter, tangent, step, index, arclength).
+  ContinuationResult resume(const ContinuationPoint& last, const PointSink& sink = {});
+  // Starts on the branch crossing the one of `branch_point` (a located simple branch point):
+  // direction from the null space of [F_x F_lambda] orthogonal to the old tangent.
+  ContinuationResult switch_branch(const ContinuationPoint& branch_point, const PointSink& sink = {},
+                                   double sign = 1.0);
+  // Starts at z = (x, lambda) (a branch point of another formulation, say) along the unit
+  // direction d: the first point is reached by a step of initial_step along d, corrected on the
+  // hyperplane normal to d. The start point itself is reported with the given type.
+  ContinuationResult run_along(const Eigen::VectorXd& x, double lambda, const Eigen::VectorXd& direction,
+                               PointType start_type, const PointSink& sink = {});
+
+  // Null vectors of [F_x F_lambda] at a point, orthonormal, orthogonal to its tangent.
+  Eigen::MatrixXd bifurcation_directions(const ContinuationPoint& point, int count);
+
+  const ShootingProblem& problem() const { return problem_; }
+  double parameter_value(const ContinuationPoint& p) const { return p.parameter; }
+
+ private:
+  struct Evaluation;
+  bool evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure);
+  bool correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
+               int* iterations);
+  bool tangent_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous, Eigen::VectorXd* t,
+                  double* determinant, double* smallest_singular, int* small_count);
+  ContinuationPoint make_point(const Eigen::VectorXd& z, const Eigen::VectorXd& t, PointType type, int index,
+                               double arclength, int iterations);
+  ContinuationResult march(ContinuationPoint start, const PointSink& sink);
+  // Locates where `monitor` (of the point reached from `from` by a step h) vanishes or is
+  // minimal, by the secant method or Brent on h in (0, h_max].
+  std::optional<ContinuationPoint> locate(const ContinuationPoint& from, double h_max,
+                                          const std::function<double(const ContinuationPoint&)>& monitor,
+                                          bool minimise, PointType type);
+  std::optional<ContinuationPoint> step_from(const ContinuationPoint& from, double h, PointType type);
+  Eigen::VectorXd join(const Eigen::VectorXd& x, double lambda) const;
+
+  ShootingProblem problem_;
+  ContinuationOptions options_;
+  int n_ = 0;  // number of shooting unknowns
+  // Monitors at each accepted point (for sign changes and minima).
+  struct Monitors {
+    double determinant = 0.0, tangent_lambda = 0.0, smallest_singular = 0.0;
+    int small_count = 0;
+  };
+  std::map<int, Monitors> monitors_;
+};
+
+}  // namespace kirchhoff
