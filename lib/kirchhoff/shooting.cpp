@@ -52,6 +52,7 @@ ShootingProblem::ShootingProblem(ProblemDefinition definition) : definition_(std
   const Eigen::VectorXd y = eq->state(RodPoint{});
   residual_count_ = static_cast<int>(eq->gauge_residual(y, nullptr).size());
   definition_.start.append_residuals(*eq, true, y, definition_.parameters, &rows, nullptr);
+  start_condition_count_ = static_cast<int>(rows.size());
   definition_.end.append_residuals(*eq, false, y, definition_.parameters, &rows, nullptr);
   residual_count_ += static_cast<int>(rows.size()) + (segments() - 1) * state_size_;
   if (residual_count_ != size())
@@ -92,24 +93,47 @@ bool ShootingProblem::depends_on_model(int unknown) const {
 bool ShootingProblem::evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
                                std::string* failure) const {
   const Parameters p = parameters_at(x);
-  if (!residual(x, p, F, J, failure)) return false;
+  Eigen::VectorXd y_end;
+  if (!residual(x, p, F, J, failure, &y_end)) return false;
   if (!J) return true;
   // Parameter columns by central differences (see the header for why this is accurate enough).
+  // A parameter that only enters the boundary conditions moves only their rows, which are
+  // closed-form in the end states: no re-integration is needed for it.
   const int offset = segments() * state_size_;
+  const Eigen::VectorXd y0 = x.head(state_size_);
   for (size_t j = 0; j < unknown_index_.size(); ++j) {
     const double h = kParameterStep * (1.0 + std::abs(x[offset + j]));
     Eigen::VectorXd xp = x, xm = x, Fp, Fm;
     xp[offset + j] += h;
     xm[offset + j] -= h;
-    if (!residual(xp, parameters_at(xp), &Fp, nullptr, failure)) return false;
-    if (!residual(xm, parameters_at(xm), &Fm, nullptr, failure)) return false;
-    J->col(offset + j) = (Fp - Fm) / (2.0 * h);
+    if (depends_on_model(static_cast<int>(j))) {
+      if (!residual(xp, parameters_at(xp), &Fp, nullptr, failure)) return false;
+      if (!residual(xm, parameters_at(xm), &Fm, nullptr, failure)) return false;
+      J->col(offset + j) = (Fp - Fm) / (2.0 * h);
+    } else {
+      const Eigen::VectorXd column =
+          (condition_rows(y0, y_end, parameters_at(xp)) - condition_rows(y0, y_end, parameters_at(xm))) / (2.0 * h);
+      J->col(offset + j).setZero();
+      const int gauge = residual_count_ - static_cast<int>(column.size()) - (segments() - 1) * state_size_;
+      const int start_rows = start_condition_count_;
+      J->col(offset + j).segment(gauge, start_rows) = column.head(start_rows);
+      J->col(offset + j).tail(column.size() - start_rows) = column.tail(column.size() - start_rows);
+    }
   }
   return true;
 }
 
+Eigen::VectorXd ShootingProblem::condition_rows(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end,
+                                                const Parameters& p) const {
+  const auto eq = equations(p);
+  std::vector<double> rows;
+  definition_.start.append_residuals(*eq, true, y0, p, &rows, nullptr);
+  definition_.end.append_residuals(*eq, false, y_end, p, &rows, nullptr);
+  return Eigen::Map<Eigen::VectorXd>(rows.data(), static_cast<Eigen::Index>(rows.size()));
+}
+
 bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
-                               Eigen::MatrixXd* J, std::string* failure) const {
+                               Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const {
   const auto eq = equations(p);
   const int n = state_size_, M = segments();
   const double L = eq->model().length;
@@ -153,6 +177,7 @@ bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Ei
     return false;
   }
 
+  if (y_end) *y_end = last.y;
   ConditionRows end;
   definition_.end.append_residuals(*eq, false, last.y, p, &end.values, J ? &end.jacobian : nullptr);
   for (size_t k = 0; k < end.values.size(); ++k, ++row) {

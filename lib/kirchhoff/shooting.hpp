@@ -81,12 +81,15 @@ class ShootingProblem final : public NonlinearSystem {
 
  private:
   bool residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F, Eigen::MatrixXd* J,
-                std::string* failure) const;
+                std::string* failure, Eigen::VectorXd* y_end = nullptr) const;
+  // The rows of F that come from the boundary conditions, at fixed end states.
+  Eigen::VectorXd condition_rows(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end, const Parameters& p) const;
   bool depends_on_model(int unknown) const;
 
   ProblemDefinition definition_;
   int state_size_ = 0;
   int residual_count_ = 0;
+  int start_condition_count_ = 0;
   std::vector<int> unknown_index_;  // index of each unknown parameter in Parameters
   mutable std::vector<double> cached_model_values_;
   mutable std::shared_ptr<const RodEquations> cached_equations_;
