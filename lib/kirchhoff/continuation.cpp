@@ -122,30 +122,21 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
   return false;
 }
 
-bool Continuation::tangent_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous, Eigen::VectorXd* t,
-                              double* determinant, double* smallest_singular, int* small_count) {
+std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous,
+                                                        PointType type, int index, double arclength, int iterations) {
   Eigen::VectorXd F;
   Eigen::MatrixXd A;
   std::string failure;
-  if (!evaluate(z, &F, &A, &failure)) return false;
+  if (!evaluate(z, &F, &A, &failure)) return std::nullopt;
   Eigen::MatrixXd M(n_ + 1, n_ + 1);
   M << A, previous.transpose();
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n_ + 1);
   rhs[n_] = 1.0;
-  *t = M.partialPivLu().solve(rhs);
-  if (!t->allFinite() || t->norm() == 0.0) return false;
-  t->normalize();
-  M.row(n_) = t->transpose();
-  *determinant = M.partialPivLu().determinant();
-  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(M).singularValues();
-  *smallest_singular = sv[n_] / sv[0];
-  *small_count = 0;
-  for (int i = 0; i <= n_; ++i) *small_count += sv[i] / sv[0] < options_.branch_point_tolerance ? 1 : 0;
-  return true;
-}
+  Eigen::VectorXd t = M.partialPivLu().solve(rhs);
+  if (!t.allFinite() || t.norm() == 0.0) return std::nullopt;
+  t.normalize();
+  M.row(n_) = t.transpose();
 
-ContinuationPoint Continuation::make_point(const Eigen::VectorXd& z, const Eigen::VectorXd& t, PointType type,
-                                           int index, double arclength, int iterations) {
   ContinuationPoint p;
   p.index = index;
   p.x = z.head(n_);
@@ -154,6 +145,10 @@ ContinuationPoint Continuation::make_point(const Eigen::VectorXd& z, const Eigen
   p.type = type;
   p.arclength = arclength;
   p.newton_iterations = iterations;
+  p.determinant = M.partialPivLu().determinant();
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(M).singularValues();
+  p.smallest_singular = sv[n_] / sv[0];
+  for (int i = 0; i <= n_; ++i) p.small_count += sv[i] / sv[0] < options_.branch_point_tolerance ? 1 : 0;
   if (options_.compute_invariants || !options_.derived.empty()) {
     problem_.set_parameter(options_.parameter, p.parameter);
     ShootingResult r;
@@ -171,17 +166,11 @@ ContinuationPoint Continuation::make_point(const Eigen::VectorXd& z, const Eigen
 std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint& from, double h, PointType type) {
   const Eigen::VectorXd z0 = join(from.x, from.parameter);
   const Eigen::VectorXd z_pred = z0 + h * from.tangent;
-  Eigen::VectorXd z = z_pred, t;
+  Eigen::VectorXd z = z_pred;
   int iterations = 0;
   if (!correct(z, z_pred, from.tangent, &iterations)) return std::nullopt;
-  Monitors m;
-  if (!tangent_at(z, from.tangent, &t, &m.determinant, &m.smallest_singular, &m.small_count)) return std::nullopt;
-  m.tangent_lambda = t[n_];
-  ContinuationPoint p = make_point(z, t, type, from.index + 1, from.arclength + (z - z0).norm(), iterations);
-  monitors_[-1] = m;  // scratch slot for the most recent trial
-  return p;
+  return point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations);
 }
-
 std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& from, double h_max,
                                                       const std::function<double(const ContinuationPoint&)>& monitor,
                                                       bool minimise, PointType type) {
@@ -230,50 +219,34 @@ std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& f
 ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink& sink) {
   ContinuationResult result;
   const double lambda0 = problem_.parameters().get(options_.parameter);
-  // Correct at fixed lambda (normal = e_lambda).
+  // Correct at fixed lambda (normal = e_lambda), then orient the tangent towards the target.
   Eigen::VectorXd z = join(x0, lambda0), e = Eigen::VectorXd::Zero(n_ + 1);
   e[n_] = 1.0;
   int iterations = 0;
-  if (!correct(z, z, e, &iterations)) {
+  const double direction = std::isnan(options_.target) ? sign_of(options_.direction) : sign_of(options_.target - lambda0);
+  std::optional<ContinuationPoint> start;
+  if (correct(z, z, e, &iterations)) start = point_at(z, direction * e, PointType::Start, 0, 0.0, iterations);
+  if (!start) {
     result.reason = StopReason::StartFailed;
     result.message = "the starting point does not converge at " + options_.parameter + " = " + std::to_string(lambda0);
     return result;
   }
-  const double direction = std::isnan(options_.target) ? sign_of(options_.direction) : sign_of(options_.target - lambda0);
-  Eigen::VectorXd t;
-  Monitors m;
-  if (!tangent_at(z, direction * e, &t, &m.determinant, &m.smallest_singular, &m.small_count)) {
-    result.reason = StopReason::StartFailed;
-    result.message = "no tangent at the starting point";
-    return result;
-  }
-  if (t[n_] * direction < 0) t = -t;
-  m.tangent_lambda = t[n_];
-  ContinuationPoint start = make_point(z, t, PointType::Start, 0, 0.0, iterations);
-  start.step = options_.initial_step;
-  monitors_.clear();
-  monitors_[0] = m;
-  return march(start, sink);
+  start->step = options_.initial_step;
+  return march(*start, sink);
 }
 
 ContinuationResult Continuation::resume(const ContinuationPoint& last, const PointSink& sink) {
-  Monitors m;
-  Eigen::VectorXd t;
-  ContinuationPoint start = last;
-  if (!tangent_at(join(last.x, last.parameter), last.tangent, &t, &m.determinant, &m.smallest_singular,
-                  &m.small_count)) {
+  auto start = point_at(join(last.x, last.parameter), last.tangent, last.type, last.index, last.arclength,
+                        last.newton_iterations);
+  if (!start) {
     ContinuationResult result;
     result.reason = StopReason::StartFailed;
     result.message = "cannot resume: no tangent at the last point";
     return result;
   }
-  m.tangent_lambda = t[n_];
-  start.tangent = t;
-  if (!(start.step > 0)) start.step = options_.initial_step;
-  monitors_.clear();
-  monitors_[start.index] = m;
-  ContinuationResult r = march(start, {});
-  // march reports the start point first; a resumed run already has it.
+  start->step = last.step > 0 ? last.step : options_.initial_step;
+  ContinuationResult r = march(*start, {});
+  // march reports its start point first; a resumed run already has it.
   if (!r.points.empty()) r.points.erase(r.points.begin());
   if (sink)
     for (const auto& p : r.points) sink(p);
@@ -298,29 +271,36 @@ ContinuationResult Continuation::run_along(const Eigen::VectorXd& x, double lamb
   ContinuationResult result;
   const Eigen::VectorXd z_bp = join(x, lambda);
   const Eigen::VectorXd d = direction.normalized();
-  ContinuationPoint origin = make_point(z_bp, d, start_type, 0, 0.0, 0);
+  auto origin = point_at(z_bp, d, start_type, 0, 0.0, 0);
   const Eigen::VectorXd z_pred = z_bp + options_.initial_step * d;
-  Eigen::VectorXd z = z_pred, t;
+  Eigen::VectorXd z = z_pred;
   int iterations = 0;
-  Monitors m;
-  if (!correct(z, z_pred, d, &iterations) || !tangent_at(z, d, &t, &m.determinant, &m.smallest_singular, &m.small_count)) {
+  std::optional<ContinuationPoint> first;
+  if (origin && correct(z, z_pred, d, &iterations))
+    first = point_at(z, d, PointType::Regular, 1, (z - z_bp).norm(), iterations);
+  if (!first) {
     result.reason = StopReason::StartFailed;
     result.message = "no solution along the switching direction";
     return result;
   }
-  m.tangent_lambda = t[n_];
-  if (sink) sink(origin);
-  ContinuationPoint first = make_point(z, t, PointType::Regular, 1, (z - z_bp).norm(), iterations);
-  first.step = options_.initial_step;
-  monitors_.clear();
-  monitors_[1] = m;
-  result = march(first, sink);
-  result.points.insert(result.points.begin(), origin);
+  // The branch point's own tangent is the direction we leave along.
+  origin->tangent = d;
+  if (sink) sink(*origin);
+  first->step = options_.initial_step;
+  result = march(*first, sink);
+  result.points.insert(result.points.begin(), *origin);
   return result;
 }
 
 ContinuationResult Continuation::switch_branch(const ContinuationPoint& bp, const PointSink& sink, double sign) {
-  const Eigen::VectorXd d = bifurcation_directions(bp, 1).col(0) * sign_of(sign);
+  Eigen::VectorXd d = bifurcation_directions(bp, 1).col(0);
+  // Orientation: the first significant component positive for sign = +1 (e.g. theta(0) > 0 on
+  // the buckled Euler column), the mirror branch for sign = -1.
+  for (int i = 0; i < d.size(); ++i)
+    if (std::abs(d[i]) > 1e-8) {
+      d *= sign_of(d[i]) * sign_of(sign);
+      break;
+    }
   return run_along(bp.x, bp.parameter, d, PointType::BranchPoint, sink);
 }
 
@@ -351,13 +331,11 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
       }
       continue;
     }
-    const Monitors m_new = monitors_[-1];
     const double angle = std::acos(std::clamp(current.tangent.dot(candidate->tangent), -1.0, 1.0));
     if (angle > options_.max_tangent_angle && ds > options_.min_step) {
       ds = std::max(ds * kShrink, options_.min_step);
       continue;
     }
-    const Monitors m_old = monitors_[current.index];
 
     // Special points inside this step, each with its position h along it.
     std::vector<std::pair<double, ContinuationPoint>> special;
@@ -384,16 +362,16 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
         }
       }
     }
-    if (options_.detect_folds && crossed(m_old.tangent_lambda, m_new.tangent_lambda)) {
+    if (options_.detect_folds && crossed(current.tangent[n_], candidate->tangent[n_])) {
       auto p = locate(current, ds, [&](const ContinuationPoint& q) { return q.tangent[n_]; }, false, PointType::Fold);
       if (p) special.push_back({p->arclength - current.arclength, *p});
     }
     bool simple_bp = false;
-    if (options_.detect_branch_points && crossed(m_old.determinant, m_new.determinant)) {
-      auto p = locate(current, ds, [&](const ContinuationPoint&) { return monitors_[-1].determinant; }, false,
+    if (options_.detect_branch_points && crossed(current.determinant, candidate->determinant)) {
+      auto p = locate(current, ds, [](const ContinuationPoint& q) { return q.determinant; }, false,
                       PointType::BranchPoint);
       if (p) {
-        p->multiplicity = std::max(1, monitors_[-1].small_count);
+        p->multiplicity = std::max(1, p->small_count);
         special.push_back({p->arclength - current.arclength, *p});
         simple_bp = true;
       }
@@ -401,13 +379,12 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
     // Branch points that keep the determinant's sign (even multiplicity): a local minimum of
     // the smallest singular value over the last two steps that is, once located, tiny.
     if (options_.detect_branch_points && !simple_bp && before_current &&
-        m_old.smallest_singular < monitors_[before_current->index].smallest_singular &&
-        m_old.smallest_singular < m_new.smallest_singular) {
-      auto p = locate(*before_current, previous_h + ds,
-                      [&](const ContinuationPoint&) { return monitors_[-1].smallest_singular; }, true,
-                      PointType::BranchPoint);
-      if (p && monitors_[-1].smallest_singular < options_.branch_point_tolerance) {
-        p->multiplicity = std::max(1, monitors_[-1].small_count - 1);
+        current.smallest_singular < before_current->smallest_singular &&
+        current.smallest_singular < candidate->smallest_singular) {
+      auto p = locate(*before_current, previous_h + ds, [](const ContinuationPoint& q) { return q.smallest_singular; },
+                      true, PointType::BranchPoint);
+      if (p && p->smallest_singular < options_.branch_point_tolerance) {
+        p->multiplicity = std::max(1, p->small_count);
         // Found behind `current` or ahead of it: record it in order with a consistent index.
         special.push_back({p->arclength - current.arclength, *p});
       }
@@ -447,7 +424,6 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
     const int iterations = candidate->newton_iterations;
     before_current = current;
     previous_h = ds;
-    monitors_[result.points.back().index + 1] = m_new;
     accept(*candidate);
     current = result.points.back();
     if (iterations <= kFast) ds = std::min(ds * kGrow, options_.max_step);

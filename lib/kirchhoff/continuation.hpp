@@ -79,6 +79,11 @@ struct ContinuationPoint {
   InvariantReport invariants;
   bool H_flat = true;       // false flags a point whose H spread exceeds 1e-9 of its scale
   double step = 0.0;        // step size after this point
+  // Test functions: det [F_x F_lambda; t^T], and the smallest singular value of that matrix
+  // over its largest, with the count of singular values below branch_point_tolerance.
+  double determinant = 0.0;
+  double smallest_singular = 0.0;
+  int small_count = 0;
 };
 
 enum class StopReason { ReachedTarget, MaxPoints, ParameterBounds, StepTooSmall, EventStop, StartFailed };
@@ -103,7 +108,8 @@ class Continuation {
   // Resumes from a point of an earlier run (its x, parameter, tangent, step, index, arclength).
   ContinuationResult resume(const ContinuationPoint& last, const PointSink& sink = {});
   // Starts on the branch crossing the one of `branch_point` (a located simple branch point):
-  // direction from the null space of [F_x F_lambda] orthogonal to the old tangent.
+  // direction from the null space of [F_x F_lambda] orthogonal to the old tangent, oriented so
+  // that its first significant component is positive (sign = +1) or negative (sign = -1).
   ContinuationResult switch_branch(const ContinuationPoint& branch_point, const PointSink& sink = {},
                                    double sign = 1.0);
   // Starts at z = (x, lambda) (a branch point of another formulation, say) along the unit
@@ -119,14 +125,13 @@ class Continuation {
   double parameter_value(const ContinuationPoint& p) const { return p.parameter; }
 
  private:
-  struct Evaluation;
   bool evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure);
   bool correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
                int* iterations);
-  bool tangent_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous, Eigen::VectorXd* t,
-                  double* determinant, double* smallest_singular, int* small_count);
-  ContinuationPoint make_point(const Eigen::VectorXd& z, const Eigen::VectorXd& t, PointType type, int index,
-                               double arclength, int iterations);
+  // Tangent at z oriented by `previous`, with the test functions, as a point (derived
+  // quantities and invariants included).
+  std::optional<ContinuationPoint> point_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous, PointType type,
+                                            int index, double arclength, int iterations);
   ContinuationResult march(ContinuationPoint start, const PointSink& sink);
   // Locates where `monitor` (of the point reached from `from` by a step h) vanishes or is
   // minimal, by the secant method or Brent on h in (0, h_max].
@@ -139,12 +144,6 @@ class Continuation {
   ShootingProblem problem_;
   ContinuationOptions options_;
   int n_ = 0;  // number of shooting unknowns
-  // Monitors at each accepted point (for sign changes and minima).
-  struct Monitors {
-    double determinant = 0.0, tangent_lambda = 0.0, smallest_singular = 0.0;
-    int small_count = 0;
-  };
-  std::map<int, Monitors> monitors_;
 };
 
 }  // namespace kirchhoff
