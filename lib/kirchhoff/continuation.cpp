@@ -13,11 +13,14 @@ namespace {
 constexpr double kLambdaStep = 1e-6;
 // Step growth and shrink factors: the usual choices for predictor-corrector continuation.
 constexpr double kGrow = 1.5, kShrink = 0.5;
-// A corrector that needs at most this many iterations lets the step grow; at least kSlow, shrink.
-constexpr int kFast = 3, kSlow = 6;
+// A corrector that needs at most this many iterations lets the step grow; at least kSlow, shrink
+// (chord iterations contract linearly, so a good step takes three or four of them).
+constexpr int kFast = 4, kSlow = 7;
 // Secant/Brent location stops when the step interval is this small relative to the step.
 constexpr double kLocateTolerance = 1e-12;
 constexpr int kLocateIterations = 60;
+// Chord iterations continue while each one reduces the residual at least by this factor.
+constexpr double kChordContraction = 0.3;
 // H is flagged as not flat above this fraction of its scale (the standard).
 constexpr double kFlatH = 1e-9;
 
@@ -44,6 +47,7 @@ const char* to_string(StopReason reason) {
     case StopReason::ParameterBounds: return "parameter_bounds";
     case StopReason::StepTooSmall: return "step_too_small";
     case StopReason::EventStop: return "event";
+    case StopReason::BranchPointStop: return "branch_point";
     case StopReason::StartFailed: return "start_failed";
   }
   return "?";
@@ -83,29 +87,47 @@ bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen:
   const double lambda = z[n_];
   const Eigen::VectorXd x = z.head(n_);
   problem_.set_parameter(options_.parameter, lambda);
+  if (!A) return problem_.evaluate(x, F, nullptr, failure);
   Eigen::MatrixXd J;
-  if (!problem_.evaluate(x, F, A ? &J : nullptr, failure)) return false;
-  if (!A) return true;
-  const double h = kLambdaStep * (1.0 + std::abs(lambda));
-  Eigen::VectorXd Fp, Fm;
-  problem_.set_parameter(options_.parameter, lambda + h);
-  const bool ok_p = problem_.evaluate(x, &Fp, nullptr, failure);
-  problem_.set_parameter(options_.parameter, lambda - h);
-  const bool ok_m = ok_p && problem_.evaluate(x, &Fm, nullptr, failure);
-  problem_.set_parameter(options_.parameter, lambda);
-  if (!ok_m) return false;
+  Eigen::VectorXd y_end, F_lambda;
+  if (!problem_.evaluate_with_end(x, F, &J, &y_end, failure)) return false;
+  if (!problem_.parameter_derivative(x, options_.parameter, &F_lambda, failure, &y_end)) return false;
   A->resize(n_, n_ + 1);
   A->leftCols(n_) = J;
-  A->col(n_) = (Fp - Fm) / (2.0 * h);
+  A->col(n_) = F_lambda;
   return true;
 }
 
 bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
-                           int* iterations) {
+                           int* iterations, const Eigen::MatrixXd* chord) {
   Eigen::VectorXd F, G(n_ + 1);
   Eigen::MatrixXd A, M(n_ + 1, n_ + 1);
   std::string failure;
-  for (int it = 0; it <= options_.corrector_max_iterations; ++it) {
+  int it = 0;
+  if (chord && chord->rows() == n_) {
+    M << *chord, normal.transpose();
+    Eigen::PartialPivLU<Eigen::MatrixXd> lu(M);
+    if (reciprocal_condition(lu) > 1e-15) {
+      const Eigen::VectorXd z_start = z;
+      double previous = INFINITY;
+      for (; it <= options_.corrector_max_iterations; ++it) {
+        if (!evaluate(z, &F, nullptr, &failure)) break;
+        G << F, normal.dot(z - z_predicted);
+        const double norm = G.lpNorm<Eigen::Infinity>();
+        if (!std::isfinite(norm)) break;
+        if (norm <= options_.corrector_tolerance) {
+          *iterations = it;
+          return true;
+        }
+        // Chord iterations contract linearly; slower than this, full Newton is cheaper.
+        if (norm > kChordContraction * previous) break;
+        previous = norm;
+        z -= lu.solve(G);
+      }
+      if (!z.allFinite()) z = z_start;
+    }
+  }
+  for (; it <= 2 * options_.corrector_max_iterations; ++it) {
     if (!evaluate(z, &F, &A, &failure)) return false;
     G << F, normal.dot(z - z_predicted);
     if (!G.allFinite()) return false;
@@ -113,7 +135,6 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
       *iterations = it;
       return true;
     }
-    if (it == options_.corrector_max_iterations) break;
     M << A, normal.transpose();
     Eigen::PartialPivLU<Eigen::MatrixXd> lu(M);
     if (!(reciprocal_condition(lu) > 1e-15)) return false;
@@ -145,10 +166,17 @@ std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z
   p.type = type;
   p.arclength = arclength;
   p.newton_iterations = iterations;
+  p.jacobian = A;
   p.determinant = M.partialPivLu().determinant();
   const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(M).singularValues();
   p.smallest_singular = sv[n_] / sv[0];
   for (int i = 0; i <= n_; ++i) p.small_count += sv[i] / sv[0] < options_.branch_point_tolerance ? 1 : 0;
+  describe(&p);
+  return p;
+}
+
+void Continuation::describe(ContinuationPoint* point) {
+  ContinuationPoint& p = *point;
   if (options_.compute_invariants || !options_.derived.empty()) {
     problem_.set_parameter(options_.parameter, p.parameter);
     ShootingResult r;
@@ -160,7 +188,6 @@ std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z
     p.invariants = s.invariants;
     p.H_flat = !s.invariants.H.applies || s.invariants.H.spread <= kFlatH * std::max(1.0, s.invariants.H.scale);
   }
-  return p;
 }
 
 std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint& from, double h, PointType type) {
@@ -168,7 +195,7 @@ std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint
   const Eigen::VectorXd z_pred = z0 + h * from.tangent;
   Eigen::VectorXd z = z_pred;
   int iterations = 0;
-  if (!correct(z, z_pred, from.tangent, &iterations)) return std::nullopt;
+  if (!correct(z, z_pred, from.tangent, &iterations, &from.jacobian)) return std::nullopt;
   return point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations);
 }
 std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& from, double h_max,
@@ -271,24 +298,29 @@ ContinuationResult Continuation::run_along(const Eigen::VectorXd& x, double lamb
   ContinuationResult result;
   const Eigen::VectorXd z_bp = join(x, lambda);
   const Eigen::VectorXd d = direction.normalized();
-  auto origin = point_at(z_bp, d, start_type, 0, 0.0, 0);
+  // The branch point itself: its Jacobian is singular, so it gets no tangent of its own; the
+  // direction we leave along stands in for it.
+  ContinuationPoint origin;
+  origin.x = x;
+  origin.parameter = lambda;
+  origin.tangent = d;
+  origin.type = start_type;
+  describe(&origin);
   const Eigen::VectorXd z_pred = z_bp + options_.initial_step * d;
   Eigen::VectorXd z = z_pred;
   int iterations = 0;
   std::optional<ContinuationPoint> first;
-  if (origin && correct(z, z_pred, d, &iterations))
+  if (correct(z, z_pred, d, &iterations))
     first = point_at(z, d, PointType::Regular, 1, (z - z_bp).norm(), iterations);
   if (!first) {
     result.reason = StopReason::StartFailed;
     result.message = "no solution along the switching direction";
     return result;
   }
-  // The branch point's own tangent is the direction we leave along.
-  origin->tangent = d;
-  if (sink) sink(*origin);
+  if (sink) sink(origin);
   first->step = options_.initial_step;
   result = march(*first, sink);
-  result.points.insert(result.points.begin(), *origin);
+  result.points.insert(result.points.begin(), origin);
   return result;
 }
 
@@ -312,6 +344,7 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
   std::optional<ContinuationPoint> before_current;  // the point before `current`, for minima
   double previous_h = 0.0;
   const bool has_target = !std::isnan(options_.target);
+  int branch_points_found = 0;
 
   auto accept = [&](ContinuationPoint p) {
     p.index = result.points.back().index + 1;
@@ -408,6 +441,13 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
     std::sort(special.begin(), special.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     for (auto& [h, p] : special) {
       accept(p);
+      if (p.type == PointType::BranchPoint) ++branch_points_found;
+      if (p.type == PointType::BranchPoint && options_.stop_at_branch_point > 0 &&
+          branch_points_found >= options_.stop_at_branch_point) {
+        result.reason = StopReason::BranchPointStop;
+        result.message = "branch point " + std::to_string(branch_points_found);
+        return result;
+      }
       if (stop && (p.type == PointType::Endpoint || p.type == PointType::Event)) {
         if (p.type == PointType::Event && stop_reason == StopReason::EventStop) {
           result.reason = stop_reason;
@@ -433,6 +473,36 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
   }
   result.reason = StopReason::MaxPoints;
   return result;
+}
+
+SymmetricBranchStart axial_symmetry_branch(Continuation& straight, const ContinuationPoint& bp, double sign) {
+  const ShootingProblem& problem = straight.problem();
+  const Eigen::MatrixXd N = straight.bifurcation_directions(bp, 2);
+  // The phase condition m(0).e2 = 0, linearised: a row on the unknowns at s = 0.
+  const auto eq = problem.equations(problem.parameters());
+  const Eigen::RowVectorXd phase = eq->slot_map(Slot::Moment).row(1);
+  const int n_state = problem.state_size();
+  auto phase_of = [&](const Eigen::VectorXd& v) { return phase.dot(v.head(n_state)); };
+  Eigen::VectorXd d = N.col(0) * phase_of(N.col(1)) - N.col(1) * phase_of(N.col(0));
+  if (d.norm() < 1e-12) d = std::abs(phase_of(N.col(0))) < std::abs(phase_of(N.col(1))) ? N.col(0) : N.col(1);
+  d.normalize();
+  for (int i = 0; i < d.size(); ++i)
+    if (std::abs(d[i]) > 1e-8) {
+      d *= sign_of(d[i]) * sign_of(sign);
+      break;
+    }
+  SymmetricBranchStart start;
+  start.definition = problem.definition();
+  add_axial_phase_condition(start.definition);
+  const int n = problem.size();
+  // The unfolding parameter is the last unknown of the new problem; it starts at 0.
+  start.x = Eigen::VectorXd::Zero(n + 1);
+  start.x.head(n) = bp.x;
+  start.parameter = bp.parameter;
+  start.direction = Eigen::VectorXd::Zero(n + 2);
+  start.direction.head(n) = d.head(n);
+  start.direction[n + 1] = d[n];
+  return start;
 }
 
 }  // namespace kirchhoff

@@ -55,6 +55,7 @@ struct ContinuationOptions {
   // points reach ~1e-12.
   double branch_point_tolerance = 1e-7;
   std::vector<ContinuationEvent> events;
+  int stop_at_branch_point = 0;       // > 0: stop once this many branch points have been found
   std::vector<std::string> derived;   // computed at every point (and available to events)
   int samples = 101;                  // profile points for invariants and derived quantities
   bool compute_invariants = true;     // false skips sampling (derived from events need it)
@@ -84,9 +85,11 @@ struct ContinuationPoint {
   double determinant = 0.0;
   double smallest_singular = 0.0;
   int small_count = 0;
+  // [F_x F_lambda] at this point: the next corrector starts with chord iterations on it.
+  Eigen::MatrixXd jacobian;
 };
 
-enum class StopReason { ReachedTarget, MaxPoints, ParameterBounds, StepTooSmall, EventStop, StartFailed };
+enum class StopReason { ReachedTarget, MaxPoints, ParameterBounds, StepTooSmall, EventStop, BranchPointStop, StartFailed };
 const char* to_string(StopReason reason);
 
 struct ContinuationResult {
@@ -126,8 +129,11 @@ class Continuation {
 
  private:
   bool evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure);
+  // Newton on [F; normal.(z - z_predicted)] = 0. With `chord` (the Jacobian at a nearby point)
+  // it first iterates with that fixed matrix, one integration without sensitivities per
+  // iteration, and turns to full Newton only if those iterations stop contracting.
   bool correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
-               int* iterations);
+               int* iterations, const Eigen::MatrixXd* chord = nullptr);
   // Tangent at z oriented by `previous`, with the test functions, as a point (derived
   // quantities and invariants included).
   std::optional<ContinuationPoint> point_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous, PointType type,
@@ -138,6 +144,8 @@ class Continuation {
   std::optional<ContinuationPoint> locate(const ContinuationPoint& from, double h_max,
                                           const std::function<double(const ContinuationPoint&)>& monitor,
                                           bool minimise, PointType type);
+  // Derived quantities and invariants of a point (its x and parameter set).
+  void describe(ContinuationPoint* point);
   std::optional<ContinuationPoint> step_from(const ContinuationPoint& from, double h, PointType type);
   Eigen::VectorXd join(const Eigen::VectorXd& x, double lambda) const;
 
@@ -145,5 +153,19 @@ class Continuation {
   ContinuationOptions options_;
   int n_ = 0;  // number of shooting unknowns
 };
+
+// Branch switching at the double branch point of an isotropic twisted rod (the straight rod's
+// first bifurcation, where the buckling modes form a circle). The bifurcating branch is followed
+// in the same problem with add_axial_phase_condition; this gives that problem, the branch point
+// in its unknowns (unfolding = 0) and the buckling direction satisfying the phase condition,
+// ready for Continuation::run_along.
+struct SymmetricBranchStart {
+  ProblemDefinition definition;  // with the phase condition
+  Eigen::VectorXd x;             // unknowns at the branch point
+  double parameter = 0.0;
+  Eigen::VectorXd direction;     // (dx, dlambda), unit
+};
+SymmetricBranchStart axial_symmetry_branch(Continuation& straight, const ContinuationPoint& branch_point,
+                                           double sign = 1.0);
 
 }  // namespace kirchhoff

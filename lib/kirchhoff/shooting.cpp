@@ -92,8 +92,46 @@ bool ShootingProblem::depends_on_model(int unknown) const {
 
 bool ShootingProblem::evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
                                std::string* failure) const {
-  const Parameters p = parameters_at(x);
   Eigen::VectorXd y_end;
+  return evaluate_with_end(x, F, J, &y_end, failure);
+}
+
+bool ShootingProblem::parameter_derivative(const Eigen::VectorXd& x, const std::string& name, Eigen::VectorXd* dF,
+                                           std::string* failure, const Eigen::VectorXd* y_end) const {
+  const double value = definition_.parameters.get(name);
+  const double h = kParameterStep * (1.0 + std::abs(value));
+  Parameters plus = parameters_at(x), minus = plus;
+  plus.set(name, value + h);
+  minus.set(name, value - h);
+  if (definition_.model_parameters.count(name)) {
+    Eigen::VectorXd Fp, Fm;
+    if (!residual(x, plus, &Fp, nullptr, failure) || !residual(x, minus, &Fm, nullptr, failure)) return false;
+    *dF = (Fp - Fm) / (2.0 * h);
+    return true;
+  }
+  Eigen::VectorXd end_state;
+  if (!y_end) {
+    Eigen::VectorXd F;
+    if (!residual(x, parameters_at(x), &F, nullptr, failure, &end_state)) return false;
+    y_end = &end_state;
+  }
+  const Eigen::VectorXd y0 = x.head(state_size_);
+  const Eigen::VectorXd column = (condition_rows(y0, *y_end, plus) - condition_rows(y0, *y_end, minus)) / (2.0 * h);
+  dF->setZero(residual_count_);
+  place_condition_rows(column, dF);
+  return true;
+}
+
+void ShootingProblem::place_condition_rows(const Eigen::VectorXd& rows, Eigen::VectorXd* column) const {
+  const int gauge = residual_count_ - static_cast<int>(rows.size()) - (segments() - 1) * state_size_;
+  column->segment(gauge, start_condition_count_) = rows.head(start_condition_count_);
+  column->tail(rows.size() - start_condition_count_) = rows.tail(rows.size() - start_condition_count_);
+}
+
+bool ShootingProblem::evaluate_with_end(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
+                                        Eigen::VectorXd* y_end_out, std::string* failure) const {
+  const Parameters p = parameters_at(x);
+  Eigen::VectorXd& y_end = *y_end_out;
   if (!residual(x, p, F, J, failure, &y_end)) return false;
   if (!J) return true;
   // Parameter columns by central differences (see the header for why this is accurate enough).
@@ -111,13 +149,11 @@ bool ShootingProblem::evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eig
       if (!residual(xm, parameters_at(xm), &Fm, nullptr, failure)) return false;
       J->col(offset + j) = (Fp - Fm) / (2.0 * h);
     } else {
-      const Eigen::VectorXd column =
+      const Eigen::VectorXd rows =
           (condition_rows(y0, y_end, parameters_at(xp)) - condition_rows(y0, y_end, parameters_at(xm))) / (2.0 * h);
-      J->col(offset + j).setZero();
-      const int gauge = residual_count_ - static_cast<int>(column.size()) - (segments() - 1) * state_size_;
-      const int start_rows = start_condition_count_;
-      J->col(offset + j).segment(gauge, start_rows) = column.head(start_rows);
-      J->col(offset + j).tail(column.size() - start_rows) = column.tail(column.size() - start_rows);
+      Eigen::VectorXd column = Eigen::VectorXd::Zero(residual_count_);
+      place_condition_rows(rows, &column);
+      J->col(offset + j) = column;
     }
   }
   return true;

@@ -79,11 +79,22 @@ class ShootingProblem final : public NonlinearSystem {
 
   long rhs_evaluations() const { return rhs_evaluations_; }
 
+  // dF/d(parameter) at x, for a known (not solved-for) parameter: from the closed-form boundary
+  // conditions when the parameter does not enter the rod model, else by central differences of
+  // the flow. y_end, when given, is the state at s = L for x (saves an integration).
+  bool parameter_derivative(const Eigen::VectorXd& x, const std::string& name, Eigen::VectorXd* dF,
+                            std::string* failure, const Eigen::VectorXd* y_end = nullptr) const;
+  // Residual, Jacobian and the state at s = L in one integration.
+  bool evaluate_with_end(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, Eigen::VectorXd* y_end,
+                         std::string* failure) const;
+
  private:
   bool residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F, Eigen::MatrixXd* J,
                 std::string* failure, Eigen::VectorXd* y_end = nullptr) const;
   // The rows of F that come from the boundary conditions, at fixed end states.
   Eigen::VectorXd condition_rows(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end, const Parameters& p) const;
+  // Scatters condition rows (start then end) into a full-length residual column.
+  void place_condition_rows(const Eigen::VectorXd& rows, Eigen::VectorXd* column) const;
   bool depends_on_model(int unknown) const;
 
   ProblemDefinition definition_;
