@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "continue_command.hpp"
 #include "reproduce_command.hpp"
 #include "solve_command.hpp"
 
@@ -17,6 +18,9 @@ int main(int argc, char** argv) {
       "  kirchhoff solve cases/simply_supported.toml --set theta0=2.0\n"
       "  kirchhoff solve cases/twisted_clamped.toml --json --profile rod.csv\n"
       "  kirchhoff check cases/tapered.toml\n"
+      "  kirchhoff continue cases/euler_column.toml --param P --to 100 --set theta_guess=0 --out column.csv\n"
+      "  kirchhoff continue cases/euler_column.toml --param P --to 12 --set theta_guess=0 --switch-at-bp 1 \\\n"
+      "      --event theta0=3 --out buckled.csv\n"
       "  kirchhoff reproduce --out out\n\n"
       "Exit status: 0 solved, 1 solver failure (status and best residual reported), 2 input refused."};
   app.require_subcommand(1);
@@ -42,6 +46,36 @@ int main(int argc, char** argv) {
   check_cmd->add_option("case", check_path, "Case file (TOML)")->required()->check(CLI::ExistingFile);
   check_cmd->add_option("--set", check_overrides, "Override a parameter: NAME=VALUE (repeatable)");
 
+  ContinueArguments cont;
+  auto* continue_cmd = app.add_subcommand(
+      "continue",
+      "Follow a branch of equilibria in one parameter (pseudo-arclength), locating folds and branch points;\n"
+      "one CSV row per point, flushed as it goes; --resume picks up a killed run");
+  continue_cmd->add_option("case", cont.case_path, "Case file (TOML)")->required()->check(CLI::ExistingFile);
+  continue_cmd->add_option("--param", cont.parameter, "Parameter to continue in (from [parameters])")->required();
+  continue_cmd->add_option("--to", cont.to, "Stop when the parameter reaches this value")
+      ->each([&](const std::string&) { cont.has_to = true; });
+  continue_cmd->add_option("--step", cont.step, "Initial pseudo-arclength step")->capture_default_str();
+  continue_cmd->add_option("--min-step", cont.min_step, "Smallest step before giving up")->capture_default_str();
+  continue_cmd->add_option("--max-step", cont.max_step, "Largest step")->capture_default_str();
+  continue_cmd->add_option("--max-points", cont.max_points, "Largest number of points")->capture_default_str();
+  continue_cmd->add_option("--switch-at-bp", cont.switch_at_bp,
+                           "Switch onto the branch bifurcating at the K-th branch point found (double branch points\n"
+                           "of isotropic twisted rods switch with the axial phase condition)");
+  continue_cmd->add_option("--side", cont.switch_side, "Which side of the bifurcating branch: 1 or -1")
+      ->capture_default_str();
+  continue_cmd->add_option("--event", cont.stop_events, "Stop when a derived quantity crosses a value: NAME=VALUE");
+  continue_cmd->add_option("--record", cont.record_events, "Record (without stopping) a crossing: NAME=VALUE");
+  continue_cmd->add_option("--out", cont.out_path, "Branch CSV (a .state.json file is kept beside it)")
+      ->capture_default_str();
+  continue_cmd->add_option("--profiles", cont.profiles_dir, "Write each point's profile CSV into this folder");
+  continue_cmd->add_option("--samples", cont.samples, "Profile samples per point (invariants, derived quantities)")
+      ->capture_default_str();
+  continue_cmd->add_flag("--resume", cont.resume, "Resume the run whose CSV is --out from its last written point");
+  continue_cmd->add_option("--set", cont.overrides, "Override a parameter: NAME=VALUE (repeatable)");
+  continue_cmd->add_option("--phase-condition", cont.phase_condition, "As for solve")
+      ->check(CLI::IsMember({"none", "axial"}));
+
   std::string out_dir = "out";
   std::string cases_dir = KIRCHHOFF_DEFAULT_CASES_DIR;
   auto* reproduce_cmd = app.add_subcommand(
@@ -58,5 +92,6 @@ int main(int argc, char** argv) {
   if (*solve_cmd) return run_solve(solve);
   if (*check_cmd) return run_check(check_path, check_overrides);
   if (*reproduce_cmd) return run_reproduce(out_dir, cases_dir);
+  if (*continue_cmd) return run_continue(cont);
   return kExitBadInput;
 }

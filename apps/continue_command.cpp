@@ -1,0 +1,318 @@
+#include "continue_command.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "kirchhoff/case_file.hpp"
+#include "kirchhoff/continuation.hpp"
+#include "kirchhoff/solution.hpp"
+#include "solve_command.hpp"
+
+namespace kirchhoff::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The run's progress so far, kept beside the CSV (branch.csv.state.json) and replaced
+// atomically after every point, so that a killed run resumes from its last written point.
+struct RunState {
+  int row = -1;                   // index of the last CSV row (continuous across branches)
+  int branch = 0;                 // 0: the starting branch, 1: after --switch-at-bp
+  std::string phase_condition;    // of the problem the branch belongs to
+  ContinuationPoint last;
+  std::vector<std::string> derived;
+};
+
+nlohmann::json to_json(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+Eigen::VectorXd vector_from(const nlohmann::json& j) {
+  const auto v = j.get<std::vector<double>>();
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+
+PointType point_type_from(const std::string& name) {
+  for (PointType t : {PointType::Start, PointType::Regular, PointType::Fold, PointType::BranchPoint, PointType::Event,
+                      PointType::Endpoint})
+    if (name == to_string(t)) return t;
+  return PointType::Regular;
+}
+
+void save_state(const fs::path& path, const RunState& s) {
+  nlohmann::json j = {{"row", s.row},             {"branch", s.branch},       {"phase_condition", s.phase_condition},
+                      {"index", s.last.index},     {"parameter", s.last.parameter},
+                      {"arclength", s.last.arclength}, {"step", s.last.step},
+                      {"x", to_json(s.last.x)},    {"tangent", to_json(s.last.tangent)},
+                      {"type", to_string(s.last.type)}, {"multiplicity", s.last.multiplicity}};
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << std::setprecision(17) << j.dump() << "\n";
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, path);  // atomic on POSIX: the state is always a complete point
+}
+
+RunState load_state(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot resume: no state file " + path.string());
+  const nlohmann::json j = nlohmann::json::parse(in);
+  RunState s;
+  s.row = j.at("row");
+  s.branch = j.at("branch");
+  s.phase_condition = j.at("phase_condition");
+  s.last.index = j.at("index");
+  s.last.parameter = j.at("parameter");
+  s.last.arclength = j.at("arclength");
+  s.last.step = j.at("step");
+  s.last.x = vector_from(j.at("x"));
+  s.last.tangent = vector_from(j.at("tangent"));
+  s.last.type = point_type_from(j.at("type"));
+  s.last.multiplicity = j.at("multiplicity");
+  return s;
+}
+
+// Keeps the header and the rows up to and including `last_index` (a row written after the
+// state was last saved is dropped, so no point is duplicated on resume).
+void truncate_csv(const fs::path& path, int last_index) {
+  std::ifstream in(path);
+  std::string header, line, kept;
+  std::getline(in, header);
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    const int index = std::stoi(line.substr(0, line.find(',')));
+    if (index > last_index) break;
+    kept += line + "\n";
+  }
+  in.close();
+  std::ofstream out(path, std::ios::trunc);
+  out << header << "\n" << kept;
+}
+
+// Branch points already written on branch 0 (for resuming a run with --switch-at-bp).
+int count_branch_points(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  int count = 0;
+  while (std::getline(in, line))
+    if (line.find(",0,") == line.find(',') && line.find(",branch_point,") != std::string::npos) ++count;
+  return count;
+}
+
+class BranchWriter {
+ public:
+  BranchWriter(const fs::path& path, const std::string& parameter, std::vector<std::string> derived, bool append)
+      : derived_(std::move(derived)) {
+    out_.open(path, append ? std::ios::app : std::ios::trunc);
+    if (!out_) throw std::runtime_error("cannot write " + path.string());
+    out_ << std::setprecision(15);
+    if (!append) {
+      out_ << "index,branch," << parameter << ",arclength";
+      for (const auto& d : derived_) out_ << ',' << d;
+      out_ << ",H_spread,m3_spread,n_dot_m_spread,H_flat,type,multiplicity,event,newton_iterations\n";
+      out_.flush();
+    }
+  }
+  void write(int row, const ContinuationPoint& p, int branch) {
+    out_ << row << ',' << branch << ',' << p.parameter << ',' << p.arclength;
+    for (const auto& d : derived_) out_ << ',' << (p.derived.count(d) ? p.derived.at(d) : NAN);
+    const auto& inv = p.invariants;
+    out_ << ',' << inv.H.relative_spread() << ',' << inv.m3.relative_spread() << ',' << inv.n_dot_m.relative_spread()
+         << ',' << (p.H_flat ? 1 : 0) << ',' << to_string(p.type) << ',' << p.multiplicity << ',' << p.event << ','
+         << p.newton_iterations << '\n';
+    out_.flush();
+  }
+
+ private:
+  std::ofstream out_;
+  std::vector<std::string> derived_;
+};
+
+// One line updated in place on a terminal, plain lines (every 10th point and every special
+// point) otherwise.
+class Progress {
+ public:
+  explicit Progress(std::string parameter) : parameter_(std::move(parameter)), tty_(isatty(STDERR_FILENO)) {}
+  void point(int row, const ContinuationPoint& p, int branch) {
+    std::ostringstream line;
+    line << "branch " << branch << "  point " << row << "  " << parameter_ << " = " << std::setprecision(10)
+         << p.parameter << "  step " << std::setprecision(3) << p.step;
+    if (p.type != PointType::Regular && p.type != PointType::Start) line << "  [" << to_string(p.type) << "]";
+    if (!p.H_flat) line << "  [H not flat]";
+    if (tty_) {
+      std::cerr << "\r" << line.str() << "\033[K" << std::flush;
+    } else if (row % 10 == 0 || p.type != PointType::Regular || !p.H_flat) {
+      std::cerr << line.str() << "\n";
+    }
+  }
+  void done() {
+    if (tty_) std::cerr << "\n";
+  }
+
+ private:
+  std::string parameter_;
+  bool tty_;
+};
+
+std::vector<ContinuationEvent> parse_events(const std::vector<std::string>& texts, bool stop) {
+  std::vector<ContinuationEvent> out;
+  for (const auto& t : texts) {
+    const auto [name, value] = parse_override(t);
+    if (!derived_catalogue().count(name)) throw CaseError("--event/--record: '" + name + "' is not a derived quantity");
+    out.push_back({name, value, stop});
+  }
+  return out;
+}
+
+}  // namespace
+
+int run_continue(const ContinueArguments& args) {
+  Case c;
+  ContinuationOptions options;
+  try {
+    ParameterOverrides overrides;
+    for (const auto& t : args.overrides) overrides.push_back(parse_override(t));
+    c = load_case(args.case_path, overrides, args.phase_condition);
+    options.parameter = args.parameter;
+    if (!c.definition.parameters.contains(args.parameter))
+      throw CaseError(args.case_path + ": --param " + args.parameter + ": not a parameter of the case");
+    if (args.has_to) options.target = args.to;
+    options.initial_step = args.step;
+    options.min_step = args.min_step;
+    options.max_step = args.max_step;
+    options.max_points = args.max_points;
+    options.samples = args.samples;
+    options.derived = c.derived;
+    options.events = parse_events(args.stop_events, true);
+    for (auto& e : parse_events(args.record_events, false)) options.events.push_back(e);
+    if (std::string e = options.validate(); !e.empty()) throw CaseError(e);
+  } catch (const CaseError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  for (const auto& e : options.events)
+    if (std::find(options.derived.begin(), options.derived.end(), e.quantity) == options.derived.end())
+      options.derived.push_back(e.quantity);
+
+  const fs::path csv(args.out_path), state_path(args.out_path + ".state.json");
+  if (!args.profiles_dir.empty()) fs::create_directories(args.profiles_dir);
+  Progress progress(args.parameter);
+  RunState state;
+  state.phase_condition = args.phase_condition.empty() ? "none" : args.phase_condition;
+  std::unique_ptr<BranchWriter> writer;
+
+  try {
+    if (args.resume) {
+      state = load_state(state_path);
+      truncate_csv(csv, state.row);
+    }
+    writer = std::make_unique<BranchWriter>(csv, args.parameter, options.derived, args.resume);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+
+  // The problem of the current branch (the switched branch of a symmetric rod has the phase
+  // condition added).
+  auto problem_for = [&](const std::string& phase) {
+    ProblemDefinition d = c.definition;
+    if (phase == "axial" && !d.parameters.contains("unfolding")) add_axial_phase_condition(d);
+    return std::make_unique<ShootingProblem>(d);
+  };
+
+  auto sink_for = [&](const ShootingProblem& problem, int branch, const std::string& phase) {
+    return [&, branch, phase](const ContinuationPoint& p) {
+      ++state.row;
+      writer->write(state.row, p, branch);
+      state.branch = branch;
+      state.phase_condition = phase;
+      state.last = p;
+      state.last.jacobian.resize(0, 0);  // not needed to resume
+      save_state(state_path, state);
+      progress.point(state.row, p, branch);
+      if (!args.profiles_dir.empty()) {
+        ShootingProblem copy = problem;
+        copy.set_parameter(args.parameter, p.parameter);
+        ShootingResult r;
+        r.x = p.x;
+        r.parameters = copy.parameters_at(p.x);
+        const Solution s = make_solution(copy, r, args.samples, {});
+        std::ostringstream name;
+        name << "point_" << std::setw(5) << std::setfill('0') << state.row << ".csv";
+        write_profile_csv((fs::path(args.profiles_dir) / name.str()).string(),
+                          copy.equations(r.parameters)->model(), s.profile);
+      }
+    };
+  };
+
+  // Branch 0 runs until its target (or, with --switch-at-bp K, its K-th branch point); branch 1
+  // starts on the bifurcating branch there. A resumed run picks up whichever it was on.
+  ContinuationResult result;
+  int branch = state.branch;
+  auto switch_branches = [&](Continuation& run, const ContinuationPoint& bp) {
+    branch = 1;
+    ContinuationOptions second = options;
+    second.target = NAN;
+    second.direction = 1.0;
+    const char* lead = isatty(STDERR_FILENO) ? "\n" : "";
+    if (bp.multiplicity == 2 && c.definition.kind == RodKind::Spatial) {
+      std::cerr << lead << "double branch point at " << args.parameter << " = " << bp.parameter
+                << ": switching with the axial phase condition\n";
+      const SymmetricBranchStart start = axial_symmetry_branch(run, bp, args.switch_side);
+      ShootingProblem switched(start.definition);
+      Continuation next(switched, second);
+      return next.run_along(start.x, start.parameter, start.direction, PointType::BranchPoint,
+                            sink_for(switched, 1, "axial"));
+    }
+    std::cerr << lead << "switching branches at " << args.parameter << " = " << bp.parameter << "\n";
+    auto problem = problem_for(state.phase_condition);
+    problem->set_parameter(args.parameter, bp.parameter);
+    Continuation next(*problem, second);
+    return next.switch_branch(bp, sink_for(*problem, 1, state.phase_condition), args.switch_side);
+  };
+  try {
+    auto problem = problem_for(state.phase_condition);
+    ContinuationOptions first = options;
+    if (branch == 0 && args.switch_at_bp > 0)
+      first.stop_at_branch_point = args.switch_at_bp - (args.resume ? count_branch_points(csv) : 0);
+    if (args.resume) problem->set_parameter(args.parameter, state.last.parameter);
+    Continuation run(*problem, first);
+    if (args.resume && first.stop_at_branch_point == 0 && branch == 0 && args.switch_at_bp > 0 &&
+        state.last.type == PointType::BranchPoint) {
+      result = switch_branches(run, state.last);  // killed right after finding it
+    } else {
+      result = args.resume ? run.resume(state.last, sink_for(*problem, branch, state.phase_condition))
+                           : run.run(problem->initial_unknowns(c.start_guess), sink_for(*problem, 0, state.phase_condition));
+      if (branch == 0 && args.switch_at_bp > 0) {
+        if (result.reason != StopReason::BranchPointStop) {
+          progress.done();
+          std::cerr << "error: no branch point " << args.switch_at_bp << " before the run stopped ("
+                    << to_string(result.reason) << ")\n";
+          return kExitNotConverged;
+        }
+        result = switch_branches(run, result.points.back());
+      }
+    }
+  } catch (const std::exception& e) {
+    progress.done();
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitNotConverged;
+  }
+  progress.done();
+  std::cerr << "stopped: " << to_string(result.reason) << (result.message.empty() ? "" : " (" + result.message + ")")
+            << "; " << result.points.size() << " points on branch " << branch << " written to " << args.out_path << "\n";
+  const bool ok = result.reason != StopReason::StartFailed && result.reason != StopReason::StepTooSmall;
+  return ok ? kExitOk : kExitNotConverged;
+}
+
+}  // namespace kirchhoff::cli

@@ -1,0 +1,33 @@
+// `kirchhoff continue`: pseudo-arclength continuation of a case in one parameter, written to a
+// CSV point by point, resumable after being killed.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace kirchhoff::cli {
+
+struct ContinueArguments {
+  std::string case_path;
+  std::vector<std::string> overrides;
+  std::string phase_condition;
+  std::string parameter;
+  double to = 0.0;
+  bool has_to = false;
+  double step = 0.05;
+  double min_step = 1e-7;
+  double max_step = 0.5;
+  int max_points = 500;
+  int switch_at_bp = 0;       // > 0: switch onto the branch bifurcating at the K-th branch point
+  double switch_side = 1.0;   // +1 / -1: which side of the bifurcating branch
+  std::vector<std::string> stop_events;    // NAME=VALUE: stop when crossed
+  std::vector<std::string> record_events;  // NAME=VALUE: record when crossed
+  std::string out_path = "branch.csv";
+  std::string profiles_dir;
+  bool resume = false;
+  int samples = 101;
+};
+
+int run_continue(const ContinueArguments& args);
+
+}  // namespace kirchhoff::cli
