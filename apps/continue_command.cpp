@@ -106,6 +106,18 @@ int count_branch_points(const fs::path& path) {
   return count;
 }
 
+// Rows already written on a branch (max_points counts a branch's points across resumes).
+int count_rows_on_branch(const fs::path& path, int branch) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  const std::string tag = "," + std::to_string(branch) + ",";
+  int count = 0;
+  while (std::getline(in, line))
+    if (line.find(tag) == line.find(',')) ++count;
+  return count;
+}
+
 class BranchWriter {
  public:
   BranchWriter(const fs::path& path, const std::string& parameter, std::vector<std::string> derived, bool append)
@@ -124,7 +136,9 @@ class BranchWriter {
     out_ << row << ',' << branch << ',' << p.parameter << ',' << p.arclength;
     for (const auto& d : derived_) out_ << ',' << (p.derived.count(d) ? p.derived.at(d) : NAN);
     const auto& inv = p.invariants;
-    out_ << ',' << inv.H.relative_spread() << ',' << inv.m3.relative_spread() << ',' << inv.n_dot_m.relative_spread()
+    // + 0.0 prints a zero spread as 0, not -0.
+    out_ << ',' << inv.H.relative_spread() + 0.0 << ',' << inv.m3.relative_spread() + 0.0 << ','
+         << inv.n_dot_m.relative_spread() + 0.0
          << ',' << (p.H_flat ? 1 : 0) << ',' << to_string(p.type) << ',' << p.multiplicity << ',' << p.event << ','
          << p.newton_iterations << '\n';
     out_.flush();
@@ -285,7 +299,11 @@ int run_continue(const ContinueArguments& args) {
     ContinuationOptions first = options;
     if (branch == 0 && args.switch_at_bp > 0)
       first.stop_at_branch_point = args.switch_at_bp - (args.resume ? count_branch_points(csv) : 0);
-    if (args.resume) problem->set_parameter(args.parameter, state.last.parameter);
+    if (args.resume) {
+      problem->set_parameter(args.parameter, state.last.parameter);
+      // The resumed march counts its start point, which is already written.
+      first.max_points = std::max(1, options.max_points - count_rows_on_branch(csv, branch) + 1);
+    }
     Continuation run(*problem, first);
     if (args.resume && first.stop_at_branch_point == 0 && branch == 0 && args.switch_at_bp > 0 &&
         state.last.type == PointType::BranchPoint) {
@@ -310,7 +328,7 @@ int run_continue(const ContinueArguments& args) {
   }
   progress.done();
   std::cerr << "stopped: " << to_string(result.reason) << (result.message.empty() ? "" : " (" + result.message + ")")
-            << "; " << result.points.size() << " points on branch " << branch << " written to " << args.out_path << "\n";
+            << "; " << state.row + 1 << " points (last on branch " << branch << ") in " << args.out_path << "\n";
   const bool ok = result.reason != StopReason::StartFailed && result.reason != StopReason::StepTooSmall;
   return ok ? kExitOk : kExitNotConverged;
 }

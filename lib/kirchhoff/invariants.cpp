@@ -15,7 +15,7 @@ InvariantStats stats(const std::vector<double>& values, double scale, bool appli
   double sum = 0.0;
   for (double v : values) sum += v;
   out.mean = sum / values.size();
-  out.spread = out.max - out.min;
+  out.spread = out.max - out.min + 0.0;  // + 0.0: never -0
   out.scale = scale;
   out.applies = applies;
   return out;

@@ -1,0 +1,126 @@
+// `kirchhoff continue` end to end: the branch CSV, progress, and a run killed with SIGKILL and
+// resumed with --resume, which must reproduce the uninterrupted run without losing or
+// duplicating a point.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> lines_of(const fs::path& p) {
+  std::ifstream in(p);
+  std::vector<std::string> out;
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) out.push_back(line);
+  return out;
+}
+
+// The run: the Euler column from P = 1 along the straight branch, switching at the first
+// branch point onto the buckled branch up to theta0 = 3; many samples per point make it slow
+// enough (~1 s) to be killed half-way.
+std::vector<std::string> continue_args(const fs::path& csv) {
+  return {KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/euler_column.toml", "--param", "P",
+          "--to", "12", "--set", "P=1", "--set", "theta_guess=0", "--switch-at-bp", "1", "--event", "theta0=3",
+          "--max-step", "0.5", "--max-points", "2000", "--samples", "4001", "--out", csv.string()};
+}
+
+int run_to_end(std::vector<std::string> args, const fs::path& log) {
+  std::string cmd;
+  for (const auto& a : args) cmd += "'" + a + "' ";
+  return WEXITSTATUS(std::system((cmd + " 2> '" + log.string() + "'").c_str()));
+}
+
+pid_t start(const std::vector<std::string>& args, const fs::path& log) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::vector<char*> argv;
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    FILE* err = std::freopen(log.c_str(), "w", stderr);
+    (void)err;
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+class ContinueCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("kirchhoff_continue_" + std::to_string(getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_F(ContinueCli, KilledRunResumesWithoutLosingOrDuplicatingPoints) {
+  const fs::path full = dir_ / "full.csv", killed = dir_ / "killed.csv";
+  ASSERT_EQ(run_to_end(continue_args(full), dir_ / "full.log"), 0);
+  const auto expected = lines_of(full);
+  ASSERT_GT(expected.size(), 100u);
+
+  // Kill the second run with SIGKILL once it has written a third of the points.
+  const pid_t pid = start(continue_args(killed), dir_ / "killed.log");
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (lines_of(killed).size() < expected.size() / 3 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the run finished before it could be killed";
+  const size_t written = lines_of(killed).size();
+  ASSERT_LT(written, expected.size());
+
+  auto args = continue_args(killed);
+  args.push_back("--resume");
+  ASSERT_EQ(run_to_end(args, dir_ / "resume.log"), 0);
+  const auto resumed = lines_of(killed);
+  ASSERT_EQ(resumed.size(), expected.size()) << "killed after " << written << " lines";
+  for (size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(resumed[i], expected[i]) << "line " << i;
+}
+
+TEST_F(ContinueCli, BranchCsvHasTheDocumentedColumnsAndPointTypes) {
+  const fs::path csv = dir_ / "b.csv";
+  auto args = continue_args(csv);
+  args[args.size() - 3] = "21";  // few samples: fast
+  ASSERT_EQ(args[args.size() - 4], "--samples");
+  ASSERT_EQ(run_to_end(args, dir_ / "b.log"), 0);
+  const auto lines = lines_of(csv);
+  EXPECT_EQ(lines[0],
+            "index,branch,P,arclength,theta0,y_max,end_to_end,H_spread,m3_spread,n_dot_m_spread,H_flat,type,"
+            "multiplicity,event,newton_iterations");
+  std::string all;
+  for (const auto& l : lines) all += l + "\n";
+  EXPECT_NE(all.find(",start,"), std::string::npos);
+  EXPECT_NE(all.find(",branch_point,"), std::string::npos);
+  EXPECT_NE(all.find(",event,0,theta0=3"), std::string::npos);
+  // Progress went to stderr as plain lines (not a terminal), ending with the reason.
+  const auto log = lines_of(dir_ / "b.log");
+  ASSERT_FALSE(log.empty());
+  EXPECT_NE(log.back().find("stopped: event"), std::string::npos);
+  EXPECT_EQ(log.front().find('\r'), std::string::npos);
+}
+
+TEST_F(ContinueCli, ContinuingAnUnknownParameterIsRefused) {
+  const std::vector<std::string> args = {KIRCHHOFF_CLI, "continue",
+                                         std::string(KIRCHHOFF_CASES_DIR) + "/simply_supported.toml", "--param",
+                                         "Q", "--to", "2", "--out", (dir_ / "x.csv").string()};
+  EXPECT_EQ(run_to_end(args, dir_ / "x.log"), 2);
+  const auto log = lines_of(dir_ / "x.log");
+  ASSERT_FALSE(log.empty());
+  EXPECT_NE(log.front().find("Q"), std::string::npos);
+}
+
+}  // namespace
