@@ -246,8 +246,17 @@ std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& f
 ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink& sink) {
   ContinuationResult result;
   const double lambda0 = problem_.parameters().get(options_.parameter);
-  // Correct at fixed lambda (normal = e_lambda), then orient the tangent towards the target.
-  Eigen::VectorXd z = join(x0, lambda0), e = Eigen::VectorXd::Zero(n_ + 1);
+  // Solve at fixed lambda with the damped Newton (and its fallback search) of a single solve,
+  // then orient the tangent towards the target.
+  problem_.set_parameter(options_.parameter, lambda0);
+  const ShootingResult first = solve(problem_, x0);
+  if (!first.summary.converged()) {
+    result.reason = StopReason::StartFailed;
+    result.message = "the starting point does not converge at " + options_.parameter + " = " +
+                     std::to_string(lambda0) + ": " + first.summary.brief_report();
+    return result;
+  }
+  Eigen::VectorXd z = join(first.x, lambda0), e = Eigen::VectorXd::Zero(n_ + 1);
   e[n_] = 1.0;
   int iterations = 0;
   const double direction = std::isnan(options_.target) ? sign_of(options_.direction) : sign_of(options_.target - lambda0);

@@ -1,5 +1,6 @@
 #include "kirchhoff/rod_model.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace kirchhoff {
@@ -45,6 +46,15 @@ Mat3 FieldSum::force_gradient(const Vec3& r) const {
   Mat3 total = Mat3::Zero();
   for (const auto& f : fields_) total += f->force_gradient(r);
   return total;
+}
+
+double FieldSum::gap(const Vec3& r) const {
+  double smallest = std::numeric_limits<double>::quiet_NaN();
+  for (const auto& f : fields_) {
+    const double g = f->gap(r);
+    if (std::isfinite(g) && !(g >= smallest)) smallest = g;
+  }
+  return smallest;
 }
 
 namespace {

@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 #include <array>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -45,6 +46,8 @@ class ExternalField {
   virtual double potential(const Vec3& r) const = 0;
   virtual Vec3 force(const Vec3& r) const = 0;
   virtual Mat3 force_gradient(const Vec3& r) const = 0;
+  // Distance to the obstacle the field models (soft walls); NaN when it models none.
+  virtual double gap(const Vec3&) const { return std::numeric_limits<double>::quiet_NaN(); }
 };
 
 // Weight per unit length w acting along -up: W_ext = w r.up (section 3.1, rho S g r.e_z).
@@ -68,6 +71,7 @@ class BarrierWall final : public ExternalField {
   double potential(const Vec3& r) const override;
   Vec3 force(const Vec3& r) const override;
   Mat3 force_gradient(const Vec3& r) const override;
+  double gap(const Vec3& r) const override { return a_ - r.dot(normal_); }
 
  private:
   double b_, a_;
@@ -82,6 +86,7 @@ class FieldSum final : public ExternalField {
   double potential(const Vec3& r) const override;
   Vec3 force(const Vec3& r) const override;
   Mat3 force_gradient(const Vec3& r) const override;
+  double gap(const Vec3& r) const override;  // the smallest of the fields' gaps
 
  private:
   std::vector<std::shared_ptr<const ExternalField>> fields_;

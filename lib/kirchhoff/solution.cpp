@@ -1,5 +1,6 @@
 #include "kirchhoff/solution.hpp"
 
+#include <boost/math/quadrature/gauss_kronrod.hpp>
 #include <boost/math/tools/minima.hpp>
 #include <cmath>
 #include <fstream>
@@ -45,6 +46,11 @@ const std::map<std::string, std::string> kCatalogue = {
     {"H", "mean of the arclength Hamiltonian H = n.v + m.u - V along the rod (eq. 29)"},
     {"H_spread", "max - min of H along the rod"},
     {"stretch_max", "largest axial strain |v3 - 1| along the rod"},
+    {"E_wall", "integral of the external potential along the rod (eq. 69 for the soft wall)"},
+    {"gap", "smallest distance to a soft wall along the rod (eq. 64's a - y)"},
+    {"ny_jump", "n_y(L) - n_y(0): the wall's total reaction (eq. 66)"},
+    {"kappa_mid", "curvature u2 at s = L/2 (signed, planar)"},
+    {"h_spread", "max - min of h = H + W_ext (eq. 67), not invariant under a field"},
 };
 
 double tangent_angle(const RodPoint& p) { return std::atan2(p.R(1, 2), p.R(0, 2)); }
@@ -70,6 +76,29 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
   if (name == "m_start") return a.m.norm();
   if (name == "H") return sol.invariants.H.mean;
   if (name == "H_spread") return sol.invariants.H.spread;
+  if (name == "E_wall") {
+    // Adaptive Gauss-Kronrod: the potential of a soft wall is sharply peaked at the contact.
+    const RodModel& model = problem.equations(sol.result.parameters)->model();
+    if (!model.field) return 0.0;
+    auto W = [&](double s) { return model.field->potential(problem.sample(x, {s}).front().r); };
+    return boost::math::quadrature::gauss_kronrod<double, 31>::integrate(W, 0.0, b.s, 20, 1e-12);
+  }
+  if (name == "gap") {
+    const RodModel& model = problem.equations(sol.result.parameters)->model();
+    if (!model.field) return NAN;
+    return -refined_maximum(problem, x, sol.profile, [&](const RodPoint& p) { return -model.field->gap(p.r); });
+  }
+  if (name == "ny_jump") return b.n.y() - a.n.y();
+  if (name == "kappa_mid") return problem.sample(x, {0.5 * b.s}).front().u[1];
+  if (name == "h_spread") {
+    const RodModel& model = problem.equations(sol.result.parameters)->model();
+    double lo = INFINITY, hi = -INFINITY;
+    for (const auto& p : sol.profile) {
+      lo = std::min(lo, hamiltonian_without_field(model, p));
+      hi = std::max(hi, hamiltonian_without_field(model, p));
+    }
+    return hi - lo;
+  }
   if (name == "stretch_max") {
     double worst = 0.0;
     for (const auto& p : sol.profile) worst = std::max(worst, std::abs(p.v[2] - 1.0));

@@ -1,0 +1,540 @@
+// Python bindings: `import kirchhoff` (pybind11). A thin layer over the library that mirrors the
+// CLI's `solve` and `continue` commands, returning plain dicts and numpy arrays.
+//
+// Conventions, as in the CLI:
+//   - bad input (a case file that cannot be used, an unknown parameter or derived quantity, bad
+//     options) raises kirchhoff.CaseError, a subclass of ValueError, with the CLI's message;
+//   - a solve that does not converge is not an exception: Solution.status says why;
+//   - a continuation run reports why it stopped in Branch.reason.
+// The GIL is released while the solver runs; Ctrl-C interrupts a continuation between points.
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/case_file.hpp"
+#include "kirchhoff/continuation.hpp"
+#include "kirchhoff/invariants.hpp"
+#include "kirchhoff/shooting.hpp"
+#include "kirchhoff/solution.hpp"
+
+namespace py = pybind11;
+
+namespace {
+
+using namespace kirchhoff;
+
+// ----- conversions -------------------------------------------------------------------------
+
+// None, a mapping (its items()) or an iterable of (name, value) pairs.
+std::vector<std::pair<std::string, double>> named_values(const py::object& obj) {
+  std::vector<std::pair<std::string, double>> out;
+  if (obj.is_none()) return out;
+  const py::object items = py::hasattr(obj, "items") ? obj.attr("items")() : obj;
+  for (const py::handle item : items) {
+    const auto pair = item.cast<py::tuple>();
+    if (pair.size() != 2) throw py::type_error("expected (name, value) pairs");
+    out.emplace_back(pair[0].cast<std::string>(), pair[1].cast<double>());
+  }
+  return out;
+}
+
+py::dict parameters_dict(const Parameters& p) {
+  py::dict d;
+  for (int i = 0; i < p.size(); ++i) d[py::str(p.names()[i])] = p.values()[i];
+  return d;
+}
+
+py::dict stats_dict(const InvariantStats& s) {
+  py::dict d;
+  d["mean"] = s.mean;
+  d["min"] = s.min;
+  d["max"] = s.max;
+  d["spread"] = s.spread;
+  d["relative_spread"] = s.relative_spread();
+  d["applies"] = s.applies;
+  return d;
+}
+
+py::dict vector_stats_dict(const VectorInvariantStats& s) {
+  py::dict d;
+  d["mean"] = py::make_tuple(s.mean.x(), s.mean.y(), s.mean.z());
+  d["spread"] = s.spread;
+  d["applies"] = s.applies;
+  return d;
+}
+
+// The same keys as the CLI's JSON "invariants" object.
+py::dict invariants_dict(const InvariantReport& r) {
+  py::dict d;
+  d["H"] = stats_dict(r.H);
+  d["m3"] = stats_dict(r.m3);
+  d["n_dot_m"] = stats_dict(r.n_dot_m);
+  d["n"] = vector_stats_dict(r.n);
+  d["r_cross_n_plus_m"] = vector_stats_dict(r.moment_about_origin);
+  return d;
+}
+
+template <typename T, typename F>
+py::array_t<T> column(size_t n, F&& f) {
+  py::array_t<T> a(static_cast<py::ssize_t>(n));
+  T* data = a.mutable_data();
+  for (size_t i = 0; i < n; ++i) data[i] = f(i);
+  return a;
+}
+
+py::dict profile_dict(const RodModel& model, const std::vector<RodPoint>& profile) {
+  const size_t n = profile.size();
+  py::dict d;
+  auto add = [&](const char* name, auto&& f) {
+    d[name] = column<double>(n, [&](size_t i) { return f(profile[i]); });
+  };
+  add("s", [](const RodPoint& p) { return p.s; });
+  add("x", [](const RodPoint& p) { return p.r.x(); });
+  add("y", [](const RodPoint& p) { return p.r.y(); });
+  add("z", [](const RodPoint& p) { return p.r.z(); });
+  add("theta", [](const RodPoint& p) { return p.turn_angle; });
+  add("nx", [](const RodPoint& p) { return p.n.x(); });
+  add("ny", [](const RodPoint& p) { return p.n.y(); });
+  add("nz", [](const RodPoint& p) { return p.n.z(); });
+  add("mx", [](const RodPoint& p) { return p.m.x(); });
+  add("my", [](const RodPoint& p) { return p.m.y(); });
+  add("mz", [](const RodPoint& p) { return p.m.z(); });
+  add("u1", [](const RodPoint& p) { return p.u[0]; });
+  add("u2", [](const RodPoint& p) { return p.u[1]; });
+  add("u3", [](const RodPoint& p) { return p.u[2]; });
+  add("H", [&](const RodPoint& p) { return hamiltonian(model, p); });
+  add("m3", [](const RodPoint& p) { return p.m.dot(p.R.col(2)); });
+  return d;
+}
+
+// ----- Python-side objects -------------------------------------------------------------------
+
+struct PySolution {
+  std::string status;
+  bool converged = false;
+  int iterations = 0;
+  double residual = 0.0;
+  std::string message;
+  bool used_fallback_search = false;
+  long rhs_evaluations = 0;
+  std::vector<double> history;
+  py::dict parameters, derived, invariants, profile;
+};
+
+struct PyBranch {
+  std::string parameter;
+  std::string reason;
+  std::string message;
+  bool switch_requested = false;
+  bool switched = false;
+  py::dict points;
+  size_t size = 0;
+  // What the CLI turns into exit status 0.
+  bool ok() const {
+    return reason != to_string(StopReason::StartFailed) && reason != to_string(StopReason::StepTooSmall) &&
+           (!switch_requested || switched);
+  }
+};
+
+struct PyCase {
+  Case c;
+  std::string phase_condition;  // as given to load_case ("" = the case's own)
+};
+
+PyCase py_load_case(const std::string& path, const py::object& set, const std::string& phase_condition) {
+  ParameterOverrides overrides = named_values(set);
+  PyCase out;
+  {
+    py::gil_scoped_release release;
+    out.c = load_case(path, overrides, phase_condition);
+  }
+  out.phase_condition = phase_condition;
+  return out;
+}
+
+PySolution py_solve(const PyCase& pc, const py::object& samples_arg) {
+  const Case& c = pc.c;
+  const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
+  if (samples < 2) throw py::value_error("samples must be >= 2 (got " + std::to_string(samples) + ")");
+
+  PySolution out;
+  std::unique_ptr<ShootingProblem> problem;
+  std::unique_ptr<Solution> sol;
+  bool integration_failed = false;
+  ShootingResult failed;
+  {
+    py::gil_scoped_release release;
+    problem = std::make_unique<ShootingProblem>(c.definition);
+    Eigen::VectorXd x0;
+    try {
+      x0 = problem->initial_unknowns(c.start_guess);
+    } catch (const IntegrationError& e) {
+      integration_failed = true;
+      failed.summary.status = SolverStatus::IntegrationFailed;
+      failed.summary.iterations = 0;
+      failed.summary.residual_norm = INFINITY;
+      failed.summary.message = std::string("the initial guess cannot be integrated: ") + e.what();
+    }
+    if (!integration_failed) {
+      ShootingResult result = solve(*problem, x0);
+      if (result.summary.converged())
+        sol = std::make_unique<Solution>(make_solution(*problem, std::move(result), samples, c.derived));
+      else
+        failed = std::move(result);
+    }
+  }
+  const ShootingResult& r = sol ? sol->result : failed;
+  out.status = to_string(r.summary.status);
+  out.converged = r.summary.converged();
+  out.iterations = r.summary.iterations;
+  out.residual = r.summary.residual_norm;
+  out.message = r.summary.message;
+  out.used_fallback_search = r.summary.used_fallback_search;
+  out.history = r.summary.history;
+  out.rhs_evaluations = problem->rhs_evaluations();
+  if (!sol) {
+    // As the CLI's failure JSON: the case's parameters, no results.
+    out.parameters = parameters_dict(c.definition.parameters);
+    return out;
+  }
+  out.parameters = parameters_dict(sol->result.parameters);
+  for (const auto& name : c.derived) out.derived[py::str(name)] = sol->derived.at(name);
+  out.invariants = invariants_dict(sol->invariants);
+  out.profile = profile_dict(problem->equations(sol->result.parameters)->model(), sol->profile);
+  return out;
+}
+
+std::vector<ContinuationEvent> events_from(const py::object& obj, bool stop) {
+  std::vector<ContinuationEvent> out;
+  for (const auto& [name, value] : named_values(obj)) {
+    if (!derived_catalogue().count(name)) throw CaseError("--event/--record: '" + name + "' is not a derived quantity");
+    out.push_back({name, value, stop});
+  }
+  return out;
+}
+
+struct BranchPoint {
+  ContinuationPoint point;
+  int branch;
+};
+
+py::dict branch_points_dict(const std::vector<BranchPoint>& pts, const std::vector<std::string>& derived) {
+  const size_t n = pts.size();
+  py::dict d;
+  auto f = [&](const char* name, auto&& g) { d[name] = column<double>(n, [&](size_t i) { return g(pts[i].point); }); };
+  auto i = [&](const char* name, auto&& g) { d[name] = column<long>(n, [&](size_t k) { return static_cast<long>(g(pts[k])); }); };
+  d["index"] = column<long>(n, [](size_t k) { return static_cast<long>(k); });
+  i("branch", [](const BranchPoint& b) { return b.branch; });
+  f("parameter", [](const ContinuationPoint& p) { return p.parameter; });
+  f("arclength", [](const ContinuationPoint& p) { return p.arclength; });
+  for (const auto& name : derived)
+    d[py::str(name)] = column<double>(n, [&](size_t k) {
+      const auto& dv = pts[k].point.derived;
+      const auto it = dv.find(name);
+      return it == dv.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
+    });
+  // Absolute spread (the catalogue's H_spread) and the relative spreads of the CLI's CSV.
+  f("H_spread", [](const ContinuationPoint& p) { return p.invariants.H.spread; });
+  f("H_relative_spread", [](const ContinuationPoint& p) { return p.invariants.H.relative_spread() + 0.0; });
+  f("m3_relative_spread", [](const ContinuationPoint& p) { return p.invariants.m3.relative_spread() + 0.0; });
+  f("n_dot_m_relative_spread", [](const ContinuationPoint& p) { return p.invariants.n_dot_m.relative_spread() + 0.0; });
+  d["H_flat"] = column<bool>(n, [&](size_t k) { return pts[k].point.H_flat; });
+  py::list types, events;
+  for (const auto& b : pts) {
+    types.append(py::str(to_string(b.point.type)));
+    events.append(py::str(b.point.event));
+  }
+  d["type"] = types;
+  d["event"] = events;
+  i("multiplicity", [](const BranchPoint& b) { return b.point.multiplicity; });
+  i("newton_iterations", [](const BranchPoint& b) { return b.point.newton_iterations; });
+  return d;
+}
+
+PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::object& to, double step,
+                     double min_step, double max_step, int max_points, const py::object& events,
+                     const py::object& record, int switch_at_bp, double side, int samples, double direction) {
+  const Case& c = pc.c;
+  ContinuationOptions options;
+  options.parameter = parameter;
+  if (!c.definition.parameters.contains(parameter))
+    throw CaseError(c.path + ": --param " + parameter + ": not a parameter of the case");
+  if (!to.is_none()) options.target = to.cast<double>();
+  options.direction = direction;
+  options.initial_step = step;
+  options.min_step = min_step;
+  options.max_step = max_step;
+  options.max_points = max_points;
+  options.samples = samples;
+  options.derived = c.derived;
+  options.events = events_from(events, true);
+  for (auto& e : events_from(record, false)) options.events.push_back(e);
+  if (std::string e = options.validate(); !e.empty()) throw CaseError(e);
+  if (switch_at_bp < 0) throw CaseError("switch_at_bp must be >= 0");
+  for (const auto& e : options.events)
+    if (std::find(options.derived.begin(), options.derived.end(), e.quantity) == options.derived.end())
+      options.derived.push_back(e.quantity);
+
+  PyBranch out;
+  out.parameter = parameter;
+  out.switch_requested = switch_at_bp > 0;
+  std::vector<BranchPoint> points;
+
+  // Lets Ctrl-C stop a long run between points (the exception unwinds the continuation).
+  const PointSink check_signals = [](const ContinuationPoint&) {
+    py::gil_scoped_acquire acquire;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  };
+  auto keep = [&](const ContinuationResult& r, int branch) {
+    for (const auto& p : r.points) {
+      points.push_back({p, branch});
+      points.back().point.jacobian.resize(0, 0);
+    }
+  };
+  {
+    py::gil_scoped_release release;
+    // As apps/continue_command.cpp: branch 0 up to the switch_at_bp-th branch point, then the
+    // bifurcating branch (with the axial phase condition at the double branch point of a
+    // spatial rod).
+    const std::string phase = pc.phase_condition.empty() ? "none" : pc.phase_condition;
+    ProblemDefinition d = c.definition;
+    if (phase == "axial" && !d.parameters.contains("unfolding")) add_axial_phase_condition(d);
+    const ShootingProblem problem(d);
+    ContinuationOptions first = options;
+    first.stop_at_branch_point = switch_at_bp;
+    Continuation run(problem, first);
+    ContinuationResult result;
+    try {
+      result = run.run(problem.initial_unknowns(c.start_guess), check_signals);
+    } catch (const IntegrationError& e) {
+      result.reason = StopReason::StartFailed;
+      result.message = std::string("the initial guess cannot be integrated: ") + e.what();
+    }
+    keep(result, 0);
+    if (switch_at_bp > 0 && result.reason != StopReason::BranchPointStop) {
+      out.reason = to_string(result.reason);
+      out.message = "no branch point " + std::to_string(switch_at_bp) + " before the run stopped (" +
+                    to_string(result.reason) + (result.message.empty() ? "" : ": " + result.message) + ")";
+    } else if (switch_at_bp > 0) {
+      const ContinuationPoint bp = result.points.back();
+      ContinuationOptions second = options;
+      second.target = std::numeric_limits<double>::quiet_NaN();
+      second.direction = 1.0;
+      if (bp.multiplicity == 2 && c.definition.kind == RodKind::Spatial) {
+        const SymmetricBranchStart start = axial_symmetry_branch(run, bp, side);
+        const ShootingProblem switched(start.definition);
+        Continuation next(switched, second);
+        result = next.run_along(start.x, start.parameter, start.direction, PointType::BranchPoint, check_signals);
+      } else {
+        ShootingProblem at_bp(d);
+        at_bp.set_parameter(parameter, bp.parameter);
+        Continuation next(at_bp, second);
+        result = next.switch_branch(bp, check_signals, side);
+      }
+      keep(result, 1);
+      out.switched = true;
+      out.reason = to_string(result.reason);
+      out.message = result.message;
+    } else {
+      out.reason = to_string(result.reason);
+      out.message = result.message;
+    }
+  }
+  out.size = points.size();
+  out.points = branch_points_dict(points, options.derived);
+  return out;
+}
+
+std::string repr_solution(const PySolution& s) {
+  std::ostringstream o;
+  o.precision(10);
+  o << "<kirchhoff.Solution status=" << s.status << " iterations=" << s.iterations << " residual=" << s.residual;
+  for (const auto& [k, v] : s.derived) o << " " << py::str(k).cast<std::string>() << "=" << v.cast<double>();
+  o << ">";
+  return o.str();
+}
+
+}  // namespace
+
+PYBIND11_MODULE(kirchhoff, m) {
+  m.doc() = R"doc(Elastic-rod equilibria by shooting and pseudo-arclength continuation.
+
+    >>> import kirchhoff
+    >>> case = kirchhoff.load_case("cases/simply_supported.toml", set={"theta0": 1.0})
+    >>> sol = case.solve(samples=201)
+    >>> sol.status, sol.derived["P"]            # ('converged', 11.2224...)
+    >>> sol.profile["x"], sol.profile["y"]      # numpy arrays along the rod
+    >>> branch = kirchhoff.load_case("cases/euler_column.toml", set={"P": 1, "theta_guess": 0}) \
+    ...     .continue_("P", to=12, switch_at_bp=1, events={"theta0": 3.0})
+    >>> branch.points["parameter"], branch.points["theta0"], branch.points["type"]
+
+Bad input raises kirchhoff.CaseError (a ValueError) with the message the command-line tool
+prints; a solve that does not converge returns a Solution whose status says why.)doc";
+
+  auto& case_error = py::register_exception<CaseError>(m, "CaseError", PyExc_ValueError);
+  case_error.attr("__doc__") = "A case file or option that cannot be used (a subclass of ValueError).";
+
+  py::class_<PySolution>(m, "Solution", R"doc(The result of Case.solve().
+
+Attributes:
+    status (str): "converged", "max_iterations", "singular_jacobian", "integration_failed",
+        "line_search_failed" or "unfolding_not_zero".
+    converged (bool): status == "converged".
+    iterations (int): Newton iterations.
+    residual (float): max |F_i| at the returned point (inf if it could not be evaluated).
+    message (str): the solver's reason when it stopped without converging.
+    used_fallback_search (bool): the NLopt search supplied the starting point.
+    rhs_evaluations (int): right-hand-side evaluations of the rod equations.
+    history (list of float): residual after each Newton iteration.
+    parameters (dict): parameter values at the solution (unknown ones solved for); the case's
+        values when not converged.
+    derived (dict): the case's derived quantities ([output] derived); empty when not converged.
+    invariants (dict): as the CLI's JSON: "H", "m3", "n_dot_m" map to dicts with mean, min, max,
+        spread, relative_spread, applies; "n" and "r_cross_n_plus_m" to mean (3-tuple), spread,
+        applies. Empty when not converged.
+    profile (dict of numpy arrays): equally spaced samples s, x, y, z, theta (frame turn angle),
+        nx, ny, nz (force), mx, my, mz (moment), u1, u2, u3 (curvatures and twist), H (arclength
+        Hamiltonian), m3 (m.d3). Empty when not converged.)doc")
+      .def_readonly("status", &PySolution::status)
+      .def_readonly("converged", &PySolution::converged)
+      .def_readonly("iterations", &PySolution::iterations)
+      .def_readonly("residual", &PySolution::residual)
+      .def_readonly("message", &PySolution::message)
+      .def_readonly("used_fallback_search", &PySolution::used_fallback_search)
+      .def_readonly("rhs_evaluations", &PySolution::rhs_evaluations)
+      .def_readonly("history", &PySolution::history)
+      .def_readonly("parameters", &PySolution::parameters)
+      .def_readonly("derived", &PySolution::derived)
+      .def_readonly("invariants", &PySolution::invariants)
+      .def_readonly("profile", &PySolution::profile)
+      .def("__bool__", [](const PySolution& s) { return s.converged; }, "True when converged.")
+      .def("__repr__", &repr_solution);
+
+  py::class_<PyBranch>(m, "Branch", R"doc(The result of Case.continue_().
+
+Attributes:
+    parameter (str): the continued parameter.
+    reason (str): why the (last) run stopped: "reached_target", "max_points",
+        "parameter_bounds", "step_too_small", "event", "branch_point" or "start_failed".
+    message (str): details (the event, why the start failed, or "no branch point K before the
+        run stopped (...)" when switch_at_bp found too few branch points).
+    switched (bool): the bifurcating branch was followed (switch_at_bp > 0 and found).
+    ok (bool): what the CLI reports with exit status 0: not start_failed/step_too_small, and the
+        requested branch switch happened.
+    points (dict): one entry per point, in order; numpy arrays unless said otherwise:
+        index, branch (0 = starting branch, 1 = after the switch), parameter, arclength, each
+        derived quantity (the case's [output] derived plus event quantities; NaN where
+        unavailable), H_spread (max - min of H along the rod), H_relative_spread,
+        m3_relative_spread, n_dot_m_relative_spread (spreads over their scale, as in the CLI's
+        CSV), H_flat (bool), type (list of str: start, regular, fold, branch_point, event,
+        endpoint), event (list of str), multiplicity, newton_iterations.
+        With a switch, the branch point ends branch 0 and starts branch 1.)doc")
+      .def_readonly("parameter", &PyBranch::parameter)
+      .def_readonly("reason", &PyBranch::reason)
+      .def_readonly("message", &PyBranch::message)
+      .def_readonly("switched", &PyBranch::switched)
+      .def_property_readonly("ok", &PyBranch::ok)
+      .def_readonly("points", &PyBranch::points)
+      .def("__len__", [](const PyBranch& b) { return b.size; })
+      .def("__repr__", [](const PyBranch& b) {
+        return "<kirchhoff.Branch " + b.parameter + ": " + std::to_string(b.size) + " points, reason=" + b.reason +
+               (b.message.empty() ? "" : " (" + b.message + ")") + ">";
+      });
+
+  py::class_<PyCase>(m, "Case", R"doc(A loaded case file (see load_case).
+
+Attributes:
+    path, title, description (str)
+    kind (str): "planar" or "spatial".
+    parameters (dict): [parameters] after the overrides given to load_case.
+    unknowns (list of str): parameters solved for ([solver] unknowns).
+    derived_names (list of str): the derived quantities reported ([output] derived).
+    samples (int): default profile samples ([output] samples).
+    phase_condition (str): the override given to load_case ("" for the case's own).)doc")
+      .def_property_readonly("path", [](const PyCase& p) { return p.c.path; })
+      .def_property_readonly("title", [](const PyCase& p) { return p.c.title; })
+      .def_property_readonly("description", [](const PyCase& p) { return p.c.description; })
+      .def_property_readonly("kind", [](const PyCase& p) {
+        return p.c.definition.kind == RodKind::Planar ? "planar" : "spatial";
+      })
+      .def_property_readonly("parameters", [](const PyCase& p) { return parameters_dict(p.c.definition.parameters); })
+      .def_property_readonly("unknowns", [](const PyCase& p) { return p.c.definition.unknown_parameters; })
+      .def_property_readonly("derived_names", [](const PyCase& p) { return p.c.derived; })
+      .def_property_readonly("samples", [](const PyCase& p) { return p.c.samples; })
+      .def_readonly("phase_condition", &PyCase::phase_condition)
+      .def("solve", &py_solve, py::arg("samples") = py::none(), R"doc(Solves the case by shooting.
+
+Args:
+    samples (int, optional): profile points (>= 2); default the case's [output] samples.
+
+Returns:
+    Solution. Non-convergence is reported in Solution.status, not raised.)doc")
+      .def("continue_", &py_continue, py::arg("param"), py::arg("to") = py::none(), py::kw_only(),
+           py::arg("step") = 0.05, py::arg("min_step") = 1e-7, py::arg("max_step") = 0.5,
+           py::arg("max_points") = 500, py::arg("events") = py::none(), py::arg("record") = py::none(),
+           py::arg("switch_at_bp") = 0, py::arg("side") = 1.0, py::arg("samples") = 101,
+           py::arg("direction") = 1.0,
+           R"doc(Pseudo-arclength continuation in one parameter (the CLI's `continue`).
+
+Args:
+    param (str): the continued parameter; its value in the case is the starting one.
+    to (float, optional): stop on reaching this value (None: no target, go along `direction`).
+    step, min_step, max_step (float): initial, smallest and largest pseudo-arclength step.
+    max_points (int): points per branch.
+    events (dict name -> value): stop when a derived quantity crosses the value.
+    record (dict name -> value): record such crossings without stopping.
+    switch_at_bp (int): > 0: stop at that branch point and follow the bifurcating branch
+        (a double branch point of a spatial rod switches with the axial phase condition).
+    side (float): +1 / -1, which side of the bifurcating branch.
+    samples (int): profile points per point for invariants and derived quantities.
+    direction (float): +1 / -1, initial direction when there is no target.
+
+Returns:
+    Branch (points of both branches concatenated, with a `branch` column).
+
+Raises:
+    CaseError (ValueError): unknown parameter or derived quantity, invalid options.)doc")
+      .def("__repr__", [](const PyCase& p) {
+        return "<kirchhoff.Case " + (p.c.title.empty() ? p.c.path : "'" + p.c.title + "'") + ">";
+      });
+
+  m.def("load_case", &py_load_case, py::arg("path"), py::arg("set") = py::none(), py::arg("phase_condition") = "",
+        R"doc(Reads and checks a TOML case file.
+
+Args:
+    path (str): the case file.
+    set (dict name -> value, optional): replaces [parameters] values (names must exist).
+    phase_condition (str): "" (the case's own), "none" or "axial".
+
+Returns:
+    Case.
+
+Raises:
+    CaseError (ValueError): the file cannot be used; the message names the key and the reason.)doc");
+
+  m.def("derived_catalogue", &derived_catalogue,
+        "The derived quantities a case or an event may name, with a one-line meaning each (dict).");
+
+  m.def(
+      "analytic_pinned_load",
+      [](double L, double EI, double theta0) { return analytic::PinnedElastica{L, EI, theta0}.load(); },
+      py::arg("L"), py::arg("EI"), py::arg("theta0"),
+      R"doc(Load P = 4 K(k)^2 EI / L^2, k = sin(theta0 / 2), of the pinned-pinned Elastica whose end
+slope is theta0 (Love's elliptic-function solution, first mode; K from GSL).
+
+Raises ValueError outside L > 0, EI > 0, 0 < theta0 < pi.)doc");
+
+  m.attr("__version__") = KIRCHHOFF_VERSION;
+}

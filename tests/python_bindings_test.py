@@ -1,0 +1,217 @@
+#!/usr/bin/env python3
+"""Tests of the `kirchhoff` Python module (python/kirchhoff_module.cpp).
+
+Run by ctest (python_bindings) with PYTHONPATH=<build>/python and KIRCHHOFF_CASES_DIR=<source>/cases;
+by hand:
+    PYTHONPATH=build/python KIRCHHOFF_CASES_DIR=cases /usr/bin/python3 tests/python_bindings_test.py -v
+"""
+import math
+import os
+import pathlib
+import re
+import tempfile
+import unittest
+
+import numpy as np
+
+import kirchhoff
+
+CASES = pathlib.Path(os.environ.get("KIRCHHOFF_CASES_DIR", pathlib.Path(__file__).resolve().parent.parent / "cases"))
+
+PROFILE_KEYS = {"s", "x", "y", "z", "theta", "nx", "ny", "nz", "mx", "my", "mz", "u1", "u2", "u3", "H", "m3"}
+
+
+def case_path(name):
+    return str(CASES / name)
+
+
+class AnalyticTest(unittest.TestCase):
+    def test_pinned_load_matches_gsl_value(self):
+        # P = 4 K(k)^2 EI / L^2 with k = sin(1/2), K from GSL.
+        self.assertAlmostEqual(kirchhoff.analytic_pinned_load(1.0, 1.0, 1.0), 11.22241847578908, places=12)
+
+    def test_pinned_load_rejects_bad_arguments(self):
+        with self.assertRaises(ValueError):
+            kirchhoff.analytic_pinned_load(1.0, 1.0, 4.0)
+
+
+class LoadCaseTest(unittest.TestCase):
+    def test_case_attributes(self):
+        case = kirchhoff.load_case(case_path("simply_supported.toml"), set={"theta0": 2.0})
+        self.assertIn("Simply supported", case.title)
+        self.assertEqual(case.parameters["theta0"], 2.0)
+        self.assertEqual(case.parameters["L"], 1.0)
+        self.assertEqual(case.derived_names, ["P", "y_max", "kappa_max", "end_to_end"])
+        self.assertEqual(case.unknowns, ["P"])
+        self.assertEqual(case.kind, "planar")
+
+    def test_unknown_parameter_raises_value_error_naming_it(self):
+        with self.assertRaises(ValueError) as cm:
+            kirchhoff.load_case(case_path("simply_supported.toml"), set={"no_such_key": 1.0})
+        self.assertIn("no_such_key", str(cm.exception))
+        self.assertIsInstance(cm.exception, kirchhoff.CaseError)
+        # The CLI's message.
+        self.assertIn("--set no_such_key: no parameter 'no_such_key' in [parameters]", str(cm.exception))
+
+    def test_bad_key_in_file_raises_value_error_naming_it(self):
+        text = pathlib.Path(case_path("simply_supported.toml")).read_text()
+        text = text.replace("[solver]\n", "[solver]\nbogus_setting = 3\n")
+        with tempfile.TemporaryDirectory() as tmp:
+            path = pathlib.Path(tmp) / "bad.toml"
+            path.write_text(text)
+            with self.assertRaises(ValueError) as cm:
+                kirchhoff.load_case(str(path))
+        self.assertIn("bogus_setting", str(cm.exception))
+
+    def test_missing_file_raises_value_error(self):
+        with self.assertRaises(ValueError):
+            kirchhoff.load_case(case_path("does_not_exist.toml"))
+
+
+class SolveTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.case = kirchhoff.load_case(case_path("simply_supported.toml"), set={"theta0": 1.0})
+        cls.solution = cls.case.solve(samples=201)
+
+    def test_converges_to_the_elliptic_load(self):
+        sol = self.solution
+        self.assertEqual(sol.status, "converged")
+        self.assertTrue(sol.converged)
+        self.assertTrue(sol)
+        self.assertGreater(sol.iterations, 0)
+        self.assertLess(sol.residual, 1e-9)
+        P = kirchhoff.analytic_pinned_load(1.0, 1.0, 1.0)
+        self.assertAlmostEqual(P, 11.22241847578908, places=12)
+        self.assertLess(abs(sol.derived["P"] - P), 1e-8 * P)
+        self.assertLess(abs(sol.parameters["P"] - P), 1e-8 * P)
+        self.assertEqual(set(sol.derived), set(self.case.derived_names))
+
+    def test_profile_arrays(self):
+        profile = self.solution.profile
+        self.assertEqual(set(profile), PROFILE_KEYS)
+        for name, values in profile.items():
+            self.assertIsInstance(values, np.ndarray, name)
+            self.assertEqual(values.shape, (201,), name)
+            self.assertTrue(np.all(np.isfinite(values)), name)
+        self.assertAlmostEqual(profile["s"][0], 0.0)
+        self.assertAlmostEqual(profile["s"][-1], 1.0)
+        self.assertAlmostEqual(profile["theta"][0], 1.0, places=9)  # imposed end slope
+        self.assertEqual(len(self.case.solve(samples=11).profile["x"]), 11)
+
+    def test_hamiltonian_is_flat(self):
+        H = self.solution.profile["H"]
+        self.assertLess(np.ptp(H), 1e-9 * abs(H.mean()))
+        # Planar Elastica: H = -P cos(theta0).
+        P = kirchhoff.analytic_pinned_load(1.0, 1.0, 1.0)
+        self.assertAlmostEqual(H.mean(), -P * math.cos(1.0), places=8)
+
+    def test_invariants_like_the_cli_json(self):
+        inv = self.solution.invariants
+        for name in ("H", "m3", "n_dot_m"):
+            self.assertEqual(set(inv[name]), {"mean", "min", "max", "spread", "relative_spread", "applies"}, name)
+        self.assertTrue(inv["H"]["applies"])
+        self.assertLess(inv["H"]["relative_spread"], 1e-9)
+        self.assertAlmostEqual(inv["H"]["mean"], self.solution.profile["H"].mean(), places=12)
+
+    def test_bad_sample_count_raises_value_error(self):
+        with self.assertRaises(ValueError):
+            self.case.solve(samples=1)
+
+    def test_non_convergence_is_a_status(self):
+        text = pathlib.Path(case_path("simply_supported.toml")).read_text()
+        self.assertIn("[solver]\n", text)
+        text = text.replace("[solver]\n", "[solver]\nmax_iterations = 1\nfallback_search = false\n")
+        with tempfile.TemporaryDirectory() as tmp:
+            path = pathlib.Path(tmp) / "one_iteration.toml"
+            path.write_text(text)
+            case = kirchhoff.load_case(str(path), set={"theta0": 2.5})
+        sol = case.solve()  # must not raise
+        self.assertNotEqual(sol.status, "converged")
+        self.assertFalse(sol.converged)
+        self.assertFalse(sol)
+        self.assertEqual(sol.derived, {})
+        self.assertEqual(sol.profile, {})
+        self.assertEqual(sol.parameters["theta0"], 2.5)
+
+
+class ContinuationTest(unittest.TestCase):
+    """The Euler column from P = 1 along the straight branch, switching at the first branch point
+    onto the buckled one, which is followed until theta0 = 3 (as tests/continue_cli_test.cpp)."""
+
+    @classmethod
+    def setUpClass(cls):
+        case = kirchhoff.load_case(case_path("euler_column.toml"), set={"P": 1.0, "theta_guess": 0.0})
+        cls.branch = case.continue_("P", to=12.0, switch_at_bp=1, events={"theta0": 3.0})
+
+    def test_stops_at_the_event_after_switching(self):
+        b = self.branch
+        self.assertEqual(b.reason, "event", b.message)
+        self.assertTrue(b.switched)
+        self.assertTrue(b.ok)
+        self.assertEqual(b.parameter, "P")
+        last_type = b.points["type"][-1]
+        self.assertEqual(last_type, "event")
+        self.assertTrue(re.match(r"theta0=3", b.points["event"][-1]))
+        self.assertAlmostEqual(b.points["theta0"][-1], 3.0, places=8)
+        self.assertEqual(b.points["branch"][-1], 1)
+
+    def test_columns(self):
+        pts = self.branch.points
+        n = len(self.branch)
+        self.assertGreater(n, 5)
+        for key in ("parameter", "arclength", "theta0", "y_max", "end_to_end", "H_spread", "branch", "multiplicity",
+                    "newton_iterations"):
+            self.assertIsInstance(pts[key], np.ndarray, key)
+            self.assertEqual(len(pts[key]), n, key)
+        self.assertEqual(len(pts["type"]), n)
+        self.assertTrue(all(isinstance(t, str) for t in pts["type"]))
+        self.assertEqual(pts["type"][0], "start")
+        self.assertEqual(pts["branch"][0], 0)
+        # Branch 0 then branch 1, each contiguous.
+        self.assertTrue(np.all(np.diff(pts["branch"]) >= 0))
+        self.assertEqual(set(pts["branch"].tolist()), {0, 1})
+
+    def test_branch_point_at_the_euler_load(self):
+        pts = self.branch.points
+        bp = [i for i, t in enumerate(pts["type"]) if t == "branch_point"]
+        self.assertTrue(bp)
+        first = bp[0]
+        self.assertEqual(pts["branch"][first], 0)
+        self.assertEqual(pts["multiplicity"][first], 1)
+        self.assertLess(abs(pts["parameter"][first] - math.pi ** 2), 1e-8 * math.pi ** 2)
+        # The switched branch starts at the branch point and buckles (theta0 > 0 with side = +1).
+        start1 = int(np.argmax(pts["branch"] == 1))
+        self.assertEqual(pts["type"][start1], "branch_point")
+        self.assertAlmostEqual(pts["parameter"][start1], pts["parameter"][first], places=10)
+        self.assertGreater(pts["theta0"][start1 + 1], 0.0)
+
+    def test_hamiltonian_flat_along_the_branch(self):
+        pts = self.branch.points
+        self.assertTrue(np.all(pts["H_flat"]))
+        self.assertLess(np.max(pts["H_relative_spread"]), 1e-9)
+
+    def test_bad_inputs_raise_value_error(self):
+        case = kirchhoff.load_case(case_path("euler_column.toml"))
+        with self.assertRaises(ValueError) as cm:
+            case.continue_("not_a_parameter", to=12.0)
+        self.assertIn("not_a_parameter", str(cm.exception))
+        with self.assertRaises(ValueError) as cm:
+            case.continue_("P", to=12.0, events={"not_derived": 1.0})
+        self.assertIn("not_derived", str(cm.exception))
+        with self.assertRaises(ValueError):
+            case.continue_("P", to=12.0, step=-1.0)
+
+    def test_missing_branch_point_is_reported(self):
+        # The straight column below the Euler load: no branch point before the target.
+        case = kirchhoff.load_case(case_path("euler_column.toml"), set={"P": 1.0, "theta_guess": 0.0})
+        b = case.continue_("P", to=2.0, switch_at_bp=1)
+        self.assertEqual(b.reason, "reached_target")
+        self.assertFalse(b.switched)
+        self.assertFalse(b.ok)
+        self.assertIn("no branch point 1", b.message)
+        self.assertEqual(set(b.points["branch"].tolist()), {0})
+
+
+if __name__ == "__main__":
+    unittest.main()
