@@ -8,6 +8,8 @@
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <map>
+#include <numeric>
 #include <optional>
 #include <sstream>
 
@@ -50,6 +52,12 @@ Solved solve_case(const fs::path& file, const ParameterOverrides& overrides, int
     throw std::runtime_error(file.string() + ": " + r.summary.brief_report());
   out.solution = make_solution(*out.problem, std::move(r), samples, c.derived);
   return out;
+}
+
+std::string format_short(double v) {
+  std::ostringstream os;
+  os << std::setprecision(4) << v;
+  return os.str();
 }
 
 // Progress on stderr: one line per result group.
@@ -189,6 +197,114 @@ void continuation(const fs::path& cases, const fs::path& out, std::vector<Report
     }
 }
 
+// Fig. 12: the wall. Hard wall by the symmetric half rod (single point contact at mid-span);
+// soft wall b / (a - y) swept in b down to 1e-6 from a solution reached by continuation in the
+// end shortening, with E_wall ~ b^(2/3) and the approach to the hard-wall values.
+void wall(const fs::path& cases, const fs::path& out, std::vector<ReportRow>* rows) {
+  const Solved hard = solve_case(cases / "wall_symmetric.toml", {}, 201);
+  const auto& d = hard.solution.derived;
+  const double H = d.at("H"), Fc = -2.0 * d.at("n_y"), kc = d.at("kappa_end");
+  const std::string sensitivity = "shooting, symmetric half rod; dH/dDelta = -3.2e4: the paper's -73.7 is Delta = 0.025994";
+  rows->push_back({"Fig. 12, hard wall", "H", -73.7, {}, H, 1.0, 0.0, sensitivity});
+  rows->push_back({"Fig. 12, hard wall", "kappa_c (curvature at the contact)", -1.54, {}, kc, 1.0, 0.0, "rounds to the paper's value"});
+  rows->push_back({"Fig. 12, hard wall", "F_c = n_y jump at the contact (eq. 63)", 18.1, {}, Fc, 1.0, 0.0,
+                   "dF_c/dDelta = 1.6e4: 18.1 is Delta = 0.025994 as well"});
+
+  // Soft wall: continuation in Delta at b = 1e-4 from a small arch, then in log10 b.
+  Case c = load_case((cases / "soft_wall.toml").string(),
+                     {{"log_b", -4.0}, {"Delta", 0.005}, {"P_guess", 40.0}, {"m_guess", 0.9}});
+  ShootingProblem problem(c.definition);
+  ContinuationOptions o;
+  o.parameter = "Delta";
+  o.target = 0.026;
+  o.max_step = 2.0;
+  o.samples = 21;
+  o.compute_invariants = false;
+  ContinuationResult shortening = Continuation(problem, o).run(problem.initial_unknowns(c.start_guess));
+  if (shortening.reason != StopReason::ReachedTarget) throw std::runtime_error("soft wall: continuation in Delta failed");
+  problem.set_parameter("Delta", 0.026);
+  std::map<int, Solution> by_log_b;  // keyed by the exponent of b
+  auto record = [&](const ContinuationPoint& p) {
+    ShootingProblem at = problem;
+    at.set_parameter("log_b", p.parameter);
+    ShootingResult r;
+    r.x = p.x;
+    r.parameters = at.parameters_at(p.x);
+    by_log_b[static_cast<int>(std::lround(p.parameter))] = make_solution(at, r, 401, {"P", "E_wall", "gap", "ny_jump", "kappa_mid", "H", "h_spread"});
+  };
+  for (const std::vector<double>& targets : {std::vector<double>{-3, -2, -1}, std::vector<double>{-5, -6}}) {
+    Eigen::VectorXd x = shortening.points.back().x;
+    double from = -4.0;
+    for (double target : targets) {
+      problem.set_parameter("log_b", from);
+      ContinuationOptions ob = o;
+      ob.parameter = "log_b";
+      ob.target = target;
+      ob.max_step = 0.5;
+      const ContinuationResult r = Continuation(problem, ob).run(x);
+      if (r.reason != StopReason::ReachedTarget) throw std::runtime_error("soft wall: continuation in b failed");
+      if (from == -4.0) record(r.points.front());
+      record(r.points.back());
+      x = r.points.back().x;
+      from = target;
+    }
+  }
+  std::ofstream csv(out / "fig12_soft_wall.csv");
+  csv.precision(15);
+  csv << "b,E_wall,gap,P,ny_jump,kappa_mid,H,h_spread,H_relative_spread\n";
+  for (const auto& [lb, sol] : by_log_b) {
+    const auto& v = sol.derived;
+    csv << std::pow(10.0, lb) << ',' << v.at("E_wall") << ',' << v.at("gap") << ',' << v.at("P") << ','
+        << v.at("ny_jump") << ',' << v.at("kappa_mid") << ',' << v.at("H") << ',' << v.at("h_spread") << ','
+        << sol.invariants.H.relative_spread() << '\n';
+    rows->push_back({"Fig. 12 c-d, b = 1e" + std::to_string(lb),
+                     "H spread / scale (eq. 67; h spreads " + format_short(v.at("h_spread")) + ")", {}, 0.0,
+                     sol.invariants.H.spread, sol.invariants.H.scale, 1e-9, "H = h - W_ext flat, h is not"});
+  }
+  // Profiles of Fig. 12 c-d: H (invariant) and h = H + W_ext (not) along the rod.
+  for (int lb : {-1, -4}) {
+    const Solution& sol = by_log_b.at(lb);
+    ShootingProblem at = problem;
+    at.set_parameter("log_b", lb);
+    const RodModel& model = at.equations(sol.result.parameters)->model();
+    std::ofstream profile(out / ("fig12_soft_wall_b1e" + std::to_string(lb) + ".csv"));
+    profile.precision(15);
+    profile << "s,x,y,H,h\n";
+    for (const auto& p : sol.profile)
+      profile << p.s << ',' << p.r.x() << ',' << p.r.y() << ',' << hamiltonian(model, p) << ','
+              << hamiltonian_without_field(model, p) << '\n';
+  }
+  {
+    std::ofstream profile(out / "fig12_hard_wall_half.csv");
+    profile.precision(15);
+    profile << "s,x,y\n";
+    for (const auto& p : hard.solution.profile) profile << p.s << ',' << p.r.x() << ',' << p.r.y() << '\n';
+  }
+  // Exponent of E_wall(b) over the three smallest b (the asymptotic regime).
+  std::vector<double> xs, ys;
+  for (const auto& [lb, sol] : by_log_b)
+    if (lb <= -4) {
+      xs.push_back(lb * std::log(10.0));
+      ys.push_back(std::log(sol.derived.at("E_wall")));
+    }
+  const double xm = std::accumulate(xs.begin(), xs.end(), 0.0) / xs.size();
+  const double ym = std::accumulate(ys.begin(), ys.end(), 0.0) / ys.size();
+  double sxy = 0.0, sxx = 0.0;
+  for (size_t i = 0; i < xs.size(); ++i) {
+    sxy += (xs[i] - xm) * (ys[i] - ym);
+    sxx += (xs[i] - xm) * (xs[i] - xm);
+  }
+  rows->push_back({"Fig. 12 b", "exponent of E_wall ~ b^e, fitted on b = 1e-4..1e-6", {}, 2.0 / 3.0, sxy / sxx,
+                   2.0 / 3.0, 0.02, "scaling argument of section 7.7"});
+  const auto& finest = by_log_b.begin()->second.derived;
+  rows->push_back({"Fig. 12, b = 1e-6", "H (tends to the hard wall's " + format_short(H) + ")", -73.7, {},
+                   finest.at("H"), 1.0, 0.0, "soft wall, converging as b -> 0"});
+  rows->push_back({"Fig. 12, b = 1e-6", "n_y jump (tends to F_c = " + format_short(Fc) + ", eq. 66)", 18.1, {},
+                   finest.at("ny_jump"), 1.0, 0.0, ""});
+  rows->push_back({"Fig. 12, b = 1e-6", "kappa at mid-span (tends to " + format_short(kc) + ")", -1.54, {},
+                   finest.at("kappa_mid"), 1.0, 0.0, ""});
+}
+
 std::string format(const std::optional<double>& v) {
   if (!v) return "";
   std::ostringstream os;
@@ -244,6 +360,8 @@ int run_reproduce(const std::string& out_dir, const std::string& cases_dir) {
     invariants(cases, &rows);
     progress("Continuation: Euler column and twisted rod bifurcations");
     continuation(cases, out / "profiles", &rows);
+    progress("Fig. 12: hard and soft walls");
+    wall(cases, out / "profiles", &rows);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitNotConverged;

@@ -61,11 +61,64 @@ def fig9(profiles, figures):
     plt.close(fig)
 
 
+def fig12(profiles, figures):
+    sweep = read(profiles / "fig12_soft_wall.csv")
+    fig, axes = plt.subplots(1, 4, figsize=(17, 3.8))
+    ax = axes[0]
+    for name, label in (("fig12_soft_wall_b1e-1.csv", "b = 0.1"), ("fig12_soft_wall_b1e-4.csv", "b = 1e-4")):
+        d = read(profiles / name)
+        ax.plot(d["x"], d["y"], label=label)
+    half = read(profiles / "fig12_hard_wall_half.csv")
+    L_minus_delta = 2 * half["x"][-1]
+    ax.plot(np.concatenate([half["x"], L_minus_delta - half["x"][::-1]]), np.concatenate([half["y"], half["y"][::-1]]),
+            "k--", lw=1, label="hard wall")
+    ax.axhline(0.1, color="gray", lw=3, alpha=0.4)
+    ax.set_xlabel("x / L")
+    ax.set_ylabel("y / L")
+    ax.set_title("(a) Elastica below a wall, a = 0.1, $\\Delta$ = 0.026")
+    ax.legend(fontsize=8)
+    ax = axes[1]
+    b = sweep["b"]
+    ax.loglog(b, sweep["E_wall"], "o", label="shooting")
+    ax.loglog(b, sweep["E_wall"][0] * (b / b[0]) ** (2 / 3), "-", label="$\\propto b^{2/3}$")
+    ax.set_xlabel("b")
+    ax.set_ylabel("E$_{wall}$ (eq. 69)")
+    ax.set_title("(b) interaction energy")
+    ax.legend()
+    for ax, name, label in ((axes[2], "fig12_soft_wall_b1e-1.csv", "(c) b = 0.1"),
+                            (axes[3], "fig12_soft_wall_b1e-4.csv", "(d) b = 1e-4")):
+        d = read(profiles / name)
+        ax.plot(d["s"], d["H"], label="H = h - W$_{ext}$ (eq. 67)")
+        ax.plot(d["s"], d["h"], label="h(s)")
+        ax.axhline(-73.7, color="gray", ls=":", label="paper's hard-wall limit -73.7")
+        ax.set_xlabel("s / L")
+        ax.set_ylabel("[EI / L$^2$]")
+        ax.set_title(label)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(figures / "fig12_soft_wall.png", dpi=120)
+    plt.close(fig)
+
+
+def euler_branch(profiles, figures):
+    d = read(profiles / "euler_buckled_branch.csv")
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(d["P_elliptic"], d["theta0"], "-", lw=3, alpha=0.4, label="elliptic integrals, 4K(k)$^2$")
+    ax.plot(d["P"], d["theta0"], ".", ms=3, label="pseudo-arclength continuation")
+    ax.set_xlabel("P L$^2$ / EI")
+    ax.set_ylabel("$\\theta_0$ (rad)")
+    ax.set_title("Fig. 3 rod: the first buckled branch")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(figures / "fig3_branch.png", dpi=130)
+    plt.close(fig)
+
+
 def main(out):
     out = pathlib.Path(out)
     profiles, figures = out / "profiles", out / "figures"
     figures.mkdir(parents=True, exist_ok=True)
-    for make in (fig3, fig9):
+    for make in (fig3, fig9, fig12, euler_branch):
         make(profiles, figures)
         print(f"  {make.__name__}: written", file=sys.stderr)
 
