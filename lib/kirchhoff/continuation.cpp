@@ -221,7 +221,7 @@ std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& f
     for (int it = 0; it < kLocateIterations && std::abs(b - a) > kLocateTolerance * h_max; ++it) {
       const double c = (a * fb - b * fa) / (fb - fa);
       auto pc = step_from(from, c, type);
-      if (!pc) return std::nullopt;
+      if (!pc) break;  // keep the best estimate so far (e.g. at a singular point)
       const double fc = monitor(*pc);
       best = pc;
       if (fc == 0.0) break;
@@ -354,6 +354,7 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
   double previous_h = 0.0;
   const bool has_target = !std::isnan(options_.target);
   int branch_points_found = 0;
+  bool just_reported_branch_point = false;
 
   auto accept = [&](ContinuationPoint p) {
     p.index = result.points.back().index + 1;
@@ -420,14 +421,15 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
     }
     // Branch points that keep the determinant's sign (even multiplicity): a local minimum of
     // the smallest singular value over the last two steps that is, once located, tiny.
-    if (options_.detect_branch_points && !simple_bp && before_current &&
+    // (Skipped right after a branch point was reported: the minimum is that point again.)
+    if (options_.detect_branch_points && !simple_bp && before_current && !just_reported_branch_point &&
         current.smallest_singular < before_current->smallest_singular &&
         current.smallest_singular < candidate->smallest_singular) {
       auto p = locate(*before_current, previous_h + ds, [](const ContinuationPoint& q) { return q.smallest_singular; },
                       true, PointType::BranchPoint);
       if (p && p->smallest_singular < options_.branch_point_tolerance) {
         p->multiplicity = std::max(1, p->small_count);
-        // Found behind `current` or ahead of it: record it in order with a consistent index.
+        // It may lie just behind `current` (already recorded): points are in detection order.
         special.push_back({p->arclength - current.arclength, *p});
       }
     }
@@ -448,6 +450,8 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
       }
     }
     std::sort(special.begin(), special.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    just_reported_branch_point = false;
+    for (const auto& sp : special) just_reported_branch_point |= sp.second.type == PointType::BranchPoint;
     for (auto& [h, p] : special) {
       accept(p);
       if (p.type == PointType::BranchPoint) ++branch_points_found;
