@@ -3,6 +3,7 @@
 // approach to the hard wall as b -> 0.
 #include <cmath>
 
+#include "kirchhoff/analytic.hpp"
 #include "kirchhoff/continuation.hpp"
 #include "test_support.hpp"
 
@@ -24,6 +25,19 @@ TEST(HardWall, SymmetricPointContactAgreesWithThePapersRoundedValues) {
   EXPECT_NEAR(solved.solution.profile.back().r.y(), 0.1, 1e-10);  // Newton's residual tolerance
   // The contact force pushes down (n_y jumps up across the contact).
   EXPECT_LT(d.at("n_y"), 0.0);
+}
+
+TEST(HardWall, ShootingAgreesWithTheEllipticSolution) {
+  // Two independent methods: shooting (RK78 + Newton to 1e-12) and Jacobi elliptic functions
+  // with a GSL root finder. Both are accurate to ~1e-11 relative; 1e-8 is the bar.
+  const auto exact = analytic::wall_contact_elastica(1.0, 1.0, 0.026, 0.1);
+  const auto d = testing::solve_case("wall_symmetric.toml").solution.derived;
+  EXPECT_NEAR(d.at("P") / exact.P, 1.0, 1e-8);
+  EXPECT_NEAR(d.at("H") / exact.H, 1.0, 1e-8);
+  EXPECT_NEAR(-2.0 * d.at("n_y") / exact.contact_force, 1.0, 1e-8);
+  EXPECT_NEAR(d.at("kappa_end") / exact.kappa_c, 1.0, 1e-8);
+  // The symmetric arch: the clamp and contact curvatures are opposite (antisymmetry about L/4).
+  EXPECT_NEAR(exact.kappa_0, -exact.kappa_c, 1e-10);
 }
 
 TEST(HardWall, PapersHIsReachedWithinATinyChangeOfDelta) {

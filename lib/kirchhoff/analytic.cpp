@@ -8,11 +8,13 @@
 #include "kirchhoff/analytic.hpp"
 
 #include <gsl/gsl_errno.h>
+#include <gsl/gsl_multiroots.h>
 #include <gsl/gsl_math.h>
 #include <gsl/gsl_roots.h>
 #include <gsl/gsl_sf_ellint.h>
 #include <gsl/gsl_sf_elljac.h>
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <memory>
@@ -377,6 +379,93 @@ double clamped_twisted_critical_moment(double B, double T, double L) {
     f = f_next;
   }
   throw std::runtime_error("clamped_twisted_critical_moment: no root found (t = " + std::to_string(t) + ")");
+}
+
+namespace {
+
+// E(u) = E(am u, k) for any real u, continued through the quarter periods: the amplitude is
+// unwrapped from atan2(sn, cn) and each half period adds 2 E(k).
+double jacobi_epsilon(double u, double k, double sn, double cn) {
+  const double K = gsl_sf_ellint_Kcomp(k, GSL_PREC_DOUBLE);
+  const double n = std::floor((u + K) / (2.0 * K));  // half periods away from (-K, K]
+  double am = std::atan2(sn, cn);                      // in (-pi, pi]
+  // Bring am into (-pi/2, pi/2] consistently with the half-period count.
+  am -= n * M_PI;
+  while (am > M_PI / 2) am -= M_PI;
+  while (am <= -M_PI / 2) am += M_PI;
+  return 2.0 * n * gsl_sf_ellint_Ecomp(k, GSL_PREC_DOUBLE) + gsl_sf_ellint_E(am, k, GSL_PREC_DOUBLE);
+}
+
+struct WallProblem {
+  double half, EI, x_end, y_end;
+};
+
+// Position and angle of the half rod at arclength s for the unknowns v = (lambda, psi, k, u0).
+void wall_shape(const double* v, double s, double* x, double* y, double* theta, double* kappa) {
+  const double lambda = v[0], psi = v[1], k = v[2], u0 = v[3];
+  const double m = k * k;
+  double sn0, cn0, dn0, sn, cn, dn;
+  gsl_sf_elljac_e(u0, m, &sn0, &cn0, &dn0);
+  gsl_sf_elljac_e(u0 + lambda * s, m, &sn, &cn, &dn);
+  // In the frame of the force: xi' = 1 - 2 k^2 sn^2, eta' = 2 k sn dn.
+  const double xi = (2.0 * (jacobi_epsilon(u0 + lambda * s, k, sn, cn) - jacobi_epsilon(u0, k, sn0, cn0)) - lambda * s) / lambda;
+  const double eta = -2.0 * k * (cn - cn0) / lambda;
+  *x = std::cos(psi) * xi - std::sin(psi) * eta;
+  *y = std::sin(psi) * xi + std::cos(psi) * eta;
+  *theta = psi + 2.0 * std::asin(std::clamp(k * sn, -1.0, 1.0));
+  *kappa = 2.0 * k * lambda * cn;
+}
+
+int wall_equations(const gsl_vector* v, void* params, gsl_vector* f) {
+  const auto* p = static_cast<const WallProblem*>(params);
+  const double* u = v->data;
+  if (!(u[0] > 0) || !(std::abs(u[2]) < 1)) return GSL_EDOM;
+  double x0, y0, t0, k0, x1, y1, t1, k1;
+  wall_shape(u, 0.0, &x0, &y0, &t0, &k0);
+  wall_shape(u, p->half, &x1, &y1, &t1, &k1);
+  gsl_vector_set(f, 0, t0);
+  gsl_vector_set(f, 1, t1);
+  gsl_vector_set(f, 2, x1 - p->x_end);
+  gsl_vector_set(f, 3, y1 - p->y_end);
+  return GSL_SUCCESS;
+}
+
+}  // namespace
+
+WallContactElastica wall_contact_elastica(double L, double EI, double Delta, double a) {
+  require_positive("wall_contact_elastica", "L", L);
+  require_positive("wall_contact_elastica", "EI", EI);
+  if (!(Delta > 0 && Delta < L)) throw std::invalid_argument("wall_contact_elastica: Delta must lie in (0, L)");
+  WallProblem problem{L / 2, EI, (L - Delta) / 2, a};
+  // Guess: the first clamped-clamped mode y = (a/2)(1 - cos 2 pi s/L) on the half rod, as a
+  // pendulum with F = 4 pi^2 EI/L^2 along x (psi = 0), small k from its slope amplitude, and
+  // the curvature's zero (u = K) at the quarter point.
+  const double lambda = 2.0 * M_PI / L;
+  const double k = std::sin(0.5 * M_PI * a / L);
+  const double K = gsl_sf_ellint_Kcomp(k, GSL_PREC_DOUBLE);
+  double guess[4] = {lambda, 0.0, k, K - lambda * L / 4};
+  gsl_multiroot_function f{&wall_equations, 4, &problem};
+  std::unique_ptr<gsl_multiroot_fsolver, decltype(&gsl_multiroot_fsolver_free)> solver(
+      gsl_multiroot_fsolver_alloc(gsl_multiroot_fsolver_hybrids, 4), &gsl_multiroot_fsolver_free);
+  gsl_vector_view x = gsl_vector_view_array(guess, 4);
+  gsl_multiroot_fsolver_set(solver.get(), &f, &x.vector);
+  int status = GSL_CONTINUE;
+  for (int it = 0; it < 500 && status == GSL_CONTINUE; ++it) {
+    if (gsl_multiroot_fsolver_iterate(solver.get()) != GSL_SUCCESS) break;
+    status = gsl_multiroot_test_residual(solver.get()->f, 1e-14);
+  }
+  if (status != GSL_SUCCESS) throw std::runtime_error("wall_contact_elastica: the root finder did not converge");
+  const double* v = solver.get()->x->data;
+  WallContactElastica out;
+  const double F = EI * v[0] * v[0];
+  out.P = F * std::cos(v[1]);
+  out.n_y = -F * std::sin(v[1]);
+  out.contact_force = -2.0 * out.n_y;
+  double xs, ys, ts;
+  wall_shape(v, 0.0, &xs, &ys, &ts, &out.kappa_0);
+  wall_shape(v, L / 2, &xs, &ys, &ts, &out.kappa_c);
+  out.H = 0.5 * EI * out.kappa_0 * out.kappa_0 - out.P;
+  return out;
 }
 
 }  // namespace kirchhoff::analytic

@@ -96,4 +96,25 @@ struct StraightTwistedRod {
 // at that load the straight rod buckles with no twist at all). The derivation is in analytic.cpp.
 double clamped_twisted_critical_moment(double B, double T, double L);
 
+// The symmetric single-arch Elastica pressed against a hard wall (Fig. 12 in the hard-wall
+// limit): clamped-clamped, length L, end shortening Delta, frictionless point contact with the
+// wall y = a at mid-span. The half rod [0, L/2] is a pendulum elastica,
+//   EI theta'' = -F sin(theta - psi),  n = -F (cos psi, sin psi),
+// written with Jacobi functions: sin(phi/2) = k sn(u), phi = theta - psi, u = lambda s + u0,
+// lambda^2 = F/EI, and x, y from E(am u) and cn u (Love's treatise). The four unknowns
+// (lambda, psi, k, u0) solve theta(0) = theta(L/2) = 0, x(L/2) = (L - Delta)/2, y(L/2) = a with
+// GSL's hybrid root finder: no differential equation is integrated, so this is independent of
+// the shooting solution it checks.
+struct WallContactElastica {
+  double P = 0.0;         // compressive load -n_x
+  double n_y = 0.0;       // n_y on [0, L/2)
+  double contact_force = 0.0;  // F_c = -2 n_y, the jump of n_y at the contact (eq. 63)
+  double kappa_0 = 0.0;   // curvature at the clamps
+  double kappa_c = 0.0;   // curvature at the contact
+  double H = 0.0;         // EI kappa_0^2 / 2 - P (eq. 67 with the hard wall)
+};
+// Throws std::runtime_error when the root finder does not converge from its built-in guess
+// (the first clamped-clamped buckling mode scaled to touch the wall).
+WallContactElastica wall_contact_elastica(double L, double EI, double Delta, double a);
+
 }  // namespace kirchhoff::analytic
