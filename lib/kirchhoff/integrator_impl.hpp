@@ -93,6 +93,38 @@ SegmentFlow flow_with_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, d
   return out;
 }
 
+// The same with only K of the N initial-state directions seeded (the columns of Phi for the
+// others are known in closed form by the caller): cheaper by about (N/K)^2 in the derivative
+// arithmetic. Returns Phi restricted to those columns (N x K) in out.Phi.
+template <int N, int K, class Rhs>
+SegmentFlow flow_with_partial_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                            const IntegratorOptions& opt, const std::array<int, K>& seeds) {
+  using State = std::array<double, N + N * K>;  // y, then the N x K block row-major
+  State x{};
+  for (int i = 0; i < N; ++i) x[i] = y0[i];
+  for (int j = 0; j < K; ++j) x[N + seeds[j] * K + j] = 1.0;
+  long evaluations = 0;
+  auto system = [&](const State& y, State& dy, double s) {
+    ++evaluations;
+    std::array<Dual<K>, N> yd, dyd;
+    for (int i = 0; i < N; ++i) {
+      yd[i].v = y[i];
+      for (int j = 0; j < K; ++j) yd[i].d[j] = y[N + i * K + j];
+    }
+    rhs(yd.data(), dyd.data(), s);
+    for (int i = 0; i < N; ++i) {
+      dy[i] = dyd[i].v;
+      for (int j = 0; j < K; ++j) dy[N + i * K + j] = dyd[i].d[j];
+    }
+  };
+  SegmentFlow out;
+  out.steps = march(x, s0, s1, system, opt);
+  out.y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
+  out.Phi = Eigen::Map<const Eigen::Matrix<double, N, K, Eigen::RowMajor>>(x.data() + N);
+  out.rhs_evaluations = evaluations;
+  return out;
+}
+
 // States at the requested arclengths (sorted). Dopri5 uses its dense output (interpolation
 // between steps); RK78 steps onto each sample point so profiles keep its accuracy.
 template <int N, class Rhs>

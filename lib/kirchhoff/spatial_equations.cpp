@@ -103,8 +103,18 @@ class SpatialEquations final : public RodEquations {
   SegmentFlow flow(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities,
                    const IntegratorOptions& options) const override {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
-    return sensitivities ? detail::flow_with_sensitivities<kStateSize>(f, y0, s0, s1, options)
-                         : detail::flow_state<kStateSize>(f, y0, s0, s1, options);
+    if (!sensitivities) return detail::flow_state<kStateSize>(f, y0, s0, s1, options);
+    if (model_.field) return detail::flow_with_sensitivities<kStateSize>(f, y0, s0, s1, options);
+    // Without a field nothing depends on r(s0) or chi(s0): their columns of Phi are unit vectors,
+    // and only the ten directions of q, n, m are carried by the dual numbers.
+    constexpr std::array<int, 10> kSeeds{kQ, kQ + 1, kQ + 2, kQ + 3, kN, kN + 1, kN + 2, kM, kM + 1, kM + 2};
+    SegmentFlow partial = detail::flow_with_partial_sensitivities<kStateSize, 10>(f, y0, s0, s1, options, kSeeds);
+    Eigen::MatrixXd Phi = Eigen::MatrixXd::Zero(kStateSize, kStateSize);
+    for (int j = 0; j < 10; ++j) Phi.col(kSeeds[j]) = partial.Phi.col(j);
+    for (int i = 0; i < 3; ++i) Phi(kR + i, kR + i) = 1.0;
+    Phi(kChi, kChi) = 1.0;
+    partial.Phi = std::move(Phi);
+    return partial;
   }
 
   std::vector<Eigen::VectorXd> sample(const Eigen::VectorXd& y0, const std::vector<double>& s,
