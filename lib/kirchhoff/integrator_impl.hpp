@@ -61,40 +61,8 @@ SegmentFlow flow_state(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, dou
 }
 
 // Integrates the state together with the variational equations Phi' = (df/dy) Phi, Phi(s0) = I,
-// by evaluating the right-hand side on Dual<N> seeded with the columns of Phi.
-template <int N, class Rhs>
-SegmentFlow flow_with_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
-                                    const IntegratorOptions& opt) {
-  using State = std::array<double, N + N * N>;  // y, then Phi row-major
-  State x{};
-  for (int i = 0; i < N; ++i) {
-    x[i] = y0[i];
-    x[N + i * N + i] = 1.0;
-  }
-  long evaluations = 0;
-  auto system = [&](const State& y, State& dy, double s) {
-    ++evaluations;
-    std::array<Dual<N>, N> yd, dyd;
-    for (int i = 0; i < N; ++i) {
-      yd[i].v = y[i];
-      for (int j = 0; j < N; ++j) yd[i].d[j] = y[N + i * N + j];
-    }
-    rhs(yd.data(), dyd.data(), s);
-    for (int i = 0; i < N; ++i) {
-      dy[i] = dyd[i].v;
-      for (int j = 0; j < N; ++j) dy[N + i * N + j] = dyd[i].d[j];
-    }
-  };
-  SegmentFlow out;
-  out.steps = march(x, s0, s1, system, opt);
-  out.y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
-  out.Phi = Eigen::Map<const Eigen::Matrix<double, N, N, Eigen::RowMajor>>(x.data() + N);
-  out.rhs_evaluations = evaluations;
-  return out;
-}
-
-// The same with only K of the N initial-state directions seeded (the columns of Phi for the
-// others are known in closed form by the caller): cheaper by about (N/K)^2 in the derivative
+// by evaluating the right-hand side on Dual<K> seeded with K of the N columns of Phi (the others
+// may be known in closed form by the caller): cheaper by about (N/K)^2 in the derivative
 // arithmetic. Returns Phi restricted to those columns (N x K) in out.Phi.
 template <int N, int K, class Rhs>
 SegmentFlow flow_with_partial_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
@@ -123,6 +91,15 @@ SegmentFlow flow_with_partial_sensitivities(const Rhs& rhs, const Eigen::VectorX
   out.Phi = Eigen::Map<const Eigen::Matrix<double, N, K, Eigen::RowMajor>>(x.data() + N);
   out.rhs_evaluations = evaluations;
   return out;
+}
+
+// All N directions seeded: the full state-transition matrix.
+template <int N, class Rhs>
+SegmentFlow flow_with_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                    const IntegratorOptions& opt) {
+  std::array<int, N> all;
+  for (int i = 0; i < N; ++i) all[i] = i;
+  return flow_with_partial_sensitivities<N, N>(rhs, y0, s0, s1, opt, all);
 }
 
 // States at the requested arclengths (sorted). Dopri5 uses its dense output (interpolation
