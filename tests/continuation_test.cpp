@@ -61,6 +61,20 @@ TEST(EulerColumn, BranchPointsAtTheEulerLoads) {
   EXPECT_TRUE(of_type(run.result, PointType::Fold).empty());
 }
 
+TEST(EulerColumn, MultipleShootingContinuesTheSameWay) {
+  Case c = load_case(testing::case_path("euler_column.toml"), {{"P", 1.0}, {"theta_guess", 0.0}});
+  c.definition.options.segments = 3;
+  const ShootingProblem problem(c.definition);
+  ContinuationOptions o = euler_options();
+  o.target = 45.0;
+  Continuation run(problem, o);
+  const ContinuationResult r = run.run(problem.initial_unknowns(c.start_guess));
+  const auto bps = of_type(r, PointType::BranchPoint);
+  ASSERT_EQ(bps.size(), 2u);
+  EXPECT_NEAR(bps[0].parameter / (M_PI * M_PI), 1.0, kLocated);
+  EXPECT_NEAR(bps[1].parameter / (4 * M_PI * M_PI), 1.0, kLocated);
+}
+
 TEST(EulerColumn, FirstBuckledBranchMatchesTheElasticaToThetaThree) {
   ContinuationOptions o = euler_options();
   o.target = 12.0;
