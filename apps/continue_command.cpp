@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "kirchhoff/case_file.hpp"
+#include "kirchhoff/contact.hpp"
 #include "kirchhoff/continuation.hpp"
 #include "kirchhoff/solution.hpp"
 #include "solve_command.hpp"
@@ -218,6 +219,11 @@ int run_continue(const ContinueArguments& args) {
     if (std::find(options.derived.begin(), options.derived.end(), e.quantity) == options.derived.end())
       options.derived.push_back(e.quantity);
 
+  if (!c.definition.obstacles.empty() && (args.resume || args.switch_at_bp > 0 || !args.profiles_dir.empty())) {
+    std::cerr << "error: " << args.case_path
+              << ": --resume, --switch-at-bp and --profiles are not implemented for cases with obstacles yet\n";
+    return kExitBadInput;
+  }
   const fs::path csv(args.out_path), state_path(args.out_path + ".state.json");
   if (!args.profiles_dir.empty()) fs::create_directories(args.profiles_dir);
   Progress progress(args.parameter);
@@ -294,6 +300,27 @@ int run_continue(const ContinueArguments& args) {
     Continuation next(*problem, second);
     return next.switch_branch(bp, sink_for(*problem, 1, state.phase_condition), args.switch_side);
   };
+  if (!c.definition.obstacles.empty()) {
+    // Contact: the active set changes along the branch (each change is an event row).
+    try {
+      ContactContinuationResult r =
+          continue_with_contacts(c.definition, c.start_guess, options, [&](const ContinuationPoint& p) {
+            ++state.row;
+            writer->write(state.row, p, 0);
+            progress.point(state.row, p, 0);
+          });
+      progress.done();
+      for (const auto& line : r.changes) std::cerr << "contact: " << line << "\n";
+      std::cerr << "stopped: " << to_string(r.result.reason)
+                << (r.result.message.empty() ? "" : " (" + r.result.message + ")") << "; " << state.row + 1
+                << " points in " << args.out_path << "\n";
+      return r.result.reason == StopReason::StartFailed ? kExitNotConverged : kExitOk;
+    } catch (const std::exception& e) {
+      progress.done();
+      std::cerr << "error: " << e.what() << "\n";
+      return kExitNotConverged;
+    }
+  }
   try {
     auto problem = problem_for(state.phase_condition);
     ContinuationOptions first = options;

@@ -43,6 +43,9 @@ nlohmann::json solution_json(const Case& c, const ShootingProblem& problem, cons
                      {"r_cross_n_plus_m", vector_stats_json(sol.invariants.moment_about_origin)}};
   j["ends"] = {{"start", end_json(sol.profile.front())}, {"end", end_json(sol.profile.back())}};
   j["rhs_evaluations"] = problem.rhs_evaluations();
+  j["contacts"] = nlohmann::json::array();
+  for (const auto& c : sol.contacts)
+    j["contacts"].push_back({{"s", c.s}, {"s_end", c.s}, {"force", c.force}, {"obstacle", c.obstacle}});
   if (sol.result.summary.used_fallback_search) j["note"] = "starting point from the NLopt fallback search";
   return j;
 }

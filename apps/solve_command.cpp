@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "kirchhoff/case_file.hpp"
+#include "kirchhoff/contact.hpp"
 #include "kirchhoff/solution.hpp"
 #include "result_json.hpp"
 
@@ -34,6 +35,9 @@ void print_human(const Case& c, const Solution& sol) {
     std::cout << "  m3 = " << sol.invariants.m3.mean << " (spread " << sol.invariants.m3.spread << ")\n";
   if (sol.invariants.n_dot_m.applies)
     std::cout << "  n.m = " << sol.invariants.n_dot_m.mean << " (spread " << sol.invariants.n_dot_m.spread << ")\n";
+  for (const auto& contact : sol.contacts)
+    std::cout << "  contact with obstacle " << contact.obstacle << " at s = " << contact.s << ", force " << contact.force
+              << "\n";
 }
 
 }  // namespace
@@ -46,16 +50,35 @@ int run_solve(const SolveArguments& args) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;
   }
-  const ShootingProblem problem(c.definition);
-  Eigen::VectorXd x0;
+  std::unique_ptr<ShootingProblem> problem;
+  ShootingResult result;
+  std::vector<std::string> contact_log;
   try {
-    x0 = problem.initial_unknowns(c.start_guess);
+    if (c.definition.obstacles.empty()) {
+      problem = std::make_unique<ShootingProblem>(c.definition);
+      result = solve(*problem, problem->initial_unknowns(c.start_guess));
+    } else {
+      // Obstacles: the active-set loop finds the point contacts.
+      ContactSolveResult contact = solve_with_contacts(c.definition, c.start_guess);
+      problem = std::make_unique<ShootingProblem>(contact.definition);
+      result = contact.result;
+      contact_log = contact.log;
+      if (result.summary.converged() && !contact.complementarity) {
+        result.summary.status = SolverStatus::MaxIterations;
+        result.summary.message = contact.message;
+      }
+    }
+  } catch (const InfeasibleContact& e) {
+    std::cerr << "error: " << c.path << ": infeasible: " << e.what() << "\n";
+    if (args.json) std::cout << failure_json(c, "infeasible", 0, INFINITY, e.what()).dump(2) << "\n";
+    return kExitNotConverged;
   } catch (const IntegrationError& e) {
     std::cerr << "error: " << c.path << ": the initial guess cannot be integrated: " << e.what() << "\n";
     if (args.json) std::cout << failure_json(c, "integration_failed", 0, INFINITY, e.what()).dump(2) << "\n";
     return kExitNotConverged;
   }
-  ShootingResult result = solve(problem, x0);
+  if (!args.json)
+    for (const auto& line : contact_log) std::cerr << "contact: " << line << "\n";
   if (!result.summary.converged()) {
     std::cerr << "error: " << c.path << ": not converged: " << result.summary.brief_report() << "\n";
     if (args.json)
@@ -65,17 +88,17 @@ int run_solve(const SolveArguments& args) {
                 << "\n";
     return kExitNotConverged;
   }
-  const Solution sol = make_solution(problem, std::move(result), c.samples, c.derived);
+  const Solution sol = make_solution(*problem, std::move(result), c.samples, c.derived);
   if (!args.profile_path.empty()) {
     try {
-      write_profile_csv(args.profile_path, problem.equations(sol.result.parameters)->model(), sol.profile);
+      write_profile_csv(args.profile_path, problem->equations(sol.result.parameters)->model(), sol.profile);
     } catch (const std::runtime_error& e) {
       std::cerr << "error: " << e.what() << "\n";
       return kExitBadInput;
     }
   }
   if (args.json)
-    std::cout << solution_json(c, problem, sol).dump(2) << "\n";
+    std::cout << solution_json(c, *problem, sol).dump(2) << "\n";
   else
     print_human(c, sol);
   return kExitOk;

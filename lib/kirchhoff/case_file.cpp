@@ -282,7 +282,7 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
   Parameters parameters;
   const Reader plain(path, {});
   plain.allow_keys(root, "", {"title", "description", "model", "parameters", "rod", "start", "end", "guess",
-                              "solver", "output"});
+                              "solver", "output", "obstacles"});
   if (const Value* table = Reader::find(root, "parameters")) {
     if (!table->is_table()) plain.fail(*table, "parameters", "must be a table of named numbers");
     for (const auto& [name, value] : table->as_table()) {
@@ -430,6 +430,27 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
   d.start = read_end(reader, root, "start", d.kind, parameters);
   d.end = read_end(reader, root, "end", d.kind, parameters);
 
+  // [[obstacles]]: planes the rod must stay on the side of (frictionless, rigid).
+  if (const Value* list = Reader::find(root, "obstacles")) {
+    if (!list->is_array()) reader.fail(*list, "obstacles", "must be an array of tables [[obstacles]]");
+    for (const auto& o : list->as_array()) {
+      reader.allow_keys(o, "obstacles", {"type", "point", "normal", "name"});
+      const Value* type = Reader::find(o, "type");
+      if (!type || reader.string(*type, "obstacles.type") != "plane")
+        reader.fail(type ? *type : o, "obstacles.type", "must be \"plane\" (a wall; two make a cavity)");
+      PlaneObstacle plane;
+      const Value* point = Reader::find(o, "point");
+      const Value* normal = Reader::find(o, "normal");
+      if (!point || !normal) reader.fail(o, "obstacles", "a plane needs a point and a normal (towards the rod's side)");
+      plane.point = vector_target(reader.vector(*point, "obstacles.point"))(parameters);
+      plane.normal = reader.unit_vector(*normal, "obstacles.normal");
+      if (d.kind == RodKind::Planar && std::abs(plane.normal.z()) > 1e-12)
+        reader.fail(*normal, "obstacles.normal", "a planar rod meets walls whose normal lies in the plane");
+      if (const Value* name = Reader::find(o, "name")) plane.name = reader.string(*name, "obstacles.name");
+      d.obstacles.push_back(plane);
+    }
+  }
+
   // [solver]
   if (const Value* s = Reader::find(root, "solver")) {
     reader.allow_keys(*s, "solver", {"unknowns", "segments", "stepper", "abs_tol", "rel_tol", "tolerance",
@@ -444,6 +465,8 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
     if (const Value* v = Reader::find(*s, "segments")) {
       o.segments = static_cast<int>(reader.integer(*v, "solver.segments"));
       if (o.segments < 1) reader.fail(*v, "solver.segments", "must be >= 1");
+      if (o.segments > 1 && !d.obstacles.empty())
+        reader.fail(*v, "solver.segments", "contact with obstacles needs single shooting (segments = 1)");
     }
     if (const Value* v = Reader::find(*s, "stepper")) {
       const std::string name = reader.string(*v, "solver.stepper");

@@ -440,7 +440,7 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
         auto p = locate(current, ds, [&](const ContinuationPoint& q) { return q.derived.at(e.quantity) - e.value; },
                         false, PointType::Event);
         if (p) {
-          p->event = e.quantity + "=" + std::to_string(e.value);
+          p->event = e.label.empty() ? e.quantity + "=" + std::to_string(e.value) : e.label;
           special.push_back({p->arclength - current.arclength, *p});
           if (e.stop) {
             stop = true;

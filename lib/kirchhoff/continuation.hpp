@@ -33,6 +33,7 @@ struct ContinuationEvent {
   std::string quantity;  // a name from derived_catalogue()
   double value = 0.0;
   bool stop = true;
+  std::string label;     // recorded in the point's `event` (default: "quantity=value")
 };
 
 struct ContinuationOptions {

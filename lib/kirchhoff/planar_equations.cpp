@@ -70,6 +70,12 @@ class PlanarEquations final : public RodEquations {
     return detail::sample_states<kStateSize>(f, y0, s, options);
   }
 
+  Eigen::VectorXd derivative(const Eigen::VectorXd& y, double s) const override {
+    Eigen::VectorXd dy(kStateSize);
+    rhs(y.data(), dy.data(), s);
+    return dy;
+  }
+
   RodPoint point(const Eigen::VectorXd& y, double s) const override {
     RodPoint p;
     p.s = s;

@@ -53,6 +53,9 @@ class RodEquations {
   virtual std::vector<Eigen::VectorXd> sample(const Eigen::VectorXd& y0, const std::vector<double>& s,
                                               const IntegratorOptions& options) const = 0;
 
+  // dy/ds at (y, s): the right-hand side itself (moving a segment end moves its end state along it).
+  virtual Eigen::VectorXd derivative(const Eigen::VectorXd& y, double s) const = 0;
+
   virtual RodPoint point(const Eigen::VectorXd& y, double s) const = 0;
   // State from lab-frame data (used to build initial guesses); the frame must be admissible.
   virtual Eigen::VectorXd state(const RodPoint& p) const = 0;

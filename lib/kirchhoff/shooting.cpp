@@ -55,12 +55,35 @@ ShootingProblem::ShootingProblem(ProblemDefinition definition) : definition_(std
   start_condition_count_ = static_cast<int>(rows.size());
   definition_.end.append_residuals(*eq, false, y, definition_.parameters, &rows, nullptr);
   residual_count_ += static_cast<int>(rows.size()) + (segments() - 1) * state_size_;
+  if (!definition_.contacts.empty()) {
+    if (segments() != 1) throw std::invalid_argument("solver: point contacts need single shooting (segments = 1)");
+    for (const auto& c : definition_.contacts)
+      if (c.obstacle < 0 || c.obstacle >= static_cast<int>(definition_.obstacles.size()))
+        throw std::invalid_argument("contact on obstacle " + std::to_string(c.obstacle) + ", which does not exist");
+    residual_count_ += 2 * static_cast<int>(definition_.contacts.size());
+  }
+  for (auto& o : definition_.obstacles) {
+    if (!(o.normal.norm() > 0)) throw std::invalid_argument("obstacle '" + o.name + "': the normal must be non-zero");
+    o.normal.normalize();
+  }
   if (residual_count_ != size())
     throw std::invalid_argument("boundary conditions give " + std::to_string(residual_count_) +
                                 " equations for " + std::to_string(size()) + " unknowns");
 }
 
-int ShootingProblem::size() const { return segments() * state_size_ + static_cast<int>(unknown_index_.size()); }
+int ShootingProblem::size() const {
+  return segments() * state_size_ + static_cast<int>(unknown_index_.size()) +
+         2 * static_cast<int>(definition_.contacts.size());
+}
+
+std::vector<PointContact> ShootingProblem::contacts_at(const Eigen::VectorXd& x) const {
+  std::vector<PointContact> out = definition_.contacts;
+  for (size_t k = 0; k < out.size(); ++k) {
+    out[k].s = x[contact_offset() + 2 * k];
+    out[k].force = x[contact_offset() + 2 * k + 1];
+  }
+  return out;
+}
 
 std::shared_ptr<const RodEquations> ShootingProblem::equations(const Parameters& p) const {
   std::vector<double> key;
@@ -170,6 +193,7 @@ Eigen::VectorXd ShootingProblem::condition_rows(const Eigen::VectorXd& y0, const
 
 bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
                                Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const {
+  if (!definition_.contacts.empty()) return residual_with_contacts(x, p, F, J, failure, y_end);
   const auto eq = equations(p);
   const int n = state_size_, M = segments();
   const double L = eq->model().length;
@@ -223,6 +247,96 @@ bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Ei
   return true;
 }
 
+bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
+                                             Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const {
+  const auto eq = equations(p);
+  const int n = state_size_, N = size(), C = static_cast<int>(definition_.contacts.size());
+  const double L = eq->model().length;
+  const auto contacts = contacts_at(x);
+  for (int k = 0; k < C; ++k) {
+    const double previous = k == 0 ? 0.0 : contacts[k - 1].s;
+    if (!(contacts[k].s > previous) || !(contacts[k].s < L)) {
+      if (failure) *failure = "contact arclengths must increase inside (0, L)";
+      return false;
+    }
+  }
+  F->resize(residual_count_);
+  if (J) J->setZero(residual_count_, N);
+  int row = 0;
+  const Eigen::VectorXd y0 = x.head(n);
+  Eigen::MatrixXd Jg;
+  const Eigen::VectorXd g = eq->gauge_residual(y0, J ? &Jg : nullptr);
+  F->segment(row, g.size()) = g;
+  if (J) J->block(row, 0, g.size(), n) = Jg;
+  row += static_cast<int>(g.size());
+  ConditionRows start;
+  definition_.start.append_residuals(*eq, true, y0, p, &start.values, J ? &start.jacobian : nullptr);
+  for (size_t k = 0; k < start.values.size(); ++k, ++row) {
+    (*F)[row] = start.values[k];
+    if (J) J->block(row, 0, 1, n) = start.jacobian[k];
+  }
+
+  // S = dy/dx of the current state, carried through segments and jumps.
+  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(n, N);
+  S.leftCols(n).setIdentity();
+  const Eigen::MatrixXd position = eq->slot_map(Slot::Position), force = eq->slot_map(Slot::Force);
+  Eigen::VectorXd y = y0;
+  double s0 = 0.0;
+  int s0_column = -1;  // the unknown that s0 is, if any
+  try {
+    for (int k = 0; k <= C; ++k) {
+      const double s1 = k < C ? contacts[k].s : L;
+      SegmentFlow flow = eq->flow(y, s0, s1, J != nullptr, definition_.options.integrator);
+      rhs_evaluations_ += flow.rhs_evaluations;
+      if (J) {
+        S = flow.Phi * S;
+        if (s0_column >= 0) S.col(s0_column) -= flow.Phi * eq->derivative(y, s0);
+        if (k < C) S.col(contact_offset() + 2 * k) += eq->derivative(flow.y, s1);
+      }
+      y = flow.y;
+      if (k == C) break;
+      // On the obstacle and tangent to it: g = 0 and g' = normal . r' = 0.
+      const PlaneObstacle& o = definition_.obstacles[contacts[k].obstacle];
+      const Eigen::RowVectorXd dg = o.normal.transpose() * position;
+      auto tangency = [&](const Eigen::VectorXd& state) { return dg.dot(eq->derivative(state, s1)); };
+      (*F)[row] = o.gap(position * y);
+      (*F)[row + 1] = tangency(y);
+      if (J) {
+        J->row(row) = dg * S;
+        // Gradient of the tangency by central differences of a closed-form function of the state.
+        Eigen::RowVectorXd dt(n);
+        for (int i = 0; i < n; ++i) {
+          const double h = 1e-7 * (1.0 + std::abs(y[i]));
+          Eigen::VectorXd yp = y, ym = y;
+          yp[i] += h;
+          ym[i] -= h;
+          dt[i] = (tangency(yp) - tangency(ym)) / (2 * h);
+        }
+        J->row(row + 1) = dt * S;
+        J->row(row + 1)[contact_offset() + 2 * k] += dg.dot(eq->derivative(y, s1 + 1e-7) - eq->derivative(y, s1 - 1e-7)) / 2e-7;
+      }
+      row += 2;
+      // The contact force f = force * normal: n jumps by -f.
+      const Eigen::VectorXd jump = -force.transpose() * o.normal;
+      y += contacts[k].force * jump;
+      if (J) S.col(contact_offset() + 2 * k + 1) += jump;
+      s0 = s1;
+      s0_column = contact_offset() + 2 * k;
+    }
+  } catch (const IntegrationError& e) {
+    if (failure) *failure = e.what();
+    return false;
+  }
+  if (y_end) *y_end = y;
+  ConditionRows end;
+  definition_.end.append_residuals(*eq, false, y, p, &end.values, J ? &end.jacobian : nullptr);
+  for (size_t k = 0; k < end.values.size(); ++k, ++row) {
+    (*F)[row] = end.values[k];
+    if (J) J->row(row) = end.jacobian[k] * S;
+  }
+  return true;
+}
+
 Eigen::VectorXd ShootingProblem::initial_unknowns(const RodPoint& start_guess) const {
   const auto eq = equations(definition_.parameters);
   RodPoint p0 = start_guess;
@@ -237,6 +351,10 @@ Eigen::VectorXd ShootingProblem::initial_unknowns(const RodPoint& start_guess) c
   }
   for (size_t j = 0; j < unknown_index_.size(); ++j)
     x[M * n + j] = definition_.parameters.values()[unknown_index_[j]];
+  for (size_t k = 0; k < definition_.contacts.size(); ++k) {
+    x[contact_offset() + 2 * k] = definition_.contacts[k].s;
+    x[contact_offset() + 2 * k + 1] = definition_.contacts[k].force;
+  }
   return x;
 }
 
@@ -248,6 +366,28 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
   std::vector<RodPoint> out;
   out.reserve(s.size());
   size_t k = 0;
+  if (!definition_.contacts.empty()) {
+    // Piece by piece between contacts, applying the jump of n at each.
+    const auto contacts = contacts_at(x);
+    const Eigen::MatrixXd force = eq->slot_map(Slot::Force);
+    Eigen::VectorXd y = x.head(n);
+    double s0 = 0.0;
+    for (size_t c = 0; c <= contacts.size(); ++c) {
+      const bool last = c == contacts.size();
+      const double s1 = last ? L : contacts[c].s;
+      std::vector<double> local{s0};
+      while (k < s.size() && (s[k] < s1 || (last && s[k] <= s1))) local.push_back(s[k++]);
+      if (local.size() > 1) {
+        const auto states = eq->sample(y, local, definition_.options.integrator);
+        for (size_t j = 1; j < states.size(); ++j) out.push_back(eq->point(states[j], local[j]));
+      }
+      if (last) break;
+      y = eq->flow(y, s0, s1, false, definition_.options.integrator).y;
+      y -= contacts[c].force * force.transpose() * definition_.obstacles[contacts[c].obstacle].normal;
+      s0 = s1;
+    }
+    return out;
+  }
   for (int i = 0; i < M; ++i) {
     const double s0 = L * i / M, s1 = L * (i + 1) / M;
     std::vector<double> local{s0};

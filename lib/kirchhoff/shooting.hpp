@@ -26,6 +26,26 @@ namespace kirchhoff {
 
 enum class RodKind { Spatial, Planar };
 
+// A rigid frictionless obstacle bounded by a plane: the rod must stay where
+// g(r) = (r - point).normal >= 0, the normal pointing into the admissible side. Two of them facing
+// each other make a cavity.
+struct PlaneObstacle {
+  Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::UnitY();
+  std::string name;
+  double gap(const Vec3& r) const { return (r - point).dot(normal); }
+};
+
+// A point of the active contact set: the rod touches obstacle `obstacle` at arclength s and
+// receives the force `force` * normal there (0 <= g perp force >= 0). Both s and force are
+// unknowns of the problem; these are their guesses, or their values once solved. At the contact
+// the centreline is on the obstacle (g = 0) and tangent to it (g' = 0); n jumps by -force*normal.
+struct PointContact {
+  int obstacle = 0;
+  double s = 0.0;
+  double force = 0.0;
+};
+
 using ModelFunction = std::function<RodModel(const Parameters&)>;
 
 struct ShootingOptions {
@@ -44,6 +64,8 @@ struct ProblemDefinition {
   Parameters parameters;                   // current values (guesses for the unknown ones)
   std::vector<std::string> unknown_parameters;
   ShootingOptions options;
+  std::vector<PlaneObstacle> obstacles;  // what the rod may touch (see solve_with_contacts)
+  std::vector<PointContact> contacts;    // the active set: point contacts solved for
 };
 
 class ShootingProblem final : public NonlinearSystem {
@@ -78,6 +100,8 @@ class ShootingProblem final : public NonlinearSystem {
   std::vector<RodPoint> sample(const Eigen::VectorXd& x, const std::vector<double>& s) const;
 
   long rhs_evaluations() const { return rhs_evaluations_; }
+  // The active contacts with their arclengths and forces taken from x.
+  std::vector<PointContact> contacts_at(const Eigen::VectorXd& x) const;
 
   // dF/d(parameter) at x, for a known (not solved-for) parameter: from the closed-form boundary
   // conditions when the parameter does not enter the rod model, else by central differences of
@@ -96,6 +120,10 @@ class ShootingProblem final : public NonlinearSystem {
   // Scatters condition rows (start then end) into a full-length residual column.
   void place_condition_rows(const Eigen::VectorXd& rows, Eigen::VectorXd* column) const;
   bool depends_on_model(int unknown) const;
+  int contact_offset() const { return segments() * state_size_ + static_cast<int>(unknown_index_.size()); }
+  // Single shooting through the contact points: the state jumps in n at each of them.
+  bool residual_with_contacts(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
+                              Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const;
 
   ProblemDefinition definition_;
   int state_size_ = 0;

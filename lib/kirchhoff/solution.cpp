@@ -50,6 +50,12 @@ const std::map<std::string, std::string> kCatalogue = {
     {"ny_jump", "n_y(L) - n_y(0): the wall's total reaction (eq. 66)"},
     {"kappa_mid", "curvature u2 at s = L/2 (signed, planar)"},
     {"kappa_end", "curvature u2 at s = L (signed, planar)"},
+    {"contact_force", "sum of the point-contact forces"},
+    {"contact_count", "number of point contacts"},
+    {"min_contact_force", "smallest point-contact force (NaN without contacts)"},
+    {"kappa_contact", "curvature u2 at the first point contact (signed, planar)"},
+    {"contact_s", "arclength of the first point contact"},
+    {"min_gap", "smallest distance to the obstacles along the rod"},
     {"h_spread", "max - min of h = H + W_ext (eq. 67), not invariant under a field"},
 };
 
@@ -98,6 +104,28 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
   }
   if (name == "ny_jump") return b.n.y() - a.n.y();
   if (name == "kappa_end") return b.u[1];
+  if (name == "contact_force") {
+    double total = 0.0;
+    for (const auto& c : sol.contacts) total += c.force;
+    return total;
+  }
+  if (name == "contact_count") return static_cast<double>(sol.contacts.size());
+  if (name == "min_contact_force") {
+    double smallest = NAN;
+    for (const auto& c : sol.contacts) smallest = std::isnan(smallest) ? c.force : std::min(smallest, c.force);
+    return smallest;
+  }
+  if (name == "kappa_contact")
+    return sol.contacts.empty() ? NAN : problem.sample(x, {sol.contacts.front().s}).front().u[1];
+  if (name == "contact_s") return sol.contacts.empty() ? NAN : sol.contacts.front().s;
+  if (name == "min_gap") {
+    const auto& obstacles = problem.definition().obstacles;
+    if (obstacles.empty()) return NAN;
+    double smallest = INFINITY;
+    for (const auto& p : sol.profile)
+      for (const auto& o : obstacles) smallest = std::min(smallest, o.gap(p.r));
+    return smallest;
+  }
   if (name == "kappa_mid") return problem.sample(x, {0.5 * b.s}).front().u[1];
   if (name == "h_spread") {
     const RodModel& model = problem.equations(sol.result.parameters)->model();
@@ -129,6 +157,7 @@ Solution make_solution(const ShootingProblem& problem, ShootingResult result, in
   std::vector<double> s(n_samples);
   for (int i = 0; i < n_samples; ++i) s[i] = L * i / (n_samples - 1);
   sol.profile = problem.sample(sol.result.x, s);
+  sol.contacts = problem.contacts_at(sol.result.x);
   sol.invariants = compute_invariants(problem.equations(sol.result.parameters)->model(), sol.profile);
   for (const auto& name : derived_names) sol.derived[name] = derived_value(name, problem, sol);
   return sol;

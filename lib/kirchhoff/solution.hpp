@@ -16,6 +16,7 @@ struct Solution {
   std::vector<RodPoint> profile;  // equally spaced in s, ends included
   InvariantReport invariants;
   std::map<std::string, double> derived;
+  std::vector<PointContact> contacts;  // the active contacts, solved
 };
 
 // Samples (n_samples >= 2 points), computes invariants and the requested derived quantities.

@@ -123,6 +123,12 @@ class SpatialEquations final : public RodEquations {
     return detail::sample_states<kStateSize>(f, y0, s, options);
   }
 
+  Eigen::VectorXd derivative(const Eigen::VectorXd& y, double s) const override {
+    Eigen::VectorXd dy(kStateSize);
+    rhs(y.data(), dy.data(), s);
+    return dy;
+  }
+
   RodPoint point(const Eigen::VectorXd& y, double s) const override {
     RodPoint p;
     p.s = s;

@@ -1,0 +1,197 @@
+#include "kirchhoff/contact.hpp"
+
+#include <algorithm>
+#include <boost/math/tools/minima.hpp>
+#include <cmath>
+#include <sstream>
+
+namespace kirchhoff {
+namespace {
+
+// The unknowns of the new active set from the solved ones of the old: state and parameters
+// are kept, contacts take their solved values, new contacts their guesses.
+Eigen::VectorXd carry_over(const ShootingProblem& old_problem, const Eigen::VectorXd& x,
+                           const ShootingProblem& new_problem) {
+  Eigen::VectorXd y = new_problem.initial_unknowns(RodPoint{});
+  const int keep = old_problem.size() - 2 * static_cast<int>(old_problem.definition().contacts.size());
+  y.head(keep) = x.head(keep);
+  return y;
+}
+
+}  // namespace
+
+ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& guess, const ContactOptions& options) {
+  ContactSolveResult out;
+  std::sort(d.contacts.begin(), d.contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
+  auto problem = std::make_unique<ShootingProblem>(d);
+  // Imposed end positions must be admissible (other positions are what the loop corrects).
+  const auto eq = problem->equations(d.parameters);
+  for (bool at_start : {true, false}) {
+    const EndCondition& end = at_start ? d.start : d.end;
+    for (const auto& condition : end.conditions()) {
+      if (condition.slot != Slot::Position || condition.directions != Directions::All || condition.extra) continue;
+      const Vec3 r = condition.value(d.parameters);
+      for (const auto& o : d.obstacles)
+        if (o.gap(r) < -options.penetration_tolerance)
+          throw InfeasibleContact(std::string("the rod's ") + (at_start ? "start" : "end") + " is imposed inside obstacle '" +
+                                  o.name + "' (gap " + std::to_string(o.gap(r)) + ")");
+    }
+  }
+  Eigen::VectorXd x = problem->initial_unknowns(guess);
+  for (int round = 0; round < options.max_rounds; ++round) {
+    out.result = solve(*problem, x);
+    out.definition = d;
+    if (!out.result.summary.converged()) {
+      out.message = "solve with " + std::to_string(d.contacts.size()) + " contact(s) did not converge";
+      return out;
+    }
+    const auto solved = problem->contacts_at(out.result.x);
+    for (size_t k = 0; k < solved.size(); ++k) d.contacts[k] = solved[k];
+    out.definition = d;
+
+    // A pulling contact is released (the most negative first).
+    auto weakest = std::min_element(solved.begin(), solved.end(),
+                                    [](const auto& a, const auto& b) { return a.force < b.force; });
+    std::ostringstream change;
+    if (weakest != solved.end() && weakest->force < -options.force_tolerance) {
+      change << "release the contact at s = " << weakest->s << " (force " << weakest->force << ")";
+      d.contacts.erase(d.contacts.begin() + (weakest - solved.begin()));
+    } else {
+      // The deepest penetration of any obstacle, refined between samples.
+      const double L = problem->length(out.result.parameters);
+      std::vector<double> s(options.samples);
+      for (int i = 0; i < options.samples; ++i) s[i] = L * i / (options.samples - 1);
+      const auto profile = problem->sample(out.result.x, s);
+      double deepest = -options.penetration_tolerance;
+      int which = -1;
+      double where = 0.0;
+      for (size_t o = 0; o < d.obstacles.size(); ++o) {
+        for (size_t i = 0; i < profile.size(); ++i) {
+          const double g = d.obstacles[o].gap(profile[i].r);
+          if (g < deepest) {
+            deepest = g;
+            which = static_cast<int>(o);
+            where = profile[i].s;
+          }
+        }
+      }
+      if (which < 0) {
+        out.complementarity = true;
+        return out;
+      }
+      const double h = L / (options.samples - 1);
+      auto gap_at = [&](double at) { return d.obstacles[which].gap(problem->sample(out.result.x, {at}).front().r); };
+      where = boost::math::tools::brent_find_minima(gap_at, std::max(0.0, where - h), std::min(L, where + h), 40).first;
+      change << "add a contact with obstacle " << which << " at s = " << where << " (gap " << deepest << ")";
+      d.contacts.push_back({which, where, 0.0});
+      std::sort(d.contacts.begin(), d.contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
+    }
+    out.log.push_back(change.str());
+    auto next = std::make_unique<ShootingProblem>(d);
+    Eigen::VectorXd y = carry_over(*problem, out.result.x, *next);
+    problem = std::move(next);
+    x = y;
+  }
+  out.message = "the active set did not settle in " + std::to_string(options.max_rounds) + " solves";
+  return out;
+}
+
+ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodPoint& guess, ContinuationOptions options,
+                                                 const PointSink& sink, const ContactOptions& contact) {
+  ContactContinuationResult out;
+  ContactSolveResult start = solve_with_contacts(d, guess, contact);
+  if (!start.result.summary.converged() || !start.complementarity) {
+    out.result.reason = StopReason::StartFailed;
+    out.result.message = "no admissible starting point: " + start.message;
+    return out;
+  }
+  d = start.definition;
+  Eigen::VectorXd x = start.result.x;
+  for (const auto& line : start.log) out.changes.push_back("start: " + line);
+  const int max_points = options.max_points;
+  bool first_leg = true;
+  while (true) {
+    ContinuationOptions leg = options;
+    leg.max_points = max_points - static_cast<int>(out.result.points.size()) + (first_leg ? 0 : 1);
+    // The gap event sits at -penetration_tolerance: an active contact touches with a gap of 0 up to
+    // round-off, whose sign must not count as a crossing.
+    leg.events.push_back({"min_gap", -contact.penetration_tolerance, true, "obstacle_reached"});
+    leg.samples = std::max(leg.samples, contact.samples);
+    if (!d.contacts.empty()) leg.events.push_back({"min_contact_force", 0.0, true, "contact_lifts_off"});
+    const ShootingProblem problem(d);
+    // A leg starts on the previous leg's last point, which is already reported.
+    bool skip = !first_leg;
+    auto leg_sink = [&](const ContinuationPoint& p) {
+      if (skip) {
+        skip = false;
+        return;
+      }
+      if (sink) sink(p);
+    };
+    ContinuationResult r = Continuation(problem, leg).run(x, leg_sink);
+    if (!first_leg && !r.points.empty()) r.points.erase(r.points.begin());
+    out.result.points.insert(out.result.points.end(), r.points.begin(), r.points.end());
+    out.result.reason = r.reason;
+    out.result.message = r.message;
+    out.definition = d;
+    first_leg = false;
+    if (r.reason != StopReason::EventStop || r.points.empty()) return out;
+
+    // The active set changes at the event point.
+    const ContinuationPoint& at = r.points.back();
+    ShootingProblem here = problem;
+    here.set_parameter(options.parameter, at.parameter);
+    std::ostringstream change;
+    change << options.parameter << " = " << at.parameter << ": ";
+    const auto contacts = here.contacts_at(at.x);
+    if (at.event == "contact_lifts_off") {
+      auto weakest = std::min_element(contacts.begin(), contacts.end(),
+                                      [](const auto& a, const auto& b) { return a.force < b.force; });
+      change << "the contact at s = " << weakest->s << " lifts off";
+      d.contacts = contacts;
+      d.contacts.erase(d.contacts.begin() + (weakest - contacts.begin()));
+    } else {
+      // Where the rod reaches an obstacle: the smallest gap, refined between samples.
+      const double L = here.length(here.parameters_at(at.x));
+      std::vector<double> s(contact.samples);
+      for (int i = 0; i < contact.samples; ++i) s[i] = L * i / (contact.samples - 1);
+      const auto profile = here.sample(at.x, s);
+      double smallest = INFINITY, where = 0.0;
+      int which = 0;
+      for (size_t o = 0; o < d.obstacles.size(); ++o)
+        for (const auto& p : profile)
+          if (d.obstacles[o].gap(p.r) < smallest) {
+            smallest = d.obstacles[o].gap(p.r);
+            where = p.s;
+            which = static_cast<int>(o);
+          }
+      for (const auto& c : contacts)
+        if (c.obstacle == which && std::abs(c.s - where) < 2.0 * L / (contact.samples - 1)) {
+          out.result.message = "extended contact forming near s = " + std::to_string(where) +
+                               " (the rod flattens along the obstacle): not modelled, the run stops here";
+          out.changes.push_back(change.str() + out.result.message);
+          return out;
+        }
+      const double h = L / (contact.samples - 1);
+      auto gap_at = [&](double u) { return d.obstacles[which].gap(here.sample(at.x, {u}).front().r); };
+      where = boost::math::tools::brent_find_minima(gap_at, std::max(0.0, where - h), std::min(L, where + h), 40).first;
+      change << "a contact appears with obstacle " << which << " at s = " << where;
+      d.contacts = contacts;
+      d.contacts.push_back({which, where, 0.0});
+      std::sort(d.contacts.begin(), d.contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
+    }
+    out.changes.push_back(change.str());
+    out.result.points.back().event = change.str();
+    // The next leg starts from the same configuration with the new set.
+    ProblemDefinition next_definition = d;
+    next_definition.parameters.set(options.parameter, at.parameter);
+    const ShootingProblem next(next_definition);
+    Eigen::VectorXd y = next.initial_unknowns(RodPoint{});
+    const int keep = problem.size() - 2 * static_cast<int>(problem.definition().contacts.size());
+    y.head(keep) = at.x.head(keep);
+    x = y;
+    d = next_definition;
+  }
+}
+
+}  // namespace kirchhoff

@@ -1,0 +1,63 @@
+// Frictionless unilateral contact with rigid obstacles, by complementarity in the shooting core.
+//
+// The active set is a list of point contacts, each with an unknown arclength and force (see
+// PointContact). An active-set loop solves the problem with the current set, then
+//   - releases the contact with the most negative force, if any (the obstacle would pull), or
+//   - adds a contact where the rod penetrates an obstacle most (refined by Brent's method),
+// until 0 <= g(r(s)) everywhere and every force is >= 0: 0 <= g perp force >= 0.
+// Only isolated point contacts are modelled: a rod lying along an obstacle over an interval
+// (extended contact) is not.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "kirchhoff/continuation.hpp"
+#include "kirchhoff/shooting.hpp"
+
+namespace kirchhoff {
+
+struct ContactOptions {
+  int max_rounds = 12;                    // solves of the active-set loop
+  double penetration_tolerance = 1e-9;    // g below -this is a penetration
+  double force_tolerance = 1e-9;          // a force below -this is a pull, and is released
+  int samples = 401;                      // where penetration is looked for (then refined)
+};
+
+struct ContactSolveResult {
+  ShootingResult result;
+  ProblemDefinition definition;           // with the final active set
+  std::vector<std::string> log;           // one line per change of the active set
+  bool complementarity = false;           // the final solution satisfies 0 <= g perp force >= 0
+  std::string message;
+};
+
+// Thrown when an end of the rod is imposed inside an obstacle: no admissible equilibrium exists.
+struct InfeasibleContact : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
+
+// Solves from `guess` (the state at s = 0, completed by the start conditions) starting with the
+// definition's contacts as the active set. Non-convergence of a solve ends the loop with that
+// status; a loop that does not settle within max_rounds reports complementarity = false.
+// Throws InfeasibleContact when an imposed end position lies inside an obstacle.
+ContactSolveResult solve_with_contacts(ProblemDefinition definition, const RodPoint& guess,
+                                       const ContactOptions& options = {});
+
+// Continuation through changes of the active contact set. Each leg is an ordinary Continuation
+// with the set fixed and two stopping events: min_gap crossing 0 (the rod reaches an obstacle:
+// a contact appears there) and min_contact_force crossing 0 (a contact lifts off and is
+// released). At each such point the set changes, the change is recorded as an event point
+// (its `event` names it) and the next leg starts there. Extended contact (the rod lying along an
+// obstacle) is not modelled: when it would form, the run stops with a message saying so.
+struct ContactContinuationResult {
+  ContinuationResult result;          // all legs' points, in order
+  std::vector<std::string> changes;   // one line per change of the active set
+  ProblemDefinition definition;       // the active set at the end
+};
+ContactContinuationResult continue_with_contacts(ProblemDefinition definition, const RodPoint& guess,
+                                                 ContinuationOptions options, const PointSink& sink = {},
+                                                 const ContactOptions& contact = {});
+
+}  // namespace kirchhoff

@@ -1,0 +1,129 @@
+// Frictionless point contact by complementarity in the shooting core (wall.toml), checked
+// against the elliptic-function solution and against the symmetric half-rod shooting.
+#include <cmath>
+
+#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/contact.hpp"
+#include "test_support.hpp"
+
+namespace kirchhoff {
+namespace {
+
+struct ContactRun {
+  Case c;
+  ContactSolveResult solve;
+  std::unique_ptr<ShootingProblem> problem;
+  Solution solution;
+};
+
+ContactRun run(const ParameterOverrides& overrides = {}) {
+  ContactRun r;
+  r.c = load_case(testing::case_path("wall.toml"), overrides);
+  r.solve = solve_with_contacts(r.c.definition, r.c.start_guess);
+  r.problem = std::make_unique<ShootingProblem>(r.solve.definition);
+  r.solution = make_solution(*r.problem, r.solve.result, 401, r.c.derived);
+  return r;
+}
+
+TEST(PointContact, WallFoundFromTheFreeArchAgreesWithTheEllipticSolution) {
+  const ContactRun r = run();
+  ASSERT_TRUE(r.solve.result.summary.converged()) << r.solve.result.summary.brief_report();
+  ASSERT_TRUE(r.solve.complementarity) << r.solve.message;
+  // One round: the free arch penetrates at mid-span, a contact is added there.
+  ASSERT_EQ(r.solve.log.size(), 1u);
+  EXPECT_NE(r.solve.log[0].find("add a contact"), std::string::npos);
+  ASSERT_EQ(r.solution.contacts.size(), 1u);
+  // Shooting (Newton to 1e-12) and Jacobi elliptic functions: ~1e-12 apart; 1e-8 is the bar.
+  const auto exact = analytic::wall_contact_elastica(1.0, 1.0, 0.026, 0.1);
+  const auto& d = r.solution.derived;
+  EXPECT_NEAR(d.at("P") / exact.P, 1.0, 1e-8);
+  EXPECT_NEAR(d.at("contact_force") / exact.contact_force, 1.0, 1e-8);
+  EXPECT_NEAR(d.at("kappa_contact") / exact.kappa_c, 1.0, 1e-8);
+  EXPECT_NEAR(d.at("H") / exact.H, 1.0, 1e-8);
+  EXPECT_NEAR(d.at("contact_s"), 0.5, 1e-9);  // symmetry, not imposed
+  // Complementarity: never inside the wall, touching where the force acts.
+  EXPECT_GE(d.at("min_gap"), -1e-10);
+  EXPECT_GT(r.solution.contacts[0].force, 0.0);
+  // H is the same on both sides of the contact (section 6.3): flat over the whole rod.
+  EXPECT_LE(r.solution.invariants.H.relative_spread(), 1e-9);
+  const RodModel& model = r.problem->equations(r.solve.result.parameters)->model();
+  const double s_c = r.solution.contacts[0].s;
+  const auto sides = r.problem->sample(r.solve.result.x, {s_c - 1e-3, s_c + 1e-3});
+  const double before = hamiltonian(model, sides[0]), after = hamiltonian(model, sides[1]);
+  EXPECT_NEAR(before, after, 1e-9 * std::abs(before));
+  // ... while n_y jumps by the contact force there (eq. 63).
+  EXPECT_NEAR(sides[1].n.y() - sides[0].n.y(), r.solution.contacts[0].force, 1e-9 * exact.contact_force);
+}
+
+TEST(PointContact, NoContactWhenTheWallIsOutOfReach) {
+  const ContactRun r = run({{"a", 0.2}});
+  ASSERT_TRUE(r.solve.complementarity);
+  EXPECT_TRUE(r.solution.contacts.empty());
+  EXPECT_GT(r.solution.derived.at("min_gap"), 0.05);
+}
+
+TEST(PointContact, AnEndInsideTheObstacleIsInfeasible) {
+  const Case c = load_case(testing::case_path("wall.toml"), {{"a", -0.01}});
+  try {
+    solve_with_contacts(c.definition, c.start_guess);
+    FAIL() << "expected InfeasibleContact";
+  } catch (const InfeasibleContact& e) {
+    EXPECT_NE(std::string(e.what()).find("inside obstacle 'wall'"), std::string::npos) << e.what();
+  }
+}
+
+TEST(PointContact, JacobianThroughTheContactEqualsFiniteDifferences) {
+  const ContactRun r = run();
+  // Away from the solution, as in jacobian_test.cpp (tolerance justified there).
+  Eigen::VectorXd x = r.solve.result.x;
+  for (int i = 0; i < x.size(); ++i) x[i] += 0.01 * std::sin(1.0 + 2.3 * i);
+  Eigen::VectorXd F;
+  Eigen::MatrixXd J, J_fd;
+  std::string failure;
+  ASSERT_TRUE(r.problem->evaluate(x, &F, &J, &failure)) << failure;
+  ASSERT_TRUE(finite_difference_jacobian(*r.problem, x, 1e-6, &J_fd));
+  EXPECT_LE((J - J_fd).cwiseAbs().maxCoeff(), 1e-6 * std::max(1.0, J.cwiseAbs().maxCoeff()));
+}
+
+ContactContinuationResult continue_wall(double to) {
+  const Case c = load_case(testing::case_path("wall.toml"), {{"Delta", 0.005}, {"m_guess", 0.9}});
+  ContinuationOptions o;
+  o.parameter = "Delta";
+  o.target = to;
+  o.max_step = 2.0;
+  o.max_points = 1000;
+  o.derived = {"P", "contact_force", "kappa_contact", "H"};
+  return continue_with_contacts(c.definition, c.start_guess, o);
+}
+
+TEST(ContactContinuation, FromTheFreeArchThroughFirstContact) {
+  const ContactContinuationResult r = continue_wall(0.026);
+  ASSERT_EQ(r.result.reason, StopReason::ReachedTarget) << r.result.message;
+  ASSERT_EQ(r.changes.size(), 1u);
+  EXPECT_NE(r.changes[0].find("a contact appears"), std::string::npos);
+  int events = 0;
+  for (const auto& p : r.result.points) events += p.type == PointType::Event ? 1 : 0;
+  EXPECT_EQ(events, 1);
+  // The free clamped-clamped arch first touches at y_max = a; its end shortening is where the
+  // event was located (before it no contact, after it one).
+  const auto& last = r.result.points.back();
+  const auto exact = analytic::wall_contact_elastica(1.0, 1.0, 0.026, 0.1);
+  // The corrector stops at |F| <= 1e-10: P to ~1e-10 relative.
+  EXPECT_NEAR(last.derived.at("P") / exact.P, 1.0, 1e-8);
+  EXPECT_NEAR(last.derived.at("contact_force") / exact.contact_force, 1.0, 1e-8);
+  for (const auto& p : r.result.points) EXPECT_TRUE(p.H_flat) << "Delta = " << p.parameter;
+}
+
+TEST(ContactContinuation, StopsWhereThePointContactBecomesExtended) {
+  const ContactContinuationResult r = continue_wall(0.035);
+  ASSERT_EQ(r.changes.size(), 2u);
+  EXPECT_NE(r.result.message.find("extended contact"), std::string::npos);
+  // There the curvature at the contact has fallen to ~0, so H = EI kappa_c^2/2 - P ~ -P: the
+  // flat-contact value of section 7.2.
+  const auto& at = r.result.points.back();
+  EXPECT_LT(std::abs(at.derived.at("kappa_contact")), 0.05);
+  EXPECT_NEAR(at.derived.at("H"), -at.derived.at("P"), 1e-3);
+}
+
+}  // namespace
+}  // namespace kirchhoff
