@@ -4,6 +4,7 @@
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/contact.hpp"
+#include "kirchhoff/discrete_elastica.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {
@@ -123,6 +124,40 @@ TEST(ContactContinuation, StopsWhereThePointContactBecomesExtended) {
   const auto& at = r.result.points.back();
   EXPECT_LT(std::abs(at.derived.at("kappa_contact")), 0.05);
   EXPECT_NEAR(at.derived.at("H"), -at.derived.at("P"), 1e-3);
+}
+
+}  // namespace
+}  // namespace kirchhoff
+
+namespace kirchhoff {
+namespace {
+
+// Ipopt on the discretised energy (midpoint rule, second order) converges to the shooting
+// solution at the rate 1/N^2, and its contact multiplier to the contact force.
+TEST(DiscreteEnergy, IpoptConvergesToTheShootingSolutionAtSecondOrder) {
+  const Case c = load_case(testing::case_path("wall.toml"));
+  const ContactSolveResult shooting = solve_with_contacts(c.definition, c.start_guess);
+  ASSERT_TRUE(shooting.complementarity);
+  const ShootingProblem problem(shooting.definition);
+  const Solution exact = make_solution(problem, shooting.result, 101, {"P", "contact_force"});
+  const std::vector<PlaneObstacle> wall{{Vec3(0, 0.1, 0), Vec3(0, -1, 0), "wall"}};
+  std::vector<double> error_P, error_F, P;
+  for (int N : {50, 100, 200}) {
+    const DiscreteElasticaResult d = solve_discrete_clamped_elastica(1.0, 1.0, 0.026, wall, N);
+    ASSERT_TRUE(d.converged) << d.status;
+    EXPECT_GE(d.min_gap, -1e-12);  // no penetration at the nodes (bounds are not relaxed)
+    P.push_back(d.P);
+    error_P.push_back(std::abs(d.P - exact.derived.at("P")));
+    error_F.push_back(std::abs(d.contact_force - exact.derived.at("contact_force")));
+  }
+  for (int k = 0; k + 1 < 3; ++k) {
+    // Halving h divides the error by 4 (observed 3.96-4.00).
+    EXPECT_NEAR(error_P[k] / error_P[k + 1], 4.0, 0.2) << k;
+    EXPECT_NEAR(error_F[k] / error_F[k + 1], 4.0, 0.3) << k;
+  }
+  // Richardson's extrapolation of the two finest removes the h^2 term: ~4e-7 left (the h^4 one).
+  const double extrapolated = (4.0 * P[2] - P[1]) / 3.0;
+  EXPECT_NEAR(extrapolated / exact.derived.at("P"), 1.0, 1e-6);
 }
 
 }  // namespace
