@@ -1,5 +1,7 @@
 #include "kirchhoff/boundary_conditions.hpp"
 
+#include "kirchhoff/invariants.hpp"
+
 #include <Eigen/Geometry>
 #include <cmath>
 #include <sstream>
@@ -110,8 +112,13 @@ EndCondition& EndCondition::impose_orientation_angle(Vec3 axis, std::function<do
   return add(std::move(c));
 }
 
+EndCondition& EndCondition::impose_hamiltonian(std::function<double(const Parameters&)> value) {
+  hamiltonian_ = std::move(value);
+  return *this;
+}
+
 int EndCondition::extra_count() const {
-  int n = 0;
+  int n = hamiltonian_ ? 1 : 0;
   for (const auto& c : conditions_) n += c.extra ? static_cast<int>(1) : 0;
   return n;
 }
@@ -180,6 +187,23 @@ void EndCondition::append_residuals(const RodEquations& eq, bool at_start, const
     for (int j = 0; j < B.cols(); ++j) {
       residual->push_back(B.col(j).dot(error));
       if (jacobian) jacobian->push_back(B.col(j).transpose() * J);
+    }
+  }
+  if (hamiltonian_) {
+    const double s = at_start ? 0.0 : eq.model().length;
+    auto H = [&](const Eigen::VectorXd& state) { return hamiltonian(eq.model(), eq.point(state, s)); };
+    residual->push_back(H(y) - hamiltonian_(p));
+    if (jacobian) {
+      // Central differences of a closed-form function of the state (no integration).
+      Eigen::RowVectorXd row(y.size());
+      for (int i = 0; i < y.size(); ++i) {
+        const double h = 1e-7 * (1.0 + std::abs(y[i]));
+        Eigen::VectorXd plus = y, minus = y;
+        plus[i] += h;
+        minus[i] -= h;
+        row[i] = (H(plus) - H(minus)) / (2.0 * h);
+      }
+      jacobian->push_back(row);
     }
   }
 }

@@ -62,8 +62,14 @@ class EndCondition {
   EndCondition& add(SlotCondition condition);
   // Extra condition: the frame's rotation about `axis` equals `angle` (e.g. theta(0) = theta0).
   EndCondition& impose_orientation_angle(Vec3 axis, std::function<double(const Parameters&)> angle);
+  // Extra condition: the arclength Hamiltonian H = n.v + m.u - V (eq. 29) at this end equals
+  // `value`. This is the configurational force balance of an end sliding out of a frictionless
+  // sleeve: H is continuous across the exit (sections 6.3, 7.3), and inside the straight sleeve
+  // it is the inner tension (e.g. -P for a rod pushed by P, 0 for an unloaded end: eq. 55, Fig. 8).
+  EndCondition& impose_hamiltonian(std::function<double(const Parameters&)> value);
 
   const std::vector<SlotCondition>& conditions() const { return conditions_; }
+  bool has_hamiltonian_condition() const { return static_cast<bool>(hamiltonian_); }
   int extra_count() const;
 
   // Checks that each work-conjugate pair is imposed exactly once along every admissible
@@ -80,6 +86,7 @@ class EndCondition {
 
  private:
   std::vector<SlotCondition> conditions_;
+  std::function<double(const Parameters&)> hamiltonian_;  // extra H condition, if any
 };
 
 VectorTarget constant(const Vec3& v);

@@ -154,7 +154,7 @@ EndCondition read_end(const Reader& reader, const Value& root, const std::string
   const Value* table = Reader::find(root, name);
   if (!table) reader.fail(name, "missing table [" + name + "] (the boundary condition at that end)");
   reader.allow_keys(*table, name, {"type", "position", "orientation", "track_turns", "force", "moment", "axis",
-                                   "extra_angle", "extra_angle_axis"});
+                                   "extra_angle", "extra_angle_axis", "extra_hamiltonian"});
   const Value* type_value = Reader::find(*table, "type");
   if (!type_value) reader.fail(*table, name + ".type", "missing (clamped, pinned, free, loaded or sliding)");
   const std::string type = reader.string(*type_value, name + ".type");
@@ -169,7 +169,7 @@ EndCondition read_end(const Reader& reader, const Value& root, const std::string
   if (it == keys_for_type.end())
     reader.fail(*type_value, name + ".type", "'" + type + "' is not one of: clamped, pinned, free, loaded, sliding");
   std::set<std::string> allowed = it->second;
-  allowed.insert({"type", "extra_angle", "extra_angle_axis"});
+  allowed.insert({"type", "extra_angle", "extra_angle_axis", "extra_hamiltonian"});
   for (const auto& [key, value] : table->as_table())
     if (!allowed.count(key))
       reader.fail(value, name + "." + key, "does not apply to a " + type + " end (allowed: " + join(allowed) + ")");
@@ -220,6 +220,10 @@ EndCondition read_end(const Reader& reader, const Value& root, const std::string
     if (axis) check_rotation_axis(reader, *axis, name + ".extra_angle_axis", a, kind, true);
     const Expression e = reader.expression(*angle, name + ".extra_angle");
     end.impose_orientation_angle(a, [e](const Parameters& p) { return e(p); });
+  }
+  if (const Value* h = Reader::find(*table, "extra_hamiltonian")) {
+    const Expression e = reader.expression(*h, name + ".extra_hamiltonian");
+    end.impose_hamiltonian([e](const Parameters& p) { return e(p); });
   }
   return end;
 }

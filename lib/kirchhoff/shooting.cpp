@@ -1,5 +1,6 @@
 #include "kirchhoff/shooting.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -376,7 +377,9 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
       const bool last = c == contacts.size();
       const double s1 = last ? L : contacts[c].s;
       std::vector<double> local{s0};
-      while (k < s.size() && (s[k] < s1 || (last && s[k] <= s1))) local.push_back(s[k++]);
+      // The last piece takes every remaining point: an arclength computed as L * i / n can exceed
+      // L by an ulp.
+      while (k < s.size() && (s[k] < s1 || last)) local.push_back(std::min(s[k++], s1));
       if (local.size() > 1) {
         const auto states = eq->sample(y, local, definition_.options.integrator);
         for (size_t j = 1; j < states.size(); ++j) out.push_back(eq->point(states[j], local[j]));
@@ -391,7 +394,7 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
   for (int i = 0; i < M; ++i) {
     const double s0 = L * i / M, s1 = L * (i + 1) / M;
     std::vector<double> local{s0};
-    while (k < s.size() && (s[k] < s1 || (i + 1 == M && s[k] <= s1))) local.push_back(s[k++]);
+    while (k < s.size() && (s[k] < s1 || i + 1 == M)) local.push_back(std::min(s[k++], s1));
     if (local.size() == 1) continue;
     const auto states = eq->sample(x.segment(i * n, n), local, definition_.options.integrator);
     for (size_t j = 1; j < states.size(); ++j) out.push_back(eq->point(states[j], local[j]));

@@ -30,6 +30,21 @@ double refined_maximum(const ShootingProblem& problem, const Eigen::VectorXd& x,
 
 double curvature(const RodPoint& p) { return std::hypot(p.u[0], p.u[1]); }
 
+// Composite Simpson on a fine sampling (one integration pass): a soft wall's potential is peaked
+// over a width ~sqrt(gap / kappa) ~ 1e-2 at b = 1e-6, which 4000 intervals resolve to ~1e-7
+// relative; smooth integrands (the elastic energy) come out to ~1e-12.
+double integral_along(const ShootingProblem& problem, const Eigen::VectorXd& x, double L,
+                      const PointFunction& f) {
+  constexpr int kIntervals = 4000;
+  std::vector<double> s(kIntervals + 1);
+  for (int i = 0; i <= kIntervals; ++i) s[i] = L * i / kIntervals;
+  s.back() = L;
+  const auto points = problem.sample(x, s);
+  double sum = 0.0;
+  for (int i = 0; i <= kIntervals; ++i) sum += (i == 0 || i == kIntervals ? 1.0 : (i % 2 ? 4.0 : 2.0)) * f(points[i]);
+  return sum * (L / kIntervals) / 3.0;
+}
+
 const std::map<std::string, std::string> kCatalogue = {
     {"P", "compressive end load -n_x(0)"},
     {"theta0", "angle of the tangent d3(0) to the x axis, in the (x, y) plane"},
@@ -46,10 +61,14 @@ const std::map<std::string, std::string> kCatalogue = {
     {"H_spread", "max - min of H along the rod"},
     {"stretch_max", "largest axial strain |v3 - 1| along the rod"},
     {"E_wall", "integral of the external potential along the rod (eq. 69 for the soft wall)"},
+    {"elastic_energy", "integral of W_bend + W_shear along the rod"},
     {"gap", "smallest distance to a soft wall along the rod (eq. 64's a - y)"},
     {"ny_jump", "n_y(L) - n_y(0): the wall's total reaction (eq. 66)"},
     {"kappa_mid", "curvature u2 at s = L/2 (signed, planar)"},
     {"kappa_end", "curvature u2 at s = L (signed, planar)"},
+    {"kappa_start", "curvature u2 at s = 0 (signed, planar)"},
+    {"H_start", "H at s = 0"},
+    {"H_end", "H at s = L"},
     {"contact_force", "sum of the point-contact forces"},
     {"contact_count", "number of point contacts"},
     {"min_contact_force", "smallest point-contact force (NaN without contacts)"},
@@ -83,19 +102,15 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
   if (name == "H") return sol.invariants.H.mean;
   if (name == "H_spread") return sol.invariants.H.spread;
   if (name == "E_wall") {
-    // Composite Simpson on a fine sampling (one integration pass): the soft wall's potential is
-    // peaked over a width ~sqrt(gap / kappa) ~ 1e-2 at b = 1e-6, which 4000 intervals resolve
-    // to ~1e-7 relative.
     const RodModel& model = problem.equations(sol.result.parameters)->model();
     if (!model.field) return 0.0;
-    constexpr int kIntervals = 4000;
-    std::vector<double> s(kIntervals + 1);
-    for (int i = 0; i <= kIntervals; ++i) s[i] = b.s * i / kIntervals;
-    const auto points = problem.sample(x, s);
-    double sum = 0.0;
-    for (int i = 0; i <= kIntervals; ++i)
-      sum += (i == 0 || i == kIntervals ? 1.0 : (i % 2 ? 4.0 : 2.0)) * model.field->potential(points[i].r);
-    return sum * (b.s / kIntervals) / 3.0;
+    return integral_along(problem, x, b.s, [&](const RodPoint& p) { return model.field->potential(p.r); });
+  }
+  if (name == "elastic_energy") {
+    const RodModel& model = problem.equations(sol.result.parameters)->model();
+    return integral_along(problem, x, b.s, [&](const RodPoint& p) {
+      return energy_density(model, p) - (model.field ? model.field->potential(p.r) : 0.0);
+    });
   }
   if (name == "gap") {
     const RodModel& model = problem.equations(sol.result.parameters)->model();
@@ -104,6 +119,11 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
   }
   if (name == "ny_jump") return b.n.y() - a.n.y();
   if (name == "kappa_end") return b.u[1];
+  if (name == "kappa_start") return a.u[1];
+  if (name == "H_start" || name == "H_end") {
+    const RodModel& model = problem.equations(sol.result.parameters)->model();
+    return hamiltonian(model, name == "H_start" ? a : b);
+  }
   if (name == "contact_force") {
     double total = 0.0;
     for (const auto& c : sol.contacts) total += c.force;
@@ -156,6 +176,7 @@ Solution make_solution(const ShootingProblem& problem, ShootingResult result, in
   const double L = problem.length(sol.result.parameters);
   std::vector<double> s(n_samples);
   for (int i = 0; i < n_samples; ++i) s[i] = L * i / (n_samples - 1);
+  s.back() = L;  // exactly: L * (n - 1) / (n - 1) may differ from L by an ulp
   sol.profile = problem.sample(sol.result.x, s);
   sol.contacts = problem.contacts_at(sol.result.x);
   sol.invariants = compute_invariants(problem.equations(sol.result.parameters)->model(), sol.profile);
