@@ -330,6 +330,26 @@ void wall(const fs::path& cases, const fs::path& out, std::vector<ReportRow>* ro
                    finest.at("kappa_mid"), 1.0, 0.0, ""});
 }
 
+// Figs. 6-8: the sliding sleeve (eq. 55) and the arm scale (horizontal tangent at the load).
+void sleeves(const fs::path& cases, const fs::path& out, std::vector<ReportRow>* rows) {
+  const Solved sleeve = solve_case(cases / "sleeve.toml", {}, 201);
+  const auto& d = sleeve.solution.derived;
+  const double P = sleeve.solution.result.parameters["P"], P_prime = sleeve.solution.result.parameters["P_prime"];
+  const double kB = d.at("kappa_end");
+  rows->push_back({"eq. (55)", "P + EI kappa_B^2 / 2 (= P')", {}, P_prime, P + 0.5 * kB * kB, P_prime, 1e-9,
+                   "length outside the sleeve solved for: " + format_short(sleeve.solution.result.parameters["ell"])});
+  rows->push_back({"Fig. 7", "H_out at the exit (= H_in = -P)", {}, -P, d.at("H_end"), P, 1e-9, ""});
+  const Solved arm = solve_case(cases / "arm_scale.toml", {}, 201);
+  rows->push_back({"Fig. 8", "theta_C, tangent at the weight (horizontal)", 0.0, 0.0, arm.solution.derived.at("theta_end"),
+                   1.0, 1e-9, "H_A = 0 = H_C = -W sin(theta_C)"});
+  for (const auto& [name, s] : {std::pair{"fig6_sleeve.csv", &sleeve}, std::pair{"fig8_arm_scale.csv", &arm}}) {
+    std::ofstream csv(out / name);
+    csv.precision(15);
+    csv << "s,x,y\n";
+    for (const auto& p : s->solution.profile) csv << p.s << ',' << p.r.x() << ',' << p.r.y() << '\n';
+  }
+}
+
 std::string format(const std::optional<double>& v) {
   if (!v) return "";
   std::ostringstream os;
@@ -385,6 +405,8 @@ int run_reproduce(const std::string& out_dir, const std::string& cases_dir) {
     invariants(cases, &rows);
     progress("Continuation: Euler column and twisted rod bifurcations");
     continuation(cases, out / "profiles", &rows);
+    progress("Figs. 6-8: sliding sleeve and arm scale");
+    sleeves(cases, out / "profiles", &rows);
     progress("Fig. 12: hard and soft walls");
     wall(cases, out / "profiles", &rows);
   } catch (const std::exception& e) {

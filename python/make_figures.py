@@ -100,6 +100,30 @@ def fig12(profiles, figures):
     plt.close(fig)
 
 
+def sleeves(profiles, figures):
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 3.6))
+    d = read(profiles / "fig6_sleeve.csv")
+    ax.plot(d["x"], d["y"], label="outside (AB)")
+    ax.plot([0, 0.6], [0, 0], "-", lw=6, color="gray", alpha=0.5, label="sleeve (BC inside)")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x / L")
+    ax.set_ylabel("y / L")
+    ax.set_title("Figs. 6-7: Elastica out of a sliding sleeve, P' = P + EI $\\kappa_B^2$/2")
+    ax.legend(fontsize=8)
+    d = read(profiles / "fig8_arm_scale.csv")
+    ax2.plot(d["x"], d["y"], label="rod outside the sleeve")
+    ax2.plot([-0.4 * np.cos(0.3), 0], [-0.4 * np.sin(0.3), 0], "-", lw=6, color="gray", alpha=0.5, label="sleeve")
+    ax2.plot(d["x"][-1], d["y"][-1], "v", ms=10, label="weight W (tangent horizontal)")
+    ax2.set_aspect("equal")
+    ax2.set_xlabel("x / L")
+    ax2.set_ylabel("y / L")
+    ax2.set_title("Fig. 8: the Elastica arm scale")
+    ax2.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(figures / "fig6_fig8_sleeves.png", dpi=130)
+    plt.close(fig)
+
+
 def euler_branch(profiles, figures):
     d = read(profiles / "euler_buckled_branch.csv")
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -118,7 +142,7 @@ def main(out):
     out = pathlib.Path(out)
     profiles, figures = out / "profiles", out / "figures"
     figures.mkdir(parents=True, exist_ok=True)
-    for make in (fig3, fig9, fig12, euler_branch):
+    for make in (fig3, fig9, fig12, euler_branch, sleeves):
         make(profiles, figures)
         print(f"  {make.__name__}: written", file=sys.stderr)
 
