@@ -192,29 +192,33 @@ Eigen::VectorXd ShootingProblem::condition_rows(const Eigen::VectorXd& y0, const
   return Eigen::Map<Eigen::VectorXd>(rows.data(), static_cast<Eigen::Index>(rows.size()));
 }
 
+int ShootingProblem::start_rows(const RodEquations& eq, const Eigen::VectorXd& y0, const Parameters& p,
+                                Eigen::VectorXd* F, Eigen::MatrixXd* J) const {
+  const int n = state_size_;
+  F->resize(residual_count_);
+  if (J) J->setZero(residual_count_, size());
+  Eigen::MatrixXd Jg;
+  const Eigen::VectorXd g = eq.gauge_residual(y0, J ? &Jg : nullptr);
+  F->head(g.size()) = g;
+  if (J) J->block(0, 0, g.size(), n) = Jg;
+  int row = static_cast<int>(g.size());
+  ConditionRows start;
+  definition_.start.append_residuals(eq, true, y0, p, &start.values, J ? &start.jacobian : nullptr);
+  for (size_t k = 0; k < start.values.size(); ++k, ++row) {
+    (*F)[row] = start.values[k];
+    if (J) J->block(row, 0, 1, n) = start.jacobian[k];
+  }
+  return row;
+}
+
 bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
                                Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const {
   if (!definition_.contacts.empty()) return residual_with_contacts(x, p, F, J, failure, y_end);
   const auto eq = equations(p);
   const int n = state_size_, M = segments();
   const double L = eq->model().length;
-  F->resize(residual_count_);
-  if (J) J->setZero(residual_count_, size());
-  int row = 0;
-
   const Eigen::VectorXd y0 = x.head(n);
-  Eigen::MatrixXd Jg;
-  const Eigen::VectorXd g = eq->gauge_residual(y0, J ? &Jg : nullptr);
-  F->segment(row, g.size()) = g;
-  if (J) J->block(row, 0, g.size(), n) = Jg;
-  row += static_cast<int>(g.size());
-
-  ConditionRows start;
-  definition_.start.append_residuals(*eq, true, y0, p, &start.values, J ? &start.jacobian : nullptr);
-  for (size_t k = 0; k < start.values.size(); ++k, ++row) {
-    (*F)[row] = start.values[k];
-    if (J) J->block(row, 0, 1, n) = start.jacobian[k];
-  }
+  int row = start_rows(*eq, y0, p, F, J);
 
   SegmentFlow last;
   try {
@@ -261,21 +265,8 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
       return false;
     }
   }
-  F->resize(residual_count_);
-  if (J) J->setZero(residual_count_, N);
-  int row = 0;
   const Eigen::VectorXd y0 = x.head(n);
-  Eigen::MatrixXd Jg;
-  const Eigen::VectorXd g = eq->gauge_residual(y0, J ? &Jg : nullptr);
-  F->segment(row, g.size()) = g;
-  if (J) J->block(row, 0, g.size(), n) = Jg;
-  row += static_cast<int>(g.size());
-  ConditionRows start;
-  definition_.start.append_residuals(*eq, true, y0, p, &start.values, J ? &start.jacobian : nullptr);
-  for (size_t k = 0; k < start.values.size(); ++k, ++row) {
-    (*F)[row] = start.values[k];
-    if (J) J->block(row, 0, 1, n) = start.jacobian[k];
-  }
+  int row = start_rows(*eq, y0, p, F, J);
 
   // S = dy/dx of the current state, carried through segments and jumps.
   Eigen::MatrixXd S = Eigen::MatrixXd::Zero(n, N);

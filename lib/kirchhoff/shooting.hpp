@@ -115,6 +115,9 @@ class ShootingProblem final : public NonlinearSystem {
  private:
   bool residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F, Eigen::MatrixXd* J,
                 std::string* failure, Eigen::VectorXd* y_end = nullptr) const;
+  // Sizes F (and J) and fills the gauge and start-condition rows; returns the next row.
+  int start_rows(const RodEquations& eq, const Eigen::VectorXd& y0, const Parameters& p, Eigen::VectorXd* F,
+                 Eigen::MatrixXd* J) const;
   // The rows of F that come from the boundary conditions, at fixed end states.
   Eigen::VectorXd condition_rows(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end, const Parameters& p) const;
   // Scatters condition rows (start then end) into a full-length residual column.
