@@ -24,6 +24,7 @@
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/case_file.hpp"
+#include "kirchhoff/contact.hpp"
 #include "kirchhoff/continuation.hpp"
 #include "kirchhoff/invariants.hpp"
 #include "kirchhoff/shooting.hpp"
@@ -131,6 +132,7 @@ struct PySolution {
   long rhs_evaluations = 0;
   std::vector<double> history;
   py::dict parameters, derived, invariants, profile;
+  py::list contacts;  // [{"s", "s_end", "force", "obstacle"}], as the CLI's JSON
 };
 
 struct PyBranch {
@@ -178,8 +180,27 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg) {
     py::gil_scoped_release release;
     problem = std::make_unique<ShootingProblem>(c.definition);
     Eigen::VectorXd x0;
+    ShootingResult contact_result;
+    bool contact_solved = false;
     try {
-      x0 = problem->initial_unknowns(c.start_guess);
+      if (c.definition.obstacles.empty()) {
+        x0 = problem->initial_unknowns(c.start_guess);
+      } else {
+        // As the CLI: the active-set loop finds the point contacts.
+        ContactSolveResult contact = solve_with_contacts(c.definition, c.start_guess);
+        problem = std::make_unique<ShootingProblem>(contact.definition);
+        contact_result = contact.result;
+        if (contact_result.summary.converged() && !contact.complementarity) {
+          contact_result.summary.status = SolverStatus::MaxIterations;
+          contact_result.summary.message = contact.message;
+        }
+        contact_solved = true;
+      }
+    } catch (const InfeasibleContact& e) {
+      integration_failed = true;
+      failed.summary.status = SolverStatus::MaxIterations;
+      failed.summary.residual_norm = INFINITY;
+      failed.summary.message = std::string("infeasible: ") + e.what();
     } catch (const IntegrationError& e) {
       integration_failed = true;
       failed.summary.status = SolverStatus::IntegrationFailed;
@@ -188,7 +209,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg) {
       failed.summary.message = std::string("the initial guess cannot be integrated: ") + e.what();
     }
     if (!integration_failed) {
-      ShootingResult result = solve(*problem, x0);
+      ShootingResult result = contact_solved ? contact_result : solve(*problem, x0);
       if (result.summary.converged())
         sol = std::make_unique<Solution>(make_solution(*problem, std::move(result), samples, c.derived));
       else
@@ -213,6 +234,14 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg) {
   for (const auto& name : c.derived) out.derived[py::str(name)] = sol->derived.at(name);
   out.invariants = invariants_dict(sol->invariants);
   out.profile = profile_dict(problem->equations(sol->result.parameters)->model(), sol->profile);
+  for (const auto& contact : sol->contacts) {
+    py::dict d;
+    d["s"] = contact.s;
+    d["s_end"] = contact.s;
+    d["force"] = contact.force;
+    d["obstacle"] = contact.obstacle;
+    out.contacts.append(d);
+  }
   return out;
 }
 
@@ -317,10 +346,19 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
     Continuation run(problem, first);
     ContinuationResult result;
     try {
-      result = run.run(problem.initial_unknowns(c.start_guess), check_signals);
+      if (!d.obstacles.empty()) {
+        // Contact: the active set changes along the branch (no branch switching there yet).
+        if (switch_at_bp > 0) throw CaseError("switch_at_bp is not implemented for cases with obstacles yet");
+        result = continue_with_contacts(d, c.start_guess, options, check_signals).result;
+      } else {
+        result = run.run(problem.initial_unknowns(c.start_guess), check_signals);
+      }
     } catch (const IntegrationError& e) {
       result.reason = StopReason::StartFailed;
       result.message = std::string("the initial guess cannot be integrated: ") + e.what();
+    } catch (const InfeasibleContact& e) {
+      result.reason = StopReason::StartFailed;
+      result.message = std::string("infeasible: ") + e.what();
     }
     keep(result, 0);
     if (switch_at_bp > 0 && result.reason != StopReason::BranchPointStop) {
@@ -414,6 +452,7 @@ Attributes:
       .def_readonly("message", &PySolution::message)
       .def_readonly("used_fallback_search", &PySolution::used_fallback_search)
       .def_readonly("rhs_evaluations", &PySolution::rhs_evaluations)
+      .def_readonly("contacts", &PySolution::contacts, "Point contacts: list of {s, s_end, force, obstacle}")
       .def_readonly("history", &PySolution::history)
       .def_readonly("parameters", &PySolution::parameters)
       .def_readonly("derived", &PySolution::derived)

@@ -135,6 +135,30 @@ class SolveTest(unittest.TestCase):
         self.assertEqual(sol.parameters["theta0"], 2.5)
 
 
+class ContactTest(unittest.TestCase):
+    def test_wall_contact_like_the_cli(self):
+        sol = kirchhoff.load_case(case_path("wall.toml")).solve()
+        self.assertEqual(sol.status, "converged")
+        self.assertEqual(len(sol.contacts), 1)
+        # The elliptic-function value (tests/contact_test.cpp): F_c = 18.2038121699.
+        self.assertAlmostEqual(sol.contacts[0]["force"], 18.2038121699, places=8)
+        self.assertAlmostEqual(sol.contacts[0]["s"], 0.5, places=9)
+        self.assertGreaterEqual(sol.derived["min_gap"], -1e-10)
+
+    def test_infeasible_wall_is_a_status(self):
+        sol = kirchhoff.load_case(case_path("wall.toml"), set={"a": -0.01}).solve()
+        self.assertFalse(sol.converged)
+        self.assertIn("infeasible", sol.message)
+
+    def test_continuation_records_the_first_contact(self):
+        branch = kirchhoff.load_case(case_path("wall.toml"), set={"Delta": 0.005, "m_guess": 0.9}).continue_(
+            "Delta", to=0.026, max_step=2.0)
+        self.assertEqual(branch.reason, "reached_target")
+        events = [e for e in branch.points["event"] if e]
+        self.assertEqual(len(events), 1)
+        self.assertIn("a contact appears", events[0])
+
+
 class ContinuationTest(unittest.TestCase):
     """The Euler column from P = 1 along the straight branch, switching at the first branch point
     onto the buckled one, which is followed until theta0 = 3 (as tests/continue_cli_test.cpp)."""
