@@ -60,8 +60,17 @@ class PlanarEquations final : public RodEquations {
   SegmentFlow flow(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities,
                    const IntegratorOptions& options) const override {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
-    return sensitivities ? detail::flow_with_sensitivities<kStateSize>(f, y0, s0, s1, options)
-                         : detail::flow_state<kStateSize>(f, y0, s0, s1, options);
+    if (!sensitivities) return detail::flow_state<kStateSize>(f, y0, s0, s1, options);
+    if (model_.field) return detail::flow_with_sensitivities<kStateSize>(f, y0, s0, s1, options);
+    // Without a field nothing depends on x(s0), y(s0): their columns of Phi are unit vectors.
+    constexpr std::array<int, 4> kSeeds{kTheta, kNx, kNy, kMoment};
+    SegmentFlow partial = detail::flow_with_partial_sensitivities<kStateSize, 4>(f, y0, s0, s1, options, kSeeds);
+    Eigen::MatrixXd Phi = Eigen::MatrixXd::Zero(kStateSize, kStateSize);
+    for (int j = 0; j < 4; ++j) Phi.col(kSeeds[j]) = partial.Phi.col(j);
+    Phi(kX, kX) = 1.0;
+    Phi(kY, kY) = 1.0;
+    partial.Phi = std::move(Phi);
+    return partial;
   }
 
   std::vector<Eigen::VectorXd> sample(const Eigen::VectorXd& y0, const std::vector<double>& s,
