@@ -61,7 +61,10 @@ ShootingProblem::ShootingProblem(ProblemDefinition definition) : definition_(std
     for (const auto& c : definition_.contacts)
       if (c.obstacle < 0 || c.obstacle >= static_cast<int>(definition_.obstacles.size()))
         throw std::invalid_argument("contact on obstacle " + std::to_string(c.obstacle) + ", which does not exist");
-    residual_count_ += 2 * static_cast<int>(definition_.contacts.size());
+    for (const auto& c : definition_.contacts) {
+      residual_count_ += c.unknowns();
+      if (c.extended && !eq->is_planar()) throw std::invalid_argument("extended contact is for planar rods");
+    }
   }
   for (auto& o : definition_.obstacles) {
     if (!(o.normal.norm() > 0)) throw std::invalid_argument("obstacle '" + o.name + "': the normal must be non-zero");
@@ -73,15 +76,27 @@ ShootingProblem::ShootingProblem(ProblemDefinition definition) : definition_(std
 }
 
 int ShootingProblem::size() const {
-  return segments() * state_size_ + static_cast<int>(unknown_index_.size()) +
-         2 * static_cast<int>(definition_.contacts.size());
+  int n = segments() * state_size_ + static_cast<int>(unknown_index_.size());
+  for (const auto& c : definition_.contacts) n += c.unknowns();
+  return n;
+}
+
+int ShootingProblem::contact_column(size_t k) const {
+  int column = contact_offset();
+  for (size_t i = 0; i < k; ++i) column += definition_.contacts[i].unknowns();
+  return column;
 }
 
 std::vector<PointContact> ShootingProblem::contacts_at(const Eigen::VectorXd& x) const {
   std::vector<PointContact> out = definition_.contacts;
   for (size_t k = 0; k < out.size(); ++k) {
-    out[k].s = x[contact_offset() + 2 * k];
-    out[k].force = x[contact_offset() + 2 * k + 1];
+    const int c = contact_column(k);
+    out[k].s = x[c];
+    out[k].force = x[c + 1];
+    if (out[k].extended) {
+      out[k].s_end = x[c + 2];
+      out[k].force_end = x[c + 3];
+    }
   }
   return out;
 }
@@ -252,15 +267,50 @@ bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Ei
   return true;
 }
 
+namespace {
+
+// A place where n jumps: a point contact, or either end of an extended one.
+struct Breakpoint {
+  double s;
+  double force;
+  int obstacle;
+  int s_column, force_column;  // their unknowns
+  enum Kind { Point, ExtendedStart, ExtendedEnd } kind;
+};
+
+std::vector<Breakpoint> breakpoints(const std::vector<PointContact>& contacts, const std::vector<int>& columns) {
+  std::vector<Breakpoint> out;
+  for (size_t k = 0; k < contacts.size(); ++k) {
+    const auto& c = contacts[k];
+    if (!c.extended) {
+      out.push_back({c.s, c.force, c.obstacle, columns[k], columns[k] + 1, Breakpoint::Point});
+    } else {
+      out.push_back({c.s, c.force, c.obstacle, columns[k], columns[k] + 1, Breakpoint::ExtendedStart});
+      out.push_back({c.s_end, c.force_end, c.obstacle, columns[k] + 2, columns[k] + 3, Breakpoint::ExtendedEnd});
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<int> ShootingProblem::contact_columns() const {
+  std::vector<int> columns;
+  for (size_t k = 0; k < definition_.contacts.size(); ++k) columns.push_back(contact_column(k));
+  return columns;
+}
+
 bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
                                              Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const {
   const auto eq = equations(p);
-  const int n = state_size_, N = size(), C = static_cast<int>(definition_.contacts.size());
+  const int n = state_size_, N = size();
   const double L = eq->model().length;
-  const auto contacts = contacts_at(x);
-  for (int k = 0; k < C; ++k) {
-    const double previous = k == 0 ? 0.0 : contacts[k - 1].s;
-    if (!(contacts[k].s > previous) || !(contacts[k].s < L)) {
+  const auto points = breakpoints(contacts_at(x), contact_columns());
+  for (size_t k = 0; k < points.size(); ++k) {
+    const double previous = k == 0 ? 0.0 : points[k - 1].s;
+    // An extended contact may have zero length (when it forms); otherwise strictly increasing.
+    const bool ok = points[k].kind == Breakpoint::ExtendedEnd ? points[k].s >= previous : points[k].s > previous;
+    if (!ok || !(points[k].s < L)) {
       if (failure) *failure = "contact arclengths must increase inside (0, L)";
       return false;
     }
@@ -272,48 +322,64 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
   Eigen::MatrixXd S = Eigen::MatrixXd::Zero(n, N);
   S.leftCols(n).setIdentity();
   const Eigen::MatrixXd position = eq->slot_map(Slot::Position), force = eq->slot_map(Slot::Force);
+  const Eigen::RowVectorXd moment_z = eq->slot_map(Slot::Moment).row(2);
   Eigen::VectorXd y = y0;
   double s0 = 0.0;
   int s0_column = -1;  // the unknown that s0 is, if any
   try {
-    for (int k = 0; k <= C; ++k) {
-      const double s1 = k < C ? contacts[k].s : L;
+    for (size_t k = 0; k <= points.size(); ++k) {
+      const bool last = k == points.size();
+      const double s1 = last ? L : points[k].s;
       SegmentFlow flow = eq->flow(y, s0, s1, J != nullptr, definition_.options.integrator);
       rhs_evaluations_ += flow.rhs_evaluations;
       if (J) {
         S = flow.Phi * S;
         if (s0_column >= 0) S.col(s0_column) -= flow.Phi * eq->derivative(y, s0);
-        if (k < C) S.col(contact_offset() + 2 * k) += eq->derivative(flow.y, s1);
+        if (!last) S.col(points[k].s_column) += eq->derivative(flow.y, s1);
       }
       y = flow.y;
-      if (k == C) break;
-      // On the obstacle and tangent to it: g = 0 and g' = normal . r' = 0.
-      const PlaneObstacle& o = definition_.obstacles[contacts[k].obstacle];
+      if (last) break;
+      const Breakpoint& b = points[k];
+      const PlaneObstacle& o = definition_.obstacles[b.obstacle];
       const Eigen::RowVectorXd dg = o.normal.transpose() * position;
-      auto tangency = [&](const Eigen::VectorXd& state) { return dg.dot(eq->derivative(state, s1)); };
-      (*F)[row] = o.gap(position * y);
-      (*F)[row + 1] = tangency(y);
-      if (J) {
-        J->row(row) = dg * S;
-        // Gradient of the tangency by central differences of a closed-form function of the state.
-        Eigen::RowVectorXd dt(n);
-        for (int i = 0; i < n; ++i) {
-          const double h = 1e-7 * (1.0 + std::abs(y[i]));
-          Eigen::VectorXd yp = y, ym = y;
-          yp[i] += h;
-          ym[i] -= h;
-          dt[i] = (tangency(yp) - tangency(ym)) / (2 * h);
+      const Eigen::VectorXd jump = -force.transpose() * o.normal;  // n jumps by -force * normal
+      if (b.kind != Breakpoint::ExtendedEnd) {
+        // On the obstacle and tangent to it: g = 0 and g' = normal . r' = 0.
+        auto tangency = [&](const Eigen::VectorXd& state) { return dg.dot(eq->derivative(state, s1)); };
+        (*F)[row] = o.gap(position * y);
+        (*F)[row + 1] = tangency(y);
+        if (J) {
+          J->row(row) = dg * S;
+          // Gradient of the tangency by central differences of a closed-form function of the state.
+          Eigen::RowVectorXd dt(n);
+          for (int i = 0; i < n; ++i) {
+            const double h = 1e-7 * (1.0 + std::abs(y[i]));
+            Eigen::VectorXd yp = y, ym = y;
+            yp[i] += h;
+            ym[i] -= h;
+            dt[i] = (tangency(yp) - tangency(ym)) / (2 * h);
+          }
+          J->row(row + 1) = dt * S;
+          J->row(row + 1)[b.s_column] += dg.dot(eq->derivative(y, s1 + 1e-7) - eq->derivative(y, s1 - 1e-7)) / 2e-7;
         }
-        J->row(row + 1) = dt * S;
-        J->row(row + 1)[contact_offset() + 2 * k] += dg.dot(eq->derivative(y, s1 + 1e-7) - eq->derivative(y, s1 - 1e-7)) / 2e-7;
+        row += 2;
       }
-      row += 2;
-      // The contact force f = force * normal: n jumps by -f.
-      const Eigen::VectorXd jump = -force.transpose() * o.normal;
-      y += contacts[k].force * jump;
-      if (J) S.col(contact_offset() + 2 * k + 1) += jump;
+      if (b.kind == Breakpoint::ExtendedStart) {
+        // Flat on the obstacle from here: no moment, and no normal force once the jump is applied.
+        const Eigen::RowVectorXd normal_force = o.normal.transpose() * force;
+        (*F)[row] = moment_z.dot(y);
+        (*F)[row + 1] = normal_force.dot(y) - b.force;
+        if (J) {
+          J->row(row) = moment_z * S;
+          J->row(row + 1) = normal_force * S;
+          (*J)(row + 1, b.force_column) -= 1.0;
+        }
+        row += 2;
+      }
+      y += b.force * jump;
+      if (J) S.col(b.force_column) += jump;
       s0 = s1;
-      s0_column = contact_offset() + 2 * k;
+      s0_column = b.s_column;
     }
   } catch (const IntegrationError& e) {
     if (failure) *failure = e.what();
@@ -344,8 +410,14 @@ Eigen::VectorXd ShootingProblem::initial_unknowns(const RodPoint& start_guess) c
   for (size_t j = 0; j < unknown_index_.size(); ++j)
     x[M * n + j] = definition_.parameters.values()[unknown_index_[j]];
   for (size_t k = 0; k < definition_.contacts.size(); ++k) {
-    x[contact_offset() + 2 * k] = definition_.contacts[k].s;
-    x[contact_offset() + 2 * k + 1] = definition_.contacts[k].force;
+    const auto& c = definition_.contacts[k];
+    const int column = contact_column(k);
+    x[column] = c.s;
+    x[column + 1] = c.force;
+    if (c.extended) {
+      x[column + 2] = c.s_end;
+      x[column + 3] = c.force_end;
+    }
   }
   return x;
 }
@@ -359,14 +431,14 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
   out.reserve(s.size());
   size_t k = 0;
   if (!definition_.contacts.empty()) {
-    // Piece by piece between contacts, applying the jump of n at each.
-    const auto contacts = contacts_at(x);
+    // Piece by piece between breakpoints, applying the jump of n at each.
+    const auto points = breakpoints(contacts_at(x), contact_columns());
     const Eigen::MatrixXd force = eq->slot_map(Slot::Force);
     Eigen::VectorXd y = x.head(n);
     double s0 = 0.0;
-    for (size_t c = 0; c <= contacts.size(); ++c) {
-      const bool last = c == contacts.size();
-      const double s1 = last ? L : contacts[c].s;
+    for (size_t c = 0; c <= points.size(); ++c) {
+      const bool last = c == points.size();
+      const double s1 = last ? L : points[c].s;
       std::vector<double> local{s0};
       // The last piece takes every remaining point: an arclength computed as L * i / n can exceed
       // L by an ulp.
@@ -377,7 +449,7 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
       }
       if (last) break;
       y = eq->flow(y, s0, s1, false, definition_.options.integrator).y;
-      y -= contacts[c].force * force.transpose() * definition_.obstacles[contacts[c].obstacle].normal;
+      y -= points[c].force * force.transpose() * definition_.obstacles[points[c].obstacle].normal;
       s0 = s1;
     }
     return out;

@@ -44,6 +44,14 @@ struct PointContact {
   int obstacle = 0;
   double s = 0.0;
   double force = 0.0;
+  // Extended contact (planar rods on a plane): the rod lies flat on the obstacle over [s, s_end],
+  // straight and free of moment, held by the forces `force` at s and `force_end` at s_end (a
+  // flat wall carries no distributed force there: n_y' = 0 and m = 0 on the interval). At s: g = 0,
+  // tangency, m = 0 and no normal force just after s; s_end and force_end are set by the rest.
+  bool extended = false;
+  double s_end = 0.0;
+  double force_end = 0.0;
+  int unknowns() const { return extended ? 4 : 2; }
 };
 
 using ModelFunction = std::function<RodModel(const Parameters&)>;
@@ -124,6 +132,8 @@ class ShootingProblem final : public NonlinearSystem {
   void place_condition_rows(const Eigen::VectorXd& rows, Eigen::VectorXd* column) const;
   bool depends_on_model(int unknown) const;
   int contact_offset() const { return segments() * state_size_ + static_cast<int>(unknown_index_.size()); }
+  int contact_column(size_t k) const;  // first unknown of contact k
+  std::vector<int> contact_columns() const;
   // Single shooting through the contact points: the state jumps in n at each of them.
   bool residual_with_contacts(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
                               Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const;

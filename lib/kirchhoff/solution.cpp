@@ -72,6 +72,8 @@ const std::map<std::string, std::string> kCatalogue = {
     {"contact_force", "sum of the point-contact forces"},
     {"contact_count", "number of point contacts"},
     {"min_contact_force", "smallest point-contact force (NaN without contacts)"},
+    {"contact_bending", "smallest g'' at the point contacts: how the rod curves away from the obstacle (0: it flattens)"},
+    {"contact_length", "total length of the extended contacts"},
     {"kappa_contact", "curvature u2 at the first point contact (signed, planar)"},
     {"contact_s", "arclength of the first point contact"},
     {"min_gap", "smallest distance to the obstacles along the rod"},
@@ -126,13 +128,32 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
   }
   if (name == "contact_force") {
     double total = 0.0;
-    for (const auto& c : sol.contacts) total += c.force;
+    for (const auto& c : sol.contacts) total += c.force + (c.extended ? c.force_end : 0.0);
     return total;
+  }
+  if (name == "contact_length") {
+    double total = 0.0;
+    for (const auto& c : sol.contacts) total += c.extended ? c.s_end - c.s : 0.0;
+    return total;
+  }
+  if (name == "contact_bending") {
+    // g'' = normal . r'' with r'' = R (u x v) for an unshearable, inextensible rod.
+    double smallest = NAN;
+    for (const auto& c : sol.contacts) {
+      if (c.extended) continue;
+      const RodPoint p = problem.sample(x, {c.s}).front();
+      const double g2 = problem.definition().obstacles[c.obstacle].normal.dot(p.R * p.u.cross(p.v));
+      smallest = std::isnan(smallest) ? g2 : std::min(smallest, g2);
+    }
+    return smallest;
   }
   if (name == "contact_count") return static_cast<double>(sol.contacts.size());
   if (name == "min_contact_force") {
     double smallest = NAN;
-    for (const auto& c : sol.contacts) smallest = std::isnan(smallest) ? c.force : std::min(smallest, c.force);
+    for (const auto& c : sol.contacts) {
+      const double f = c.extended ? std::min(c.force, c.force_end) : c.force;
+      smallest = std::isnan(smallest) ? f : std::min(smallest, f);
+    }
     return smallest;
   }
   if (name == "kappa_contact")
