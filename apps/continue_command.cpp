@@ -181,7 +181,7 @@ std::vector<ContinuationEvent> parse_events(const std::vector<std::string>& text
   for (const auto& t : texts) {
     const auto [name, value] = parse_override(t);
     if (!derived_catalogue().count(name)) throw CaseError("--event/--record: '" + name + "' is not a derived quantity");
-    out.push_back({name, value, stop});
+    out.push_back({name, value, stop, ""});
   }
   return out;
 }

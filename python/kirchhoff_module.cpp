@@ -249,7 +249,7 @@ std::vector<ContinuationEvent> events_from(const py::object& obj, bool stop) {
   std::vector<ContinuationEvent> out;
   for (const auto& [name, value] : named_values(obj)) {
     if (!derived_catalogue().count(name)) throw CaseError("--event/--record: '" + name + "' is not a derived quantity");
-    out.push_back({name, value, stop});
+    out.push_back({name, value, stop, ""});
   }
   return out;
 }
