@@ -69,7 +69,6 @@ class EndCondition {
   EndCondition& impose_hamiltonian(std::function<double(const Parameters&)> value);
 
   const std::vector<SlotCondition>& conditions() const { return conditions_; }
-  bool has_hamiltonian_condition() const { return static_cast<bool>(hamiltonian_); }
   int extra_count() const;
 
   // Checks that each work-conjugate pair is imposed exactly once along every admissible

@@ -126,7 +126,6 @@ class Continuation {
   Eigen::MatrixXd bifurcation_directions(const ContinuationPoint& point, int count);
 
   const ShootingProblem& problem() const { return problem_; }
-  double parameter_value(const ContinuationPoint& p) const { return p.parameter; }
 
  private:
   bool evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure);
