@@ -25,11 +25,13 @@ namespace fs = std::filesystem;
 // The run's progress so far, kept beside the CSV (branch.csv.state.json) and replaced
 // atomically after every point, so that a killed run resumes from its last written point.
 struct RunState {
-  int row = -1;                   // index of the last CSV row (continuous across branches)
+  int row = -1;                   // index of the last CSV row written (continuous across branches)
+  int saved_row = -1;             // the row of `last`, the point a resume starts from
   int branch = 0;                 // 0: the starting branch, 1: after --switch-at-bp
   std::string phase_condition;    // of the problem the branch belongs to
   ContinuationPoint last;
   std::vector<std::string> derived;
+  std::vector<PointContact> contacts;  // the active set of `last` (contact runs)
 };
 
 nlohmann::json to_json(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
@@ -45,12 +47,18 @@ PointType point_type_from(const std::string& name) {
   return PointType::Regular;
 }
 
+bool resumable(const ContinuationPoint& p) { return p.type == PointType::Start || p.type == PointType::Regular; }
+
 void save_state(const fs::path& path, const RunState& s) {
-  nlohmann::json j = {{"row", s.row},             {"branch", s.branch},       {"phase_condition", s.phase_condition},
+  nlohmann::json j = {{"row", s.saved_row},             {"branch", s.branch},       {"phase_condition", s.phase_condition},
                       {"index", s.last.index},     {"parameter", s.last.parameter},
                       {"arclength", s.last.arclength}, {"step", s.last.step},
                       {"x", to_json(s.last.x)},    {"tangent", to_json(s.last.tangent)},
                       {"type", to_string(s.last.type)}, {"multiplicity", s.last.multiplicity}};
+  j["contacts"] = nlohmann::json::array();
+  for (const auto& c : s.contacts)
+    j["contacts"].push_back({{"obstacle", c.obstacle}, {"s", c.s}, {"force", c.force}, {"extended", c.extended},
+                             {"s_end", c.s_end}, {"force_end", c.force_end}});
   const fs::path tmp = path.string() + ".tmp";
   {
     std::ofstream out(tmp);
@@ -65,7 +73,7 @@ RunState load_state(const fs::path& path) {
   if (!in) throw std::runtime_error("cannot resume: no state file " + path.string());
   const nlohmann::json j = nlohmann::json::parse(in);
   RunState s;
-  s.row = j.at("row");
+  s.row = s.saved_row = j.at("row");
   s.branch = j.at("branch");
   s.phase_condition = j.at("phase_condition");
   s.last.index = j.at("index");
@@ -76,6 +84,10 @@ RunState load_state(const fs::path& path) {
   s.last.tangent = vector_from(j.at("tangent"));
   s.last.type = point_type_from(j.at("type"));
   s.last.multiplicity = j.at("multiplicity");
+  if (j.contains("contacts"))
+    for (const auto& c : j.at("contacts"))
+      s.contacts.push_back({c.at("obstacle").get<int>(), c.at("s").get<double>(), c.at("force").get<double>(),
+                            c.at("extended").get<bool>(), c.at("s_end").get<double>(), c.at("force_end").get<double>()});
   return s;
 }
 
@@ -219,9 +231,9 @@ int run_continue(const ContinueArguments& args) {
     if (std::find(options.derived.begin(), options.derived.end(), e.quantity) == options.derived.end())
       options.derived.push_back(e.quantity);
 
-  if (!c.definition.obstacles.empty() && (args.resume || args.switch_at_bp > 0 || !args.profiles_dir.empty())) {
+  if (!c.definition.obstacles.empty() && (args.switch_at_bp > 0 || !args.profiles_dir.empty())) {
     std::cerr << "error: " << args.case_path
-              << ": --resume, --switch-at-bp and --profiles are not implemented for cases with obstacles yet\n";
+              << ": --switch-at-bp and --profiles are not implemented for cases with obstacles yet\n";
     return kExitBadInput;
   }
   const fs::path csv(args.out_path), state_path(args.out_path + ".state.json");
@@ -254,11 +266,16 @@ int run_continue(const ContinueArguments& args) {
     return [&, branch, phase](const ContinuationPoint& p) {
       ++state.row;
       writer->write(state.row, p, branch);
-      state.branch = branch;
-      state.phase_condition = phase;
-      state.last = p;
-      state.last.jacobian.resize(0, 0);  // not needed to resume
-      save_state(state_path, state);
+      // Only points the march goes on from are resumable: a run killed after a special point
+      // (fold, branch point, event) redoes the step that found it, and its row is rewritten.
+      if (resumable(p)) {
+        state.branch = branch;
+        state.phase_condition = phase;
+        state.last = p;
+        state.last.jacobian.resize(0, 0);  // not needed to resume
+        state.saved_row = state.row;
+        save_state(state_path, state);
+      }
       progress.point(state.row, p, branch);
       if (!args.profiles_dir.empty()) {
         ShootingProblem copy = problem;
@@ -303,12 +320,32 @@ int run_continue(const ContinueArguments& args) {
   if (!c.definition.obstacles.empty()) {
     // Contact: the active set changes along the branch (each change is an event row).
     try {
-      ContactContinuationResult r =
-          continue_with_contacts(c.definition, c.start_guess, options, [&](const ContinuationPoint& p) {
-            ++state.row;
-            writer->write(state.row, p, 0);
-            progress.point(state.row, p, 0);
-          });
+      std::vector<PointContact> active;
+      auto sink = [&](const ContinuationPoint& p) {
+        ++state.row;
+        writer->write(state.row, p, 0);
+        if (resumable(p)) {
+          state.last = p;
+          state.last.jacobian.resize(0, 0);
+          state.contacts = active;
+          state.saved_row = state.row;
+          save_state(state_path, state);
+        }
+        progress.point(state.row, p, 0);
+      };
+      auto on_active_set = [&](const std::vector<PointContact>& contacts) { active = contacts; };
+      ContactContinuationResult r;
+      if (args.resume) {
+        ProblemDefinition d = c.definition;
+        d.contacts = state.contacts;
+        ContinuationOptions rest = options;
+        // The resumed march counts its start point, which is already written.
+        rest.max_points = std::max(1, options.max_points - count_rows_on_branch(csv, 0) + 1);
+        active = state.contacts;
+        r = resume_with_contacts(d, state.last, rest, sink, {}, on_active_set);
+      } else {
+        r = continue_with_contacts(c.definition, c.start_guess, options, sink, {}, on_active_set);
+      }
       progress.done();
       for (const auto& line : r.changes) std::cerr << "contact: " << line << "\n";
       std::cerr << "stopped: " << to_string(r.result.reason)

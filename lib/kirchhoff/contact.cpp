@@ -103,18 +103,12 @@ ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& gues
   return out;
 }
 
-ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodPoint& guess, ContinuationOptions options,
-                                                 const PointSink& sink, const ContactOptions& contact) {
-  ContactContinuationResult out;
-  ContactSolveResult start = solve_with_contacts(d, guess, contact);
-  if (!start.result.summary.converged() || !start.complementarity) {
-    out.result.reason = StopReason::StartFailed;
-    out.result.message = "no admissible starting point: " + start.message;
-    return out;
-  }
-  d = start.definition;
-  Eigen::VectorXd x = start.result.x;
-  for (const auto& line : start.log) out.changes.push_back("start: " + line);
+namespace {
+
+// The legs of a contact continuation, from unknowns x (a new run) or from a point (a resume).
+ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const ContinuationPoint* resume_from,
+                                   ContinuationOptions options, const PointSink& sink, const ContactOptions& contact,
+                                   const ActiveSetSink& active_set_sink, ContactContinuationResult out) {
   const int max_points = options.max_points;
   bool first_leg = true;
   while (true) {
@@ -134,6 +128,7 @@ ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodP
       leg.detect_branch_points = false;
     if (has_point && d.kind == RodKind::Planar) leg.events.push_back({"contact_bending", 0.0, true, "contact_flattens"});
     const ShootingProblem problem(d);
+    if (active_set_sink) active_set_sink(d.contacts);
     // A leg starts on the previous leg's last point, which is already reported.
     bool skip = !first_leg;
     auto leg_sink = [&](const ContinuationPoint& p) {
@@ -143,7 +138,8 @@ ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodP
       }
       if (sink) sink(p);
     };
-    ContinuationResult r = Continuation(problem, leg).run(x, leg_sink);
+    ContinuationResult r = first_leg && resume_from ? Continuation(problem, leg).resume(*resume_from, leg_sink)
+                                                    : Continuation(problem, leg).run(x, leg_sink);
     if (!first_leg && !r.points.empty()) r.points.erase(r.points.begin());
     out.result.points.insert(out.result.points.end(), r.points.begin(), r.points.end());
     out.result.reason = r.reason;
@@ -226,6 +222,31 @@ ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodP
     x = carry_over(problem, at.x, next);
     d = next_definition;
   }
+}
+
+
+}  // namespace
+
+ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodPoint& guess, ContinuationOptions options,
+                                                 const PointSink& sink, const ContactOptions& contact,
+                                                 const ActiveSetSink& active_set_sink) {
+  ContactContinuationResult out;
+  ContactSolveResult start = solve_with_contacts(d, guess, contact);
+  if (!start.result.summary.converged() || !start.complementarity) {
+    out.result.reason = StopReason::StartFailed;
+    out.result.message = "no admissible starting point: " + start.message;
+    return out;
+  }
+  for (const auto& line : start.log) out.changes.push_back("start: " + line);
+  return run_legs(start.definition, start.result.x, nullptr, std::move(options), sink, contact, active_set_sink,
+                  std::move(out));
+}
+
+ContactContinuationResult resume_with_contacts(ProblemDefinition d, const ContinuationPoint& last,
+                                               ContinuationOptions options, const PointSink& sink,
+                                               const ContactOptions& contact, const ActiveSetSink& active_set_sink) {
+  d.parameters.set(options.parameter, last.parameter);
+  return run_legs(std::move(d), last.x, &last, std::move(options), sink, contact, active_set_sink, {});
 }
 
 }  // namespace kirchhoff

@@ -9,6 +9,7 @@
 // (extended contact) is not.
 #pragma once
 
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -56,8 +57,18 @@ struct ContactContinuationResult {
   std::vector<std::string> changes;   // one line per change of the active set
   ProblemDefinition definition;       // the active set at the end
 };
+// Called when a leg starts, with its active set (the points that follow belong to it): lets a
+// caller save it beside the points to resume later.
+using ActiveSetSink = std::function<void(const std::vector<PointContact>&)>;
+
 ContactContinuationResult continue_with_contacts(ProblemDefinition definition, const RodPoint& guess,
                                                  ContinuationOptions options, const PointSink& sink = {},
-                                                 const ContactOptions& contact = {});
+                                                 const ContactOptions& contact = {},
+                                                 const ActiveSetSink& active_set_sink = {});
+// Resumes such a run from its last point, whose active set is the definition's contacts.
+ContactContinuationResult resume_with_contacts(ProblemDefinition definition, const ContinuationPoint& last,
+                                               ContinuationOptions options, const PointSink& sink = {},
+                                               const ContactOptions& contact = {},
+                                               const ActiveSetSink& active_set_sink = {});
 
 }  // namespace kirchhoff

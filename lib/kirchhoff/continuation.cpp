@@ -479,12 +479,12 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
     const int iterations = candidate->newton_iterations;
     before_current = current;
     previous_h = ds;
-    accept(*candidate);
-    current = result.points.back();
+    // The next step is decided before the point is reported, so that a run resumed from it takes
+    // the same step as the uninterrupted one.
     if (iterations <= kFast) ds = std::min(ds * kGrow, options_.max_step);
     if (iterations >= kSlow) ds = std::max(ds * kShrink, options_.min_step);
-    result.points.back().step = ds;
-    current.step = ds;
+    accept(*candidate);
+    current = result.points.back();
   }
   result.reason = StopReason::MaxPoints;
   return result;
