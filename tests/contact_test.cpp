@@ -140,6 +140,26 @@ TEST(ContactContinuation, PointContactFlattensIntoAnExtendedContact) {
   EXPECT_TRUE(at.H_flat);
 }
 
+// Further on, the flat part is a strut clamped by the wall at both ends under the compression P:
+// it buckles away from the wall (a hanging fold forms) when P l^2 = 4 pi^2 EI, where the run stops.
+TEST(ContactContinuation, StopsWhereTheFlatContactBuckles) {
+  const Case c = load_case(testing::case_path("wall.toml"), {{"Delta", 0.005}, {"m_guess", 0.9}});
+  ContinuationOptions o;
+  o.parameter = "Delta";
+  o.target = 0.06;
+  o.max_step = 2.0;
+  o.max_points = 6000;
+  o.derived = {"P", "contact_length"};
+  const ContactContinuationResult r = continue_with_contacts(c.definition, c.start_guess, o);
+  ASSERT_EQ(r.changes.size(), 3u);
+  EXPECT_NE(r.result.message.find("hanging fold"), std::string::npos);
+  const auto& at = r.result.points.back();
+  const double l = at.derived.at("contact_length");
+  // Located by the secant method on the margin to the corrector's tolerance.
+  EXPECT_NEAR(at.derived.at("P") * l * l / (4.0 * M_PI * M_PI), 1.0, 1e-8);
+  EXPECT_GT(at.parameter, 0.04);
+}
+
 }  // namespace
 }  // namespace kirchhoff
 

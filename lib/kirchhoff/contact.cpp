@@ -124,8 +124,10 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     // on wall.toml). Likely cause: the ends of a flat contact are contacts of higher order (the
     // rod leaves with zero curvature, gap ~ (s - s1)^3), which makes the Jacobian nearly singular
     // there, so the sign is noise. Branch points are not looked for rather than reported falsely.
-    if (std::any_of(d.contacts.begin(), d.contacts.end(), [](const auto& c) { return c.extended; }))
+    if (std::any_of(d.contacts.begin(), d.contacts.end(), [](const auto& c) { return c.extended; })) {
       leg.detect_branch_points = false;
+      leg.events.push_back({"flat_contact_margin", 0.0, true, "flat_contact_buckles"});
+    }
     if (has_point && d.kind == RodKind::Planar) leg.events.push_back({"contact_bending", 0.0, true, "contact_flattens"});
     const ShootingProblem problem(d);
     if (active_set_sink) active_set_sink(d.contacts);
@@ -155,6 +157,12 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     std::ostringstream change;
     change << options.parameter << " = " << at.parameter << ": ";
     const auto contacts = here.contacts_at(at.x);
+    if (at.event == "flat_contact_buckles") {
+      out.result.message = "the flat contact reaches its Euler load (P l^2 = 4 pi^2 EI): a hanging fold forms "
+                           "here, which is not modelled; beyond, the flat branch is unstable";
+      out.changes.push_back(change.str() + out.result.message);
+      return out;
+    }
     if (at.event == "contact_flattens") {
       // The point contact whose curvature away from the obstacle vanished becomes an extended
       // contact of zero length there; it grows along the obstacle from the next leg on.

@@ -74,6 +74,7 @@ const std::map<std::string, std::string> kCatalogue = {
     {"min_contact_force", "smallest point-contact force (NaN without contacts)"},
     {"contact_bending", "smallest g'' at the point contacts: how the rod curves away from the obstacle (0: it flattens)"},
     {"contact_length", "total length of the extended contacts"},
+    {"flat_contact_margin", "smallest 4 pi^2 B2 / l^2 - P_flat over extended contacts: < 0 once a flat part would buckle away"},
     {"kappa_contact", "curvature u2 at the first point contact (signed, planar)"},
     {"contact_s", "arclength of the first point contact"},
     {"min_gap", "smallest distance to the obstacles along the rod"},
@@ -135,6 +136,20 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
     double total = 0.0;
     for (const auto& c : sol.contacts) total += c.extended ? c.s_end - c.s : 0.0;
     return total;
+  }
+  if (name == "flat_contact_margin") {
+    // A flat contact of length l is a strut clamped at both ends (tangent to the wall) under the
+    // compression P_flat = -n.d3; its first mode, 1 - cos(2 pi x / l), leaves the wall on the free
+    // side, so the wall does not stop it: it buckles (a hanging fold forms) at 4 pi^2 B2 / l^2.
+    double smallest = INFINITY;
+    const RodModel& model = problem.equations(sol.result.parameters)->model();
+    for (const auto& c : sol.contacts) {
+      if (!c.extended || !(c.s_end > c.s)) continue;
+      const RodPoint p = problem.sample(x, {0.5 * (c.s + c.s_end)}).front();
+      const double l = c.s_end - c.s;
+      smallest = std::min(smallest, 4.0 * M_PI * M_PI * model.B[1](p.s) / (l * l) + p.n.dot(p.R.col(2)));
+    }
+    return std::isfinite(smallest) ? smallest : NAN;
   }
   if (name == "contact_bending") {
     // g'' = normal . r'' with r'' = R (u x v) for an unshearable, inextensible rod.
