@@ -8,6 +8,41 @@
 namespace kirchhoff {
 namespace {
 
+// The smallest gap to any obstacle over `samples` equally spaced points of the rod.
+struct SampledGap {
+  int obstacle = -1;
+  double s = 0.0;
+  double gap = INFINITY;
+  double spacing = 0.0;  // between samples
+};
+
+SampledGap smallest_gap(const ShootingProblem& problem, const Eigen::VectorXd& x,
+                        const std::vector<PlaneObstacle>& obstacles, int samples) {
+  SampledGap out;
+  const double L = problem.length(problem.parameters_at(x));
+  out.spacing = L / (samples - 1);
+  std::vector<double> s(samples);
+  for (int i = 0; i < samples; ++i) s[i] = L * i / (samples - 1);
+  for (const auto& p : problem.sample(x, s))
+    for (size_t o = 0; o < obstacles.size(); ++o)
+      if (obstacles[o].gap(p.r) < out.gap) {
+        out.gap = obstacles[o].gap(p.r);
+        out.obstacle = static_cast<int>(o);
+        out.s = p.s;
+      }
+  return out;
+}
+
+// Where between the neighbouring samples the gap is smallest (Brent's method).
+double refined_gap_minimum(const ShootingProblem& problem, const Eigen::VectorXd& x,
+                           const std::vector<PlaneObstacle>& obstacles, const SampledGap& sampled) {
+  const double L = problem.length(problem.parameters_at(x));
+  auto gap_at = [&](double at) { return obstacles[sampled.obstacle].gap(problem.sample(x, {at}).front().r); };
+  return boost::math::tools::brent_find_minima(gap_at, std::max(0.0, sampled.s - sampled.spacing),
+                                               std::min(L, sampled.s + sampled.spacing), 40)
+      .first;
+}
+
 // Unknowns before the contacts' (state and unknown parameters).
 int non_contact_unknowns(const ShootingProblem& problem) {
   int n = problem.size();
@@ -65,31 +100,14 @@ ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& gues
       d.contacts.erase(d.contacts.begin() + (weakest - solved.begin()));
     } else {
       // The deepest penetration of any obstacle, refined between samples.
-      const double L = problem->length(out.result.parameters);
-      std::vector<double> s(options.samples);
-      for (int i = 0; i < options.samples; ++i) s[i] = L * i / (options.samples - 1);
-      const auto profile = problem->sample(out.result.x, s);
-      double deepest = -options.penetration_tolerance;
-      int which = -1;
-      double where = 0.0;
-      for (size_t o = 0; o < d.obstacles.size(); ++o) {
-        for (size_t i = 0; i < profile.size(); ++i) {
-          const double g = d.obstacles[o].gap(profile[i].r);
-          if (g < deepest) {
-            deepest = g;
-            which = static_cast<int>(o);
-            where = profile[i].s;
-          }
-        }
-      }
-      if (which < 0) {
+      const SampledGap deepest = smallest_gap(*problem, out.result.x, d.obstacles, options.samples);
+      if (!(deepest.gap < -options.penetration_tolerance)) {
         out.complementarity = true;
         return out;
       }
-      const double h = L / (options.samples - 1);
-      auto gap_at = [&](double at) { return d.obstacles[which].gap(problem->sample(out.result.x, {at}).front().r); };
-      where = boost::math::tools::brent_find_minima(gap_at, std::max(0.0, where - h), std::min(L, where + h), 40).first;
-      change << "add a contact with obstacle " << which << " at s = " << where << " (gap " << deepest << ")";
+      const int which = deepest.obstacle;
+      const double where = refined_gap_minimum(*problem, out.result.x, d.obstacles, deepest);
+      change << "add a contact with obstacle " << which << " at s = " << where << " (gap " << deepest.gap << ")";
       d.contacts.push_back({which, where, 0.0});
       std::sort(d.contacts.begin(), d.contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
     }
@@ -171,8 +189,7 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
       size_t which = 0;
       for (size_t k = 0; k < contacts.size(); ++k) {
         if (contacts[k].extended) continue;
-        const RodPoint p = here.sample(at.x, {contacts[k].s}).front();
-        const double g2 = d.obstacles[contacts[k].obstacle].normal.dot(p.R * p.u.cross(p.v));
+        const double g2 = here.contact_bending(at.x, contacts[k]);
         if (g2 < smallest) {
           smallest = g2;
           which = k;
@@ -192,30 +209,18 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
       d.contacts.erase(d.contacts.begin() + (weakest - contacts.begin()));
     } else {
       // Where the rod reaches an obstacle: the smallest gap, refined between samples.
-      const double L = here.length(here.parameters_at(at.x));
-      std::vector<double> s(contact.samples);
-      for (int i = 0; i < contact.samples; ++i) s[i] = L * i / (contact.samples - 1);
-      const auto profile = here.sample(at.x, s);
-      double smallest = INFINITY, where = 0.0;
-      int which = 0;
-      for (size_t o = 0; o < d.obstacles.size(); ++o)
-        for (const auto& p : profile)
-          if (d.obstacles[o].gap(p.r) < smallest) {
-            smallest = d.obstacles[o].gap(p.r);
-            where = p.s;
-            which = static_cast<int>(o);
-          }
+      const SampledGap reached = smallest_gap(here, at.x, d.obstacles, contact.samples);
+      const int which = reached.obstacle;
+      const double margin = 2.0 * reached.spacing;
       for (const auto& c : contacts)
-        if (c.obstacle == which && where > c.s - 2.0 * L / (contact.samples - 1) &&
-            where < (c.extended ? c.s_end : c.s) + 2.0 * L / (contact.samples - 1)) {
+        if (c.obstacle == which && reached.s > c.s - margin && reached.s < (c.extended ? c.s_end : c.s) + margin) {
           out.result.message = "the rod penetrates the obstacle next to an active contact at s = " +
-                               std::to_string(where) + " (a curved obstacle or a lift-off pattern not modelled): the run stops here";
+                               std::to_string(reached.s) +
+                               " (a curved obstacle or a lift-off pattern not modelled): the run stops here";
           out.changes.push_back(change.str() + out.result.message);
           return out;
         }
-      const double h = L / (contact.samples - 1);
-      auto gap_at = [&](double u) { return d.obstacles[which].gap(here.sample(at.x, {u}).front().r); };
-      where = boost::math::tools::brent_find_minima(gap_at, std::max(0.0, where - h), std::min(L, where + h), 40).first;
+      const double where = refined_gap_minimum(here, at.x, d.obstacles, reached);
       change << "a contact appears with obstacle " << which << " at s = " << where;
       d.contacts = contacts;
       d.contacts.push_back({which, where, 0.0});

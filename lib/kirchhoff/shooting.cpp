@@ -81,6 +81,11 @@ int ShootingProblem::size() const {
   return n;
 }
 
+double ShootingProblem::contact_bending(const Eigen::VectorXd& x, const PointContact& contact) const {
+  const RodPoint p = sample(x, {contact.s}).front();
+  return definition_.obstacles[contact.obstacle].normal.dot(p.R * p.u.cross(p.v));
+}
+
 int ShootingProblem::contact_column(size_t k) const {
   int column = contact_offset();
   for (size_t i = 0; i < k; ++i) column += definition_.contacts[i].unknowns();

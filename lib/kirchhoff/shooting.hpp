@@ -110,6 +110,9 @@ class ShootingProblem final : public NonlinearSystem {
   long rhs_evaluations() const { return rhs_evaluations_; }
   // The active contacts with their arclengths and forces taken from x.
   std::vector<PointContact> contacts_at(const Eigen::VectorXd& x) const;
+  // g'' at a point contact: how the rod curves away from the obstacle there (0: it flattens).
+  // g'' = normal . r'' with r'' = R (u x v) for an unshearable, inextensible rod.
+  double contact_bending(const Eigen::VectorXd& x, const PointContact& contact) const;
 
   // dF/d(parameter) at x, for a known (not solved-for) parameter: from the closed-form boundary
   // conditions when the parameter does not enter the rod model, else by central differences of

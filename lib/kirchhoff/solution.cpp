@@ -152,12 +152,10 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
     return std::isfinite(smallest) ? smallest : NAN;
   }
   if (name == "contact_bending") {
-    // g'' = normal . r'' with r'' = R (u x v) for an unshearable, inextensible rod.
     double smallest = NAN;
     for (const auto& c : sol.contacts) {
       if (c.extended) continue;
-      const RodPoint p = problem.sample(x, {c.s}).front();
-      const double g2 = problem.definition().obstacles[c.obstacle].normal.dot(p.R * p.u.cross(p.v));
+      const double g2 = problem.contact_bending(x, c);
       smallest = std::isnan(smallest) ? g2 : std::min(smallest, g2);
     }
     return smallest;
