@@ -54,20 +54,10 @@ int run_solve(const SolveArguments& args) {
   ShootingResult result;
   std::vector<std::string> contact_log;
   try {
-    if (c.definition.obstacles.empty()) {
-      problem = std::make_unique<ShootingProblem>(c.definition);
-      result = solve(*problem, problem->initial_unknowns(c.start_guess));
-    } else {
-      // Obstacles: the active-set loop finds the point contacts.
-      ContactSolveResult contact = solve_with_contacts(c.definition, c.start_guess);
-      problem = std::make_unique<ShootingProblem>(contact.definition);
-      result = contact.result;
-      contact_log = contact.log;
-      if (result.summary.converged() && !contact.complementarity) {
-        result.summary.status = SolverStatus::MaxIterations;
-        result.summary.message = contact.message;
-      }
-    }
+    DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
+    problem = std::move(solved.problem);
+    result = std::move(solved.result);
+    contact_log = std::move(solved.contact_log);
   } catch (const InfeasibleContact& e) {
     std::cerr << "error: " << c.path << ": infeasible: " << e.what() << "\n";
     if (args.json) std::cout << failure_json(c, "infeasible", 0, INFINITY, e.what()).dump(2) << "\n";

@@ -178,24 +178,12 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg) {
   ShootingResult failed;
   {
     py::gil_scoped_release release;
-    problem = std::make_unique<ShootingProblem>(c.definition);
-    Eigen::VectorXd x0;
-    ShootingResult contact_result;
-    bool contact_solved = false;
+    ShootingResult solved_result;
     try {
-      if (c.definition.obstacles.empty()) {
-        x0 = problem->initial_unknowns(c.start_guess);
-      } else {
-        // As the CLI: the active-set loop finds the point contacts.
-        ContactSolveResult contact = solve_with_contacts(c.definition, c.start_guess);
-        problem = std::make_unique<ShootingProblem>(contact.definition);
-        contact_result = contact.result;
-        if (contact_result.summary.converged() && !contact.complementarity) {
-          contact_result.summary.status = SolverStatus::MaxIterations;
-          contact_result.summary.message = contact.message;
-        }
-        contact_solved = true;
-      }
+      // As the CLI: plain shooting, or the active-set loop when the case has obstacles.
+      DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
+      problem = std::move(solved.problem);
+      solved_result = std::move(solved.result);
     } catch (const InfeasibleContact& e) {
       integration_failed = true;
       failed.summary.status = SolverStatus::MaxIterations;
@@ -209,7 +197,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg) {
       failed.summary.message = std::string("the initial guess cannot be integrated: ") + e.what();
     }
     if (!integration_failed) {
-      ShootingResult result = contact_solved ? contact_result : solve(*problem, x0);
+      ShootingResult result = std::move(solved_result);
       if (result.summary.converged())
         sol = std::make_unique<Solution>(make_solution(*problem, std::move(result), samples, c.derived));
       else
@@ -224,7 +212,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg) {
   out.message = r.summary.message;
   out.used_fallback_search = r.summary.used_fallback_search;
   out.history = r.summary.history;
-  out.rhs_evaluations = problem->rhs_evaluations();
+  out.rhs_evaluations = problem ? problem->rhs_evaluations() : 0;  // none when the guess failed
   if (!sol) {
     // As the CLI's failure JSON: the case's parameters, no results.
     out.parameters = parameters_dict(c.definition.parameters);

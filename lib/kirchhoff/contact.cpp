@@ -121,6 +121,24 @@ ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& gues
   return out;
 }
 
+DefinitionSolve solve_definition(const ProblemDefinition& definition, const RodPoint& guess) {
+  DefinitionSolve out;
+  if (definition.obstacles.empty()) {
+    out.problem = std::make_unique<ShootingProblem>(definition);
+    out.result = solve(*out.problem, out.problem->initial_unknowns(guess));
+    return out;
+  }
+  ContactSolveResult contact = solve_with_contacts(definition, guess);
+  out.problem = std::make_unique<ShootingProblem>(contact.definition);
+  out.result = std::move(contact.result);
+  out.contact_log = std::move(contact.log);
+  if (out.result.summary.converged() && !contact.complementarity) {
+    out.result.summary.status = SolverStatus::MaxIterations;
+    out.result.summary.message = contact.message;
+  }
+  return out;
+}
+
 namespace {
 
 // The legs of a contact continuation, from unknowns x (a new run) or from a point (a resume).

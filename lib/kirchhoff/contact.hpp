@@ -10,6 +10,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -45,6 +46,17 @@ struct InfeasibleContact : std::invalid_argument {
 // Throws InfeasibleContact when an imposed end position lies inside an obstacle.
 ContactSolveResult solve_with_contacts(ProblemDefinition definition, const RodPoint& guess,
                                        const ContactOptions& options = {});
+
+// Solves a definition from a guess: plain shooting, or the active-set loop when it has obstacles
+// (a loop that does not settle is reported as max_iterations with its message). `problem` is the
+// problem the result's unknowns belong to. Throws IntegrationError when the guess cannot be
+// integrated and InfeasibleContact when an end is imposed inside an obstacle.
+struct DefinitionSolve {
+  std::unique_ptr<ShootingProblem> problem;
+  ShootingResult result;
+  std::vector<std::string> contact_log;
+};
+DefinitionSolve solve_definition(const ProblemDefinition& definition, const RodPoint& guess);
 
 // Continuation through changes of the active contact set. Each leg is an ordinary Continuation
 // with the set fixed and two stopping events: min_gap crossing 0 (the rod reaches an obstacle:
