@@ -54,7 +54,7 @@ void save_state(const fs::path& path, const RunState& s) {
                       {"index", s.last.index},     {"parameter", s.last.parameter},
                       {"arclength", s.last.arclength}, {"step", s.last.step},
                       {"x", to_json(s.last.x)},    {"tangent", to_json(s.last.tangent)},
-                      {"type", to_string(s.last.type)}, {"multiplicity", s.last.multiplicity}};
+                      {"type", to_string(s.last.type)}};
   j["contacts"] = nlohmann::json::array();
   for (const auto& c : s.contacts)
     j["contacts"].push_back({{"obstacle", c.obstacle}, {"s", c.s}, {"force", c.force}, {"extended", c.extended},
@@ -83,7 +83,6 @@ RunState load_state(const fs::path& path) {
   s.last.x = vector_from(j.at("x"));
   s.last.tangent = vector_from(j.at("tangent"));
   s.last.type = point_type_from(j.at("type"));
-  s.last.multiplicity = j.at("multiplicity");
   if (j.contains("contacts"))
     for (const auto& c : j.at("contacts"))
       s.contacts.push_back({c.at("obstacle").get<int>(), c.at("s").get<double>(), c.at("force").get<double>(),
@@ -298,24 +297,18 @@ int run_continue(const ContinueArguments& args) {
   int branch = state.branch;
   auto switch_branches = [&](Continuation& run, const ContinuationPoint& bp) {
     branch = 1;
-    ContinuationOptions second = options;
-    second.target = NAN;
-    second.direction = 1.0;
-    const char* lead = isatty(STDERR_FILENO) ? "\n" : "";
-    if (bp.multiplicity == 2 && c.definition.kind == RodKind::Spatial) {
-      std::cerr << lead << "double branch point at " << args.parameter << " = " << bp.parameter
-                << ": switching with the axial phase condition\n";
-      const SymmetricBranchStart start = axial_symmetry_branch(run, bp, args.switch_side);
-      ShootingProblem switched(start.definition);
-      Continuation next(switched, second);
-      return next.run_along(start.x, start.parameter, start.direction, PointType::BranchPoint,
-                            sink_for(switched, 1, "axial"));
-    }
-    std::cerr << lead << "switching branches at " << args.parameter << " = " << bp.parameter << "\n";
-    auto problem = problem_for(state.phase_condition);
-    problem->set_parameter(args.parameter, bp.parameter);
-    Continuation next(*problem, second);
-    return next.switch_branch(bp, sink_for(*problem, 1, state.phase_condition), args.switch_side);
+    return follow_bifurcating_branch(run, bp, options, args.switch_side,
+                                     [&](const ShootingProblem& problem, bool with_phase_condition) {
+                                       std::cerr << (isatty(STDERR_FILENO) ? "\n" : "");
+                                       if (with_phase_condition)
+                                         std::cerr << "double branch point at " << args.parameter << " = "
+                                                   << bp.parameter << ": switching with the axial phase condition\n";
+                                       else
+                                         std::cerr << "switching branches at " << args.parameter << " = "
+                                                   << bp.parameter << "\n";
+                                       return sink_for(problem, 1,
+                                                       with_phase_condition ? "axial" : state.phase_condition);
+                                     });
   };
   if (!c.definition.obstacles.empty()) {
     // Contact: the active set changes along the branch (each change is an event row).
@@ -369,21 +362,17 @@ int run_continue(const ContinueArguments& args) {
       first.max_points = std::max(1, options.max_points - count_rows_on_branch(csv, branch) + 1);
     }
     Continuation run(*problem, first);
-    if (args.resume && first.stop_at_branch_point == 0 && branch == 0 && args.switch_at_bp > 0 &&
-        state.last.type == PointType::BranchPoint) {
-      result = switch_branches(run, state.last);  // killed right after finding it
-    } else {
-      result = args.resume ? run.resume(state.last, sink_for(*problem, branch, state.phase_condition))
-                           : run.run(problem->initial_unknowns(c.start_guess), sink_for(*problem, 0, state.phase_condition));
-      if (branch == 0 && args.switch_at_bp > 0) {
-        if (result.reason != StopReason::BranchPointStop) {
-          progress.done();
-          std::cerr << "error: no branch point " << args.switch_at_bp << " before the run stopped ("
-                    << to_string(result.reason) << ")\n";
-          return kExitNotConverged;
-        }
-        result = switch_branches(run, result.points.back());
+    // (A resume never starts on a branch point: only points the march goes on from are saved.)
+    result = args.resume ? run.resume(state.last, sink_for(*problem, branch, state.phase_condition))
+                         : run.run(problem->initial_unknowns(c.start_guess), sink_for(*problem, 0, state.phase_condition));
+    if (branch == 0 && args.switch_at_bp > 0) {
+      if (result.reason != StopReason::BranchPointStop) {
+        progress.done();
+        std::cerr << "error: no branch point " << args.switch_at_bp << " before the run stopped ("
+                  << to_string(result.reason) << ")\n";
+        return kExitNotConverged;
       }
+      result = switch_branches(run, result.points.back());
     }
   } catch (const std::exception& e) {
     progress.done();

@@ -354,21 +354,8 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
       out.message = "no branch point " + std::to_string(switch_at_bp) + " before the run stopped (" +
                     to_string(result.reason) + (result.message.empty() ? "" : ": " + result.message) + ")";
     } else if (switch_at_bp > 0) {
-      const ContinuationPoint bp = result.points.back();
-      ContinuationOptions second = options;
-      second.target = std::numeric_limits<double>::quiet_NaN();
-      second.direction = 1.0;
-      if (bp.multiplicity == 2 && c.definition.kind == RodKind::Spatial) {
-        const SymmetricBranchStart start = axial_symmetry_branch(run, bp, side);
-        const ShootingProblem switched(start.definition);
-        Continuation next(switched, second);
-        result = next.run_along(start.x, start.parameter, start.direction, PointType::BranchPoint, check_signals);
-      } else {
-        ShootingProblem at_bp(d);
-        at_bp.set_parameter(parameter, bp.parameter);
-        Continuation next(at_bp, second);
-        result = next.switch_branch(bp, check_signals, side);
-      }
+      result = follow_bifurcating_branch(run, result.points.back(), options, side,
+                                         [&](const ShootingProblem&, bool) { return PointSink(check_signals); });
       keep(result, 1);
       out.switched = true;
       out.reason = to_string(result.reason);

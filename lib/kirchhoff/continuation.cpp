@@ -520,4 +520,22 @@ SymmetricBranchStart axial_symmetry_branch(Continuation& straight, const Continu
   return start;
 }
 
+ContinuationResult follow_bifurcating_branch(Continuation& run, const ContinuationPoint& bp,
+                                             ContinuationOptions options, double side,
+                                             const BranchSinkFactory& sink_for) {
+  options.target = NAN;
+  options.direction = 1.0;
+  if (bp.multiplicity == 2 && run.problem().definition().kind == RodKind::Spatial) {
+    const SymmetricBranchStart start = axial_symmetry_branch(run, bp, side);
+    const ShootingProblem switched(start.definition);
+    Continuation next(switched, options);
+    return next.run_along(start.x, start.parameter, start.direction, PointType::BranchPoint,
+                          sink_for(switched, true));
+  }
+  ShootingProblem at_bp = run.problem();
+  at_bp.set_parameter(options.parameter, bp.parameter);
+  Continuation next(at_bp, options);
+  return next.switch_branch(bp, sink_for(at_bp, false), side);
+}
+
 }  // namespace kirchhoff

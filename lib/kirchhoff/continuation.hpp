@@ -168,4 +168,14 @@ struct SymmetricBranchStart {
 SymmetricBranchStart axial_symmetry_branch(Continuation& straight, const ContinuationPoint& branch_point,
                                            double sign = 1.0);
 
+// Follows the branch bifurcating at `branch_point`, found by `run`: along the null vector of
+// [F_x F_lambda] at a simple branch point, or, at the double branch point of a spatial rod, in the
+// problem with the axial phase condition (axial_symmetry_branch). The run has no target (it stops
+// on the options' events, bounds or point count). `sink_for` gives the sink for the new branch's
+// points from the problem they belong to and whether the phase condition was added.
+using BranchSinkFactory = std::function<PointSink(const ShootingProblem&, bool with_phase_condition)>;
+ContinuationResult follow_bifurcating_branch(Continuation& run, const ContinuationPoint& branch_point,
+                                             ContinuationOptions options, double side,
+                                             const BranchSinkFactory& sink_for);
+
 }  // namespace kirchhoff
