@@ -468,4 +468,41 @@ WallContactElastica wall_contact_elastica(double L, double EI, double Delta, dou
   return out;
 }
 
+double clamped_clamped_elastica_load(double EI, double L, double D) {
+  if (!(EI > 0.0) || !(L > 0.0)) throw std::invalid_argument("clamped elastica: EI and L must be > 0");
+  if (!(D > 0.0 && D < L)) throw std::invalid_argument("clamped elastica: need 0 < D < L");
+  // 2E/K - 1 falls from 1 (k = 0) through 0 (k ~ 0.909); D/L in (0, 1) has one root there.
+  const double k = brent_root([&](double k) { return 2.0 * complete_E(k) / complete_K(k) - 1.0 - D / L; }, 0.0, 0.9);
+  const double K = complete_K(k);
+  return 16.0 * K * K * EI / (L * L);
+}
+
+namespace {
+void require_helix(double theta, double EI, double R) {
+  if (!(theta > 0.0 && theta < 0.25 * M_PI))
+    throw std::invalid_argument("helical angle must be in (0, pi/4), got " + std::to_string(theta));
+  if (!(EI > 0.0) || !(R > 0.0)) throw std::invalid_argument("helix: EI and R must be > 0");
+}
+}  // namespace
+
+double helix_contact_pressure(double theta, double EI, double R) {
+  require_helix(theta, EI, R);
+  return EI / (R * R * R) * std::pow(std::sin(theta), 4) / std::cos(2.0 * theta);
+}
+
+double helix_twisting_moment(double theta, double EI, double R) {
+  require_helix(theta, EI, R);
+  return EI / R * 2.0 * std::pow(std::sin(theta), 3) * std::cos(theta) / std::cos(2.0 * theta);
+}
+
+double helix_tension(double theta, double EI, double R) {
+  require_helix(theta, EI, R);
+  return EI / (R * R) * std::pow(std::sin(theta), 4) / std::cos(2.0 * theta);
+}
+
+double plectoneme_end_tension(double theta, double EI, double R) {
+  require_helix(theta, EI, R);
+  return 0.5 * EI / (R * R) * std::pow(std::sin(theta), 4) * (1.0 + 2.0 / std::cos(2.0 * theta));
+}
+
 }  // namespace kirchhoff::analytic

@@ -117,4 +117,19 @@ struct WallContactElastica {
 // (the first clamped-clamped buckling mode scaled to touch the wall).
 WallContactElastica wall_contact_elastica(double L, double EI, double Delta, double a);
 
+// The clamped-clamped Elastica in its first (symmetric) mode with its ends a distance D apart
+// (0 < D < L): one full wave of the pendulum elastica, so D/L = 2 E(k)/K(k) - 1 fixes the modulus
+// and the compression is P = 16 K(k)^2 EI/L^2. Returns P.
+double clamped_clamped_elastica_load(double EI, double L, double D);
+
+// Two strands of radius R wound into a double helix of helical angle theta (between the tangent
+// and the helix axis), each touching the other along a line (Thompson et al. 2002, eq. 58):
+// contact force per length, twisting moment and axial tension of each strand.
+double helix_contact_pressure(double theta, double EI, double R);  // (58a) EI sin^4/(R^3 cos 2theta)
+double helix_twisting_moment(double theta, double EI, double R);   // (58b) 2 EI sin^3 cos/(R cos 2theta)
+double helix_tension(double theta, double EI, double R);           // (58c) EI sin^4/(R^2 cos 2theta)
+// Eq. (61): the end pull of a plectoneme whose contact region has helical angle theta, from
+// H_A = H_B: T_ext = EI/(2 R^2) sin^4 theta (1 + 2/cos 2theta). Valid for theta < pi/4.
+double plectoneme_end_tension(double theta, double EI, double R);
+
 }  // namespace kirchhoff::analytic

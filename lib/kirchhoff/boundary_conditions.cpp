@@ -96,6 +96,23 @@ EndCondition EndCondition::sliding(Vec3 axis, VectorTarget position, VectorTarge
   return c;
 }
 
+EndCondition EndCondition::half_turn_symmetry(Vec3 axis, int director) {
+  if (director != 1 && director != 2) throw std::invalid_argument("half-turn symmetry: director must be 1 or 2");
+  const Vec3 a = axis.normalized();
+  const Vec3 d = director == 1 ? Vec3::UnitX() : Vec3::UnitY();
+  // The rotation taking d to a: the frame in which d_director lies along the axis.
+  Vec3 rotation_axis = d.cross(a);
+  const double angle = std::atan2(rotation_axis.norm(), d.dot(a));
+  if (rotation_axis.norm() < 1e-14) rotation_axis = Vec3::UnitZ();  // parallel or opposite: turn about e3
+  const OrientationTarget frame{rotation_axis.normalized(), angle};
+  EndCondition c;
+  c.add({Slot::Position, Directions::LateralToAxis, a, constant(Vec3::Zero()), {}, false, false});
+  c.add({Slot::Force, Directions::AlongAxis, a, constant(Vec3::Zero()), {}, false, false});
+  c.add({Slot::Orientation, Directions::LateralToAxis, a, {}, constant_orientation(frame), false, false});
+  c.add({Slot::Moment, Directions::AlongAxis, a, constant(Vec3::Zero()), {}, false, false});
+  return c;
+}
+
 EndCondition& EndCondition::add(SlotCondition condition) {
   conditions_.push_back(std::move(condition));
   return *this;

@@ -59,6 +59,15 @@ class EndCondition {
   static EndCondition sliding(Vec3 axis, VectorTarget position, VectorTarget force,
                               OrientationFunction orientation = {}, bool track_turns = false);
 
+  // The end s = L is the point where the rod meets its own image under a half-turn about `axis`
+  // (through the origin): symmetric plectonemes (section 7.6) solved on half the rod. The image
+  // of the rest of the rod continues it smoothly when the end lies on the axis, the director
+  // d_director (1 or 2) lies along the axis (so d3 is across it), and the force and moment have
+  // no component along the axis. Which director is along the axis sets the parity of the end
+  // rotation: with the start clamped at angle alpha about e3 and director 1 the whole rod's ends
+  // differ by -2 alpha.
+  static EndCondition half_turn_symmetry(Vec3 axis, int director);
+
   EndCondition& add(SlotCondition condition);
   // Extra condition: the frame's rotation about `axis` equals `angle` (e.g. theta(0) = theta0).
   EndCondition& impose_orientation_angle(Vec3 axis, std::function<double(const Parameters&)> angle);

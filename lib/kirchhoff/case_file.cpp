@@ -4,11 +4,13 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <toml.hpp>
 
 #include "kirchhoff/expression.hpp"
+#include "kirchhoff/self_contact.hpp"
 #include "kirchhoff/solution.hpp"
 
 namespace kirchhoff {
@@ -154,9 +156,10 @@ EndCondition read_end(const Reader& reader, const Value& root, const std::string
   const Value* table = Reader::find(root, name);
   if (!table) reader.fail(name, "missing table [" + name + "] (the boundary condition at that end)");
   reader.allow_keys(*table, name, {"type", "position", "orientation", "track_turns", "force", "moment", "axis",
-                                   "extra_angle", "extra_angle_axis", "extra_hamiltonian"});
+                                   "director", "extra_angle", "extra_angle_axis", "extra_hamiltonian"});
   const Value* type_value = Reader::find(*table, "type");
-  if (!type_value) reader.fail(*table, name + ".type", "missing (clamped, pinned, free, loaded or sliding)");
+  if (!type_value)
+    reader.fail(*table, name + ".type", "missing (clamped, pinned, free, loaded, sliding or half_turn)");
   const std::string type = reader.string(*type_value, name + ".type");
   static const std::map<std::string, std::set<std::string>> keys_for_type = {
       {"clamped", {"position", "orientation", "track_turns"}},
@@ -164,10 +167,12 @@ EndCondition read_end(const Reader& reader, const Value& root, const std::string
       {"free", {}},
       {"loaded", {"force", "moment"}},
       {"sliding", {"axis", "position", "force", "orientation", "track_turns"}},
+      {"half_turn", {"axis", "director"}},
   };
   const auto it = keys_for_type.find(type);
   if (it == keys_for_type.end())
-    reader.fail(*type_value, name + ".type", "'" + type + "' is not one of: clamped, pinned, free, loaded, sliding");
+    reader.fail(*type_value, name + ".type",
+                "'" + type + "' is not one of: clamped, pinned, free, loaded, sliding, half_turn");
   std::set<std::string> allowed = it->second;
   allowed.insert({"type", "extra_angle", "extra_angle_axis", "extra_hamiltonian"});
   for (const auto& [key, value] : table->as_table())
@@ -208,6 +213,19 @@ EndCondition read_end(const Reader& reader, const Value& root, const std::string
     end = EndCondition::free();
   } else if (type == "loaded") {
     end = EndCondition::loaded(vec("force"), vec("moment"));
+  } else if (type == "half_turn") {
+    if (kind != RodKind::Spatial) reader.fail(*type_value, name + ".type", "a half_turn end is for spatial rods");
+    if (name != "end")
+      reader.fail(*type_value, name + ".type", "the half-turn symmetry point is the end s = L of the half rod");
+    const Value* axis = Reader::find(*table, "axis");
+    if (!axis) reader.fail(*table, name + ".axis", "a half_turn end needs the symmetry axis");
+    int director = 1;
+    if (const Value* d = Reader::find(*table, "director")) {
+      const double value = reader.number(*d, name + ".director");
+      if (value != 1.0 && value != 2.0) reader.fail(*d, name + ".director", "must be 1 or 2 (the director along the axis)");
+      director = static_cast<int>(value);
+    }
+    end = EndCondition::half_turn_symmetry(reader.unit_vector(*axis, name + ".axis"), director);
   } else {
     const Value* axis = Reader::find(*table, "axis");
     if (!axis) reader.fail(*table, name + ".axis", "a sliding end needs the axis it slides along");
@@ -322,7 +340,7 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
   const Value* rod = Reader::find(root, "rod");
   if (!rod) reader.fail("rod", "missing table [rod]");
   reader.allow_keys(*rod, "rod", {"length", "B", "B1", "B2", "B3", "extensible", "A1", "A2", "A3", "u_hat",
-                                  "v_hat", "gravity", "barrier"});
+                                  "v_hat", "gravity", "barrier", "self_contact"});
   const Value* length_value = Reader::find(*rod, "length");
   if (!length_value) reader.fail(*rod, "rod.length", "missing");
   const Expression length = reader.expression(*length_value, "rod.length");
@@ -358,7 +376,8 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
     }
   }
   // External fields.
-  std::function<void(const Parameters&, FieldSum*)> add_fields = [](const Parameters&, FieldSum*) {};
+  // Each adds its field for the parameter values and the rod length.
+  std::function<void(const Parameters&, double, FieldSum*)> add_fields = [](const Parameters&, double, FieldSum*) {};
   std::set<std::string> field_parameters;
   if (const Value* g = Reader::find(*rod, "gravity")) {
     reader.allow_keys(*g, "rod.gravity", {"weight", "up"});
@@ -368,8 +387,8 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
     const Value* up_value = Reader::find(*g, "up");
     const Vec3 up = up_value ? reader.unit_vector(*up_value, "rod.gravity.up") : Vec3::UnitY();
     for (const auto& n : weight.used_parameters()) field_parameters.insert(n);
-    add_fields = [prev = add_fields, weight, up](const Parameters& p, FieldSum* f) {
-      prev(p, f);
+    add_fields = [prev = add_fields, weight, up](const Parameters& p, double length, FieldSum* f) {
+      prev(p, length, f);
       f->add(std::make_shared<UniformGravity>(weight(p), up));
     };
   }
@@ -384,9 +403,45 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
     if (!(range(parameters) > 0)) reader.fail(*b, "rod.barrier.b", "must be > 0");
     for (const auto& e : {range, height})
       for (const auto& n : e.used_parameters()) field_parameters.insert(n);
-    add_fields = [prev = add_fields, range, height, normal](const Parameters& p, FieldSum* f) {
-      prev(p, f);
+    add_fields = [prev = add_fields, range, height, normal](const Parameters& p, double length, FieldSum* f) {
+      prev(p, length, f);
       f->add(std::make_shared<BarrierWall>(range(p), height(p), normal));
+    };
+  }
+
+  if (const Value* sc = Reader::find(*rod, "self_contact")) {
+    const std::string key = "rod.self_contact";
+    if (d.kind != RodKind::Spatial) reader.fail(*sc, key, "self-contact is for spatial rods");
+    reader.allow_keys(*sc, key, {"radius", "axis", "softness", "range", "adjacent"});
+    const Value* radius_value = Reader::find(*sc, "radius");
+    if (!radius_value) reader.fail(*sc, key + ".radius", "missing (the cross-section radius R)");
+    const Expression radius = reader.expression(*radius_value, key + ".radius");
+    // Defaults (see self_contact.hpp): strength b = softness B1 / R, so that the gap at the
+    // pressures of a plectoneme (~0.05 B/R^3) is ~4e-4 R; the barrier decays over 0.25 R and is
+    // off within 2 R of the symmetry point.
+    std::optional<Expression> softness, range, adjacent;
+    if (const Value* v = Reader::find(*sc, "softness")) softness = reader.expression(*v, key + ".softness");
+    if (const Value* v = Reader::find(*sc, "range")) range = reader.expression(*v, key + ".range");
+    if (const Value* v = Reader::find(*sc, "adjacent")) adjacent = reader.expression(*v, key + ".adjacent");
+    for (const auto* e : {&softness, &range, &adjacent})
+      if (*e) for (const auto& n : (*e)->used_parameters()) field_parameters.insert(n);
+    for (const auto& n : radius.used_parameters()) field_parameters.insert(n);
+    if (!(radius(parameters) > 0)) reader.fail(*radius_value, key + ".radius", "must be > 0");
+    if (softness && !((*softness)(parameters) > 0)) reader.fail(*Reader::find(*sc, "softness"), key + ".softness", "must be > 0");
+    const Value* axis_value = Reader::find(*sc, "axis");
+    const Vec3 axis = axis_value ? reader.unit_vector(*axis_value, key + ".axis") : Vec3::UnitX();
+    const Expression bend = B[0].expression;
+    add_fields = [prev = add_fields, radius, softness, range, adjacent, axis, bend](const Parameters& p, double length,
+                                                                                  FieldSum* f) {
+      prev(p, length, f);
+      HalfTurnSelfContactOptions o;
+      o.radius = radius(p);
+      o.axis = axis;
+      o.symmetry_s = length;
+      o.strength = (softness ? (*softness)(p) : 1e-8) * bend(p, 0.0) / o.radius;
+      o.range = range ? (*range)(p) : 0.25 * o.radius;
+      o.adjacent = adjacent ? (*adjacent)(p) : 2.0 * o.radius;
+      f->add(std::make_shared<HalfTurnSelfContact>(o));
     };
   }
 
@@ -426,7 +481,7 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
       m.v_hat[i] = v_hat[i].build(p);
     }
     auto fields = std::make_shared<FieldSum>();
-    add_fields(p, fields.get());
+    add_fields(p, m.length, fields.get());
     if (!fields->empty()) m.field = fields;
     return m;
   };

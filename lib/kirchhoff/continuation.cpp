@@ -58,7 +58,8 @@ std::string ContinuationOptions::validate() const {
   if (!(initial_step > 0) || !(min_step > 0) || !(max_step >= min_step)) return "steps must satisfy 0 < min_step <= max_step, initial_step > 0";
   if (max_points < 1) return "max_points must be >= 1";
   if (!(parameter_min < parameter_max)) return "parameter_min must be < parameter_max";
-  if (corrector_max_iterations < 1 || !(corrector_tolerance > 0)) return "corrector settings must be positive";
+  if (corrector_max_iterations < 1 || !(corrector_tolerance > 0 || std::isnan(corrector_tolerance)))
+    return "corrector settings must be positive";
   if (samples < 2) return "samples must be >= 2";
   return {};
 }
@@ -66,6 +67,8 @@ std::string ContinuationOptions::validate() const {
 Continuation::Continuation(const ShootingProblem& problem, ContinuationOptions options)
     : problem_(problem), options_(std::move(options)) {
   if (std::string e = options_.validate(); !e.empty()) throw std::invalid_argument(e);
+  if (std::isnan(options_.corrector_tolerance))
+    options_.corrector_tolerance = std::max(1e-10, problem_.definition().options.newton.residual_tolerance);
   if (!problem_.parameters().contains(options_.parameter))
     throw std::invalid_argument("continuation parameter '" + options_.parameter + "' is not a parameter of the problem");
   for (const auto& u : problem_.definition().unknown_parameters)

@@ -48,7 +48,9 @@ struct ContinuationOptions {
   double parameter_min = -std::numeric_limits<double>::infinity();
   double parameter_max = std::numeric_limits<double>::infinity();
   int corrector_max_iterations = 8;
-  double corrector_tolerance = 1e-10;   // max |F| and |arclength condition|
+  // On max |F| and |arclength condition|; NaN: 1e-10, or the problem's Newton residual tolerance
+  // (a case's [solver] tolerance) when that is looser - rods with large forces need it.
+  double corrector_tolerance = std::numeric_limits<double>::quiet_NaN();
   bool detect_folds = true;
   bool detect_branch_points = true;
   // Located branch point: smallest singular value of the bordered matrix below this times the

@@ -55,7 +55,7 @@ double energy_density(const RodModel& model, const RodPoint& p) {
       V += 0.5 * model.A[i](p.s) * dv * dv;
     }
   }
-  if (model.field) V += model.field->potential(p.r);
+  if (model.field) V += model.field->potential(p.s, p.r);
   return V;
 }
 
@@ -64,7 +64,7 @@ double hamiltonian(const RodModel& model, const RodPoint& p) {
 }
 
 double hamiltonian_without_field(const RodModel& model, const RodPoint& p) {
-  return hamiltonian(model, p) + (model.field ? model.field->potential(p.r) : 0.0);
+  return hamiltonian(model, p) + (model.field ? model.field->potential(p.s, p.r) : 0.0);
 }
 
 InvariantReport compute_invariants(const RodModel& model, const std::vector<RodPoint>& profile) {

@@ -47,7 +47,7 @@ class PlanarEquations final : public RodEquations {
     if (model_.field) {
       const T r[3] = {y[kX], y[kY], T(0.0)};
       T f[3];
-      detail::field_force(*model_.field, r, f);
+      detail::field_force(*model_.field, s, r, f);
       dy[kNx] = -f[0];
       dy[kNy] = -f[1];
     } else {

@@ -20,38 +20,38 @@ BarrierWall::BarrierWall(double range_b, double height_a, Vec3 normal)
   if (!(b_ > 0.0)) throw std::invalid_argument("barrier range b must be > 0");
 }
 
-double BarrierWall::potential(const Vec3& r) const { return b_ / (a_ - r.dot(normal_)); }
+double BarrierWall::potential(double, const Vec3& r) const { return b_ / (a_ - r.dot(normal_)); }
 
-Vec3 BarrierWall::force(const Vec3& r) const {
+Vec3 BarrierWall::force(double, const Vec3& r) const {
   const double gap = a_ - r.dot(normal_);
   return -b_ / (gap * gap) * normal_;
 }
 
-Mat3 BarrierWall::force_gradient(const Vec3& r) const {
+Mat3 BarrierWall::force_gradient(double, const Vec3& r) const {
   const double gap = a_ - r.dot(normal_);
   return -2.0 * b_ / (gap * gap * gap) * normal_ * normal_.transpose();
 }
 
-double FieldSum::potential(const Vec3& r) const {
+double FieldSum::potential(double s, const Vec3& r) const {
   double w = 0.0;
-  for (const auto& f : fields_) w += f->potential(r);
+  for (const auto& f : fields_) w += f->potential(s, r);
   return w;
 }
-Vec3 FieldSum::force(const Vec3& r) const {
+Vec3 FieldSum::force(double s, const Vec3& r) const {
   Vec3 total = Vec3::Zero();
-  for (const auto& f : fields_) total += f->force(r);
+  for (const auto& f : fields_) total += f->force(s, r);
   return total;
 }
-Mat3 FieldSum::force_gradient(const Vec3& r) const {
+Mat3 FieldSum::force_gradient(double s, const Vec3& r) const {
   Mat3 total = Mat3::Zero();
-  for (const auto& f : fields_) total += f->force_gradient(r);
+  for (const auto& f : fields_) total += f->force_gradient(s, r);
   return total;
 }
 
-double FieldSum::gap(const Vec3& r) const {
+double FieldSum::gap(double s, const Vec3& r) const {
   double smallest = std::numeric_limits<double>::quiet_NaN();
   for (const auto& f : fields_) {
-    const double g = f->gap(r);
+    const double g = f->gap(s, r);
     if (std::isfinite(g) && !(g >= smallest)) smallest = g;
   }
   return smallest;

@@ -38,25 +38,27 @@ class Profile {
   std::function<double(double)> derivative_;
 };
 
-// A conservative external field per unit length: potential W_ext(r), force f = -dW/dr and the
-// force's gradient df/dr, which the variational equations need.
+// A conservative external field per unit length: potential W_ext(s, r), force f = -dW/dr and the
+// force's gradient df/dr, which the variational equations need. Most fields depend on r only;
+// the arclength is there for fields that act on part of the rod (self-contact, which must not
+// act between neighbouring cross-sections). H is conserved where W_ext does not depend on s.
 class ExternalField {
  public:
   virtual ~ExternalField() = default;
-  virtual double potential(const Vec3& r) const = 0;
-  virtual Vec3 force(const Vec3& r) const = 0;
-  virtual Mat3 force_gradient(const Vec3& r) const = 0;
+  virtual double potential(double s, const Vec3& r) const = 0;
+  virtual Vec3 force(double s, const Vec3& r) const = 0;
+  virtual Mat3 force_gradient(double s, const Vec3& r) const = 0;
   // Distance to the obstacle the field models (soft walls); NaN when it models none.
-  virtual double gap(const Vec3&) const { return std::numeric_limits<double>::quiet_NaN(); }
+  virtual double gap(double, const Vec3&) const { return std::numeric_limits<double>::quiet_NaN(); }
 };
 
 // Weight per unit length w acting along -up: W_ext = w r.up (section 3.1, rho S g r.e_z).
 class UniformGravity final : public ExternalField {
  public:
   UniformGravity(double weight_per_length, Vec3 up);
-  double potential(const Vec3& r) const override { return weight_ * r.dot(up_); }
-  Vec3 force(const Vec3&) const override { return -weight_ * up_; }
-  Mat3 force_gradient(const Vec3&) const override { return Mat3::Zero(); }
+  double potential(double, const Vec3& r) const override { return weight_ * r.dot(up_); }
+  Vec3 force(double, const Vec3&) const override { return -weight_ * up_; }
+  Mat3 force_gradient(double, const Vec3&) const override { return Mat3::Zero(); }
 
  private:
   double weight_;
@@ -68,10 +70,10 @@ class UniformGravity final : public ExternalField {
 class BarrierWall final : public ExternalField {
  public:
   BarrierWall(double range_b, double height_a, Vec3 normal);
-  double potential(const Vec3& r) const override;
-  Vec3 force(const Vec3& r) const override;
-  Mat3 force_gradient(const Vec3& r) const override;
-  double gap(const Vec3& r) const override { return a_ - r.dot(normal_); }
+  double potential(double s, const Vec3& r) const override;
+  Vec3 force(double s, const Vec3& r) const override;
+  Mat3 force_gradient(double s, const Vec3& r) const override;
+  double gap(double, const Vec3& r) const override { return a_ - r.dot(normal_); }
 
  private:
   double b_, a_;
@@ -83,10 +85,11 @@ class FieldSum final : public ExternalField {
  public:
   void add(std::shared_ptr<const ExternalField> f) { fields_.push_back(std::move(f)); }
   bool empty() const { return fields_.empty(); }
-  double potential(const Vec3& r) const override;
-  Vec3 force(const Vec3& r) const override;
-  Mat3 force_gradient(const Vec3& r) const override;
-  double gap(const Vec3& r) const override;  // the smallest of the fields' gaps
+  double potential(double s, const Vec3& r) const override;
+  Vec3 force(double s, const Vec3& r) const override;
+  Mat3 force_gradient(double s, const Vec3& r) const override;
+  double gap(double s, const Vec3& r) const override;  // the smallest of the fields' gaps
+  const std::vector<std::shared_ptr<const ExternalField>>& fields() const { return fields_; }
 
  private:
   std::vector<std::shared_ptr<const ExternalField>> fields_;

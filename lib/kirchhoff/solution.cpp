@@ -4,7 +4,10 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <optional>
 #include <stdexcept>
+
+#include "kirchhoff/plectoneme.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -107,18 +110,18 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
   if (name == "E_wall") {
     const RodModel& model = problem.equations(sol.result.parameters)->model();
     if (!model.field) return 0.0;
-    return integral_along(problem, x, b.s, [&](const RodPoint& p) { return model.field->potential(p.r); });
+    return integral_along(problem, x, b.s, [&](const RodPoint& p) { return model.field->potential(p.s, p.r); });
   }
   if (name == "elastic_energy") {
     const RodModel& model = problem.equations(sol.result.parameters)->model();
     return integral_along(problem, x, b.s, [&](const RodPoint& p) {
-      return energy_density(model, p) - (model.field ? model.field->potential(p.r) : 0.0);
+      return energy_density(model, p) - (model.field ? model.field->potential(p.s, p.r) : 0.0);
     });
   }
   if (name == "gap") {
     const RodModel& model = problem.equations(sol.result.parameters)->model();
     if (!model.field) return NAN;
-    return -refined_maximum(problem, x, sol.profile, [&](const RodPoint& p) { return -model.field->gap(p.r); });
+    return -refined_maximum(problem, x, sol.profile, [&](const RodPoint& p) { return -model.field->gap(p.s, p.r); });
   }
   if (name == "ny_jump") return b.n.y() - a.n.y();
   if (name == "kappa_end") return b.u[1];
@@ -200,7 +203,14 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
 
 }  // namespace
 
-const std::map<std::string, std::string>& derived_catalogue() { return kCatalogue; }
+const std::map<std::string, std::string>& derived_catalogue() {
+  static const std::map<std::string, std::string> all = [] {
+    auto names = kCatalogue;
+    for (const auto& [name, meaning] : plectoneme_quantities()) names[name] = meaning;
+    return names;
+  }();
+  return all;
+}
 
 Solution make_solution(const ShootingProblem& problem, ShootingResult result, int n_samples,
                        const std::vector<std::string>& derived_names) {
@@ -214,7 +224,15 @@ Solution make_solution(const ShootingProblem& problem, ShootingResult result, in
   sol.profile = problem.sample(sol.result.x, s);
   sol.contacts = problem.contacts_at(sol.result.x);
   sol.invariants = compute_invariants(problem.equations(sol.result.parameters)->model(), sol.profile);
-  for (const auto& name : derived_names) sol.derived[name] = derived_value(name, problem, sol);
+  std::optional<PlectonemeMeasures> plectoneme;  // measured once, when a quantity asks for it
+  for (const auto& name : derived_names) {
+    if (kCatalogue.count(name)) {
+      sol.derived[name] = derived_value(name, problem, sol);
+      continue;
+    }
+    if (!plectoneme) plectoneme = measure_plectoneme(problem, sol.result.x, sol.profile);
+    sol.derived[name] = plectoneme_quantity(*plectoneme, name);
+  }
   return sol;
 }
 

@@ -81,7 +81,7 @@ class SpatialEquations final : public RodEquations {
     dy[kQ + 3] = 0.5 * (w * u[2] + qx * u[1] - qy * u[0]);
     if (model_.field) {
       T f[3];
-      detail::field_force(*model_.field, y + kR, f);
+      detail::field_force(*model_.field, s, y + kR, f);
       for (int i = 0; i < 3; ++i) dy[kN + i] = -f[i];
     } else {
       for (int i = 0; i < 3; ++i) dy[kN + i] = T(0.0);

@@ -1,0 +1,134 @@
+#include "kirchhoff/plectoneme.hpp"
+
+#include <boost/math/tools/minima.hpp>
+#include <cmath>
+#include <stdexcept>
+
+#include "kirchhoff/invariants.hpp"
+#include "kirchhoff/self_contact.hpp"
+
+namespace kirchhoff {
+namespace {
+
+// A cross-section of the whole rod: its arclength along the whole rod and its centre.
+struct Section {
+  double s_whole;
+  Vec3 r;
+};
+
+// The whole rod from the half rod: the half [0, L_h] followed by its image under the half-turn,
+// traversed backwards (r(2 L_h - s) = S r(s)).
+std::vector<Section> whole_rod(const std::vector<RodPoint>& half, const HalfTurnSelfContact& contact) {
+  std::vector<Section> out;
+  const double Lh = half.back().s;
+  for (const auto& p : half) out.push_back({p.s, p.r});
+  for (auto it = half.rbegin() + 1; it != half.rend(); ++it) out.push_back({2.0 * Lh - it->s, contact.image(it->r)});
+  return out;
+}
+
+// Position on the whole rod at arclength s (exact, by integrating the half rod).
+Vec3 whole_position(const ShootingProblem& problem, const Eigen::VectorXd& x, const HalfTurnSelfContact& contact,
+                    double Lh, double s) {
+  if (s <= Lh) return problem.sample(x, {std::max(0.0, s)}).front().r;
+  return contact.image(problem.sample(x, {std::max(0.0, 2.0 * Lh - s)}).front().r);
+}
+
+// Closest pair of sections more than `apart` apart along the rod: the best sampled pair, then
+// alternating Brent minimisations in each arclength on exact positions (sampling alone could
+// miss the minimum between samples and overstate the distance).
+double smallest_self_distance(const ShootingProblem& problem, const Eigen::VectorXd& x,
+                              const HalfTurnSelfContact& contact, const std::vector<Section>& rod, double apart) {
+  double best = INFINITY;
+  size_t bi = 0, bj = 0;
+  for (size_t i = 0; i < rod.size(); ++i)
+    for (size_t j = i + 1; j < rod.size(); ++j) {
+      if (rod[j].s_whole - rod[i].s_whole <= apart) continue;
+      const double d = (rod[i].r - rod[j].r).squaredNorm();
+      if (d < best) best = d, bi = i, bj = j;
+    }
+  if (!std::isfinite(best)) return NAN;
+  const double Lh = 0.5 * rod.back().s_whole;
+  const double h = rod[1].s_whole - rod[0].s_whole;
+  double si = rod[bi].s_whole, sj = rod[bj].s_whole;
+  for (int sweep = 0; sweep < 3; ++sweep) {
+    const Vec3 rj = whole_position(problem, x, contact, Lh, sj);
+    auto di = [&](double s) { return (whole_position(problem, x, contact, Lh, s) - rj).norm(); };
+    si = boost::math::tools::brent_find_minima(di, std::max(0.0, si - h), std::min(sj - apart, si + h), 40).first;
+    const Vec3 ri = whole_position(problem, x, contact, Lh, si);
+    auto dj = [&](double s) { return (whole_position(problem, x, contact, Lh, s) - ri).norm(); };
+    sj = boost::math::tools::brent_find_minima(dj, std::max(si + apart, sj - h), std::min(2.0 * Lh, sj + h), 40).first;
+  }
+  const double refined = (whole_position(problem, x, contact, Lh, si) - whole_position(problem, x, contact, Lh, sj)).norm();
+  return std::min(refined, std::sqrt(best));
+}
+
+}  // namespace
+
+PlectonemeMeasures measure_plectoneme(const ShootingProblem& problem, const Eigen::VectorXd& x,
+                                      const std::vector<RodPoint>& profile) {
+  const RodModel& model = problem.equations(problem.parameters_at(x))->model();
+  const HalfTurnSelfContact* contact = find_half_turn_self_contact(model);
+  if (!contact) throw std::invalid_argument("plectoneme quantities need a rod with [rod.self_contact]");
+  const auto& o = contact->options();
+  const Vec3 axis = o.axis.normalized();
+  PlectonemeMeasures m;
+  const RodPoint& clamp = profile.front();
+  m.T_ext = clamp.n.dot(clamp.R.col(2));
+  m.m3 = clamp.m.dot(clamp.R.col(2));
+  m.H_B = hamiltonian(model, clamp);
+
+  double angle_sum = 0.0, pressure_sum = 0.0;
+  int in_contact = 0;
+  m.loop_clearance = INFINITY;
+  for (const auto& p : profile) {
+    const double g = contact->gap(p.s, p.r);
+    const double w = contact->weight(p.s);
+    if (w > 0.0 && w < 1.0) m.loop_clearance = std::min(m.loop_clearance, g / o.range);
+    if (!(g < kContactGap * o.radius)) continue;
+    if (in_contact == 0) m.contact_start = p.s;
+    m.contact_end = p.s;
+    angle_sum += std::acos(std::min(1.0, std::abs(p.R.col(2).dot(axis))));
+    pressure_sum += contact->force(p.s, p.r).norm();
+    ++in_contact;
+  }
+  if (in_contact > 0) {
+    m.helix_angle = angle_sum / in_contact;
+    m.contact_pressure = pressure_sum / in_contact;
+    m.H_A = hamiltonian(model, problem.sample(x, {0.5 * (m.contact_start + m.contact_end)}).front());
+  }
+  m.self_distance = smallest_self_distance(problem, x, *contact, whole_rod(profile, *contact), M_PI * o.radius) /
+                    (2.0 * o.radius);
+  return m;
+}
+
+const std::vector<std::pair<std::string, std::string>>& plectoneme_quantities() {
+  static const std::vector<std::pair<std::string, std::string>> names = {
+      {"T_ext", "plectoneme: tension n.d3 at the clamp (the end pull T_ext of Fig. 10)"},
+      {"m3", "plectoneme: twisting moment m.d3 at the clamp"},
+      {"helix_angle", "plectoneme: mean angle (rad) between d3 and the axis over the contact region"},
+      {"contact_pressure", "plectoneme: mean self-contact force per length over the contact region"},
+      {"contact_start", "plectoneme: arclength where the contact region starts (half rod)"},
+      {"contact_end", "plectoneme: arclength where the contact region ends (half rod)"},
+      {"H_A", "plectoneme: H in the middle of the contact region (eq. 60)"},
+      {"H_B", "plectoneme: H at the clamped end (eq. 59)"},
+      {"self_distance", "plectoneme: smallest distance between non-neighbouring cross-sections / 2R (>= 1)"},
+      {"loop_clearance", "plectoneme: smallest gap / range where the contact is switched off (H drifts by ~exp(-it^2))"},
+  };
+  return names;
+}
+
+double plectoneme_quantity(const PlectonemeMeasures& m, const std::string& name) {
+  if (name == "T_ext") return m.T_ext;
+  if (name == "m3") return m.m3;
+  if (name == "helix_angle") return m.helix_angle;
+  if (name == "contact_pressure") return m.contact_pressure;
+  if (name == "contact_start") return m.contact_start;
+  if (name == "contact_end") return m.contact_end;
+  if (name == "H_A") return m.H_A;
+  if (name == "H_B") return m.H_B;
+  if (name == "self_distance") return m.self_distance;
+  if (name == "loop_clearance") return m.loop_clearance;
+  throw std::invalid_argument("unknown plectoneme quantity '" + name + "'");
+}
+
+}  // namespace kirchhoff

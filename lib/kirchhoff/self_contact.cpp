@@ -1,0 +1,98 @@
+#include "kirchhoff/self_contact.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "kirchhoff/integrator.hpp"
+
+namespace kirchhoff {
+
+HalfTurnSelfContact::HalfTurnSelfContact(const HalfTurnSelfContactOptions& options)
+    : options_(options), axis_(options.axis.normalized()) {
+  auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw std::invalid_argument(what);
+  };
+  require(options.radius > 0.0, "self-contact radius must be > 0");
+  require(options.strength > 0.0, "self-contact strength must be > 0");
+  require(options.range > 0.0, "self-contact range must be > 0");
+  require(options.adjacent > 0.0, "self-contact adjacent length must be > 0");
+  require(options.axis.norm() > 0.0, "self-contact axis must be a non-zero vector");
+  require(options.symmetry_s > 2.0 * options.adjacent,
+          "self-contact: the rod is shorter than twice the adjacent length");
+}
+
+Vec3 HalfTurnSelfContact::radial(const Vec3& r) const {
+  const Vec3 d = r - options_.origin;
+  return d - axis_ * axis_.dot(d);
+}
+
+double HalfTurnSelfContact::distance_to_axis(const Vec3& r) const { return radial(r).norm(); }
+
+Vec3 HalfTurnSelfContact::image(const Vec3& r) const { return r - 2.0 * radial(r); }
+
+double HalfTurnSelfContact::weight(double s) const {
+  const double off = options_.symmetry_s - options_.adjacent;
+  const double on = options_.symmetry_s - 2.0 * options_.adjacent;
+  if (s <= on) return 1.0;
+  if (s >= off) return 0.0;
+  const double t = (off - s) / (off - on);  // 0 at `off`, 1 at `on`
+  return t * t * t * (10.0 + t * (-15.0 + 6.0 * t));  // C2 smoothstep
+}
+
+void HalfTurnSelfContact::barrier(double s, double g, double* phi, double* dphi, double* ddphi) const {
+  if (!(g > 0.0))
+    throw IntegrationError("the rod passes through itself at s = " + std::to_string(s) +
+                           " (distance to the symmetry axis below the radius)");
+  const double c = options_.range;
+  const double e = options_.strength * std::exp(-(g * g) / (c * c));
+  *phi = e / g;
+  *dphi = -e * (2.0 / (c * c) + 1.0 / (g * g));
+  *ddphi = e * (4.0 * g / (c * c * c * c) + 2.0 / (c * c * g) + 2.0 / (g * g * g));
+}
+
+double HalfTurnSelfContact::potential(double s, const Vec3& r) const {
+  const double w = weight(s);
+  if (w == 0.0) return 0.0;
+  double phi, dphi, ddphi;
+  barrier(s, distance_to_axis(r) - options_.radius, &phi, &dphi, &ddphi);
+  return w * phi;
+}
+
+Vec3 HalfTurnSelfContact::force(double s, const Vec3& r) const {
+  const double w = weight(s);
+  if (w == 0.0) return Vec3::Zero();
+  const Vec3 d = radial(r);
+  const double rho = d.norm();
+  double phi, dphi, ddphi;
+  barrier(s, rho - options_.radius, &phi, &dphi, &ddphi);
+  return -w * dphi * d / rho;
+}
+
+Mat3 HalfTurnSelfContact::force_gradient(double s, const Vec3& r) const {
+  const double w = weight(s);
+  if (w == 0.0) return Mat3::Zero();
+  const Vec3 d = radial(r);
+  const double rho = d.norm();
+  double phi, dphi, ddphi;
+  barrier(s, rho - options_.radius, &phi, &dphi, &ddphi);
+  const Vec3 e = d / rho;
+  const Mat3 across = Mat3::Identity() - axis_ * axis_.transpose() - e * e.transpose();
+  return -w * (ddphi * e * e.transpose() + dphi * across / rho);
+}
+
+double HalfTurnSelfContact::gap(double s, const Vec3& r) const {
+  if (weight(s) == 0.0) return std::numeric_limits<double>::quiet_NaN();
+  return distance_to_axis(r) - options_.radius;
+}
+
+const HalfTurnSelfContact* find_half_turn_self_contact(const RodModel& model) {
+  if (!model.field) return nullptr;
+  if (auto* direct = dynamic_cast<const HalfTurnSelfContact*>(model.field.get())) return direct;
+  if (auto* sum = dynamic_cast<const FieldSum*>(model.field.get()))
+    for (const auto& f : sum->fields())
+      if (auto* found = dynamic_cast<const HalfTurnSelfContact*>(f.get())) return found;
+  return nullptr;
+}
+
+}  // namespace kirchhoff
