@@ -411,7 +411,8 @@ void vibrations(const fs::path& cases, const fs::path& out, std::vector<ReportRo
   std::ofstream csv(out / "vibration_column.csv");
   csv.precision(15);
   csv << "P,branch,k,omega_squared,omega_squared_analytic\n";
-  for (double P = 0.0; P < 9.6; P += 1.2) {
+  for (int i = 0; i <= 8; ++i) {
+    const double P = 1.2 * i;  // up to 9.6, just below the Euler load pi^2
     const Solved s = solve_case(cases / "euler_column.toml", {{"P", P}, {"theta_guess", 0.0}}, 21);
     const VibrationAnalysis a = analyse(s, 3);
     for (int k = 1; k <= 3; ++k) {
