@@ -13,8 +13,9 @@ namespace kirchhoff {
 namespace {
 
 // The frequencies come from a determinant of solutions integrated at 1e-12 per step over a
-// half rod; the high modes grow like exp(sqrt(omega) L / 2) ~ 1e2 there, so the determinant is
-// accurate to ~1e-10 and its roots (simple) to the same relative order. 1e-9 leaves a margin of 10.
+// half rod; the solutions of the highest modes tested grow like exp(sqrt(omega) L / 2) ~ 1e2 there,
+// which bounds the determinant's relative error, and so its simple roots', by ~1e-10. 1e-9 leaves a
+// margin of 10 on that bound; measured errors are 4e-14 to 1.4e-12.
 constexpr double kFrequencyTolerance = 1e-9;
 // H_vib is a sum of terms integrated to ~1e-10 relative; a flat invariant varies by less than this
 // relative to its largest term.
