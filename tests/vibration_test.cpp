@@ -267,6 +267,22 @@ TEST(Vibration, BuckledElasticaWithImposedChordDoesNotSoften) {
   }
 }
 
+TEST(Vibration, MultipleShootingGivesTheSameFrequencies) {
+  // The equilibrium restarts from the shooting nodes; the frequencies must not depend on how many.
+  std::vector<std::vector<double>> by_segments;
+  for (int segments : {1, 4}) {
+    Case c = load_case(testing::case_path("simply_supported.toml"), {{"theta0", 2.0}});
+    c.definition.options.segments = segments;
+    const ShootingProblem problem(c.definition);
+    const ShootingResult r = solve(problem, problem.initial_unknowns(c.start_guess));
+    ASSERT_TRUE(r.summary.converged()) << r.summary.brief_report();
+    VibrationOptions options;
+    options.modes = 3;
+    by_segments.push_back(VibrationProblem(problem, r.x, options).frequencies());
+  }
+  for (int k = 0; k < 3; ++k) EXPECT_LE(relative_error(by_segments[1][k], by_segments[0][k]), kFrequencyTolerance);
+}
+
 TEST(Vibration, RefusesWhatItDoesNotModel) {
   const auto twisted = testing::solve_case("twisted_clamped.toml", {{"phi", 1.0}});
   EXPECT_THROW(VibrationProblem(*twisted.problem, twisted.solution.result.x), std::invalid_argument);

@@ -132,7 +132,9 @@ class VibrationProblem {
   VibrationOptions options_;
   double length_ = 0.0;
   double omega_scale_ = 0.0;
-  Eigen::VectorXd y_start_, y_mid_, y_end_;  // equilibrium at s = 0, L/2, L
+  Eigen::VectorXd y_start_, y_end_;  // equilibrium at s = 0 and s = L
+  std::vector<double> node_s_;       // shooting nodes L i / M, i = 0..M
+  std::vector<Eigen::VectorXd> node_y_;  // the equilibrium there
   Eigen::MatrixXd start_basis_, end_basis_;  // 6 x k: initial perturbations allowed by each end
   Eigen::MatrixXd row_projection_;           // r x 6: identity, or drops the axial pair when degenerate
   Eigen::VectorXd row_scale_;                // makes the state components dimensionless
