@@ -5,6 +5,7 @@
 #include "continue_command.hpp"
 #include "reproduce_command.hpp"
 #include "solve_command.hpp"
+#include "vibrate_command.hpp"
 
 int main(int argc, char** argv) {
   using namespace kirchhoff::cli;
@@ -21,6 +22,7 @@ int main(int argc, char** argv) {
       "  kirchhoff continue cases/euler_column.toml --param P --to 100 --set theta_guess=0 --out column.csv\n"
       "  kirchhoff continue cases/euler_column.toml --param P --to 12 --set theta_guess=0 --switch-at-bp 1 \\\n"
       "      --event theta0=3 --out buckled.csv\n"
+      "  kirchhoff vibrate cases/euler_column.toml --set P=5 --set theta_guess=0 --modes 3\n"
       "  kirchhoff reproduce --out out\n\n"
       "Exit status: 0 solved, 1 solver failure (status and best residual reported), 2 input refused."};
   app.require_subcommand(1);
@@ -76,6 +78,43 @@ int main(int argc, char** argv) {
   continue_cmd->add_option("--phase-condition", cont.phase_condition, "As for solve")
       ->check(CLI::IsMember({"none", "axial"}));
 
+  VibrateArguments vib;
+  auto* vibrate_cmd = app.add_subcommand(
+      "vibrate",
+      "Small-amplitude vibrations about a planar equilibrium (section 9, eqs. B.4): the lowest\n"
+      "eigenfrequencies omega_k and mode shapes of qbar = (xbar, ybar, thetabar, mbar, nbar_x, nbar_y),\n"
+      "with the invariant H_vib of eq. (95b) along each mode");
+  vibrate_cmd->footer(
+      "The equilibrium is solved as `kirchhoff solve` does. The vibrating rod keeps the case's end\n"
+      "conditions with every imposed quantity held at its equilibrium value: supports and clamps stay\n"
+      "put, applied end loads are dead loads (nbar = 0, mbar = 0 along them). So euler_column.toml\n"
+      "(pinned, far end rolling along x under P) is the classic column under a dead load, whose first\n"
+      "frequency vanishes at the Euler load; a case with both ends pinned holds the chord instead.\n"
+      "Extra conditions (the end slope theta0 of simply_supported.toml) only pick the equilibrium.\n\n"
+      "H_vib = 1/2 EI thetabar'^2 - thetabar (nbar_x sin theta_e - nbar_y cos theta_e)\n"
+      "        + 1/2 rhoS omega^2 (xbar^2 + ybar^2) - 1/2 thetabar^2 (n_xe cos theta_e + n_ye sin theta_e)\n"
+      "is conserved along s only when the equilibrium is straight; its spread is reported either way.\n"
+      "omega is in the case's units; sqrt(EI / (rhoS L^4)) sets its scale. Mode shapes are scaled to a\n"
+      "largest displacement of 1. Exit status: 0 done, 1 the equilibrium did not converge, 2 refused\n"
+      "(spatial case, extensible rod, active contacts, a sleeve end, or fewer frequencies than asked).\n\n"
+      "Examples:\n"
+      "  kirchhoff vibrate cases/euler_column.toml --set P=4.934802200544679 --set theta_guess=0\n"
+      "  kirchhoff vibrate cases/simply_supported.toml --set theta0=1 --modes 4 --out vib.json --profiles modes/\n"
+      "  kirchhoff vibrate cases/heavy_cantilever.toml --set w=0 --rho-s 2 --json");
+  vibrate_cmd->add_option("case", vib.case_path, "Case file (TOML) of a planar rod")->required()->check(CLI::ExistingFile);
+  vibrate_cmd->add_option("--set", vib.overrides, "Override a parameter: NAME=VALUE (repeatable)");
+  vibrate_cmd->add_option("--modes", vib.modes, "Number of lowest frequencies to find")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  vibrate_cmd->add_option("--rho-s", vib.rho_s, "Mass per unit length rho S (uniform)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  vibrate_cmd->add_option("--out", vib.out_path,
+                          "Write JSON {\"frequencies\": [...], \"modes\": [{\"omega\", \"H_vib_spread\", ...}]}");
+  vibrate_cmd->add_option("--profiles", vib.profiles_dir,
+                          "Write each mode as DIR/mode_K.csv: s, xbar, ybar, thetabar, mbar, nbarx, nbary, H_vib");
+  vibrate_cmd->add_flag("--json", vib.json, "Print the JSON on stdout instead of the table");
+
   std::string out_dir = "out";
   std::string cases_dir = KIRCHHOFF_DEFAULT_CASES_DIR;
   auto* reproduce_cmd = app.add_subcommand(
@@ -93,5 +132,6 @@ int main(int argc, char** argv) {
   if (*check_cmd) return run_check(check_path, check_overrides);
   if (*reproduce_cmd) return run_reproduce(out_dir, cases_dir);
   if (*continue_cmd) return run_continue(cont);
+  if (*vibrate_cmd) return run_vibrate(vib);
   return kExitBadInput;
 }

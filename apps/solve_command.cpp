@@ -11,18 +11,6 @@
 namespace kirchhoff::cli {
 namespace {
 
-ParameterOverrides parse_overrides(const std::vector<std::string>& texts) {
-  ParameterOverrides out;
-  for (const auto& t : texts) {
-    try {
-      out.push_back(parse_override(t));
-    } catch (const std::invalid_argument& e) {
-      throw CaseError(std::string("--set: ") + e.what());
-    }
-  }
-  return out;
-}
-
 void print_human(const Case& c, const Solution& sol) {
   std::cout << (c.title.empty() ? c.path : c.title) << "\n";
   std::cout << "  " << sol.result.summary.brief_report() << "\n";
@@ -42,16 +30,29 @@ void print_human(const Case& c, const Solution& sol) {
 
 }  // namespace
 
-int run_solve(const SolveArguments& args) {
-  Case c;
+ParameterOverrides parse_overrides(const std::vector<std::string>& texts) {
+  ParameterOverrides out;
+  for (const auto& t : texts) {
+    try {
+      out.push_back(parse_override(t));
+    } catch (const std::invalid_argument& e) {
+      throw CaseError(std::string("--set: ") + e.what());
+    }
+  }
+  return out;
+}
+
+int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
+                   const std::string& phase_condition, bool json, SolvedCase* out) {
+  Case& c = out->c;
   try {
-    c = load_case(args.case_path, parse_overrides(args.overrides), args.phase_condition);
+    c = load_case(case_path, parse_overrides(overrides), phase_condition);
   } catch (const CaseError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;
   }
-  std::unique_ptr<ShootingProblem> problem;
-  ShootingResult result;
+  std::unique_ptr<ShootingProblem>& problem = out->problem;
+  ShootingResult& result = out->result;
   std::vector<std::string> contact_log;
   try {
     DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
@@ -60,24 +61,35 @@ int run_solve(const SolveArguments& args) {
     contact_log = std::move(solved.contact_log);
   } catch (const InfeasibleContact& e) {
     std::cerr << "error: " << c.path << ": infeasible: " << e.what() << "\n";
-    if (args.json) std::cout << failure_json(c, "infeasible", 0, INFINITY, e.what()).dump(2) << "\n";
+    if (json) std::cout << failure_json(c, "infeasible", 0, INFINITY, e.what()).dump(2) << "\n";
     return kExitNotConverged;
   } catch (const IntegrationError& e) {
     std::cerr << "error: " << c.path << ": the initial guess cannot be integrated: " << e.what() << "\n";
-    if (args.json) std::cout << failure_json(c, "integration_failed", 0, INFINITY, e.what()).dump(2) << "\n";
+    if (json) std::cout << failure_json(c, "integration_failed", 0, INFINITY, e.what()).dump(2) << "\n";
     return kExitNotConverged;
   }
-  if (!args.json)
+  if (!json)
     for (const auto& line : contact_log) std::cerr << "contact: " << line << "\n";
   if (!result.summary.converged()) {
     std::cerr << "error: " << c.path << ": not converged: " << result.summary.brief_report() << "\n";
-    if (args.json)
+    if (json)
       std::cout << failure_json(c, to_string(result.summary.status), result.summary.iterations,
                                 result.summary.residual_norm, result.summary.message)
                        .dump(2)
                 << "\n";
     return kExitNotConverged;
   }
+  return kExitOk;
+}
+
+int run_solve(const SolveArguments& args) {
+  SolvedCase solved;
+  if (const int status = load_and_solve(args.case_path, args.overrides, args.phase_condition, args.json, &solved);
+      status != kExitOk)
+    return status;
+  const Case& c = solved.c;
+  const std::unique_ptr<ShootingProblem>& problem = solved.problem;
+  ShootingResult result = std::move(solved.result);
   const Solution sol = make_solution(*problem, std::move(result), c.samples, c.derived);
   if (!args.profile_path.empty()) {
     try {

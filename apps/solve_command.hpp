@@ -1,8 +1,11 @@
 // The CLI's commands; each returns the process exit status.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "kirchhoff/case_file.hpp"
 
 namespace kirchhoff::cli {
 
@@ -20,6 +23,20 @@ struct SolveArguments {
 };
 
 int run_solve(const SolveArguments& args);
+
+// NAME=VALUE texts as overrides; throws CaseError naming the bad one.
+ParameterOverrides parse_overrides(const std::vector<std::string>& texts);
+
+// A case loaded and solved the way `solve` does it (active-set loop when it has obstacles).
+struct SolvedCase {
+  Case c;
+  std::unique_ptr<ShootingProblem> problem;
+  ShootingResult result;
+};
+// Loads and solves; on failure prints the reason (and, with json, a failure object on stdout)
+// and returns the exit status, else kExitOk.
+int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
+                   const std::string& phase_condition, bool json, SolvedCase* out);
 int run_check(const std::string& case_path, const std::vector<std::string>& overrides);
 
 }  // namespace kirchhoff::cli

@@ -1,5 +1,5 @@
 // Python bindings: `import kirchhoff` (pybind11). A thin layer over the library that mirrors the
-// CLI's `solve` and `continue` commands, returning plain dicts and numpy arrays.
+// CLI's `solve`, `continue` and `vibrate` commands, returning plain dicts and numpy arrays.
 //
 // Conventions, as in the CLI:
 //   - bad input (a case file that cannot be used, an unknown parameter or derived quantity, bad
@@ -29,6 +29,7 @@
 #include "kirchhoff/invariants.hpp"
 #include "kirchhoff/shooting.hpp"
 #include "kirchhoff/solution.hpp"
+#include "kirchhoff/vibration.hpp"
 
 namespace py = pybind11;
 
@@ -280,6 +281,47 @@ py::dict branch_points_dict(const std::vector<BranchPoint>& pts, const std::vect
   return d;
 }
 
+// Vibrations about the case's equilibrium (the CLI's `vibrate`).
+py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
+  const Case& c = pc.c;
+  if (c.definition.kind != RodKind::Planar)
+    throw py::value_error(c.path + ": vibrate handles planar rods only (eqs. B.4); this case is spatial");
+  VibrationOptions options;
+  options.modes = modes;
+  options.rho_s = rho_s;
+  options.profile_samples = samples;
+  if (std::string e = options.validate(); !e.empty()) throw py::value_error(e);
+  VibrationAnalysis analysis;
+  {
+    py::gil_scoped_release release;
+    DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
+    if (!solved.result.summary.converged())
+      throw std::runtime_error(c.path + ": the equilibrium did not converge: " + solved.result.summary.brief_report());
+    analysis = VibrationProblem(*solved.problem, solved.result.x, options).analyse();  // invalid_argument -> ValueError
+  }
+  py::list mode_list;
+  for (const VibrationMode& m : analysis.modes) {
+    py::dict d;
+    d["omega"] = m.omega;
+    d["H_vib"] = stats_dict(m.H_vib_stats);
+    d["matching_residual"] = m.matching_residual;
+    const size_t n = m.s.size();
+    d["s"] = column<double>(n, [&](size_t i) { return m.s[i]; });
+    // Planar state layout (x, y, theta, n_x, n_y, m).
+    const std::pair<const char*, int> components[] = {{"xbar", 0}, {"ybar", 1}, {"thetabar", 2},
+                                                      {"nbarx", 3}, {"nbary", 4}, {"mbar", 5}};
+    for (const auto& [name, index] : components)
+      d[name] = column<double>(n, [&, index = index](size_t i) { return m.state[i][index]; });
+    d["H_vib_along_s"] = column<double>(n, [&](size_t i) { return m.H_vib[i]; });
+    mode_list.append(d);
+  }
+  py::dict out;
+  out["frequencies"] = column<double>(analysis.modes.size(), [&](size_t k) { return analysis.modes[k].omega; });
+  out["straight_equilibrium"] = analysis.straight_equilibrium;
+  out["modes"] = mode_list;
+  return out;
+}
+
 PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::object& to, double step,
                      double min_step, double max_step, int max_points, const py::object& events,
                      const py::object& record, int switch_at_bp, double side, int samples, double direction) {
@@ -520,6 +562,27 @@ Returns:
 
 Raises:
     CaseError (ValueError): unknown parameter or derived quantity, invalid options.)doc")
+      .def("vibrate", &py_vibrate, py::kw_only(), py::arg("modes") = 3, py::arg("rho_s") = 1.0,
+           py::arg("samples") = 201,
+           R"doc(Small-amplitude vibrations about the case's equilibrium (the CLI's `vibrate`, eqs. B.4).
+
+The equilibrium is solved as solve() does; the ends keep the case's conditions with imposed
+positions and angles held and end loads dead (nbar = 0, mbar = 0 along them).
+
+Args:
+    modes (int): number of lowest frequencies.
+    rho_s (float): mass per unit length.
+    samples (int): points per mode shape.
+
+Returns:
+    dict: "frequencies" (numpy array, increasing), "straight_equilibrium" (bool), "modes": a list
+    of dicts with "omega", "H_vib" (mean, min, max, spread, relative_spread, applies: invariant of
+    eq. 95b only on a straight equilibrium), "matching_residual", and numpy arrays "s", "xbar",
+    "ybar", "thetabar", "nbarx", "nbary", "mbar", "H_vib_along_s".
+
+Raises:
+    ValueError: a spatial case, bad options, or a rod the vibration equations do not cover.
+    RuntimeError: the equilibrium does not converge.)doc")
       .def("__repr__", [](const PyCase& p) {
         return "<kirchhoff.Case " + (p.c.title.empty() ? p.c.path : "'" + p.c.title + "'") + ">";
       });

@@ -138,11 +138,35 @@ def euler_branch(profiles, figures):
     plt.close(fig)
 
 
+def vibrations(profiles, figures):
+    d = np.genfromtxt(profiles / "vibration_column.csv", delimiter=",", names=True, dtype=None, encoding="utf-8")
+    straight, buckled = d[d["branch"] == "straight"], d[d["branch"] == "buckled"]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    for ax, ks in ((axes[0], (1, 2, 3)), (axes[1], (1,))):
+        for k in ks:
+            rows = straight[straight["k"] == k]
+            line, = ax.plot(rows["P"], rows["omega_squared_analytic"], "-", lw=1.2,
+                            label=f"eq. (96), k = {k}: $EI(k\\pi)^4 - P(k\\pi)^2$")
+            ax.plot(rows["P"], rows["omega_squared"], "o", ms=4, color=line.get_color(), label=f"shooting, k = {k}")
+        ax.set_xlabel("P L$^2$ / EI")
+        ax.set_ylabel("$\\omega_k^2$   [EI / ($\\rho S$ L$^4$)]")
+    axes[1].plot(buckled["P"], buckled["omega_squared"], "s", ms=4, color="k",
+                 label="buckled Elastica (dead load), k = 1")
+    axes[1].axvline(np.pi ** 2, color="gray", lw=0.8, ls=":")
+    axes[0].set_title("Pinned column under a dead load: $\\omega_k^2$ linear in P")
+    axes[1].set_title("$\\omega_1 \\to 0$ at the Euler load, from both sides")
+    for ax in axes:
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(figures / "vibration_column.png", dpi=130)
+    plt.close(fig)
+
+
 def main(out):
     out = pathlib.Path(out)
     profiles, figures = out / "profiles", out / "figures"
     figures.mkdir(parents=True, exist_ok=True)
-    for make in (fig3, fig9, fig12, euler_branch, sleeves):
+    for make in (fig3, fig9, fig12, euler_branch, sleeves, vibrations):
         make(profiles, figures)
         print(f"  {make.__name__}: written", file=sys.stderr)
 

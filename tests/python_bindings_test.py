@@ -237,5 +237,35 @@ class ContinuationTest(unittest.TestCase):
         self.assertEqual(set(b.points["branch"].tolist()), {0})
 
 
+class VibrateTest(unittest.TestCase):
+    def test_pinned_column_frequencies_and_flat_h_vib(self):
+        # Straight column under the dead load P = pi^2/2: omega_k^2 = (k pi)^4 - P (k pi)^2 (eq. 96).
+        P = 0.5 * math.pi ** 2
+        case = kirchhoff.load_case(case_path("euler_column.toml"), set={"P": P, "theta_guess": 0.0})
+        result = case.vibrate(modes=2, samples=51)
+        self.assertIsInstance(result["frequencies"], np.ndarray)
+        self.assertTrue(result["straight_equilibrium"])
+        for k, mode in enumerate(result["modes"], start=1):
+            q = k * math.pi
+            self.assertLess(abs(mode["omega"] / math.sqrt(q ** 4 - P * q ** 2) - 1.0), 1e-9)
+            self.assertTrue(mode["H_vib"]["applies"])
+            self.assertLess(mode["H_vib"]["relative_spread"], 1e-9)
+            self.assertEqual(mode["ybar"].shape, (51,))
+            # sin(k pi s), normalised to a largest deflection of 1.
+            self.assertAlmostEqual(np.max(np.abs(mode["ybar"])), 1.0, places=12)
+
+    def test_buckled_h_vib_is_not_flat(self):
+        case = kirchhoff.load_case(case_path("simply_supported.toml"), set={"theta0": 1.0})
+        mode = case.vibrate(modes=1)["modes"][0]
+        self.assertFalse(mode["H_vib"]["applies"])
+        self.assertGreater(mode["H_vib"]["relative_spread"], 1e-3)
+
+    def test_spatial_case_and_bad_options_raise_value_error(self):
+        with self.assertRaises(ValueError):
+            kirchhoff.load_case(case_path("twisted_clamped.toml")).vibrate()
+        with self.assertRaises(ValueError):
+            kirchhoff.load_case(case_path("euler_column.toml")).vibrate(rho_s=-1.0)
+
+
 if __name__ == "__main__":
     unittest.main()

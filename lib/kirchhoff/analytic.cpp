@@ -286,6 +286,80 @@ double euler_critical_load(EulerEnds ends, double EI, double L, int mode) {
 }
 
 // =============================================================================================
+// Vibrations of straight columns and beams (eq. 96)
+
+double pinned_column_frequency(double EI, double P, double rho_s, double L, int mode) {
+  const char* where = "pinned_column_frequency";
+  require_positive(where, "EI", EI);
+  require_finite(where, "P", P);
+  require_positive(where, "rho_s", rho_s);
+  require_positive(where, "L", L);
+  require_index(where, "mode", mode);
+  const double q = mode * kPi / L;
+  const double omega2 = (EI * q * q * q * q - P * q * q) / rho_s;
+  if (!(omega2 > 0.0))
+    reject(where, "P", "must be below the mode's Euler load " + std::to_string(EI * q * q) + ", got " + std::to_string(P));
+  return std::sqrt(omega2);
+}
+
+double beam_frequency_parameter(BeamEnds ends, int mode) {
+  require_index("beam_frequency_parameter", "mode", mode);
+  // Divided by cosh x, the characteristic functions are cos x +- 1/cosh x: on each interval
+  // between consecutive multiples of pi the cosine runs monotonically from +-1 to -+1 and 1/cosh
+  // is below 0.1 past pi, so each interval holds exactly one root.
+  if (ends == BeamEnds::ClampedFree)
+    return brent_root([](double x) { return std::cos(x) + 1.0 / std::cosh(x); }, (mode - 1) * kPi, mode * kPi);
+  return brent_root([](double x) { return std::cos(x) - 1.0 / std::cosh(x); }, mode * kPi, (mode + 1) * kPi);
+}
+
+double beam_frequency(BeamEnds ends, double EI, double rho_s, double L, int mode) {
+  const char* where = "beam_frequency";
+  require_positive(where, "EI", EI);
+  require_positive(where, "rho_s", rho_s);
+  require_positive(where, "L", L);
+  const double x = beam_frequency_parameter(ends, mode);
+  return x * x * std::sqrt(EI / rho_s) / (L * L);
+}
+
+double clamped_column_frequency(double EI, double P, double rho_s, double L, int mode) {
+  const char* where = "clamped_column_frequency";
+  require_positive(where, "EI", EI);
+  require_finite(where, "P", P);
+  require_positive(where, "rho_s", rho_s);
+  require_positive(where, "L", L);
+  require_index(where, "mode", mode);
+  if (!(P < 4.0 * kPi * kPi * EI / (L * L)))
+    reject(where, "P", "must be below the clamped-clamped Euler load 4 pi^2 EI / L^2, got " + std::to_string(P));
+  // Parametrised by x = b L: (a L)^2 = x^2 - P L^2 / EI > 0 and omega = a b sqrt(EI / rhoS).
+  const double p = P * L * L / EI;
+  const double x_min = std::sqrt(std::max(p, 0.0));
+  auto aL = [p](double x) { return std::sqrt(x * x - p); };
+  // The characteristic function divided by cosh(a L), so that it stays O(1).
+  auto characteristic = [&](double x) {
+    const double a = aL(x);
+    return 2.0 * a * x * (1.0 / std::cosh(a) - std::cos(x)) + (a * a - x * x) * std::tanh(a) * std::sin(x);
+  };
+  // a = 0 is a trivial root: start above it, where the sign is resolved (at P = 0 the function
+  // is ~(b L)^6 / 3 there, computed from terms of size ~(b L)^4 / 6: 1e-3 keeps it clear of round-off;
+  // frequencies below ~1e-3 sqrt(EI / rhoS) / L^2 are out of reach). Roots are about pi apart in
+  // b L, far more than the scan step.
+  constexpr double kScanStep = 0.05;
+  constexpr double kStart = 1e-3;
+  double lo = x_min + kStart, f_lo = characteristic(lo);
+  int found = 0;
+  for (int i = 1; i < 1000000; ++i) {
+    const double hi = x_min + kStart + i * kScanStep, f_hi = characteristic(hi);
+    if ((f_lo > 0.0) != (f_hi > 0.0) && ++found == mode) {
+      const double x = brent_root(characteristic, lo, hi);
+      return aL(x) * x * std::sqrt(EI / rho_s) / (L * L);
+    }
+    lo = hi;
+    f_lo = f_hi;
+  }
+  throw std::runtime_error("clamped_column_frequency: root not found");
+}
+
+// =============================================================================================
 // Straight twisted rod: m = C u3 e3 with uniform twist u3 = phi / L; n = T e3.
 
 double StraightTwistedRod::twisting_moment() const {

@@ -7,6 +7,8 @@
 //   * eq54_*: the maximum curvature and deflection of the same rod read off the Noether
 //     invariant H = 1/2 EI kappa^2 - P cos(theta) (eq. 54 of the reference paper).
 //   * euler_critical_load: Euler buckling loads for the four classical end conditions.
+//   * pinned_column_frequency, beam_frequency, clamped_column_frequency: vibration frequencies
+//     of straight columns and beams (eq. 96).
 //   * StraightTwistedRod and clamped_twisted_critical_moment: the straight twisted rod under
 //     tension and its Greenhill instability for clamped ends.
 //
@@ -75,6 +77,32 @@ double euler_critical_load(EulerEnds ends, double EI, double L, int mode = 1);
 
 // n-th positive root (n >= 1) of tan x = x; it lies in (n pi, n pi + pi / 2).
 double tan_x_equals_x_root(int n);
+
+// Transverse vibrations of a straight uniform column (section 9, eq. 96):
+//   EI w'''' + P w'' - rhoS omega^2 w = 0,  P the compressive dead load, rhoS the mass per length.
+//
+// Pinned-pinned (the far end sliding axially under P): w = sin(k pi s / L) and
+//   omega_k^2 = (EI (k pi / L)^4 - P (k pi / L)^2) / rhoS,
+// real for P below the k-th Euler load (k pi)^2 EI / L^2; above it the straight column is unstable
+// in that mode and the function throws.
+double pinned_column_frequency(double EI, double P, double rho_s, double L, int mode = 1);
+
+// Beams without axial load, omega = (beta L)^2 sqrt(EI / rhoS) / L^2 with beta L the mode-th
+// positive root of the characteristic equation:
+//   ClampedFree     1 + cos(x) cosh(x) = 0   1.87510406871196, 4.69409113297418, 7.85475743823761, ...
+//   ClampedClamped  cos(x) cosh(x) = 1       4.73004074486270, 7.85320462409584, ...  (x = 0 excluded)
+enum class BeamEnds { ClampedFree, ClampedClamped };
+double beam_frequency_parameter(BeamEnds ends, int mode = 1);
+double beam_frequency(BeamEnds ends, double EI, double rho_s, double L, int mode = 1);
+
+// Clamped-clamped column under the compressive dead load P (one clamp sliding axially), from
+// the characteristic equation of (96): with w = A cosh(a s) + B sinh(a s) + C cos(b s) + D sin(b s),
+//   a^2 = (-P + sqrt(P^2 + 4 EI rhoS omega^2)) / 2EI,  b^2 = (P + sqrt(...)) / 2EI,
+// the four clamp conditions are singular when
+//   2 a b (1 - cosh(a L) cos(b L)) + (a^2 - b^2) sinh(a L) sin(b L) = 0.
+// The mode-th root in omega > 0, found by scanning b L and refining with Brent. Domain: P below
+// the clamped-clamped Euler load 4 pi^2 EI / L^2 (P < 0 is a tension).
+double clamped_column_frequency(double EI, double P, double rho_s, double L, int mode = 1);
 
 // A straight rod along e3, twisted by an end rotation phi and pulled by a tension T.
 // Isotropic bending stiffness B, twist stiffness C; m = (C phi / L) e3, n = T e3, and the

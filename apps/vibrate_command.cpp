@@ -1,0 +1,119 @@
+#include "vibrate_command.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "kirchhoff/vibration.hpp"
+#include "result_json.hpp"
+#include "solve_command.hpp"
+
+namespace kirchhoff::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+nlohmann::json vibration_json(const Case& c, const ShootingResult& equilibrium, const VibrationOptions& options,
+                               const VibrationAnalysis& analysis, const std::vector<std::string>& profile_files) {
+  nlohmann::json modes = nlohmann::json::array();
+  for (size_t k = 0; k < analysis.modes.size(); ++k) {
+    const VibrationMode& m = analysis.modes[k];
+    nlohmann::json row = {{"omega", m.omega},
+                          {"omega_squared", m.omega * m.omega},
+                          {"H_vib_mean", m.H_vib_stats.mean},
+                          {"H_vib_spread", m.H_vib_stats.spread},
+                          {"H_vib_scale", m.H_vib_stats.scale},
+                          {"H_vib_relative_spread", m.H_vib_stats.relative_spread()},
+                          {"H_vib_invariant", m.H_vib_stats.applies},
+                          {"matching_residual", m.matching_residual}};
+    if (k < profile_files.size()) row["profile"] = profile_files[k];
+    modes.push_back(row);
+  }
+  return {{"case", c.path},
+          {"status", "converged"},
+          {"parameters", parameters_json(equilibrium.parameters)},
+          {"rho_s", options.rho_s},
+          {"straight_equilibrium", analysis.straight_equilibrium},
+          {"axial_indeterminate", analysis.axial_indeterminate},
+          {"omega_scale", analysis.omega_scale},
+          {"frequencies", analysis.frequencies()},
+          {"modes", modes}};
+}
+
+void write_mode_csv(const fs::path& path, const VibrationMode& m) {
+  std::ofstream csv(path);
+  if (!csv) throw std::runtime_error("cannot write " + path.string());
+  csv.precision(15);
+  csv << "s,xbar,ybar,thetabar,mbar,nbarx,nbary,H_vib\n";
+  for (size_t i = 0; i < m.s.size(); ++i) {
+    const VibrationState& q = m.state[i];
+    // The state is stored in the planar layout (x, y, theta, n_x, n_y, m).
+    csv << m.s[i] << ',' << q[0] << ',' << q[1] << ',' << q[2] << ',' << q[5] << ',' << q[3] << ',' << q[4] << ','
+        << m.H_vib[i] << '\n';
+  }
+}
+
+void print_table(const Case& c, const VibrationAnalysis& analysis) {
+  std::cout << (c.title.empty() ? c.path : c.title) << ": vibrations about the equilibrium"
+            << (analysis.straight_equilibrium ? " (straight)" : "") << "\n";
+  std::cout << "  k  omega               omega^2             H_vib mean          H_vib spread/scale\n";
+  for (size_t k = 0; k < analysis.modes.size(); ++k) {
+    const VibrationMode& m = analysis.modes[k];
+    std::cout << "  " << std::setw(2) << k + 1 << std::setprecision(12) << "  " << std::setw(18) << m.omega << "  "
+              << std::setw(18) << m.omega * m.omega << "  " << std::setw(18) << m.H_vib_stats.mean << "  "
+              << std::setprecision(3) << m.H_vib_stats.relative_spread()
+              << (m.H_vib_stats.applies ? "" : "  (not invariant: theta_e varies)") << "\n";
+  }
+}
+
+}  // namespace
+
+int run_vibrate(const VibrateArguments& args) {
+  SolvedCase solved;
+  if (const int status = load_and_solve(args.case_path, args.overrides, "", args.json, &solved); status != kExitOk)
+    return status;
+  if (solved.c.definition.kind != RodKind::Planar) {
+    std::cerr << "error: " << args.case_path
+              << ": vibrate handles planar rods only (the vibration equations B.4 are planar); this case is spatial\n";
+    return kExitBadInput;
+  }
+  VibrationOptions options;
+  options.modes = args.modes;
+  options.rho_s = args.rho_s;
+  VibrationAnalysis analysis;
+  try {
+    analysis = VibrationProblem(*solved.problem, solved.result.x, options).analyse();
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "error: " << args.case_path << ": " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  std::vector<std::string> profile_files;
+  try {
+    if (!args.profiles_dir.empty()) {
+      fs::create_directories(args.profiles_dir);
+      for (size_t k = 0; k < analysis.modes.size(); ++k) {
+        const fs::path file = fs::path(args.profiles_dir) / ("mode_" + std::to_string(k + 1) + ".csv");
+        write_mode_csv(file, analysis.modes[k]);
+        profile_files.push_back(file.string());
+      }
+    }
+    const nlohmann::json json = vibration_json(solved.c, solved.result, options, analysis, profile_files);
+    if (!args.out_path.empty()) {
+      std::ofstream out(args.out_path);
+      if (!out) throw std::runtime_error("cannot write " + args.out_path);
+      out << std::setprecision(17) << json.dump(2) << "\n";
+    }
+    if (args.json)
+      std::cout << json.dump(2) << "\n";
+    else
+      print_table(solved.c, analysis);
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
+}  // namespace kirchhoff::cli
