@@ -63,7 +63,7 @@ struct LinearisedFlow {
     const double inverse_EI = 1.0 / model.B[1](s);
     // nbar' = -(rhoS omega^2 I + df/dr) rbar: inertia (B.4b) plus the linearised field force.
     Eigen::Matrix2d stiffness = inertia * Eigen::Matrix2d::Identity();
-    if (model.field) stiffness += model.field->force_gradient(Vec3(y_e[kX], y_e[kY], 0.0)).topLeftCorner<2, 2>();
+    if (model.field) stiffness += model.field->force_gradient(s, Vec3(y_e[kX], y_e[kY], 0.0)).topLeftCorner<2, 2>();
     for (int j = 0; j < K; ++j) {
       const double* q = y.data() + kState * (j + 1);
       double* dq = dy.data() + kState * (j + 1);
