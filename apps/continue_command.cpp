@@ -247,7 +247,9 @@ int run_continue(const ContinueArguments& args) {
       state = load_state(state_path);
       truncate_csv(csv, state.row);
     }
-    writer = std::make_unique<BranchWriter>(csv, args.parameter, options.derived, args.resume);
+    std::vector<std::string> columns = c.definition.unknown_parameters;  // solved-for parameters first
+    columns.insert(columns.end(), options.derived.begin(), options.derived.end());
+    writer = std::make_unique<BranchWriter>(csv, args.parameter, columns, args.resume);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;

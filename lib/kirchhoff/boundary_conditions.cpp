@@ -96,7 +96,8 @@ EndCondition EndCondition::sliding(Vec3 axis, VectorTarget position, VectorTarge
   return c;
 }
 
-EndCondition EndCondition::half_turn_symmetry(Vec3 axis, int director) {
+EndCondition EndCondition::half_turn_symmetry(Vec3 axis, int director,
+                                              std::function<double(const Parameters&)> rotation) {
   if (director != 1 && director != 2) throw std::invalid_argument("half-turn symmetry: director must be 1 or 2");
   const Vec3 a = axis.normalized();
   const Vec3 d = director == 1 ? Vec3::UnitX() : Vec3::UnitY();
@@ -104,12 +105,22 @@ EndCondition EndCondition::half_turn_symmetry(Vec3 axis, int director) {
   Vec3 rotation_axis = d.cross(a);
   const double angle = std::atan2(rotation_axis.norm(), d.dot(a));
   if (rotation_axis.norm() < 1e-14) rotation_axis = Vec3::UnitZ();  // parallel or opposite: turn about e3
-  const OrientationTarget frame{rotation_axis.normalized(), angle};
+  const Eigen::AngleAxisd base(angle, rotation_axis.normalized());
   EndCondition c;
   c.add({Slot::Position, Directions::LateralToAxis, a, constant(Vec3::Zero()), {}, false, false});
   c.add({Slot::Force, Directions::AlongAxis, a, constant(Vec3::Zero()), {}, false, false});
-  c.add({Slot::Orientation, Directions::LateralToAxis, a, {}, constant_orientation(frame), false, false});
-  c.add({Slot::Moment, Directions::AlongAxis, a, constant(Vec3::Zero()), {}, false, false});
+  if (!rotation) {
+    c.add({Slot::Orientation, Directions::LateralToAxis, a, {},
+           constant_orientation({base.axis(), base.angle()}), false, false});
+    c.add({Slot::Moment, Directions::AlongAxis, a, constant(Vec3::Zero()), {}, false, false});
+    return c;
+  }
+  OrientationFunction turned = [a, base, rotation](const Parameters& p) {
+    const Eigen::AngleAxisd frame(Eigen::AngleAxisd(rotation(p), a) * base);
+    return OrientationTarget{frame.axis(), frame.angle()};
+  };
+  c.add({Slot::Orientation, Directions::All, a, {}, std::move(turned), false, false});
+  c.add({Slot::Moment, Directions::AlongAxis, a, constant(Vec3::Zero()), {}, false, true});
   return c;
 }
 

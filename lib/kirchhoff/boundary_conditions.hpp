@@ -66,7 +66,14 @@ class EndCondition {
   // no component along the axis. Which director is along the axis sets the parity of the end
   // rotation: with the start clamped at angle alpha about e3 and director 1 the whole rod's ends
   // differ by -2 alpha.
-  static EndCondition half_turn_symmetry(Vec3 axis, int director);
+  //
+  // With `rotation`, the frame's turn about the axis is imposed as well (the angle by which the
+  // frame is turned about the axis from the one with d_director along it and d3 = e3 x axis
+  // rotated into place), and "no moment along the axis" becomes an extra condition balanced by
+  // an unknown parameter such as the end rotation: the same equilibria, parameterised by how far
+  // the end loop has turned about the axis instead of by the end rotation.
+  static EndCondition half_turn_symmetry(Vec3 axis, int director,
+                                         std::function<double(const Parameters&)> rotation = {});
 
   EndCondition& add(SlotCondition condition);
   // Extra condition: the frame's rotation about `axis` equals `angle` (e.g. theta(0) = theta0).

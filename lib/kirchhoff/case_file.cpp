@@ -156,7 +156,7 @@ EndCondition read_end(const Reader& reader, const Value& root, const std::string
   const Value* table = Reader::find(root, name);
   if (!table) reader.fail(name, "missing table [" + name + "] (the boundary condition at that end)");
   reader.allow_keys(*table, name, {"type", "position", "orientation", "track_turns", "force", "moment", "axis",
-                                   "director", "extra_angle", "extra_angle_axis", "extra_hamiltonian"});
+                                   "director", "rotation", "extra_angle", "extra_angle_axis", "extra_hamiltonian"});
   const Value* type_value = Reader::find(*table, "type");
   if (!type_value)
     reader.fail(*table, name + ".type", "missing (clamped, pinned, free, loaded, sliding or half_turn)");
@@ -167,7 +167,7 @@ EndCondition read_end(const Reader& reader, const Value& root, const std::string
       {"free", {}},
       {"loaded", {"force", "moment"}},
       {"sliding", {"axis", "position", "force", "orientation", "track_turns"}},
-      {"half_turn", {"axis", "director"}},
+      {"half_turn", {"axis", "director", "rotation"}},
   };
   const auto it = keys_for_type.find(type);
   if (it == keys_for_type.end())
@@ -225,7 +225,12 @@ EndCondition read_end(const Reader& reader, const Value& root, const std::string
       if (value != 1.0 && value != 2.0) reader.fail(*d, name + ".director", "must be 1 or 2 (the director along the axis)");
       director = static_cast<int>(value);
     }
-    end = EndCondition::half_turn_symmetry(reader.unit_vector(*axis, name + ".axis"), director);
+    std::function<double(const Parameters&)> rotation;
+    if (const Value* r = Reader::find(*table, "rotation")) {
+      const Expression e = reader.expression(*r, name + ".rotation");
+      rotation = [e](const Parameters& p) { return e(p); };
+    }
+    end = EndCondition::half_turn_symmetry(reader.unit_vector(*axis, name + ".axis"), director, rotation);
   } else {
     const Value* axis = Reader::find(*table, "axis");
     if (!axis) reader.fail(*table, name + ".axis", "a sliding end needs the axis it slides along");

@@ -186,8 +186,11 @@ void Continuation::describe(ContinuationPoint* point) {
     r.x = p.x;
     r.summary.status = SolverStatus::Converged;
     r.parameters = problem_.parameters_at(p.x);
+    const Parameters at = r.parameters;
     const Solution s = make_solution(problem_, std::move(r), options_.samples, options_.derived);
     p.derived = s.derived;
+    // Parameters solved for belong on the branch too (e.g. the load of a displacement-controlled run).
+    for (const auto& name : problem_.definition().unknown_parameters) p.derived[name] = at.get(name);
     p.invariants = s.invariants;
     p.H_flat = !s.invariants.H.applies || s.invariants.H.spread <= kFlatH * std::max(1.0, s.invariants.H.scale);
   }
