@@ -138,6 +138,9 @@ struct FlatContactBuckling {
   double alpha = 0.0;      // angle of the outer arcs' line of force to the wall
 };
 FlatContactBuckling flat_contact_buckling(double L, double EI, double a);
+// The same rod where its mid-span point contact flattens (kappa_c = 0, hence H = -P): the two
+// outer arcs meet at s = L / 2 with no flat part between them (flat_length = 0).
+FlatContactBuckling contact_flattening(double L, double EI, double a);
 
 // The clamped-clamped Elastica in its second symmetric mode (two arches of length L / 2 side by
 // side, clamps and the middle on y = 0) whose crests reach the height a: where a hanging fold's
