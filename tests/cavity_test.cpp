@@ -22,17 +22,6 @@ testing::ContactBranch follow_cavity(double target) {
   return testing::follow_contacts(c, o);
 }
 
-bool has_extended(const std::vector<PointContact>& contacts) {
-  return std::any_of(contacts.begin(), contacts.end(), [](const auto& c) { return c.extended; });
-}
-// A hanging fold: two neighbouring point contacts on the same wall with the rod off it between.
-bool has_fold(const std::vector<PointContact>& contacts) {
-  for (size_t k = 0; k + 1 < contacts.size(); ++k)
-    if (!contacts[k].extended && !contacts[k + 1].extended && contacts[k].obstacle == contacts[k + 1].obstacle)
-      return true;
-  return false;
-}
-
 class Cavity : public ::testing::Test {
  protected:
   static void SetUpTestSuite() { branch = new testing::ContactBranch(follow_cavity(0.1)); }
@@ -95,12 +84,12 @@ TEST_F(Cavity, ExtendedContactAndHangingFoldNeverCoexist) {
     const ContinuationPoint& p = branch->points[i];
     const auto contacts = branch->contacts(i);
     const double P = p.derived.at("P"), H_plus_P = p.derived.at("H") + P;
-    EXPECT_FALSE(has_extended(contacts) && has_fold(contacts)) << p.parameter;
-    if (has_extended(contacts) && contacts.front().s_end > contacts.front().s) {
+    EXPECT_FALSE(has_extended_contact(contacts) && has_hanging_fold(contacts)) << p.parameter;
+    if (has_extended_contact(contacts) && contacts.front().s_end > contacts.front().s) {
       ++flat;
       EXPECT_NEAR(H_plus_P, 0.0, 1e-9 * P) << p.parameter;
     }
-    if (has_fold(contacts)) {
+    if (has_hanging_fold(contacts)) {
       ++folds;
       const double kc = p.derived.at("kappa_contact");
       EXPECT_NEAR(H_plus_P, 0.5 * kc * kc, 1e-9 * P) << p.parameter;

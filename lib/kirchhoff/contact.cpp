@@ -63,6 +63,17 @@ Eigen::VectorXd carry_over(const ShootingProblem& old_problem, const Eigen::Vect
 
 }  // namespace
 
+bool has_extended_contact(const std::vector<PointContact>& contacts) {
+  return std::any_of(contacts.begin(), contacts.end(), [](const auto& c) { return c.extended; });
+}
+
+bool has_hanging_fold(const std::vector<PointContact>& contacts) {
+  for (size_t k = 0; k + 1 < contacts.size(); ++k)
+    if (!contacts[k].extended && !contacts[k + 1].extended && contacts[k].obstacle == contacts[k + 1].obstacle)
+      return true;
+  return false;
+}
+
 ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& guess, const ContactOptions& options) {
   ContactSolveResult out;
   std::sort(d.contacts.begin(), d.contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
@@ -268,7 +279,7 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     // (dm0, ds) = (1, 1 / n_y). The solution is isolated only at second order. Branch points
     // are not looked for rather than reported falsely; removing the degeneracy would need the
     // double root replaced by its square root (kappa0 = 0 imposed at such an end).
-    if (std::any_of(d.contacts.begin(), d.contacts.end(), [](const auto& c) { return c.extended; })) {
+    if (has_extended_contact(d.contacts)) {
       leg.detect_branch_points = false;
       leg.events.push_back({"flat_contact_margin", 0.0, true, "flat_contact_buckles"});
     }

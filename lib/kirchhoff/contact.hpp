@@ -40,6 +40,11 @@ struct InfeasibleContact : std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+// Whether an active set has an extended contact, and a hanging fold: two neighbouring point
+// contacts on the same obstacle (the rod leaves it between them).
+bool has_extended_contact(const std::vector<PointContact>& contacts);
+bool has_hanging_fold(const std::vector<PointContact>& contacts);
+
 // Solves from `guess` (the state at s = 0, completed by the start conditions) starting with the
 // definition's contacts as the active set. Non-convergence of a solve ends the loop with that
 // status; a loop that does not settle within max_rounds reports complementarity = false.
