@@ -200,8 +200,8 @@ Eigen::Vector2d blister_gap_and_centre(ShootingProblem problem, const std::strin
 // makes the flat branch degenerate (see run_legs on branch points): the outer arc can slide
 // along itself, which moves a contact and leaves the blister flat. Of the combinations we take
 // the one whose blister leaves the obstacle (gap at mid-blister 2 eps > 0) and stays centred on
-// the flat part it replaces (d(s1 + s2) = 0); the sliding would start an asymmetric fold
-// instead (another branch through the same point, followed if this one is not).
+// the flat part it replaces (d(s1 + s2) = 0); with some sliding in it, the predictor lands on an
+// asymmetric fold instead, another branch through the same point.
 struct FoldStart {
   Eigen::VectorXd direction;  // unit, in (x, lambda)
   double step = 0.0;          // the first step along it
@@ -221,7 +221,12 @@ FoldStart fold_direction(Continuation& flat, const ContinuationPoint& onset, siz
                 blister_gap_and_centre(problem, parameter, z - h * N.col(j), k)) /
                (2 * h);
   }
-  const Eigen::VectorXd v = N * D.fullPivLu().solve(Eigen::Vector2d(2.0, 0.0));
+  // Where only one null vector moves the blister (no sliding mode: the second is not a null
+  // vector at all), the blister's own direction is the one with the larger gap derivative.
+  const Eigen::FullPivLU<Eigen::Matrix2d> lu(D);
+  const int own = std::abs(D(0, 0)) >= std::abs(D(0, 1)) ? 0 : 1;
+  const Eigen::VectorXd v = lu.rank() == 2 ? Eigen::VectorXd(N * lu.solve(Eigen::Vector2d(2.0, 0.0)))
+                                           : Eigen::VectorXd(N.col(own) * (2.0 / D(0, own)));
   // First step: a blister 1e-3 l deep (deeper first steps leave the corrector's reach; the
   // contacts move ~100 times faster than the blister deepens near the onset).
   const auto contacts = problem.contacts_at(onset.x);
@@ -231,9 +236,13 @@ FoldStart fold_direction(Continuation& flat, const ContinuationPoint& onset, siz
 
 ContinuationResult leave_flat_branch(const ShootingProblem& problem, ContinuationOptions leg,
                                      const ContinuationPoint& onset, size_t first_contact, const PointSink& sink) {
-  const FoldStart start = fold_direction(*std::make_unique<Continuation>(problem, leg), onset, first_contact);
+  Continuation flat(problem, leg);
+  const FoldStart start = fold_direction(flat, onset, first_contact);
   leg.initial_step = std::min(leg.initial_step, start.step);
-  return Continuation(problem, leg).run_along(onset.x, onset.parameter, start.direction, PointType::Event, sink);
+  ContinuationResult r = Continuation(problem, leg).run_along(onset.x, onset.parameter, start.direction,
+                                                             PointType::Event, sink);
+  if (r.reason == StopReason::StartFailed) r.message = "the hanging fold could not be started: " + r.message;
+  return r;
 }
 
 // What is wrong with a point of a contact branch, or "" when 0 <= gap perp force >= 0 holds to
