@@ -346,7 +346,9 @@ int run_continue(const ContinueArguments& args) {
       std::cerr << "stopped: " << to_string(r.result.reason)
                 << (r.result.message.empty() ? "" : " (" + r.result.message + ")") << "; " << state.row + 1
                 << " points in " << args.out_path << "\n";
-      return r.result.reason == StopReason::StartFailed ? kExitNotConverged : kExitOk;
+      const bool failed = r.result.reason == StopReason::StartFailed || r.result.reason == StopReason::StepTooSmall ||
+                          r.result.reason == StopReason::Inadmissible;
+      return failed ? kExitNotConverged : kExitOk;
     } catch (const std::exception& e) {
       progress.done();
       std::cerr << "error: " << e.what() << "\n";

@@ -147,7 +147,7 @@ struct PyBranch {
   // What the CLI turns into exit status 0.
   bool ok() const {
     return reason != to_string(StopReason::StartFailed) && reason != to_string(StopReason::StepTooSmall) &&
-           (!switch_requested || switched);
+           reason != to_string(StopReason::Inadmissible) && (!switch_requested || switched);
   }
 };
 

@@ -159,6 +159,49 @@ def vibrations(profiles, figures):
         ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(figures / "vibration_column.png", dpi=130)
+def fig5(profiles, figures):
+    """Section 7.2 / Fig. 5: the Elastica in a cavity (walls y = +-a) as the end shortening grows."""
+    a = 0.1  # cases/cavity.toml
+    shapes = np.genfromtxt(profiles / "fig5_cavity_profiles.csv", delimiter=",", names=True, dtype=None,
+                           encoding="utf-8")
+    branch = np.genfromtxt(profiles / "fig5_cavity_branch.csv", delimiter=",", names=True, dtype=None,
+                           encoding="utf-8")
+    fig, (ax, axp) = plt.subplots(1, 2, figsize=(13, 4.4), gridspec_kw={"width_ratios": [1.5, 1]})
+    deltas = sorted(set(shapes["Delta"]))
+    for offset, delta in enumerate(deltas):
+        rows = shapes[shapes["Delta"] == delta]
+        shift = -2.6 * a * offset  # stacked, each between its own pair of walls
+        for wall in (a, -a):
+            ax.plot([-0.02, 1.02], [wall + shift] * 2, color="gray", lw=3, alpha=0.4)
+        ax.plot(rows["x"], rows["y"] + shift, "-", lw=1.6)
+        ax.text(1.04, shift, f"$\\Delta$ = {delta:.4f}\n{rows['state'][0]}", va="center", fontsize=8)
+    ax.set_aspect("equal")
+    ax.set_xlim(-0.05, 1.25)
+    ax.set_yticks([])
+    ax.set_xlabel("x / L")
+    ax.set_title("Fig. 5: clamped Elastica in a cavity, walls at y = $\\pm$a (a = 0.1 L)")
+    colours = {"free": "C0", "point": "C1", "flat": "C2", "fold": "C3"}
+    for state, colour in colours.items():
+        on = branch["state"] == state
+        axp.plot(branch["Delta"][on], branch["P"][on], ".", ms=3, color=colour, label=state)
+    names = (("appears", "first contact"), ("flattens", "contact flattens"),
+             ("hanging fold", "flat part buckles: hanging fold"), ("lifts off", "fold contacts lift off together"))
+    marked = set()
+    for delta, p, label in zip(branch["Delta"], branch["P"], branch["event"]):
+        name = next((short for key, short in names if key in label), None)
+        if name is None or round(delta, 6) in marked:
+            continue
+        marked.add(round(delta, 6))  # simultaneous changes: one mark
+        axp.plot(delta, p, "kx", ms=7)
+        axp.annotate(name, (delta, p), textcoords="offset points", xytext=(5, 3), fontsize=7.5)
+    turns = (branch["type"] == "fold") & (branch["state"] == "fold")
+    axp.plot(branch["Delta"][turns], branch["P"][turns], "k^", ms=6, label="turning point (subcritical fold)")
+    axp.set_xlabel("end shortening $\\Delta$ / L")
+    axp.set_ylabel("P L$^2$ / EI")
+    axp.set_title("load along the branch, contact events marked")
+    axp.legend(fontsize=8, loc="lower right")
+    fig.tight_layout()
+    fig.savefig(figures / "fig5_cavity.png", dpi=130)
     plt.close(fig)
 
 
@@ -166,7 +209,7 @@ def main(out):
     out = pathlib.Path(out)
     profiles, figures = out / "profiles", out / "figures"
     figures.mkdir(parents=True, exist_ok=True)
-    for make in (fig3, fig9, fig12, euler_branch, sleeves, vibrations):
+    for make in (fig3, fig9, fig12, euler_branch, sleeves, vibrations, fig5):
         make(profiles, figures)
         print(f"  {make.__name__}: written", file=sys.stderr)
 

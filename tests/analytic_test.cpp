@@ -324,6 +324,27 @@ TEST(Analytic, BadInputsThrow) {
   expect_invalid([] { clamped_twisted_critical_moment(1.0, 1.0, 0.0); }, "L");
   expect_invalid([] { clamped_twisted_critical_moment(1.0, -50.0, 1.0); }, "T");
   expect_invalid([] { clamped_twisted_critical_moment(1.0, NAN, 1.0); }, "T");
+  expect_invalid([] { flat_contact_buckling(1.0, 1.0, 0.0); }, "a");
+  expect_invalid([] { flat_contact_buckling(1.0, 1.0, 0.2); }, "a");
+  expect_invalid([] { contact_flattening(0.0, 1.0, 0.1); }, "L");
+  expect_invalid([] { second_mode_arches(1.0, 0.0, 0.1); }, "EI");
+  expect_invalid([] { second_mode_arches(1.0, 1.0, 0.25); }, "a");
+}
+
+// A clamped-clamped rod against a wall a -> 0 above its clamps: where the contact flattens the
+// two outer arcs are full waves of length L/2 (P -> 4 pi^2 EI / (L/4)^2 = 16 pi^2 EI / L^2); where the
+// flat part buckles, arcs and flat part all have length L/3 (P -> 36 pi^2 EI / L^2); the second
+// mode touching the wall is the clamped-clamped 16 pi^2 EI / L^2 mode. Corrections are O(a^2).
+TEST(Analytic, WallConfigurationsTendToEulerLoadsForALowWall) {
+  const double a = 1e-4, pi2 = kPi * kPi;
+  EXPECT_NEAR(contact_flattening(1.0, 1.0, a).P / (16.0 * pi2), 1.0, 1e-6);
+  EXPECT_NEAR(flat_contact_buckling(1.0, 1.0, a).P / (36.0 * pi2), 1.0, 1e-6);
+  EXPECT_NEAR(flat_contact_buckling(1.0, 1.0, a).flat_length, 1.0 / 3.0, 1e-6);
+  EXPECT_NEAR(second_mode_arches(1.0, 1.0, a).P / (16.0 * pi2), 1.0, 1e-6);
+  // Scaling: lengths with L, loads with EI / L^2.
+  const auto base = flat_contact_buckling(1.0, 1.0, 0.1), scaled = flat_contact_buckling(2.0, 3.0, 0.2);
+  EXPECT_NEAR(scaled.P, base.P * 3.0 / 4.0, 1e-9 * base.P);
+  EXPECT_NEAR(scaled.Delta, 2.0 * base.Delta, 1e-12);
 }
 
 }  // namespace

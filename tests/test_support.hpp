@@ -6,6 +6,8 @@
 #include <string>
 
 #include "kirchhoff/case_file.hpp"
+#include "kirchhoff/contact.hpp"
+#include "kirchhoff/invariants.hpp"
 #include "kirchhoff/solution.hpp"
 
 namespace kirchhoff::testing {
@@ -28,6 +30,37 @@ inline Solved solve_case(const std::string& name, const ParameterOverrides& over
   EXPECT_TRUE(r.summary.converged()) << name << ": " << r.summary.brief_report();
   out.solution = make_solution(*out.problem, std::move(r), samples, out.c.derived);
   return out;
+}
+
+// A contact continuation with, for every reported point, the problem it was solved in (its
+// active set and parameter value), to look at its contacts and profile.
+struct ContactBranch {
+  ContactContinuationResult result;
+  std::vector<ContinuationPoint> points;  // as reported, events labelled by what changed
+  std::vector<std::shared_ptr<ShootingProblem>> problems;
+  std::vector<PointContact> contacts(size_t i) const { return problems[i]->contacts_at(points[i].x); }
+};
+
+inline ContactBranch follow_contacts(const Case& c, const ContinuationOptions& o) {
+  ContactBranch out;
+  ProblemDefinition leg = c.definition;
+  auto on_leg = [&](const std::vector<PointContact>& active) { leg.contacts = active; };
+  auto on_point = [&](const ContinuationPoint& p) {
+    auto problem = std::make_shared<ShootingProblem>(leg);
+    problem->set_parameter(o.parameter, p.parameter);
+    out.problems.push_back(problem);
+  };
+  out.result = continue_with_contacts(c.definition, c.start_guess, o, on_point, {}, on_leg);
+  out.points = out.result.result.points;
+  EXPECT_EQ(out.points.size(), out.problems.size());
+  return out;
+}
+
+// H just before and just after arclength s (either side of a contact).
+inline std::pair<double, double> hamiltonian_across(const ShootingProblem& problem, const Eigen::VectorXd& x, double s) {
+  const RodModel& model = problem.equations(problem.parameters_at(x))->model();
+  const auto pair = problem.sample(x, {s - 1e-9, s + 1e-9});
+  return {hamiltonian(model, pair[0]), hamiltonian(model, pair[1])};
 }
 
 }  // namespace kirchhoff::testing

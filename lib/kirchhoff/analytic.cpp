@@ -579,4 +579,68 @@ double plectoneme_end_tension(double theta, double EI, double R) {
   return 0.5 * EI / (R * R) * std::pow(std::sin(theta), 4) * (1.0 + 2.0 / std::cos(2.0 * theta));
 }
 
+namespace {
+
+// The clamped-clamped rod on the wall with H = -P (see FlatContactBuckling): the outer arcs are
+// full inflectional waves of two half-waves of length s_h each, with end slope alpha to the line
+// of force. The flat part has the length flat_length(mu) (mu = sqrt(EI / P)); 4 s_h + l = L fixes
+// mu for each alpha, and the arcs' height a fixes alpha.
+template <class FlatLength>
+FlatContactBuckling flat_wall_contact(const char* where, double L, double EI, double a, FlatLength flat_length) {
+  require_positive(where, "L", L);
+  require_positive(where, "EI", EI);
+  require_positive(where, "a", a);
+  if (!(a < L / 6.0)) reject(where, "a", "must be below L / 6");
+  struct Shape {
+    double mu, s_h, chord;
+  };
+  auto shape = [&](double alpha) {
+    const double k = std::sin(0.5 * alpha), K = complete_K(k), E = complete_E(k);
+    const double root_cos = std::sqrt(std::cos(alpha));
+    // 4 s_h + l(mu) = L with s_h = 2 K mu sqrt(cos alpha) and l linear in mu.
+    const double mu = L / (8.0 * K * root_cos + flat_length(1.0));
+    const double s_h = 2.0 * K * mu * root_cos;
+    return Shape{mu, s_h, 2.0 * s_h * (2.0 * E / K - 1.0)};
+  };
+  // The height grows monotonically from 0 (alpha -> 0, a straight rod) to ~0.19 L near alpha = 1
+  // (beyond, the chord shrinks: 2E/K - 1 -> 0 near alpha = 130 deg); the root is below 1 rad.
+  const double alpha = brent_root([&](double al) { return shape(al).chord * std::sin(al) - a; }, 1e-9, 1.0);
+  const Shape s = shape(alpha);
+  FlatContactBuckling out;
+  out.alpha = alpha;
+  out.P = EI / (s.mu * s.mu);
+  out.flat_length = flat_length(s.mu);
+  out.contact_start = 2.0 * s.s_h;
+  out.Delta = L - out.flat_length - 2.0 * s.chord * std::cos(alpha);
+  return out;
+}
+
+}  // namespace
+
+FlatContactBuckling flat_contact_buckling(double L, double EI, double a) {
+  // The flat part at its clamped-clamped Euler load: l = 2 pi mu.
+  return flat_wall_contact("flat_contact_buckling", L, EI, a, [](double mu) { return 2.0 * M_PI * mu; });
+}
+
+FlatContactBuckling contact_flattening(double L, double EI, double a) {
+  // A flat part of zero length: the point contact at mid-span with kappa_c = 0.
+  return flat_wall_contact("contact_flattening", L, EI, a, [](double) { return 0.0; });
+}
+
+SecondModeArches second_mode_arches(double L, double EI, double a) {
+  const char* where = "second_mode_arches";
+  require_positive(where, "L", L);
+  require_positive(where, "EI", EI);
+  require_positive(where, "a", a);
+  if (!(a < 0.2 * L)) reject(where, "a", "must be below 0.2 L");
+  // 2 y_max = 2 k L / (4 K(k)) grows monotonically with theta0 on (0, 2), to 0.2016 L.
+  auto crest = [&](double theta0) { return 2.0 * PinnedElastica{0.25 * L, EI, theta0}.y_max() - a; };
+  SecondModeArches out;
+  out.theta0 = brent_root(crest, 1e-9, 2.0);
+  const PinnedElastica quarter{0.25 * L, EI, out.theta0};
+  out.P = quarter.load();
+  out.Delta = L - 4.0 * quarter.end_to_end();
+  return out;
+}
+
 }  // namespace kirchhoff::analytic

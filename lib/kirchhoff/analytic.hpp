@@ -160,4 +160,42 @@ double helix_tension(double theta, double EI, double R);           // (58c) EI s
 // H_A = H_B: T_ext = EI/(2 R^2) sin^4 theta (1 + 2/cos 2theta). Valid for theta < pi/4.
 double plectoneme_end_tension(double theta, double EI, double R);
 
+// Where the flat contact of a clamped-clamped Elastica pressed against a wall buckles into a
+// hanging fold (section 7.2): clamps at y = 0 with horizontal tangents, wall y = a, the middle of
+// the rod flat on the wall over a length l under the compression P, which reaches its
+// clamped-clamped Euler load there, P l^2 = 4 pi^2 EI.
+// H = -P on the flat part, so the curvature vanishes wherever theta = 0: at the clamps as at the
+// ends of the flat part. Each outer arc is then one full wave of an inflectional Elastica
+// between inflection points on the line of action of the force F = P / cos(alpha), alpha being
+// that line's angle with the wall: two pinned half-waves (PinnedElastica) of length s_h with end
+// slope alpha to their chord. With mu = sqrt(EI / P):
+//   s_h = 2 K(k) mu sqrt(cos alpha),  k = sin(alpha / 2),  l = 2 pi mu,  4 s_h + l = L,
+//   height of the arc  2 s_h (2 E(k) / K(k) - 1) sin(alpha) = a,
+// one equation in alpha (GSL's Brent), without any differential equation.
+// Domain: L > 0, EI > 0, 0 < a < L / 6 (beyond, no such configuration).
+struct FlatContactBuckling {
+  double Delta = 0.0;      // end shortening at the onset
+  double P = 0.0;          // compressive load
+  double flat_length = 0.0;
+  double contact_start = 0.0;  // arclength where the flat part begins (= 2 s_h)
+  double alpha = 0.0;      // angle of the outer arcs' line of force to the wall
+};
+FlatContactBuckling flat_contact_buckling(double L, double EI, double a);
+// The same rod where its mid-span point contact flattens (kappa_c = 0, hence H = -P): the two
+// outer arcs meet at s = L / 2 with no flat part between them (flat_length = 0).
+FlatContactBuckling contact_flattening(double L, double EI, double a);
+
+// The clamped-clamped Elastica in its second symmetric mode (two arches of length L / 2 side by
+// side, clamps and the middle on y = 0) whose crests reach the height a: where a hanging fold's
+// contact forces vanish (both contacts, at L / 4 and 3 L / 4, at once). Each arch is a pinned
+// half-wave of length L / 4 between its inflection points with a quarter wave on either side,
+// so P = PinnedElastica{L / 4, EI, theta0}.load() with 2 y_max = a, and Delta = L - 4 chord.
+// Domain: L > 0, EI > 0, 0 < a < 0.2 L (2 y_max peaks at 0.2016 L, at theta0 = 2).
+struct SecondModeArches {
+  double Delta = 0.0;
+  double P = 0.0;
+  double theta0 = 0.0;     // slope at the inflection points
+};
+SecondModeArches second_mode_arches(double L, double EI, double a);
+
 }  // namespace kirchhoff::analytic

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <boost/math/tools/minima.hpp>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 namespace kirchhoff {
@@ -61,6 +62,17 @@ Eigen::VectorXd carry_over(const ShootingProblem& old_problem, const Eigen::Vect
 }
 
 }  // namespace
+
+bool has_extended_contact(const std::vector<PointContact>& contacts) {
+  return std::any_of(contacts.begin(), contacts.end(), [](const auto& c) { return c.extended; });
+}
+
+bool has_hanging_fold(const std::vector<PointContact>& contacts) {
+  for (size_t k = 0; k + 1 < contacts.size(); ++k)
+    if (!contacts[k].extended && !contacts[k + 1].extended && contacts[k].obstacle == contacts[k + 1].obstacle)
+      return true;
+  return false;
+}
 
 ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& guess, const ContactOptions& options) {
   ContactSolveResult out;
@@ -141,12 +153,122 @@ DefinitionSolve solve_definition(const ProblemDefinition& definition, const RodP
 
 namespace {
 
+// Which extended contact buckles at a flat_contact_buckles event: the one with the smallest margin.
+size_t buckling_flat_contact(const ShootingProblem& problem, const Eigen::VectorXd& x,
+                             const std::vector<PointContact>& contacts) {
+  size_t which = 0;
+  double smallest = INFINITY;
+  for (size_t k = 0; k < contacts.size(); ++k) {
+    const double margin = problem.flat_contact_margin(x, contacts[k]);
+    if (std::isfinite(margin) && margin < smallest) {
+      smallest = margin;
+      which = k;
+    }
+  }
+  return which;
+}
+
+// The hanging fold: the flat contact `which` is replaced by point contacts at its two ends, with
+// the same arclengths and forces. The unknowns keep their layout ([s, force, s_end, force_end]
+// become [s1, f1], [s2, f2]), so the flat configuration's x solves the new problem as well.
+std::vector<PointContact> split_into_fold(std::vector<PointContact> contacts, size_t which) {
+  const PointContact flat = contacts[which];
+  PointContact first{flat.obstacle, flat.s, flat.force}, second{flat.obstacle, flat.s_end, flat.force_end};
+  contacts[which] = first;
+  contacts.insert(contacts.begin() + which + 1, second);
+  return contacts;
+}
+
+// The quantities that pick the fold's direction at (x, lambda): the blister's gap at mid-way
+// between contacts k and k + 1, and where its middle is (s_k + s_k+1) / 2.
+Eigen::Vector2d blister_gap_and_centre(ShootingProblem problem, const std::string& parameter, const Eigen::VectorXd& z,
+                                       size_t k) {
+  const Eigen::VectorXd x = z.head(z.size() - 1);
+  problem.set_parameter(parameter, z[z.size() - 1]);
+  const auto contacts = problem.contacts_at(x);
+  const PlaneObstacle& obstacle = problem.definition().obstacles[contacts[k].obstacle];
+  const double centre = 0.5 * (contacts[k].s + contacts[k + 1].s);
+  return {obstacle.gap(problem.sample(x, {centre}).front().r), centre};
+}
+
+// With the ends of a flat contact as two point contacts, the flat configuration solves the
+// problem at every Delta (the flat branch), and the hanging fold bifurcates from it where the flat
+// part of length l reaches its Euler load, along the clamped-clamped strut's first mode between
+// the contacts, g(s) = eps (1 - cos(2 pi (s - s1) / l)), with the response of the rest of the rod.
+// That direction is sought among the null vectors of [F_x F_lambda] orthogonal to the flat
+// branch's tangent: there are two, not one, because an end clamped parallel to the obstacle
+// makes the flat branch degenerate (see run_legs on branch points): the outer arc can slide
+// along itself, which moves a contact and leaves the blister flat. Of the combinations we take
+// the one whose blister leaves the obstacle (gap at mid-blister 2 eps > 0) and stays centred on
+// the flat part it replaces (d(s1 + s2) = 0); with some sliding in it, the predictor lands on an
+// asymmetric fold instead, another branch through the same point.
+struct FoldStart {
+  Eigen::VectorXd direction;  // unit, in (x, lambda)
+  double step = 0.0;          // the first step along it
+};
+FoldStart fold_direction(Continuation& flat, const ContinuationPoint& onset, size_t k) {
+  const ShootingProblem& problem = flat.problem();
+  const std::string& parameter = flat.options().parameter;
+  const Eigen::MatrixXd N = flat.bifurcation_directions(onset, 2);
+  Eigen::VectorXd z(onset.x.size() + 1);
+  z << onset.x, onset.parameter;
+  // Directional derivatives by central differences (the functions are smooth in z; h balances
+  // the truncation error ~h^2 and the integrator's ~1e-12 noise / h).
+  Eigen::Matrix2d D;
+  for (int j = 0; j < 2; ++j) {
+    const double h = 1e-5 / N.col(j).lpNorm<Eigen::Infinity>();
+    D.col(j) = (blister_gap_and_centre(problem, parameter, z + h * N.col(j), k) -
+                blister_gap_and_centre(problem, parameter, z - h * N.col(j), k)) /
+               (2 * h);
+  }
+  // Where only one null vector moves the blister (no sliding mode: the second is not a null
+  // vector at all), the blister's own direction is the one with the larger gap derivative.
+  const Eigen::FullPivLU<Eigen::Matrix2d> lu(D);
+  const int own = std::abs(D(0, 0)) >= std::abs(D(0, 1)) ? 0 : 1;
+  const Eigen::VectorXd v = lu.rank() == 2 ? Eigen::VectorXd(N * lu.solve(Eigen::Vector2d(2.0, 0.0)))
+                                           : Eigen::VectorXd(N.col(own) * (2.0 / D(0, own)));
+  // First step: a blister 1e-3 l deep (deeper first steps leave the corrector's reach; the
+  // contacts move ~100 times faster than the blister deepens near the onset).
+  const auto contacts = problem.contacts_at(onset.x);
+  const double l = contacts[k + 1].s - contacts[k].s;
+  return {v.normalized(), 1e-3 * l * v.norm() / 2.0};
+}
+
+ContinuationResult leave_flat_branch(const ShootingProblem& problem, ContinuationOptions leg,
+                                     const ContinuationPoint& onset, size_t first_contact, const PointSink& sink) {
+  Continuation flat(problem, leg);
+  const FoldStart start = fold_direction(flat, onset, first_contact);
+  leg.initial_step = std::min(leg.initial_step, start.step);
+  ContinuationResult r = Continuation(problem, leg).run_along(onset.x, onset.parameter, start.direction,
+                                                             PointType::Event, sink);
+  if (r.reason == StopReason::StartFailed) r.message = "the hanging fold could not be started: " + r.message;
+  return r;
+}
+
+// What is wrong with a point of a contact branch, or "" when 0 <= gap perp force >= 0 holds to
+// 1e3 times the active-set loop's tolerances (events are located far closer than that).
+std::string complementarity_violation(const ContinuationPoint& p, const ContactOptions& contact) {
+  const auto value = [&](const char* name) { return p.derived.count(name) ? p.derived.at(name) : NAN; };
+  std::ostringstream what;
+  if (value("min_gap") < -1e3 * contact.penetration_tolerance)
+    what << "the rod penetrates an obstacle (min_gap " << value("min_gap") << ")";
+  else if (value("min_contact_force") < -1e3 * contact.force_tolerance)
+    what << "a contact pulls (force " << value("min_contact_force") << ")";
+  else
+    return "";
+  what << " at " << p.parameter;
+  return what.str();
+}
+
 // The legs of a contact continuation, from unknowns x (a new run) or from a point (a resume).
 ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const ContinuationPoint* resume_from,
                                    ContinuationOptions options, const PointSink& sink, const ContactOptions& contact,
                                    const ActiveSetSink& active_set_sink, ContactContinuationResult out) {
   const int max_points = options.max_points;
   bool first_leg = true;
+  // Set when a flat contact has just buckled: the next leg leaves the flat branch along the fold.
+  std::optional<ContinuationPoint> fold_onset;
+  size_t fold_contact = 0;  // the first of the fold's two contacts
   while (true) {
     ContinuationOptions leg = options;
     leg.max_points = max_points - static_cast<int>(out.result.points.size()) + (first_leg ? 0 : 1);
@@ -156,29 +278,49 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     leg.samples = std::max(leg.samples, contact.samples);
     if (!d.contacts.empty()) leg.events.push_back({"min_contact_force", 0.0, true, "contact_lifts_off"});
     const bool has_point = std::any_of(d.contacts.begin(), d.contacts.end(), [](const auto& c) { return !c.extended; });
-    // With an extended contact the bordered determinant changes sign at almost every step (seen
-    // on wall.toml). Likely cause: the ends of a flat contact are contacts of higher order (the
-    // rod leaves with zero curvature, gap ~ (s - s1)^3), which makes the Jacobian nearly singular
-    // there, so the sign is noise. Branch points are not looked for rather than reported falsely.
-    if (std::any_of(d.contacts.begin(), d.contacts.end(), [](const auto& c) { return c.extended; })) {
+    // With an extended contact the Jacobian is singular all along the branch (smallest singular
+    // value ~1e-9 of the largest on wall.toml), so the bordered determinant's sign is noise.
+    // Cause: H is invariant and equals -P on the flat part (theta = 0, kappa = 0), so wherever
+    // else the rod is parallel to the obstacle - at an end clamped parallel to it - the curvature
+    // vanishes too. That end's moment m0 is then a double root (H = EI kappa0^2 / 2 - P = -P),
+    // and to first order the arc between the clamp and the flat part can slide along itself
+    // (m0 and s change together, the tangency rows do not see it): the null vector of F_x is
+    // (dm0, ds) = (1, 1 / n_y). The solution is isolated only at second order. Branch points
+    // are not looked for rather than reported falsely; removing the degeneracy would need the
+    // double root replaced by its square root (kappa0 = 0 imposed at such an end).
+    if (has_extended_contact(d.contacts)) {
       leg.detect_branch_points = false;
       leg.events.push_back({"flat_contact_margin", 0.0, true, "flat_contact_buckles"});
     }
     if (has_point && d.kind == RodKind::Planar) leg.events.push_back({"contact_bending", 0.0, true, "contact_flattens"});
     const ShootingProblem problem(d);
     if (active_set_sink) active_set_sink(d.contacts);
-    // A leg starts on the previous leg's last point, which is already reported.
+    // A leg starts on the previous leg's last point, which is already reported. A point that
+    // violates complementarity (an event missed, e.g. a leg started where two changes coincide)
+    // ends the run there: it and the points after it are not reported.
     bool skip = !first_leg;
+    std::string violation;
     auto leg_sink = [&](const ContinuationPoint& p) {
       if (skip) {
         skip = false;
         return;
       }
-      if (sink) sink(p);
+      if (violation.empty()) violation = complementarity_violation(p, contact);
+      if (violation.empty() && sink) sink(p);
     };
     ContinuationResult r = first_leg && resume_from ? Continuation(problem, leg).resume(*resume_from, leg_sink)
-                                                    : Continuation(problem, leg).run(x, leg_sink);
+                           : fold_onset ? leave_flat_branch(problem, leg, *fold_onset, fold_contact, leg_sink)
+                                        : Continuation(problem, leg).run(x, leg_sink);
+    fold_onset.reset();
     if (!first_leg && !r.points.empty()) r.points.erase(r.points.begin());
+    if (!violation.empty()) {
+      const auto bad = std::find_if(r.points.begin(), r.points.end(), [&](const ContinuationPoint& p) {
+        return !complementarity_violation(p, contact).empty();
+      });
+      r.points.erase(bad, r.points.end());
+      r.reason = StopReason::Inadmissible;
+      r.message = "the branch leaves the admissible set: " + violation + " (no event located before it)";
+    }
     out.result.points.insert(out.result.points.end(), r.points.begin(), r.points.end());
     out.result.reason = r.reason;
     out.result.message = r.message;
@@ -194,12 +336,15 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     change << options.parameter << " = " << at.parameter << ": ";
     const auto contacts = here.contacts_at(at.x);
     if (at.event == "flat_contact_buckles") {
-      out.result.message = "the flat contact reaches its Euler load (P l^2 = 4 pi^2 EI): a hanging fold forms "
-                           "here, which is not modelled; beyond, the flat branch is unstable";
-      out.changes.push_back(change.str() + out.result.message);
-      return out;
-    }
-    if (at.event == "contact_flattens") {
+      // Beyond, the flat branch is unstable: the flat part buckles away from the obstacle into a
+      // hanging fold, two point contacts with a blister between them.
+      const size_t which = buckling_flat_contact(here, at.x, contacts);
+      change << "the flat contact over [" << contacts[which].s << ", " << contacts[which].s_end
+             << "] buckles away from the obstacle: a hanging fold";
+      d.contacts = split_into_fold(contacts, which);
+      fold_onset = at;
+      fold_contact = which;
+    } else if (at.event == "contact_flattens") {
       // The point contact whose curvature away from the obstacle vanished becomes an extended
       // contact of zero length there; it grows along the obstacle from the next leg on.
       d.contacts = contacts;

@@ -5,8 +5,8 @@
 //   - releases the contact with the most negative force, if any (the obstacle would pull), or
 //   - adds a contact where the rod penetrates an obstacle most (refined by Brent's method),
 // until 0 <= g(r(s)) everywhere and every force is >= 0: 0 <= g perp force >= 0.
-// Only isolated point contacts are modelled: a rod lying along an obstacle over an interval
-// (extended contact) is not.
+// Point contacts and, for planar rods on flat obstacles, extended contacts (the rod lying flat
+// over an interval; see PointContact).
 #pragma once
 
 #include <functional>
@@ -40,6 +40,11 @@ struct InfeasibleContact : std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+// Whether an active set has an extended contact, and a hanging fold: two neighbouring point
+// contacts on the same obstacle (the rod leaves it between them).
+bool has_extended_contact(const std::vector<PointContact>& contacts);
+bool has_hanging_fold(const std::vector<PointContact>& contacts);
+
 // Solves from `guess` (the state at s = 0, completed by the start conditions) starting with the
 // definition's contacts as the active set. Non-convergence of a solve ends the loop with that
 // status; a loop that does not settle within max_rounds reports complementarity = false.
@@ -59,11 +64,16 @@ struct DefinitionSolve {
 DefinitionSolve solve_definition(const ProblemDefinition& definition, const RodPoint& guess);
 
 // Continuation through changes of the active contact set. Each leg is an ordinary Continuation
-// with the set fixed and two stopping events: min_gap crossing 0 (the rod reaches an obstacle:
-// a contact appears there) and min_contact_force crossing 0 (a contact lifts off and is
-// released). At each such point the set changes, the change is recorded as an event point
-// (its `event` names it) and the next leg starts there. Extended contact (the rod lying along an
-// obstacle) is not modelled: when it would form, the run stops with a message saying so.
+// with the set fixed and stopping events, at which the set changes, the change is recorded as an
+// event point (its `event` says what changed) and the next leg starts there:
+//   - obstacle_reached: min_gap crosses 0, a point contact appears where the rod touches;
+//   - contact_lifts_off: min_contact_force crosses 0, that contact is released;
+//   - contact_flattens (planar): a point contact's curvature away from the obstacle vanishes, it
+//     becomes an extended contact of zero length that then spreads;
+//   - flat_contact_buckles: an extended contact's flat part reaches its clamped-clamped Euler
+//     load, P l^2 = 4 pi^2 EI; it becomes a hanging fold, point contacts at its two ends with a
+//     blister between them, and the next leg leaves the (now unstable) flat branch along the
+//     strut's first mode, away from the obstacle.
 struct ContactContinuationResult {
   ContinuationResult result;          // all legs' points, in order
   std::vector<std::string> changes;   // one line per change of the active set

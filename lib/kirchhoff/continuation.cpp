@@ -49,6 +49,7 @@ const char* to_string(StopReason reason) {
     case StopReason::EventStop: return "event";
     case StopReason::BranchPointStop: return "branch_point";
     case StopReason::StartFailed: return "start_failed";
+    case StopReason::Inadmissible: return "inadmissible";
   }
   return "?";
 }

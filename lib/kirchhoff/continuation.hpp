@@ -92,7 +92,10 @@ struct ContinuationPoint {
   Eigen::MatrixXd jacobian;
 };
 
-enum class StopReason { ReachedTarget, MaxPoints, ParameterBounds, StepTooSmall, EventStop, BranchPointStop, StartFailed };
+// Inadmissible: a contact continuation reached a point that penetrates an obstacle or has a
+// pulling contact with no event located before it (reported, not followed).
+enum class StopReason { ReachedTarget, MaxPoints, ParameterBounds, StepTooSmall, EventStop, BranchPointStop, StartFailed,
+                        Inadmissible };
 const char* to_string(StopReason reason);
 
 struct ContinuationResult {
@@ -128,6 +131,7 @@ class Continuation {
   Eigen::MatrixXd bifurcation_directions(const ContinuationPoint& point, int count);
 
   const ShootingProblem& problem() const { return problem_; }
+  const ContinuationOptions& options() const { return options_; }
 
  private:
   bool evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure);

@@ -86,6 +86,13 @@ double ShootingProblem::contact_bending(const Eigen::VectorXd& x, const PointCon
   return definition_.obstacles[contact.obstacle].normal.dot(p.R * p.u.cross(p.v));
 }
 
+double ShootingProblem::flat_contact_margin(const Eigen::VectorXd& x, const PointContact& contact) const {
+  if (!contact.extended || !(contact.s_end > contact.s)) return NAN;
+  const RodPoint p = sample(x, {0.5 * (contact.s + contact.s_end)}).front();
+  const double l = contact.s_end - contact.s;
+  return 4.0 * M_PI * M_PI * equations(parameters_at(x))->model().B[1](p.s) / (l * l) + p.n.dot(p.R.col(2));
+}
+
 int ShootingProblem::contact_column(size_t k) const {
   int column = contact_offset();
   for (size_t i = 0; i < k; ++i) column += definition_.contacts[i].unknowns();

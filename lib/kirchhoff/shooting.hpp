@@ -113,6 +113,11 @@ class ShootingProblem final : public NonlinearSystem {
   // g'' at a point contact: how the rod curves away from the obstacle there (0: it flattens).
   // g'' = normal . r'' with r'' = R (u x v) for an unshearable, inextensible rod.
   double contact_bending(const Eigen::VectorXd& x, const PointContact& contact) const;
+  // For an extended contact of length l: 4 pi^2 B2 / l^2 - P_flat, with P_flat = -n.d3 the
+  // compression of the flat part. The flat part is a strut clamped by the obstacle at both ends;
+  // its first mode 1 - cos(2 pi (s - s1) / l) leaves the obstacle, so it buckles (a hanging fold
+  // forms) where this margin reaches 0. NaN for a point contact or a flat part of zero length.
+  double flat_contact_margin(const Eigen::VectorXd& x, const PointContact& contact) const;
 
   // dF/d(parameter) at x, for a known (not solved-for) parameter: from the closed-form boundary
   // conditions when the parameter does not enter the rod model, else by central differences of

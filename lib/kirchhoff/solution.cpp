@@ -141,18 +141,12 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
     return total;
   }
   if (name == "flat_contact_margin") {
-    // A flat contact of length l is a strut clamped at both ends (tangent to the wall) under the
-    // compression P_flat = -n.d3; its first mode, 1 - cos(2 pi x / l), leaves the wall on the free
-    // side, so the wall does not stop it: it buckles (a hanging fold forms) at 4 pi^2 B2 / l^2.
-    double smallest = INFINITY;
-    const RodModel& model = problem.equations(sol.result.parameters)->model();
+    double smallest = NAN;
     for (const auto& c : sol.contacts) {
-      if (!c.extended || !(c.s_end > c.s)) continue;
-      const RodPoint p = problem.sample(x, {0.5 * (c.s + c.s_end)}).front();
-      const double l = c.s_end - c.s;
-      smallest = std::min(smallest, 4.0 * M_PI * M_PI * model.B[1](p.s) / (l * l) + p.n.dot(p.R.col(2)));
+      const double margin = problem.flat_contact_margin(x, c);
+      if (std::isfinite(margin)) smallest = std::isnan(smallest) ? margin : std::min(smallest, margin);
     }
-    return std::isfinite(smallest) ? smallest : NAN;
+    return smallest;
   }
   if (name == "contact_bending") {
     double smallest = NAN;
