@@ -3,8 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
+
+#include <Eigen/Geometry>
 
 #include "kirchhoff/analytic.hpp"
+#include "kirchhoff/continuation.hpp"
 #include "kirchhoff/integrator.hpp"
 #include "kirchhoff/plectoneme.hpp"
 #include "kirchhoff/self_contact.hpp"
@@ -87,6 +92,98 @@ TEST(Plectoneme, UntwistedIsTheClampedClampedElastica) {
     EXPECT_NEAR(solved.solution.derived.at("m3"), 0.0, 1e-12);
     EXPECT_LT(solved.solution.invariants.H.spread, 1e-9 * std::abs(solved.solution.invariants.H.mean));
   }
+}
+
+// The half-turn end conditions are right when the whole rod, integrated from the half rod's
+// clamp with no symmetry assumed, ends at the mirror clamp: z = +D/2 on e3, turned by +pi*turns
+// about e3, with the clamp's reactions mirrored. Twisted (turns = 0.3, the rod out of its plane)
+// and before any contact. The integration runs at 1e-12 over forces ~40 and a unit length: 1e-8.
+TEST(Plectoneme, WholeRodFromTheHalfEndsAtTheMirrorClamp) {
+  const double turns = 0.3, D = 0.8;
+  const auto solved = testing::solve_case("plectoneme.toml", {{"turns", turns}, {"end_distance", D}});
+  ASSERT_GT(solved.solution.derived.at("self_distance"), 1.2);  // far from contact: no field needed
+  RodModel whole;
+  whole.length = 1.0;
+  whole.B = {Profile(1.0), Profile(1.0), Profile(solved.c.definition.parameters.get("GJ"))};
+  const auto eq = make_spatial_equations(whole);
+  const Eigen::VectorXd y0 = solved.problem->start_state(solved.solution.result.x);
+  const RodPoint end = eq->point(eq->flow(y0, 0.0, 1.0, false, IntegratorOptions{}).y, 1.0);
+  const RodPoint start = solved.solution.profile.front();
+  EXPECT_LT((end.r - Vec3(0.0, 0.0, 0.5 * D)).norm(), 1e-8);
+  const Mat3 mirror_clamp = Eigen::AngleAxisd(M_PI * turns, Vec3::UnitZ()).toRotationMatrix();
+  EXPECT_LT((end.R - mirror_clamp).norm(), 1e-8);
+  // n(L) = -S n(0) and m(L) = -S m(0) for the half-turn S about e1 (internal force and moment
+  // change sign with the direction of the arclength).
+  const Mat3 S = Eigen::AngleAxisd(M_PI, Vec3::UnitX()).toRotationMatrix();
+  EXPECT_LT((end.n + S * start.n).norm(), 1e-8 * start.n.norm());
+  EXPECT_LT((end.m + S * start.m).norm(), 1e-8 * start.m.norm());
+}
+
+// Twisting the clamped rod (L/2R = 100, D = 0.8 L) from the planar Elastica: it leaves its plane,
+// forms an end loop (two folds in turns) and the loop closes on itself - self-contact appears
+// with no contact set given. Along the whole branch: no two cross-sections closer than 2R
+// (checked over all pairs, not only the symmetric ones the barrier acts on), m3 and H conserved
+// (H_A = H_B, the paper's eq. 59-60 argument, holds to 1e-8 relative with the barrier's
+// potential in H), and once in contact the contact holds the strands apart with a positive force.
+TEST(Plectoneme, TwistingFormsALoopThatTouchesItself) {
+  Case c = load_case(testing::case_path("plectoneme.toml"), {{"end_distance", 0.8}});
+  ShootingProblem problem(c.definition);
+  ShootingResult start = solve(problem, problem.initial_unknowns(c.start_guess));
+  ASSERT_TRUE(start.summary.converged());
+  ContinuationOptions o;
+  o.parameter = "turns";
+  o.target = 10.0;
+  o.initial_step = 1.0;
+  o.max_step = 60.0;
+  o.max_points = 240;
+  o.derived = c.derived;
+  o.samples = 1001;
+  o.detect_branch_points = false;  // the barrier's stiffness makes the determinant's sign noise
+  Continuation run(problem, o);
+  const ContinuationResult branch = run.run(start.x);
+  int folds = 0, in_contact = 0;
+  for (const auto& p : branch.points) {
+    folds += p.type == PointType::Fold;
+    EXPECT_GE(p.derived.at("self_distance"), 1.0 - 1e-9) << "turns " << p.parameter;
+    // Against |m|, the size of the terms m3 is read from: RK78 at 1e-12 per step on states whose
+    // forces reach ~50-500, over ~1e3 steps, leaves ~1e-9 of it; the bar is ten times that.
+    EXPECT_LT(p.invariants.m3.relative_spread(), 1e-8) << "turns " << p.parameter;
+    const double H_A = p.derived.at("H_A"), H_B = p.derived.at("H_B");
+    if (std::isnan(H_A)) continue;
+    ++in_contact;
+    EXPECT_NEAR(H_A, H_B, 1e-8 * std::max(1.0, std::abs(H_B))) << "turns " << p.parameter;
+    EXPECT_GT(p.derived.at("contact_pressure"), 0.0);
+    EXPECT_GT(p.derived.at("loop_clearance"), 4.0);
+  }
+  EXPECT_GE(folds, 2);
+  EXPECT_GT(in_contact, 10) << "self-contact never appeared (" << to_string(branch.reason) << ")";
+}
+
+// Bad input names the file, the key and the reason.
+TEST(Plectoneme, CaseErrorsNameTheKey) {
+  const std::string base = testing::case_path("plectoneme.toml");
+  std::ifstream in(base);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto refused = [&](const std::string& from, const std::string& to, const std::string& expected) {
+    const std::string path = ::testing::TempDir() + "/plectoneme_bad.toml";
+    std::string changed = text;
+    const auto at = changed.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    changed.replace(at, from.size(), to);
+    std::ofstream(path) << changed;
+    try {
+      load_case(path);
+      ADD_FAILURE() << "accepted: " << to;
+    } catch (const CaseError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refused("radius = \"L/(2*slenderness)\"", "radius = \"-L/(2*slenderness)\"", "rod.self_contact.radius");
+  refused("radius = \"L/(2*slenderness)\"", "radius = \"L/(2*slenderness)\", softnes = 1", "rod.self_contact.softnes");
+  refused("director = 1", "director = 3", "end.director");
+  refused("[start]\ntype = \"clamped\"\nposition = [0, 0, \"-end_distance*L/2\"]\n"
+          "orientation = { axis = [0, 0, 1], angle = \"-_pi*turns\" }",
+          "[start]\ntype = \"half_turn\"\naxis = [1, 0, 0]", "start.type");
 }
 
 }  // namespace
