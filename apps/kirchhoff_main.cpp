@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "continue_command.hpp"
+#include "plectonemes_command.hpp"
 #include "reproduce_command.hpp"
 #include "solve_command.hpp"
 #include "vibrate_command.hpp"
@@ -23,7 +24,8 @@ int main(int argc, char** argv) {
       "  kirchhoff continue cases/euler_column.toml --param P --to 12 --set theta_guess=0 --switch-at-bp 1 \\\n"
       "      --event theta0=3 --out buckled.csv\n"
       "  kirchhoff vibrate cases/euler_column.toml --set P=5 --set theta_guess=0 --modes 3\n"
-      "  kirchhoff reproduce --out out\n\n"
+      "  kirchhoff reproduce --out out\n"
+      "  kirchhoff plectonemes --slenderness 100,200 --turns 10,20 --out plectonemes\n\n"
       "Exit status: 0 solved, 1 solver failure (status and best residual reported), 2 input refused."};
   app.require_subcommand(1);
 
@@ -122,6 +124,23 @@ int main(int argc, char** argv) {
   reproduce_cmd->add_option("--out", out_dir, "Output folder (created)")->capture_default_str();
   reproduce_cmd->add_option("--cases", cases_dir, "Folder of the case files")->capture_default_str()->check(CLI::ExistingDirectory);
 
+  PlectonemesArguments plect;
+  plect.case_path = std::string(KIRCHHOFF_DEFAULT_CASES_DIR) + "/plectoneme.toml";
+  auto* plectonemes_cmd = app.add_subcommand(
+      "plectonemes",
+      "The Fig. 11 sweep: plectoneme branches (cases/plectoneme.toml) for several slendernesses L/2R,\n"
+      "each followed in the end rotation from the untwisted rod through the end loop into the ply;\n"
+      "DIR/plectoneme_<L/2R>.csv per branch (turns, T_ext, helix_angle, helix_radius rho,\n"
+      "T_rho2_over_EI and eq61 side by side, m3 and m3_eq58b, H_A, H_B, self_distance, ...),\n"
+      "wall time and points per second on stdout. Long: minutes per slenderness.");
+  plectonemes_cmd->add_option("--case", plect.case_path, "The plectoneme case file")->capture_default_str()
+      ->check(CLI::ExistingFile);
+  plectonemes_cmd->add_option("--slenderness", plect.slenderness, "Slendernesses L/2R")->delimiter(',')
+      ->capture_default_str();
+  plectonemes_cmd->add_option("--turns", plect.turns, "Largest end rotation (turns), one per slenderness")
+      ->delimiter(',')->capture_default_str();
+  plectonemes_cmd->add_option("--out", plect.out_dir, "Output folder (created)")->capture_default_str();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -133,5 +152,6 @@ int main(int argc, char** argv) {
   if (*reproduce_cmd) return run_reproduce(out_dir, cases_dir);
   if (*continue_cmd) return run_continue(cont);
   if (*vibrate_cmd) return run_vibrate(vib);
+  if (*plectonemes_cmd) return run_plectonemes(plect);
   return kExitBadInput;
 }

@@ -423,7 +423,7 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
     const Expression radius = reader.expression(*radius_value, key + ".radius");
     // Defaults (see self_contact.hpp): strength b = softness B1 / R, so that the gap at the
     // pressures of a plectoneme (~0.05 B/R^3) is ~4e-4 R; the barrier decays over 0.25 R and is
-    // off within 2 R of the symmetry point.
+    // off within 4 R of the symmetry point.
     std::optional<Expression> softness, range, adjacent;
     if (const Value* v = Reader::find(*sc, "softness")) softness = reader.expression(*v, key + ".softness");
     if (const Value* v = Reader::find(*sc, "range")) range = reader.expression(*v, key + ".range");
@@ -445,7 +445,7 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
       o.symmetry_s = length;
       o.strength = (softness ? (*softness)(p) : 1e-8) * bend(p, 0.0) / o.radius;
       o.range = range ? (*range)(p) : 0.25 * o.radius;
-      o.adjacent = adjacent ? (*adjacent)(p) : 2.0 * o.radius;
+      o.adjacent = adjacent ? (*adjacent)(p) : 4.0 * o.radius;
       f->add(std::make_shared<HalfTurnSelfContact>(o));
     };
   }
@@ -527,7 +527,10 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
           reader.fail(*v, "solver.unknowns", "'" + name + "' is not in [parameters] (give it there with a guess)");
     }
     if (const Value* v = Reader::find(*s, "segments")) {
-      o.segments = static_cast<int>(reader.integer(*v, "solver.segments"));
+      // An integer, or an expression of the parameters rounded (e.g. "slenderness / 5": long
+      // slender rods need more segments) evaluated at load time.
+      o.segments = v->is_string() ? static_cast<int>(std::lround(reader.expression(*v, "solver.segments")(parameters)))
+                                  : static_cast<int>(reader.integer(*v, "solver.segments"));
       if (o.segments < 1) reader.fail(*v, "solver.segments", "must be >= 1");
       if (o.segments > 1 && !d.obstacles.empty())
         reader.fail(*v, "solver.segments", "contact with obstacles needs single shooting (segments = 1)");

@@ -366,6 +366,9 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
   bool just_reported_branch_point = false;
 
   auto accept = [&](ContinuationPoint p) {
+    // Only the newest point's matrix is needed (the next corrector's chord); a long branch
+    // keeping every one would hold n^2 doubles per point. Branch points keep theirs for switching.
+    if (result.points.back().type != PointType::BranchPoint) result.points.back().jacobian.resize(0, 0);
     p.index = result.points.back().index + 1;
     p.step = ds;
     result.points.push_back(p);

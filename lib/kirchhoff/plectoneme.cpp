@@ -50,13 +50,14 @@ double smallest_self_distance(const ShootingProblem& problem, const Eigen::Vecto
   const double Lh = 0.5 * rod.back().s_whole;
   const double h = rod[1].s_whole - rod[0].s_whole;
   double si = rod[bi].s_whole, sj = rod[bj].s_whole;
-  for (int sweep = 0; sweep < 3; ++sweep) {
+  // 24 bits locate each arclength to ~1e-7 of a sample spacing: the distance to ~1e-14 of it.
+  for (int sweep = 0; sweep < 2; ++sweep) {
     const Vec3 rj = whole_position(problem, x, contact, Lh, sj);
     auto di = [&](double s) { return (whole_position(problem, x, contact, Lh, s) - rj).norm(); };
-    si = boost::math::tools::brent_find_minima(di, std::max(0.0, si - h), std::min(sj - apart, si + h), 40).first;
+    si = boost::math::tools::brent_find_minima(di, std::max(0.0, si - h), std::min(sj - apart, si + h), 24).first;
     const Vec3 ri = whole_position(problem, x, contact, Lh, si);
     auto dj = [&](double s) { return (whole_position(problem, x, contact, Lh, s) - ri).norm(); };
-    sj = boost::math::tools::brent_find_minima(dj, std::max(si + apart, sj - h), std::min(2.0 * Lh, sj + h), 40).first;
+    sj = boost::math::tools::brent_find_minima(dj, std::max(si + apart, sj - h), std::min(2.0 * Lh, sj + h), 24).first;
   }
   const double refined = (whole_position(problem, x, contact, Lh, si) - whole_position(problem, x, contact, Lh, sj)).norm();
   return std::min(refined, std::sqrt(best));
@@ -77,23 +78,39 @@ PlectonemeMeasures measure_plectoneme(const ShootingProblem& problem, const Eige
   m.m3 = clamp.m.dot(clamp.R.col(2));
   m.H_B = hamiltonian(model, clamp);
 
-  double angle_sum = 0.0, pressure_sum = 0.0;
-  int in_contact = 0;
+  // Contact force per length along the rod (the pull of the homotopy aid excluded: it is zero).
+  std::vector<double> pressure(profile.size(), 0.0);
+  double largest = 0.0, smallest_gap = INFINITY;
   m.loop_clearance = INFINITY;
-  for (const auto& p : profile) {
-    const double g = contact->gap(p.s, p.r);
+  for (size_t i = 0; i < profile.size(); ++i) {
+    const RodPoint& p = profile[i];
     const double w = contact->weight(p.s);
-    if (w > 0.0 && w < 1.0) m.loop_clearance = std::min(m.loop_clearance, g / o.range);
-    if (!(g < kContactGap * o.radius)) continue;
-    if (in_contact == 0) m.contact_start = p.s;
-    m.contact_end = p.s;
-    angle_sum += std::acos(std::min(1.0, std::abs(p.R.col(2).dot(axis))));
-    pressure_sum += contact->force(p.s, p.r).norm();
-    ++in_contact;
+    if (w > 0.0 && w < 1.0) m.loop_clearance = std::min(m.loop_clearance, contact->gap(p.s, p.r) / o.range);
+    if (w > 0.0) pressure[i] = contact->force(p.s, p.r).norm();
+    if (w > 0.0) smallest_gap = std::min(smallest_gap, contact->gap(p.s, p.r));
+    largest = std::max(largest, pressure[i]);
   }
-  if (in_contact > 0) {
-    m.helix_angle = angle_sum / in_contact;
-    m.contact_pressure = pressure_sum / in_contact;
+  if (!(smallest_gap < o.range)) largest = 0.0;  // nothing within the barrier's range: no contact
+  size_t first = profile.size(), last = 0;
+  for (size_t i = 0; i < profile.size(); ++i)
+    if (largest > 0.0 && pressure[i] >= kContactFraction * largest) first = std::min(first, i), last = i;
+  if (first <= last) {
+    // The helix of eqs. (58)-(61) is the middle of the ply: its ends bend into the tails and the
+    // end loop, so the angle and radius are averaged over the central half of the region.
+    const size_t quarter = (last - first) / 4;
+    double angle_sum = 0.0, pressure_sum = 0.0, radius_sum = 0.0;
+    for (size_t i = first + quarter; i <= last - quarter; ++i) {
+      const RodPoint& p = profile[i];
+      angle_sum += std::acos(std::min(1.0, std::abs(p.R.col(2).dot(axis))));
+      radius_sum += contact->distance_to_axis(p.r);
+      pressure_sum += pressure[i];
+    }
+    const double count = static_cast<double>(last - quarter - (first + quarter) + 1);
+    m.contact_start = profile[first].s;
+    m.contact_end = profile[last].s;
+    m.helix_angle = angle_sum / count;
+    m.helix_radius = radius_sum / count;
+    m.contact_pressure = pressure_sum / count;
     m.H_A = hamiltonian(model, problem.sample(x, {0.5 * (m.contact_start + m.contact_end)}).front());
   }
   m.self_distance = smallest_self_distance(problem, x, *contact, whole_rod(profile, *contact), M_PI * o.radius) /
@@ -105,8 +122,9 @@ const std::vector<std::pair<std::string, std::string>>& plectoneme_quantities() 
   static const std::vector<std::pair<std::string, std::string>> names = {
       {"T_ext", "plectoneme: tension n.d3 at the clamp (the end pull T_ext of Fig. 10)"},
       {"m3", "plectoneme: twisting moment m.d3 at the clamp"},
-      {"helix_angle", "plectoneme: mean angle (rad) between d3 and the axis over the contact region"},
-      {"contact_pressure", "plectoneme: mean self-contact force per length over the contact region"},
+      {"helix_angle", "plectoneme: mean angle (rad) between d3 and the axis over the central half of the contact region"},
+      {"helix_radius", "plectoneme: mean distance to the axis over the central half of the contact region (R + gap)"},
+      {"contact_pressure", "plectoneme: mean self-contact force per length over the central half of the contact region"},
       {"contact_start", "plectoneme: arclength where the contact region starts (half rod)"},
       {"contact_end", "plectoneme: arclength where the contact region ends (half rod)"},
       {"H_A", "plectoneme: H in the middle of the contact region (eq. 60)"},
@@ -121,6 +139,7 @@ double plectoneme_quantity(const PlectonemeMeasures& m, const std::string& name)
   if (name == "T_ext") return m.T_ext;
   if (name == "m3") return m.m3;
   if (name == "helix_angle") return m.helix_angle;
+  if (name == "helix_radius") return m.helix_radius;
   if (name == "contact_pressure") return m.contact_pressure;
   if (name == "contact_start") return m.contact_start;
   if (name == "contact_end") return m.contact_end;

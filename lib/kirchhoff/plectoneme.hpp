@@ -14,11 +14,15 @@ namespace kirchhoff {
 struct PlectonemeMeasures {
   double T_ext = 0.0;             // tension at the clamp, n(0).d3(0) (the pull on the end B)
   double m3 = 0.0;                // twisting moment m.d3 (constant for an isotropic rod)
-  // Cross-sections within kContactGap of contact form the contact region [contact_start,
-  // contact_end] (arclengths on the half rod); NaN bounds and averages when there is none.
+  // The contact region [contact_start, contact_end] (arclengths on the half rod) runs from the
+  // first to the last cross-section pressed with at least kContactFraction of the largest contact
+  // force per length: the interwound part, crossings and line contacts alike. NaN bounds and
+  // averages when nothing is pressed.
   double contact_start = NAN, contact_end = NAN;
-  double helix_angle = NAN;       // mean over the contact region of the angle between d3 and the axis
-  double contact_pressure = NAN;  // mean over the contact region of the contact force per length
+  // Means over the central half of the contact region (the ply's ends bend away from a helix):
+  double helix_angle = NAN;       // the angle between d3 and the axis
+  double helix_radius = NAN;      // the distance to the axis (R + the barrier's gap)
+  double contact_pressure = NAN;  // the contact force per length
   double H_A = NAN;               // H in the middle of the contact region (point A of eq. 60)
   double H_B = 0.0;               // H at the clamped end (point B of eq. 59)
   // Smallest distance between cross-sections of the whole rod (both halves) that are more than
@@ -29,9 +33,10 @@ struct PlectonemeMeasures {
   double loop_clearance = NAN;
 };
 
-// A cross-section is in contact when its gap rho - R is below this fraction of R (the barrier's
-// gap at plectoneme pressures is ~1e-3 R; free cross-sections are at least ~R away).
-constexpr double kContactGap = 0.02;
+// Cross-sections pressed with less than this fraction of the largest contact force per length
+// are outside the contact region (the barrier's force falls like exp(-(g/c)^2)/g^2 away from
+// contact, so the threshold moves the region's ends by a small fraction of the range c).
+constexpr double kContactFraction = 0.01;
 
 // Throws std::invalid_argument when the problem has no half-turn self-contact.
 PlectonemeMeasures measure_plectoneme(const ShootingProblem& problem, const Eigen::VectorXd& x,

@@ -1,0 +1,111 @@
+#include "plectonemes_command.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+
+#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/case_file.hpp"
+#include "kirchhoff/continuation.hpp"
+
+namespace kirchhoff::cli {
+namespace {
+
+// Columns of a plectoneme branch: the case's measures, then what Fig. 11 plots and the closed
+// forms beside them (NaN where there is no ply, theta outside (0, pi/4)).
+const std::vector<std::string> kMeasured = {"T_ext", "helix_angle", "helix_radius", "m3", "contact_pressure",
+                                            "contact_start", "contact_end", "H_A", "H_B", "self_distance",
+                                            "loop_clearance"};
+
+std::map<std::string, double> columns(const ContinuationPoint& p, double EI) {
+  std::map<std::string, double> c;
+  for (const auto& name : kMeasured) c[name] = p.derived.count(name) ? p.derived.at(name) : NAN;
+  const double theta = c["helix_angle"], rho = c["helix_radius"];
+  const bool ply = theta > 0.0 && theta < 0.25 * M_PI && rho > 0.0;
+  // rho, the strands' distance to the axis, is the helix radius R of eqs. (58)-(61).
+  c["T_rho2_over_EI"] = c["T_ext"] * rho * rho / EI;
+  c["eq61"] = ply ? analytic::plectoneme_end_tension(theta, 1.0, 1.0) : NAN;  // T rho^2/EI by (61)
+  c["m3_eq58b"] = ply ? analytic::helix_twisting_moment(theta, EI, rho) : NAN;
+  return c;
+}
+
+}  // namespace
+
+PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, double slenderness, double turns_max,
+                                                 const std::string& csv_path, int progress_every) {
+  const auto started = std::chrono::steady_clock::now();
+  const Case c = load_case(case_path, {{"slenderness", slenderness}});
+  const double EI = c.definition.parameters.get("EI");
+  ShootingProblem problem(c.definition);
+  const ShootingResult untwisted = solve(problem, problem.initial_unknowns(c.start_guess));
+  if (!untwisted.summary.converged())
+    throw std::runtime_error(case_path + ": the untwisted rod does not solve: " + untwisted.summary.brief_report());
+  ContinuationOptions o;
+  o.parameter = "turns";
+  o.target = turns_max;
+  o.initial_step = 1.0;
+  o.max_step = 60.0;  // pseudo-arclength over forces ~1e2-1e4: steps of tens are small
+  o.max_points = 20000;
+  o.derived = c.derived;
+  o.samples = 10 * static_cast<int>(slenderness) + 1;  // R/10 apart on the half rod: the ply's pitch is 10-30 R
+  o.detect_branch_points = false;  // the barrier's stiffness turns the determinant's sign into noise
+  std::ofstream csv(csv_path);
+  if (!csv) throw std::runtime_error("cannot write " + csv_path);
+  csv << std::setprecision(12) << "turns,type";
+  const std::vector<std::string> names = [] {
+    std::vector<std::string> n = kMeasured;
+    for (const char* extra : {"T_rho2_over_EI", "eq61", "m3_eq58b"}) n.push_back(extra);
+    return n;
+  }();
+  for (const auto& n : names) csv << ',' << n;
+  csv << '\n';
+  PlectonemeBranchSummary summary;
+  Continuation run(problem, o);
+  const ContinuationResult branch = run.run(untwisted.x, [&](const ContinuationPoint& p) {
+    const auto row = columns(p, EI);
+    csv << p.parameter << ',' << to_string(p.type);
+    for (const auto& n : names) csv << ',' << row.at(n);
+    csv << '\n' << std::flush;
+    ++summary.points;
+    if (!std::isnan(row.at("eq61"))) summary.last = row, summary.last["turns"] = p.parameter;
+    if (progress_every > 0 && summary.points % progress_every == 0)
+      std::cerr << "  L/2R = " << slenderness << "  point " << summary.points << "  turns = " << std::setprecision(6)
+                << p.parameter << "\n";
+  });
+  summary.stop = to_string(branch.reason);
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return summary;
+}
+
+int run_plectonemes(const PlectonemesArguments& args) {
+  if (args.slenderness.size() != args.turns.size()) {
+    std::cerr << "error: --slenderness and --turns need the same number of values\n";
+    return 2;
+  }
+  std::filesystem::create_directories(args.out_dir);
+  const auto started = std::chrono::steady_clock::now();
+  int total = 0;
+  for (size_t k = 0; k < args.slenderness.size(); ++k) {
+    const double sl = args.slenderness[k];
+    const std::string csv = args.out_dir + "/plectoneme_" + std::to_string(static_cast<int>(sl)) + ".csv";
+    std::cerr << "L/2R = " << sl << ": turns 0 -> " << args.turns[k] << "\n";
+    try {
+      const auto s = follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, 50);
+      total += s.points;
+      std::cout << "L/2R = " << sl << ": " << s.points << " points in " << std::setprecision(3) << s.seconds << " s ("
+                << s.points / s.seconds << " points/s), stopped: " << s.stop << ", " << csv << "\n";
+    } catch (const std::exception& e) {
+      std::cerr << "L/2R = " << sl << ": " << e.what() << "\n";
+      return 1;
+    }
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  std::cout << "sweep: " << total << " points in " << std::setprecision(4) << seconds << " s ("
+            << total / seconds << " points/s)\n";
+  return 0;
+}
+
+}  // namespace kirchhoff::cli

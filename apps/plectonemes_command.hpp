@@ -1,0 +1,34 @@
+// `kirchhoff plectonemes`: the Fig. 11 sweep - plectoneme branches of cases/plectoneme.toml for
+// several slendernesses, each followed in the end rotation from the untwisted rod, written as
+// CSV rows of T_ext rho^2/EI against the helical angle beside eq. (61).
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace kirchhoff::cli {
+
+struct PlectonemeBranchSummary {
+  int points = 0;
+  double seconds = 0.0;
+  std::string stop;                         // the continuation's stop reason
+  std::map<std::string, double> last;       // the CSV columns at the last point with a ply
+};
+
+// Follows cases/plectoneme.toml (at `case_path`) with slenderness set, from turns = 0 to
+// turns_max, writing one CSV row per point to csv_path (flushed as it goes). Progress every
+// `progress_every` points on stderr (0: none). Throws on a case that does not solve at turns = 0.
+PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, double slenderness, double turns_max,
+                                                 const std::string& csv_path, int progress_every);
+
+struct PlectonemesArguments {
+  std::string case_path;
+  std::vector<double> slenderness{100, 200, 500, 1000};
+  std::vector<double> turns{10, 20, 20, 50};
+  std::string out_dir = "plectonemes";
+};
+
+int run_plectonemes(const PlectonemesArguments& args);
+
+}  // namespace kirchhoff::cli
