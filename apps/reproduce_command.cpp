@@ -661,7 +661,7 @@ int run_reproduce(const std::string& out_dir, const std::string& cases_dir) {
     vibrations(cases, out / "profiles", &rows);
     progress("Section 7.2 / Fig. 5: the Elastica in a cavity, hanging fold");
     cavity(cases, out / "profiles", &rows);
-    progress("Section 7.6 / Fig. 11: a plectoneme, from the untwisted rod into the ply (about 2 minutes)");
+    progress("Section 7.6 / Fig. 11: a plectoneme, from the untwisted rod into the ply (about 3 minutes)");
     plectonemes(cases, out / "profiles", &rows);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";

@@ -215,7 +215,7 @@ def fig11(profiles, figures):
     if not paths:
         return
     fig, (ax, axm) = plt.subplots(1, 2, figsize=(11, 4.2))
-    theta = np.linspace(0.02, 0.6, 200)
+    theta = np.radians(np.linspace(5.0, 30.0, 200))
     eq61 = 0.5 * np.sin(theta) ** 4 * (1 + 2 / np.cos(2 * theta))
     ax.plot(np.degrees(theta), eq61, "k-", lw=1.2, label="eq. (61)")
     for path in paths:
@@ -230,6 +230,7 @@ def fig11(profiles, figures):
     ax.set_xlabel("helical angle $\\theta$ (degrees, middle of the ply)")
     ax.set_ylabel("T$_{ext}$ $\\rho^2$ / EI")
     ax.set_yscale("log")
+    ax.set_xlim(5, 30)
     ax.set_title("Fig. 11: plectonemes, end pull against helical angle")
     ax.legend(fontsize=8)
     axm.axhline(1.0, color="k", lw=0.8)
