@@ -613,5 +613,16 @@ slope is theta0 (Love's elliptic-function solution, first mode; K from GSL).
 
 Raises ValueError outside L > 0, EI > 0, 0 < theta0 < pi.)doc");
 
+  m.def("analytic_pinned_column_frequency", &analytic::pinned_column_frequency, py::arg("EI"), py::arg("P"),
+        py::arg("rho_s"), py::arg("L"), py::arg("mode") = 1,
+        R"doc(Frequency of mode k of a pinned-pinned column under the compressive dead load P (eq. 96):
+omega^2 = (EI (k pi/L)^4 - P (k pi/L)^2) / rho_s.)doc");
+  m.def("analytic_plectoneme_end_tension", &analytic::plectoneme_end_tension, py::arg("theta"), py::arg("EI"),
+        py::arg("R"),
+        R"doc(Eq. (61): the end pull of a plectoneme of helical angle theta (rad, < pi/4) and helix radius R:
+T_ext = EI/(2 R^2) sin^4 theta (1 + 2/cos 2theta).)doc");
+  m.def("analytic_helix_twisting_moment", &analytic::helix_twisting_moment, py::arg("theta"), py::arg("EI"),
+        py::arg("R"), R"doc(Eq. (58b): m3 = 2 EI sin^3 theta cos theta / (R cos 2theta) in a ply of radius R.)doc");
+
   m.attr("__version__") = KIRCHHOFF_VERSION;
 }

@@ -267,5 +267,18 @@ class VibrateTest(unittest.TestCase):
             kirchhoff.load_case(case_path("euler_column.toml")).vibrate(rho_s=-1.0)
 
 
+class AnalyticHelixTest(unittest.TestCase):
+    def test_closed_forms_of_the_ply_and_the_column(self):
+        theta = 0.3
+        s, c2 = math.sin(theta), math.cos(2 * theta)
+        self.assertAlmostEqual(kirchhoff.analytic_plectoneme_end_tension(theta, 1.0, 1.0),
+                               0.5 * s ** 4 * (1 + 2 / c2), places=14)
+        self.assertAlmostEqual(kirchhoff.analytic_helix_twisting_moment(theta, 2.0, 0.5),
+                               2.0 / 0.5 * 2 * s ** 3 * math.cos(theta) / c2, places=12)
+        self.assertAlmostEqual(kirchhoff.analytic_pinned_column_frequency(1.0, 0.0, 1.0, 1.0, 1), math.pi ** 2, places=12)
+        with self.assertRaises(ValueError):
+            kirchhoff.analytic_plectoneme_end_tension(1.0, 1.0, 1.0)  # theta beyond pi/4: no ply
+
+
 if __name__ == "__main__":
     unittest.main()
