@@ -54,10 +54,12 @@ double smallest_self_distance(const ShootingProblem& problem, const Eigen::Vecto
   for (int sweep = 0; sweep < 2; ++sweep) {
     const Vec3 rj = whole_position(problem, x, contact, Lh, sj);
     auto di = [&](double s) { return (whole_position(problem, x, contact, Lh, s) - rj).norm(); };
-    si = boost::math::tools::brent_find_minima(di, std::max(0.0, si - h), std::min(sj - apart, si + h), 24).first;
+    const double lo_i = std::max(0.0, si - h), hi_i = std::min(sj - apart, si + h);
+    if (hi_i > lo_i) si = boost::math::tools::brent_find_minima(di, lo_i, hi_i, 24).first;
     const Vec3 ri = whole_position(problem, x, contact, Lh, si);
     auto dj = [&](double s) { return (whole_position(problem, x, contact, Lh, s) - ri).norm(); };
-    sj = boost::math::tools::brent_find_minima(dj, std::max(si + apart, sj - h), std::min(2.0 * Lh, sj + h), 24).first;
+    const double lo_j = std::max(si + apart, sj - h), hi_j = std::min(2.0 * Lh, sj + h);
+    if (hi_j > lo_j) sj = boost::math::tools::brent_find_minima(dj, lo_j, hi_j, 24).first;
   }
   const double refined = (whole_position(problem, x, contact, Lh, si) - whole_position(problem, x, contact, Lh, sj)).norm();
   return std::min(refined, std::sqrt(best));
@@ -78,7 +80,7 @@ PlectonemeMeasures measure_plectoneme(const ShootingProblem& problem, const Eige
   m.m3 = clamp.m.dot(clamp.R.col(2));
   m.H_B = hamiltonian(model, clamp);
 
-  // Contact force per length along the rod (the pull of the homotopy aid excluded: it is zero).
+  // Contact force per length along the rod.
   std::vector<double> pressure(profile.size(), 0.0);
   double largest = 0.0, smallest_gap = INFINITY;
   m.loop_clearance = INFINITY;

@@ -8,7 +8,7 @@
 // the distance to the axis. Self-contact of the whole rod thus becomes contact of the half rod
 // with a cylinder of radius R (the cross-section radius) about the axis, with the contact
 // pressure radial - one strand, one constraint, no search for contact partners. Pairs other
-// than (s, L - s) are checked afterwards (min_self_distance), not imposed.
+// than (s, L - s) are checked afterwards (the self_distance measure), not imposed.
 //
 // The contact is a stiff, short-range repulsion rather than complementarity: in a plectoneme
 // the contact is a line that starts and ends with concentrated forces and may split into
