@@ -617,7 +617,7 @@ void write_report(const fs::path& out, const std::vector<ReportRow>& rows, doubl
   for (const auto& r : rows) {
     std::ostringstream err, tol;
     err << std::setprecision(2) << std::scientific << r.rel_error();
-    tol << std::setprecision(0) << std::scientific << r.tolerance;
+    tol << std::setprecision(2) << r.tolerance;  // 1e-09, 0.12: as stated, not rounded to a power of ten
     const bool checked = r.analytic.has_value();
     md << "| " << r.id << " | " << r.quantity << " | " << format(r.paper) << " | " << format(r.analytic) << " | "
        << format(r.numeric) << " | " << (checked ? err.str() : "") << " | " << (checked ? tol.str() : "") << " | "
