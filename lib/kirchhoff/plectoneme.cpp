@@ -87,9 +87,11 @@ PlectonemeMeasures measure_plectoneme(const ShootingProblem& problem, const Eige
   for (size_t i = 0; i < profile.size(); ++i) {
     const RodPoint& p = profile[i];
     const double w = contact->weight(p.s);
-    if (w > 0.0 && w < 1.0) m.loop_clearance = std::min(m.loop_clearance, contact->gap(p.s, p.r) / o.range);
-    if (w > 0.0) pressure[i] = contact->force(p.s, p.r).norm();
-    if (w > 0.0) smallest_gap = std::min(smallest_gap, contact->gap(p.s, p.r));
+    if (w == 0.0) continue;
+    const double g = contact->gap(p.s, p.r);
+    if (w < 1.0) m.loop_clearance = std::min(m.loop_clearance, g / o.range);
+    smallest_gap = std::min(smallest_gap, g);
+    pressure[i] = contact->force(p.s, p.r).norm();
     largest = std::max(largest, pressure[i]);
   }
   if (!(smallest_gap < o.range)) largest = 0.0;  // nothing within the barrier's range: no contact

@@ -40,45 +40,41 @@ double HalfTurnSelfContact::weight(double s) const {
   return t * t * t * (10.0 + t * (-15.0 + 6.0 * t));  // C2 smoothstep
 }
 
-void HalfTurnSelfContact::barrier(double s, double g, double* phi, double* dphi, double* ddphi) const {
+HalfTurnSelfContact::Barrier HalfTurnSelfContact::barrier(double s, const Vec3& r) const {
+  Barrier b;
+  b.w = weight(s);
+  if (b.w == 0.0) return b;
+  b.d = radial(r);
+  b.rho = b.d.norm();
+  const double g = b.rho - options_.radius;
   if (!(g > 0.0))
     throw IntegrationError("the rod passes through itself at s = " + std::to_string(s) +
                            " (distance to the symmetry axis below the radius)");
   const double c = options_.range;
   const double e = options_.strength * std::exp(-(g * g) / (c * c));
-  *phi = e / g;
-  *dphi = -e * (2.0 / (c * c) + 1.0 / (g * g));
-  *ddphi = e * (4.0 * g / (c * c * c * c) + 2.0 / (c * c * g) + 2.0 / (g * g * g));
+  b.phi = e / g;
+  b.dphi = -e * (2.0 / (c * c) + 1.0 / (g * g));
+  b.ddphi = e * (4.0 * g / (c * c * c * c) + 2.0 / (c * c * g) + 2.0 / (g * g * g));
+  return b;
 }
 
 double HalfTurnSelfContact::potential(double s, const Vec3& r) const {
-  const double w = weight(s);
-  if (w == 0.0) return 0.0;
-  double phi, dphi, ddphi;
-  barrier(s, distance_to_axis(r) - options_.radius, &phi, &dphi, &ddphi);
-  return w * phi;
+  const Barrier b = barrier(s, r);
+  return b.w * b.phi;
 }
 
 Vec3 HalfTurnSelfContact::force(double s, const Vec3& r) const {
-  const double w = weight(s);
-  if (w == 0.0) return Vec3::Zero();
-  const Vec3 d = radial(r);
-  const double rho = d.norm();
-  double phi, dphi, ddphi;
-  barrier(s, rho - options_.radius, &phi, &dphi, &ddphi);
-  return -w * dphi * d / rho;
+  const Barrier b = barrier(s, r);
+  if (b.w == 0.0) return Vec3::Zero();
+  return -b.w * b.dphi * b.d / b.rho;
 }
 
 Mat3 HalfTurnSelfContact::force_gradient(double s, const Vec3& r) const {
-  const double w = weight(s);
-  if (w == 0.0) return Mat3::Zero();
-  const Vec3 d = radial(r);
-  const double rho = d.norm();
-  double phi, dphi, ddphi;
-  barrier(s, rho - options_.radius, &phi, &dphi, &ddphi);
-  const Vec3 e = d / rho;
+  const Barrier b = barrier(s, r);
+  if (b.w == 0.0) return Mat3::Zero();
+  const Vec3 e = b.d / b.rho;
   const Mat3 across = Mat3::Identity() - axis_ * axis_.transpose() - e * e.transpose();
-  return -w * (ddphi * e * e.transpose() + dphi * across / rho);
+  return -b.w * (b.ddphi * e * e.transpose() + b.dphi * across / b.rho);
 }
 
 double HalfTurnSelfContact::gap(double s, const Vec3& r) const {

@@ -61,9 +61,15 @@ class HalfTurnSelfContact final : public ExternalField {
  private:
   // Component of r - origin across the axis.
   Vec3 radial(const Vec3& r) const;
-  // Barrier phi(g) and its first two derivatives; throws IntegrationError when g <= 0 (the rod
+  // The barrier at a cross-section: weight w(s), radial vector d and |d|, and phi(g) with its
+  // first two derivatives. Throws IntegrationError when g <= 0 where the barrier acts (the rod
   // would pass through itself, which a Newton iterate may try: the step is then shortened).
-  void barrier(double s, double g, double* phi, double* dphi, double* ddphi) const;
+  struct Barrier {
+    double w = 0.0;  // 0: the barrier is off here and the rest is not evaluated
+    Vec3 d = Vec3::Zero();
+    double rho = 0.0, phi = 0.0, dphi = 0.0, ddphi = 0.0;
+  };
+  Barrier barrier(double s, const Vec3& r) const;
 
   HalfTurnSelfContactOptions options_;
   Vec3 axis_;
