@@ -543,8 +543,10 @@ WallContactElastica wall_contact_elastica(double L, double EI, double Delta, dou
 }
 
 double clamped_clamped_elastica_load(double EI, double L, double D) {
-  if (!(EI > 0.0) || !(L > 0.0)) throw std::invalid_argument("clamped elastica: EI and L must be > 0");
-  if (!(D > 0.0 && D < L)) throw std::invalid_argument("clamped elastica: need 0 < D < L");
+  const char* where = "clamped_clamped_elastica_load";
+  require_positive(where, "EI", EI);
+  require_positive(where, "L", L);
+  if (!(D > 0.0 && D < L)) reject(where, "D", "must be in (0, L), got " + std::to_string(D));
   // 2E/K - 1 falls from 1 (k = 0) through 0 (k ~ 0.909); D/L in (0, 1) has one root there.
   const double k = brent_root([&](double k) { return 2.0 * complete_E(k) / complete_K(k) - 1.0 - D / L; }, 0.0, 0.9);
   const double K = complete_K(k);
@@ -552,30 +554,29 @@ double clamped_clamped_elastica_load(double EI, double L, double D) {
 }
 
 namespace {
-void require_helix(double theta, double EI, double R) {
-  if (!(theta > 0.0 && theta < 0.25 * M_PI))
-    throw std::invalid_argument("helical angle must be in (0, pi/4), got " + std::to_string(theta));
-  if (!(EI > 0.0) || !(R > 0.0)) throw std::invalid_argument("helix: EI and R must be > 0");
+void require_helix(const char* where, double theta, double EI, double R) {
+  if (!(theta > 0.0 && theta < 0.25 * kPi)) reject(where, "theta", "must be in (0, pi/4), got " + std::to_string(theta));
+  require_positive(where, "EI", EI);
+  require_positive(where, "R", R);
 }
 }  // namespace
 
 double helix_contact_pressure(double theta, double EI, double R) {
-  require_helix(theta, EI, R);
-  return EI / (R * R * R) * std::pow(std::sin(theta), 4) / std::cos(2.0 * theta);
+  return helix_tension(theta, EI, R) / R;  // (58a) = (58c) / R
 }
 
 double helix_twisting_moment(double theta, double EI, double R) {
-  require_helix(theta, EI, R);
+  require_helix("helix_twisting_moment", theta, EI, R);
   return EI / R * 2.0 * std::pow(std::sin(theta), 3) * std::cos(theta) / std::cos(2.0 * theta);
 }
 
 double helix_tension(double theta, double EI, double R) {
-  require_helix(theta, EI, R);
+  require_helix("helix_tension", theta, EI, R);
   return EI / (R * R) * std::pow(std::sin(theta), 4) / std::cos(2.0 * theta);
 }
 
 double plectoneme_end_tension(double theta, double EI, double R) {
-  require_helix(theta, EI, R);
+  require_helix("plectoneme_end_tension", theta, EI, R);
   return 0.5 * EI / (R * R) * std::pow(std::sin(theta), 4) * (1.0 + 2.0 / std::cos(2.0 * theta));
 }
 
