@@ -577,13 +577,15 @@ void cavity(const fs::path& cases, const fs::path& out, std::vector<ReportRow>* 
 // radius rho (R plus the self-contact barrier's gap) and angle, and H_A = H_B (eqs. 59-60).
 void plectonemes(const fs::path& cases, const fs::path& out, std::vector<ReportRow>* rows) {
   const std::string id = "Fig. 11, eq. (61)";
-  const auto branch =
-      follow_plectoneme_branch((cases / "plectoneme.toml").string(), 100.0, 6.0, (out / "plectoneme_100.csv").string(), 0);
+  constexpr double kSlenderness = 100.0;
+  const double R = 1.0 / (2.0 * kSlenderness);  // the case's L = 1
+  const auto branch = follow_plectoneme_branch((cases / "plectoneme.toml").string(), kSlenderness, 6.0,
+                                               (out / "plectoneme_100.csv").string(), 0);
   if (branch.last.empty()) throw std::runtime_error("plectoneme: no ply formed up to 6 turns (" + branch.stop + ")");
   const auto& ply = branch.last;
   const std::string where = "L/2R = 100, D = L/2, turns = " + format_short(ply.at("turns")) + ", theta = " +
                             format_short(ply.at("helix_angle") * 180.0 / M_PI) + " deg, rho/R = " +
-                            format_short(ply.at("helix_radius") / 0.005);
+                            format_short(ply.at("helix_radius") / R);
   // The helix formulas idealise the middle of a long ply; this one has a few turns between a
   // tail and an end loop. Observed along the branch: (61) within 2-7 %, (58b) within 1-2 %.
   rows->push_back({id, "T_ext rho^2 / EI in the ply", {}, ply.at("eq61"), ply.at("T_rho2_over_EI"), ply.at("eq61"), 0.12,
