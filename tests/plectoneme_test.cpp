@@ -5,6 +5,8 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -171,18 +173,41 @@ TEST(Plectoneme, TwistingWindsAPlyThatFollowsTheHelixFormulas) {
   EXPECT_NEAR(ply.at("T_ext") * rho * rho / EI / analytic::plectoneme_end_tension(theta, 1.0, 1.0), 1.0, 0.12);
 }
 
+// cases/plectoneme.toml with one piece of its text replaced, written to a temporary file.
+std::string edited_case(const std::vector<std::pair<std::string, std::string>>& replacements) {
+  std::ifstream in(testing::case_path("plectoneme.toml"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const auto& [from, to] : replacements) {
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+  }
+  const std::string path = ::testing::TempDir() + "/plectoneme_edited.toml";
+  std::ofstream(path) << text;
+  return path;
+}
+
+// The `rotation` form of the half_turn end imposes the end frame's turn about the axis and
+// solves for `turns`: given the turn of a solution found the usual way, it finds the same
+// solution (turns = 0.3 back to the Newton tolerance over the clamp's sensitivity, 1e-8).
+TEST(Plectoneme, ImposedLoopRotationGivesBackTheTurns) {
+  const auto usual = testing::solve_case("plectoneme.toml", {{"turns", 0.3}});
+  const Vec3 d3 = usual.solution.profile.back().R.col(2);
+  const double beta = std::atan2(-d3.y(), d3.z());  // the tip frame is Rot_e1(beta) at identity
+  const std::string path = edited_case({{"director = 1", "director = 1\nrotation = \"beta\""},
+                                        {"turns = 0.0 ", "beta = 0.0\nturns = 0.0 "},
+                                        {"[solver]\n", "[solver]\nunknowns = [\"turns\"]\n"}});
+  Case c = load_case(path, {{"beta", beta}, {"turns", 0.2}});
+  ShootingProblem problem(c.definition);
+  const ShootingResult r = solve(problem, problem.initial_unknowns(c.start_guess));
+  ASSERT_TRUE(r.summary.converged()) << r.summary.brief_report();
+  EXPECT_NEAR(r.parameters.get("turns"), 0.3, 1e-8);
+}
+
 // Bad input names the file, the key and the reason.
 TEST(Plectoneme, CaseErrorsNameTheKey) {
-  const std::string base = testing::case_path("plectoneme.toml");
-  std::ifstream in(base);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   auto refused = [&](const std::string& from, const std::string& to, const std::string& expected) {
-    const std::string path = ::testing::TempDir() + "/plectoneme_bad.toml";
-    std::string changed = text;
-    const auto at = changed.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    changed.replace(at, from.size(), to);
-    std::ofstream(path) << changed;
+    const std::string path = edited_case({{from, to}});
     try {
       load_case(path);
       ADD_FAILURE() << "accepted: " << to;
