@@ -84,7 +84,8 @@ struct ContinuationPoint {
   bool H_flat = true;       // false flags a point whose H spread exceeds 1e-9 of its scale
   double step = 0.0;        // step size after this point
   // Test functions: det [F_x F_lambda; t^T], and the smallest singular value of that matrix
-  // over its largest, with the count of singular values below branch_point_tolerance.
+  // over its largest, with the count of singular values below branch_point_tolerance (both left
+  // at 0 when the run does not detect branch points).
   double determinant = 0.0;
   double smallest_singular = 0.0;
   int small_count = 0;

@@ -4,6 +4,8 @@
 #include <nlopt.hpp>
 #include <sstream>
 
+#include "kirchhoff/jacobian_lu.hpp"
+
 namespace kirchhoff {
 
 const char* to_string(SolverStatus status) {
@@ -32,13 +34,6 @@ std::string NewtonSummary::brief_report() const {
   if (used_fallback_search) os << " (starting point from NLopt search)";
   if (!message.empty()) os << ": " << message;
   return os.str();
-}
-
-double reciprocal_condition(const Eigen::PartialPivLU<Eigen::MatrixXd>& lu) {
-  const Eigen::VectorXd pivots = lu.matrixLU().diagonal().cwiseAbs();
-  const double largest = pivots.maxCoeff();
-  if (!(largest > 0)) return 0.0;
-  return std::min(lu.rcond(), pivots.minCoeff() / largest);
 }
 
 bool finite_difference_jacobian(const NonlinearSystem& system, const Eigen::VectorXd& x, double step,
@@ -92,8 +87,8 @@ NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, co
       summary.message = failure;
       return summary;
     }
-    Eigen::PartialPivLU<Eigen::MatrixXd> lu(J);
-    const double rcond = reciprocal_condition(lu);
+    const JacobianLU lu(J);
+    const double rcond = lu.reciprocal_condition();
     if (!(rcond > options.singular_rcond)) {
       summary.status = SolverStatus::SingularJacobian;
       summary.message = "reciprocal condition number " + std::to_string(rcond);

@@ -68,7 +68,6 @@ NewtonSummary solve_with_fallback(const NonlinearSystem& system, Eigen::VectorXd
 
 // Reciprocal condition estimate of an LU factorisation that also sees exactly zero pivots
 // (Eigen's estimate alone does not when a whole column vanishes): min(rcond, min|U_ii|/max|U_ii|).
-double reciprocal_condition(const Eigen::PartialPivLU<Eigen::MatrixXd>& lu);
 
 // Central-difference Jacobian; returns false when an evaluation fails.
 bool finite_difference_jacobian(const NonlinearSystem& system, const Eigen::VectorXd& x, double step,

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "kirchhoff/jacobian_lu.hpp"
+
 namespace kirchhoff {
 namespace {
 
@@ -515,7 +517,7 @@ ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) 
   Eigen::MatrixXd J;
   std::string failure;
   if (problem.evaluate(result.x, &F, &J, &failure) &&
-      !(reciprocal_condition(J.partialPivLu()) > problem.definition().options.newton.singular_rcond * 1e3)) {
+      !(JacobianLU(J).reciprocal_condition() > problem.definition().options.newton.singular_rcond * 1e3)) {
     result.summary.status = SolverStatus::SingularJacobian;
     result.summary.message =
         "the axial phase condition is degenerate here (a straight rod): solve it without the phase condition";

@@ -1,0 +1,45 @@
+#pragma once
+// LU factorisation of the matrices Newton and the continuation corrector solve with.
+
+#include <Eigen/Dense>
+#include <Eigen/SparseLU>
+#include <memory>
+
+namespace kirchhoff {
+
+// Multiple shooting makes these matrices block-bidiagonal (one state-sized block per segment and
+// its matching identity) with a few dense rows and columns (boundary conditions, unknown
+// parameters, the continuation parameter and the arclength row). A dense LU costs
+// O((segments * state)^3) and dominated long multiple-shooting runs; a sparse LU costs
+// O(segments * state^3). Large matrices that are mostly zeros are therefore factorised as sparse
+// (COLAMD ordering); small or dense ones by partial-pivoting dense LU, as before.
+class JacobianLU {
+ public:
+  explicit JacobianLU(const Eigen::MatrixXd& M);
+
+  // False when the factorisation broke down (an exactly singular sparse matrix).
+  bool ok() const { return ok_; }
+  bool sparse() const { return sparse_ != nullptr; }
+  // 1 / cond_1 estimate; for dense matrices also at most the smallest pivot over the largest
+  // (a cheap guard that the estimate alone can miss). 0 when the factorisation failed.
+  double reciprocal_condition() const { return rcond_; }
+  Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
+  // Sign-faithful determinant; its magnitude is clamped to the double range (only the sign and
+  // order of magnitude serve, as a branch-point test function).
+  double determinant() const;
+
+  // Matrices at least this large, with at most kSparseDensity of their entries non-zero, go sparse.
+  static constexpr int kSparseFrom = 96;
+  static constexpr double kSparseDensity = 0.15;
+
+ private:
+  Eigen::VectorXd solve_transposed(const Eigen::VectorXd& b) const;
+  double estimate_reciprocal_condition(const Eigen::MatrixXd& M) const;
+
+  bool ok_ = false;
+  double rcond_ = 0.0;
+  Eigen::PartialPivLU<Eigen::MatrixXd> dense_;
+  std::unique_ptr<Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>>> sparse_;
+};
+
+}  // namespace kirchhoff
