@@ -215,6 +215,9 @@ int run_continue(const ContinueArguments& args) {
     options.max_step = args.max_step;
     options.max_points = args.max_points;
     options.samples = args.samples;
+    options.detect_branch_points = !args.no_branch_points;
+    if (args.no_branch_points && args.switch_at_bp > 0)
+      throw CaseError("--switch-at-bp needs branch points: drop --no-branch-points");
     options.derived = c.derived;
     options.events = parse_events(args.stop_events, true);
     for (auto& e : parse_events(args.record_events, false)) options.events.push_back(e);

@@ -324,7 +324,8 @@ py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
 
 PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::object& to, double step,
                      double min_step, double max_step, int max_points, const py::object& events,
-                     const py::object& record, int switch_at_bp, double side, int samples, double direction) {
+                     const py::object& record, int switch_at_bp, double side, int samples, double direction,
+                     bool branch_points) {
   const Case& c = pc.c;
   ContinuationOptions options;
   options.parameter = parameter;
@@ -337,11 +338,13 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
   options.max_step = max_step;
   options.max_points = max_points;
   options.samples = samples;
+  options.detect_branch_points = branch_points;
   options.derived = c.derived;
   options.events = events_from(events, true);
   for (auto& e : events_from(record, false)) options.events.push_back(e);
   if (std::string e = options.validate(); !e.empty()) throw CaseError(e);
   if (switch_at_bp < 0) throw CaseError("switch_at_bp must be >= 0");
+  if (switch_at_bp > 0 && !branch_points) throw CaseError("switch_at_bp needs branch_points=True");
   for (const auto& e : options.events)
     if (std::find(options.derived.begin(), options.derived.end(), e.quantity) == options.derived.end())
       options.derived.push_back(e.quantity);
@@ -541,7 +544,7 @@ Returns:
            py::arg("step") = 0.05, py::arg("min_step") = 1e-7, py::arg("max_step") = 0.5,
            py::arg("max_points") = 500, py::arg("events") = py::none(), py::arg("record") = py::none(),
            py::arg("switch_at_bp") = 0, py::arg("side") = 1.0, py::arg("samples") = 101,
-           py::arg("direction") = 1.0,
+           py::arg("direction") = 1.0, py::arg("branch_points") = true,
            R"doc(Pseudo-arclength continuation in one parameter (the CLI's `continue`).
 
 Args:
@@ -556,6 +559,9 @@ Args:
     side (float): +1 / -1, which side of the bifurcating branch.
     samples (int): profile points per point for invariants and derived quantities.
     direction (float): +1 / -1, initial direction when there is no target.
+    branch_points (bool): look for branch points (an SVD per point: most of the cost of a run on
+        a multiple-shooting case of hundreds of unknowns, such as plectoneme.toml); folds are
+        found either way.
 
 Returns:
     Branch (points of both branches concatenated, with a `branch` column).

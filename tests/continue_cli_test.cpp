@@ -153,6 +153,27 @@ TEST_F(ContinueCli, BranchCsvHasTheDocumentedColumnsAndPointTypes) {
   EXPECT_EQ(log.front().find('\r'), std::string::npos);
 }
 
+// --no-branch-points: the straight column is followed past its Euler loads with no branch point
+// row; asking to switch at one without looking for them is refused.
+TEST_F(ContinueCli, BranchPointsCanBeSkippedButNotSwitchedAt) {
+  const std::vector<std::string> straight = {KIRCHHOFF_CLI, "continue",
+                                             std::string(KIRCHHOFF_CASES_DIR) + "/euler_column.toml", "--param",
+                                             "P", "--to", "12", "--set", "P=1", "--set", "theta_guess=0",
+                                             "--max-step", "0.5", "--samples", "21", "--no-branch-points",
+                                             "--out", (dir_ / "s.csv").string()};
+  ASSERT_EQ(run_to_end(straight, dir_ / "s.log"), 0);
+  std::string all;
+  for (const auto& l : lines_of(dir_ / "s.csv")) all += l + "\n";
+  EXPECT_EQ(all.find(",branch_point,"), std::string::npos);
+  EXPECT_NE(all.find(",endpoint,"), std::string::npos);
+  auto refused = continue_args(dir_ / "r.csv");
+  refused.push_back("--no-branch-points");
+  EXPECT_EQ(run_to_end(refused, dir_ / "r.log"), 2);
+  const auto log = lines_of(dir_ / "r.log");
+  ASSERT_FALSE(log.empty());
+  EXPECT_NE(log.front().find("--no-branch-points"), std::string::npos);
+}
+
 TEST_F(ContinueCli, ContinuingAnUnknownParameterIsRefused) {
   const std::vector<std::string> args = {KIRCHHOFF_CLI, "continue",
                                          std::string(KIRCHHOFF_CASES_DIR) + "/simply_supported.toml", "--param",

@@ -226,6 +226,17 @@ class ContinuationTest(unittest.TestCase):
         with self.assertRaises(ValueError):
             case.continue_("P", to=12.0, step=-1.0)
 
+    def test_branch_points_can_be_skipped(self):
+        case = kirchhoff.load_case(case_path("euler_column.toml"), set={"P": 1.0, "theta_guess": 0.0})
+        found = case.continue_("P", to=12.0, max_step=1.0)
+        skipped = case.continue_("P", to=12.0, max_step=1.0, branch_points=False)
+        self.assertIn("branch_point", list(found.points["type"]))
+        self.assertNotIn("branch_point", list(skipped.points["type"]))
+        self.assertAlmostEqual(skipped.points["parameter"][-1], 12.0, places=12)
+        with self.assertRaises(ValueError) as cm:
+            case.continue_("P", to=12.0, switch_at_bp=1, branch_points=False)
+        self.assertIn("branch_points", str(cm.exception))
+
     def test_missing_branch_point_is_reported(self):
         # The straight column below the Euler load: no branch point before the target.
         case = kirchhoff.load_case(case_path("euler_column.toml"), set={"P": 1.0, "theta_guess": 0.0})
