@@ -143,6 +143,10 @@ int main(int argc, char** argv) {
   plectonemes_cmd->add_option("--turns", plect.turns, "Largest end rotation (turns), one per slenderness")
       ->delimiter(',')->capture_default_str();
   plectonemes_cmd->add_option("--out", plect.out_dir, "Output folder (created)")->capture_default_str();
+  plectonemes_cmd
+      ->add_option("--max-step", plect.max_step,
+                   "Largest pseudo-arclength step at L/2R = 100 (scaled by (L/2R / 100)^2 with the forces)")
+      ->capture_default_str();
 
   try {
     app.parse(argc, argv);

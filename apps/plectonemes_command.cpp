@@ -35,7 +35,8 @@ std::map<std::string, double> columns(const ContinuationPoint& p, double EI) {
 }  // namespace
 
 PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, double slenderness, double turns_max,
-                                                 const std::string& csv_path, int progress_every) {
+                                                 const std::string& csv_path, int progress_every,
+                                                 double max_step) {
   const auto started = std::chrono::steady_clock::now();
   const Case c = load_case(case_path, {{"slenderness", slenderness}});
   const double EI = c.definition.parameters.get("EI");
@@ -46,11 +47,18 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
   ContinuationOptions o;
   o.parameter = "turns";
   o.target = turns_max;
-  o.initial_step = 1.0;
-  o.max_step = 60.0;  // pseudo-arclength over forces ~1e2-1e4: steps of tens are small
+  // Forces, and with them the unknowns and the pseudo-arclength, scale as EI/R^2.
+  const double scale = (slenderness / 100.0) * (slenderness / 100.0);
+  o.initial_step = 1.0 * scale;
+  o.max_step = max_step * scale;
   o.max_points = 20000;
   o.derived = c.derived;
   o.samples = 10 * static_cast<int>(slenderness) + 1;  // R/10 apart on the half rod: the ply's pitch is 10-30 R
+  // A point's Jacobian (14 sensitivities per segment) and measures cost tens of residual
+  // evaluations: longer steps that take up to 9 chord iterations are cheaper per turn.
+  o.corrector_max_iterations = 12;
+  o.grow_iterations = 6;
+  o.shrink_iterations = 10;
   o.detect_branch_points = false;  // the barrier's stiffness turns the determinant's sign into noise
   std::ofstream csv(csv_path);
   if (!csv) throw std::runtime_error("cannot write " + csv_path);
@@ -61,14 +69,14 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
     return n;
   }();
   for (const auto& n : names) csv << ',' << n;
-  csv << '\n';
+  csv << ",newton_iterations,step\n";
   PlectonemeBranchSummary summary;
   Continuation run(problem, o);
   const ContinuationResult branch = run.run(untwisted.x, [&](const ContinuationPoint& p) {
     const auto row = columns(p, EI);
     csv << p.parameter << ',' << to_string(p.type);
     for (const auto& n : names) csv << ',' << row.at(n);
-    csv << '\n' << std::flush;
+    csv << ',' << p.newton_iterations << ',' << p.step << '\n' << std::flush;
     ++summary.points;
     if (!std::isnan(row.at("eq61"))) summary.last = row, summary.last["turns"] = p.parameter;
     if (progress_every > 0 && summary.points % progress_every == 0)
@@ -93,7 +101,7 @@ int run_plectonemes(const PlectonemesArguments& args) {
     const std::string csv = args.out_dir + "/plectoneme_" + std::to_string(static_cast<int>(sl)) + ".csv";
     std::cerr << "L/2R = " << sl << ": turns 0 -> " << args.turns[k] << "\n";
     try {
-      const auto s = follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, 50);
+      const auto s = follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, 50, args.max_step);
       total += s.points;
       std::cout << "L/2R = " << sl << ": " << s.points << " points in " << std::setprecision(3) << s.seconds << " s ("
                 << s.points / s.seconds << " points/s), stopped: " << s.stop << ", " << csv << "\n";

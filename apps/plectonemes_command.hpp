@@ -9,6 +9,10 @@
 
 namespace kirchhoff::cli {
 
+// Largest pseudo-arclength step at L/2R = 100: the unknowns are dominated by forces of 1e2-1e4
+// there, so steps of tens are small.
+inline constexpr double kPlectonemeMaxStep = 60.0;
+
 struct PlectonemeBranchSummary {
   int points = 0;
   double seconds = 0.0;
@@ -19,14 +23,17 @@ struct PlectonemeBranchSummary {
 // Follows cases/plectoneme.toml (at `case_path`) with slenderness set, from turns = 0 to
 // turns_max, writing one CSV row per point to csv_path (flushed as it goes). Progress every
 // `progress_every` points on stderr (0: none). Throws on a case that does not solve at turns = 0.
+// The largest pseudo-arclength step is max_step at L/2R = 100, scaled with the forces (1/R^2).
 PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, double slenderness, double turns_max,
-                                                 const std::string& csv_path, int progress_every);
+                                                 const std::string& csv_path, int progress_every,
+                                                 double max_step = kPlectonemeMaxStep);
 
 struct PlectonemesArguments {
   std::string case_path;
   std::vector<double> slenderness{100, 200, 500, 1000};
   std::vector<double> turns{10, 20, 20, 50};
   std::string out_dir = "plectonemes";
+  double max_step = kPlectonemeMaxStep;
 };
 
 int run_plectonemes(const PlectonemesArguments& args);

@@ -14,9 +14,6 @@ namespace {
 constexpr double kLambdaStep = 1e-6;
 // Step growth and shrink factors: the usual choices for predictor-corrector continuation.
 constexpr double kGrow = 1.5, kShrink = 0.5;
-// A corrector that needs at most this many iterations lets the step grow; at least kSlow, shrink
-// (chord iterations contract linearly, so a good step takes three or four of them).
-constexpr int kFast = 4, kSlow = 7;
 // Secant/Brent location stops when the step interval is this small relative to the step.
 constexpr double kLocateTolerance = 1e-12;
 constexpr int kLocateIterations = 60;
@@ -63,6 +60,8 @@ std::string ContinuationOptions::validate() const {
   if (corrector_max_iterations < 1 || !(corrector_tolerance > 0 || std::isnan(corrector_tolerance)))
     return "corrector settings must be positive";
   if (samples < 2) return "samples must be >= 2";
+  if (!(0 <= grow_iterations && grow_iterations < shrink_iterations))
+    return "grow_iterations must be >= 0 and below shrink_iterations";
   return {};
 }
 
@@ -363,6 +362,7 @@ ContinuationResult Continuation::switch_branch(const ContinuationPoint& bp, cons
 ContinuationResult Continuation::march(ContinuationPoint current, const PointSink& sink) {
   ContinuationResult result;
   result.points.push_back(current);
+  if (current.type != PointType::BranchPoint) result.points.back().jacobian.resize(0, 0);
   if (sink) sink(current);
   double ds = current.step > 0 ? current.step : options_.initial_step;
   std::optional<ContinuationPoint> before_current;  // the point before `current`, for minima
@@ -371,13 +371,16 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
   int branch_points_found = 0;
   bool just_reported_branch_point = false;
 
+  // Only branch points keep their matrix in the branch (for switching); the newest point's moves
+  // on to `current`, for the next corrector's chord. A long branch keeping every one would hold
+  // n^2 doubles per point, and copying them cost ~10 % of a point at L/2R = 500.
+  Eigen::MatrixXd newest_matrix;
   auto accept = [&](ContinuationPoint p) {
-    // Only the newest point's matrix is needed (the next corrector's chord); a long branch
-    // keeping every one would hold n^2 doubles per point. Branch points keep theirs for switching.
-    if (result.points.back().type != PointType::BranchPoint) result.points.back().jacobian.resize(0, 0);
     p.index = result.points.back().index + 1;
     p.step = ds;
-    result.points.push_back(p);
+    newest_matrix = std::move(p.jacobian);
+    p.jacobian = p.type == PointType::BranchPoint ? newest_matrix : Eigen::MatrixXd();
+    result.points.push_back(std::move(p));
     if (sink) sink(result.points.back());
   };
 
@@ -493,14 +496,15 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
     }
 
     const int iterations = candidate->newton_iterations;
-    before_current = current;
+    before_current = std::move(current);
     previous_h = ds;
     // The next step is decided before the point is reported, so that a run resumed from it takes
     // the same step as the uninterrupted one.
-    if (iterations <= kFast) ds = std::min(ds * kGrow, options_.max_step);
-    if (iterations >= kSlow) ds = std::max(ds * kShrink, options_.min_step);
-    accept(*candidate);
+    if (iterations <= options_.grow_iterations) ds = std::min(ds * kGrow, options_.max_step);
+    if (iterations >= options_.shrink_iterations) ds = std::max(ds * kShrink, options_.min_step);
+    accept(std::move(*candidate));
     current = result.points.back();
+    current.jacobian = std::move(newest_matrix);
   }
   result.reason = StopReason::MaxPoints;
   return result;

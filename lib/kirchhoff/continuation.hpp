@@ -48,6 +48,13 @@ struct ContinuationOptions {
   double parameter_min = -std::numeric_limits<double>::infinity();
   double parameter_max = std::numeric_limits<double>::infinity();
   int corrector_max_iterations = 8;
+  // A corrector that needed at most grow_iterations lets the step grow, at least
+  // shrink_iterations shrink it (chord iterations contract linearly, so a good step takes three
+  // or four). Where a point's Jacobian and derived quantities cost many residual evaluations
+  // (long multiple-shooting rods), more chord iterations on longer steps are cheaper per unit of
+  // branch: raise both.
+  int grow_iterations = 4;
+  int shrink_iterations = 7;
   // On max |F| and |arclength condition|; NaN: 1e-10, or the problem's Newton residual tolerance
   // (a case's [solver] tolerance) when that is looser - rods with large forces need it.
   double corrector_tolerance = std::numeric_limits<double>::quiet_NaN();
