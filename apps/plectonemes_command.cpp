@@ -83,7 +83,7 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
       std::cerr << "  L/2R = " << slenderness << "  point " << summary.points << "  turns = " << std::setprecision(6)
                 << p.parameter << "\n";
   });
-  summary.stop = to_string(branch.reason);
+  summary.stop = to_string(branch.reason) + (branch.message.empty() ? "" : " (" + branch.message + ")");
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return summary;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <boost/math/tools/minima.hpp>
 #include <cmath>
+#include <sstream>
 
 #include "kirchhoff/jacobian_lu.hpp"
 #include "kirchhoff/solution.hpp"
@@ -131,19 +132,36 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
       if (!z.allFinite()) z = z_start;
     }
   }
+  double best = INFINITY;
   for (; it <= 2 * options_.corrector_max_iterations; ++it) {
-    if (!evaluate(z, &F, &A, &failure)) return false;
+    if (!evaluate(z, &F, &A, &failure)) {
+      last_corrector_failure_ = failure;
+      return false;
+    }
     G << F, normal.dot(z - z_predicted);
-    if (!G.allFinite()) return false;
+    if (!G.allFinite()) {
+      last_corrector_failure_ = "the residual is not finite";
+      return false;
+    }
+    best = std::min(best, G.lpNorm<Eigen::Infinity>());
     if (G.lpNorm<Eigen::Infinity>() <= options_.corrector_tolerance) {
       *iterations = it;
       return true;
     }
     M << A, normal.transpose();
     const JacobianLU lu(M);
-    if (!(lu.reciprocal_condition() > 1e-15)) return false;
+    if (!(lu.reciprocal_condition() > 1e-15)) {
+      std::ostringstream os;
+      os << "singular bordered matrix (reciprocal condition " << lu.reciprocal_condition() << ", residual "
+         << G.lpNorm<Eigen::Infinity>() << ")";
+      last_corrector_failure_ = os.str();
+      return false;
+    }
     z -= lu.solve(G);
   }
+  std::ostringstream os;
+  os << "no convergence, best residual " << best;
+  last_corrector_failure_ = os.str();
   return false;
 }
 
@@ -390,7 +408,7 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
       ds *= kShrink;
       if (ds < options_.min_step) {
         result.reason = StopReason::StepTooSmall;
-        result.message = "the corrector failed down to the minimum step";
+        result.message = "the corrector failed down to the minimum step (last failure: " + last_corrector_failure_ + ")";
         return result;
       }
       continue;

@@ -166,6 +166,7 @@ class Continuation {
   ShootingProblem problem_;
   ContinuationOptions options_;
   int n_ = 0;  // number of shooting unknowns
+  std::string last_corrector_failure_;  // why the last failed corrector failed, for the stop message
 };
 
 // Branch switching at the double branch point of an isotropic twisted rod (the straight rod's

@@ -20,8 +20,9 @@ class JacobianLU {
   // False when the factorisation broke down (an exactly singular sparse matrix).
   bool ok() const { return ok_; }
   bool sparse() const { return sparse_ != nullptr; }
-  // 1 / cond_1 estimate; for dense matrices also at most the smallest pivot over the largest
-  // (a cheap guard that the estimate alone can miss). 0 when the factorisation failed.
+  // 1 / cond_1 estimate (of the row-equilibrated matrix when large); for dense matrices also at most the
+  // smallest pivot over the largest (a cheap guard that the estimate alone can miss). 0 when the
+  // factorisation failed.
   double reciprocal_condition() const { return rcond_; }
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
   // Sign-faithful determinant; its magnitude is clamped to the double range (only the sign and
@@ -33,9 +34,11 @@ class JacobianLU {
   static constexpr double kSparseDensity = 0.15;
 
  private:
+  Eigen::VectorXd solve_scaled(const Eigen::VectorXd& b) const;  // by the factors of the row-scaled matrix
   Eigen::VectorXd solve_transposed(const Eigen::VectorXd& b) const;
   double estimate_reciprocal_condition(const Eigen::MatrixXd& M) const;
 
+  Eigen::VectorXd row_scale_;  // 1 / largest |entry| of each row
   bool ok_ = false;
   double rcond_ = 0.0;
   Eigen::PartialPivLU<Eigen::MatrixXd> dense_;
