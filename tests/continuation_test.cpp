@@ -111,6 +111,39 @@ TEST(EulerColumn, FirstBuckledBranchMatchesTheElasticaToThetaThree) {
   EXPECT_NEAR(r.points.back().parameter / (analytic::PinnedElastica{1.0, 1.0, 3.0}.load()), 1.0, kLocated);
 }
 
+// Reusing the previous point's matrix where the corrector converged quickly on it changes the
+// tangents and chords, not the equilibria: every point is still on the elastica to kLocated.
+TEST(EulerColumn, ReusedJacobiansGiveTheSameBuckledBranch) {
+  ContinuationOptions o = euler_options();
+  o.target = 12.0;
+  o.stop_at_branch_point = 1;
+  BranchRun run = continue_case("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, o);
+  ASSERT_EQ(run.result.reason, StopReason::BranchPointStop);
+  ContinuationOptions buckled = euler_options();
+  buckled.target = NAN;
+  buckled.initial_step = 0.05;
+  buckled.max_step = 1.0;
+  buckled.events = {{"theta0", 2.5, true}};
+  buckled.reuse_jacobian_iterations = 6;
+  EXPECT_NE(buckled.validate().find("detect_branch_points"), std::string::npos);
+  buckled.detect_branch_points = false;
+  Continuation branch(*run.problem, buckled);
+  const ContinuationResult r = branch.switch_branch(run.result.points.back());
+  ASSERT_EQ(r.reason, StopReason::EventStop) << r.message;
+  int compared = 0, reused = 0;
+  for (const auto& p : r.points) {
+    reused += p.jacobian_reused;
+    const double theta0 = p.derived.at("theta0");
+    if (theta0 < 1e-3) continue;
+    const double exact = analytic::PinnedElastica{1.0, 1.0, theta0}.load();
+    EXPECT_NEAR(p.parameter / exact, 1.0, kLocated) << theta0;
+    ++compared;
+  }
+  EXPECT_GT(compared, 20);
+  EXPECT_GT(reused, compared / 4);
+  EXPECT_NEAR(r.points.back().derived.at("theta0"), 2.5, 1e-9);
+}
+
 ContinuationOptions twist_options() {
   ContinuationOptions o;
   o.parameter = "phi";

@@ -63,6 +63,8 @@ std::string ContinuationOptions::validate() const {
   if (samples < 2) return "samples must be >= 2";
   if (!(0 <= grow_iterations && grow_iterations < shrink_iterations))
     return "grow_iterations must be >= 0 and below shrink_iterations";
+  if (reuse_jacobian_iterations >= 0 && detect_branch_points)
+    return "reusing Jacobians needs detect_branch_points = false (the test functions need each point's own)";
   return {};
 }
 
@@ -104,7 +106,7 @@ bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen:
 }
 
 bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
-                           int* iterations, const Eigen::MatrixXd* chord) {
+                           int* iterations, const Eigen::MatrixXd* chord, bool* by_chord) {
   Eigen::VectorXd F, G(n_ + 1);
   Eigen::MatrixXd A, M(n_ + 1, n_ + 1);
   std::string failure;
@@ -122,6 +124,7 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
         if (!std::isfinite(norm)) break;
         if (norm <= options_.corrector_tolerance) {
           *iterations = it;
+          if (by_chord) *by_chord = true;
           return true;
         }
         // Chord iterations contract linearly; slower than this, full Newton is cheaper.
@@ -166,11 +169,16 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
 }
 
 std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous,
-                                                        PointType type, int index, double arclength, int iterations) {
+                                                        PointType type, int index, double arclength, int iterations,
+                                                        const Eigen::MatrixXd* reused) {
   Eigen::VectorXd F;
   Eigen::MatrixXd A;
   std::string failure;
-  if (!evaluate(z, &F, &A, &failure)) return std::nullopt;
+  if (reused) {
+    A = *reused;
+  } else if (!evaluate(z, &F, &A, &failure)) {
+    return std::nullopt;
+  }
   Eigen::MatrixXd M(n_ + 1, n_ + 1);
   M << A, previous.transpose();
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n_ + 1);
@@ -188,6 +196,7 @@ std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z
   p.type = type;
   p.arclength = arclength;
   p.newton_iterations = iterations;
+  p.jacobian_reused = reused != nullptr;
   p.jacobian = A;
   // The determinant and singular values only serve branch-point detection, and the SVD costs
   // O(n^3) with a large constant: on multiple-shooting problems of several hundred unknowns it
@@ -225,8 +234,13 @@ std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint
   const Eigen::VectorXd z_pred = z0 + h * from.tangent;
   Eigen::VectorXd z = z_pred;
   int iterations = 0;
-  if (!correct(z, z_pred, from.tangent, &iterations, &from.jacobian)) return std::nullopt;
-  return point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations);
+  bool by_chord = false;
+  if (!correct(z, z_pred, from.tangent, &iterations, &from.jacobian, &by_chord)) return std::nullopt;
+  // A corrector that converged quickly on the previous matrix shows that matrix still serves:
+  // the new point keeps it for its tangent and the next chord instead of paying for its own.
+  const bool reuse = by_chord && iterations <= options_.reuse_jacobian_iterations && from.jacobian.rows() == n_;
+  return point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations,
+                  reuse ? &from.jacobian : nullptr);
 }
 std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& from, double h_max,
                                                       const std::function<double(const ContinuationPoint&)>& monitor,

@@ -55,6 +55,11 @@ struct ContinuationOptions {
   // branch: raise both.
   int grow_iterations = 4;
   int shrink_iterations = 7;
+  // A point whose corrector converged by at most this many chord iterations on the previous
+  // point's matrix keeps that matrix (for its tangent and the next chord) instead of evaluating
+  // its own - the variational equations are most of a point's cost on long multiple-shooting
+  // rods. -1: every point evaluates its own (needed for branch points and exact tangents).
+  int reuse_jacobian_iterations = -1;
   // On max |F| and |arclength condition|; NaN: 1e-10, or the problem's Newton residual tolerance
   // (a case's [solver] tolerance) when that is looser - rods with large forces need it.
   double corrector_tolerance = std::numeric_limits<double>::quiet_NaN();
@@ -85,6 +90,7 @@ struct ContinuationPoint {
   PointType type = PointType::Regular;
   int multiplicity = 0;     // branch points: number of small singular values
   int newton_iterations = 0;
+  bool jacobian_reused = false;  // its matrix is the previous point's (reuse_jacobian_iterations)
   std::string event;        // events: the quantity that crossed
   std::map<std::string, double> derived;
   InvariantReport invariants;
@@ -147,11 +153,13 @@ class Continuation {
   // it first iterates with that fixed matrix, one integration without sensitivities per
   // iteration, and turns to full Newton only if those iterations stop contracting.
   bool correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
-               int* iterations, const Eigen::MatrixXd* chord = nullptr);
+               int* iterations, const Eigen::MatrixXd* chord = nullptr, bool* by_chord = nullptr);
   // Tangent at z oriented by `previous`, with the test functions, as a point (derived
   // quantities and invariants included).
+  // With `reused`, that matrix stands for [F_x F_lambda] at z (no evaluation).
   std::optional<ContinuationPoint> point_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous, PointType type,
-                                            int index, double arclength, int iterations);
+                                            int index, double arclength, int iterations,
+                                            const Eigen::MatrixXd* reused = nullptr);
   ContinuationResult march(ContinuationPoint start, const PointSink& sink);
   // Locates where `monitor` (of the point reached from `from` by a step h) vanishes or is
   // minimal, by the secant method or Brent on h in (0, h_max].
