@@ -18,6 +18,7 @@ struct PlectonemeBranchSummary {
   double seconds = 0.0;
   std::string stop;                         // the continuation's stop reason
   std::map<std::string, double> last;       // the CSV columns at the last point with a ply
+  std::vector<std::map<std::string, double>> ply;  // the same at every point with a ply, in order
 };
 
 // Follows cases/plectoneme.toml (at `case_path`) with slenderness set, from turns = 0 to

@@ -208,7 +208,7 @@ def fig5(profiles, figures):
 def fig11(profiles, figures):
     """Plectoneme branches: T_ext rho^2/EI against the helical angle, eq. (61) alongside.
 
-    Reads profiles/plectoneme_*.csv (reproduce writes L/2R = 100; `kirchhoff plectonemes --out
+    Reads profiles/plectoneme_*.csv (reproduce writes L/2R = 100 and 200; `kirchhoff plectonemes --out
     OUT/profiles` adds the other slendernesses). rho is the computed helix radius (R plus the
     self-contact barrier's gap), the R of eqs. (58)-(61)."""
     paths = sorted(profiles.glob("plectoneme_*.csv"), key=lambda p: int(p.stem.split("_")[-1]))
