@@ -75,19 +75,29 @@ TEST(EulerColumn, MultipleShootingContinuesTheSameWay) {
   EXPECT_NEAR(bps[1].parameter / (4 * M_PI * M_PI), 1.0, kLocated);
 }
 
-TEST(EulerColumn, FirstBuckledBranchMatchesTheElasticaToThetaThree) {
+// Options for the column's first buckled branch, followed until theta0 reaches `theta_end`.
+ContinuationOptions buckled_options(double theta_end) {
+  ContinuationOptions o = euler_options();
+  o.target = NAN;
+  o.initial_step = 0.05;
+  o.max_step = 1.0;
+  o.events = {{"theta0", theta_end, true}};
+  return o;
+}
+
+// The straight column up to its first branch point, then the branch bifurcating there.
+ContinuationResult first_buckled_branch(const ContinuationOptions& buckled) {
   ContinuationOptions o = euler_options();
   o.target = 12.0;
   o.stop_at_branch_point = 1;
   BranchRun run = continue_case("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, o);
-  ASSERT_EQ(run.result.reason, StopReason::BranchPointStop);
-  ContinuationOptions buckled = euler_options();
-  buckled.target = NAN;
-  buckled.initial_step = 0.05;
-  buckled.max_step = 1.0;
-  buckled.events = {{"theta0", 3.0, true}};
+  EXPECT_EQ(run.result.reason, StopReason::BranchPointStop);
   Continuation branch(*run.problem, buckled);
-  const ContinuationResult r = branch.switch_branch(run.result.points.back());
+  return branch.switch_branch(run.result.points.back());
+}
+
+TEST(EulerColumn, FirstBuckledBranchMatchesTheElasticaToThetaThree) {
+  const ContinuationResult r = first_buckled_branch(buckled_options(3.0));
   ASSERT_EQ(r.reason, StopReason::EventStop) << r.message;
   int compared = 0;
   for (const auto& p : r.points) {
@@ -114,21 +124,11 @@ TEST(EulerColumn, FirstBuckledBranchMatchesTheElasticaToThetaThree) {
 // Reusing the previous point's matrix where the corrector converged quickly on it changes the
 // tangents and chords, not the equilibria: every point is still on the elastica to kLocated.
 TEST(EulerColumn, ReusedJacobiansGiveTheSameBuckledBranch) {
-  ContinuationOptions o = euler_options();
-  o.target = 12.0;
-  o.stop_at_branch_point = 1;
-  BranchRun run = continue_case("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, o);
-  ASSERT_EQ(run.result.reason, StopReason::BranchPointStop);
-  ContinuationOptions buckled = euler_options();
-  buckled.target = NAN;
-  buckled.initial_step = 0.05;
-  buckled.max_step = 1.0;
-  buckled.events = {{"theta0", 2.5, true}};
+  ContinuationOptions buckled = buckled_options(2.5);
   buckled.reuse_jacobian_iterations = 6;
   EXPECT_NE(buckled.validate().find("detect_branch_points"), std::string::npos);
   buckled.detect_branch_points = false;
-  Continuation branch(*run.problem, buckled);
-  const ContinuationResult r = branch.switch_branch(run.result.points.back());
+  const ContinuationResult r = first_buckled_branch(buckled);
   ASSERT_EQ(r.reason, StopReason::EventStop) << r.message;
   int compared = 0, reused = 0;
   for (const auto& p : r.points) {
