@@ -174,13 +174,9 @@ std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z
   Eigen::VectorXd F;
   Eigen::MatrixXd A;
   std::string failure;
-  if (reused) {
-    A = *reused;
-  } else if (!evaluate(z, &F, &A, &failure)) {
-    return std::nullopt;
-  }
+  if (!reused && !evaluate(z, &F, &A, &failure)) return std::nullopt;
   Eigen::MatrixXd M(n_ + 1, n_ + 1);
-  M << A, previous.transpose();
+  M << (reused ? *reused : A), previous.transpose();
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n_ + 1);
   rhs[n_] = 1.0;
   Eigen::VectorXd t = JacobianLU(M).solve(rhs);
@@ -197,7 +193,7 @@ std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z
   p.arclength = arclength;
   p.newton_iterations = iterations;
   p.jacobian_reused = reused != nullptr;
-  p.jacobian = A;
+  p.jacobian = reused ? *reused : std::move(A);
   // The determinant and singular values only serve branch-point detection, and the SVD costs
   // O(n^3) with a large constant: on multiple-shooting problems of several hundred unknowns it
   // was 95 % of a run.
