@@ -15,97 +15,13 @@
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/continuation.hpp"
 #include "kirchhoff/solution.hpp"
+#include "run_state.hpp"
 #include "solve_command.hpp"
 
 namespace kirchhoff::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-// The run's progress so far, kept beside the CSV (branch.csv.state.json) and replaced
-// atomically after every point, so that a killed run resumes from its last written point.
-struct RunState {
-  int row = -1;                   // index of the last CSV row written (continuous across branches)
-  int saved_row = -1;             // the row of `last`, the point a resume starts from
-  int branch = 0;                 // 0: the starting branch, 1: after --switch-at-bp
-  std::string phase_condition;    // of the problem the branch belongs to
-  ContinuationPoint last;
-  std::vector<std::string> derived;
-  std::vector<PointContact> contacts;  // the active set of `last` (contact runs)
-};
-
-nlohmann::json to_json(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
-Eigen::VectorXd vector_from(const nlohmann::json& j) {
-  const auto v = j.get<std::vector<double>>();
-  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
-}
-
-PointType point_type_from(const std::string& name) {
-  for (PointType t : {PointType::Start, PointType::Regular, PointType::Fold, PointType::BranchPoint, PointType::Event,
-                      PointType::Endpoint})
-    if (name == to_string(t)) return t;
-  return PointType::Regular;
-}
-
-bool resumable(const ContinuationPoint& p) { return p.type == PointType::Start || p.type == PointType::Regular; }
-
-void save_state(const fs::path& path, const RunState& s) {
-  nlohmann::json j = {{"row", s.saved_row},             {"branch", s.branch},       {"phase_condition", s.phase_condition},
-                      {"index", s.last.index},     {"parameter", s.last.parameter},
-                      {"arclength", s.last.arclength}, {"step", s.last.step},
-                      {"x", to_json(s.last.x)},    {"tangent", to_json(s.last.tangent)},
-                      {"type", to_string(s.last.type)}};
-  j["contacts"] = nlohmann::json::array();
-  for (const auto& c : s.contacts)
-    j["contacts"].push_back({{"obstacle", c.obstacle}, {"s", c.s}, {"force", c.force}, {"extended", c.extended},
-                             {"s_end", c.s_end}, {"force_end", c.force_end}});
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << std::setprecision(17) << j.dump() << "\n";
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  fs::rename(tmp, path);  // atomic on POSIX: the state is always a complete point
-}
-
-RunState load_state(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot resume: no state file " + path.string());
-  const nlohmann::json j = nlohmann::json::parse(in);
-  RunState s;
-  s.row = s.saved_row = j.at("row");
-  s.branch = j.at("branch");
-  s.phase_condition = j.at("phase_condition");
-  s.last.index = j.at("index");
-  s.last.parameter = j.at("parameter");
-  s.last.arclength = j.at("arclength");
-  s.last.step = j.at("step");
-  s.last.x = vector_from(j.at("x"));
-  s.last.tangent = vector_from(j.at("tangent"));
-  s.last.type = point_type_from(j.at("type"));
-  if (j.contains("contacts"))
-    for (const auto& c : j.at("contacts"))
-      s.contacts.push_back({c.at("obstacle").get<int>(), c.at("s").get<double>(), c.at("force").get<double>(),
-                            c.at("extended").get<bool>(), c.at("s_end").get<double>(), c.at("force_end").get<double>()});
-  return s;
-}
-
-// Keeps the header and the rows up to and including `last_index` (a row written after the
-// state was last saved is dropped, so no point is duplicated on resume).
-void truncate_csv(const fs::path& path, int last_index) {
-  std::ifstream in(path);
-  std::string header, line, kept;
-  std::getline(in, header);
-  while (std::getline(in, line)) {
-    if (line.empty()) continue;
-    const int index = std::stoi(line.substr(0, line.find(',')));
-    if (index > last_index) break;
-    kept += line + "\n";
-  }
-  in.close();
-  std::ofstream out(path, std::ios::trunc);
-  out << header << "\n" << kept;
-}
 
 // Branch points already written on branch 0 (for resuming a run with --switch-at-bp).
 int count_branch_points(const fs::path& path) {

@@ -133,9 +133,10 @@ int main(int argc, char** argv) {
       "plectonemes",
       "The Fig. 11 sweep: plectoneme branches (cases/plectoneme.toml) for several slendernesses L/2R,\n"
       "each followed in the end rotation from the untwisted rod through the end loop into the ply;\n"
-      "DIR/plectoneme_<L/2R>.csv per branch (turns, T_ext, helix_angle, helix_radius rho,\n"
+      "DIR/plectoneme_<L/2R>.csv per branch (index, turns, T_ext, helix_angle, helix_radius rho,\n"
       "T_rho2_over_EI and eq61 side by side, m3 and m3_eq58b, H_A, H_B, self_distance, ...),\n"
-      "wall time and points per second on stdout. Long: minutes per slenderness.");
+      "wall time and points per second on stdout. Long: minutes to hours per slenderness; --resume\n"
+      "continues a killed sweep.");
   plectonemes_cmd->add_option("--case", plect.case_path, "The plectoneme case file")->capture_default_str()
       ->check(CLI::ExistingFile);
   plectonemes_cmd->add_option("--slenderness", plect.slenderness, "Slendernesses L/2R")->delimiter(',')
@@ -143,6 +144,9 @@ int main(int argc, char** argv) {
   plectonemes_cmd->add_option("--turns", plect.turns, "Largest end rotation (turns), one per slenderness")
       ->delimiter(',')->capture_default_str();
   plectonemes_cmd->add_option("--out", plect.out_dir, "Output folder (created)")->capture_default_str();
+  plectonemes_cmd->add_flag("--resume", plect.resume,
+                            "Pick a killed sweep up where it stopped: finished branches are kept, an unfinished one\n"
+                            "continues from its last point (DIR/plectoneme_<L/2R>.csv.state.json)");
   plectonemes_cmd
       ->add_option("--max-step", plect.max_step,
                    "Largest pseudo-arclength step at L/2R = 100 (scaled by (L/2R / 100)^2 with the forces)")

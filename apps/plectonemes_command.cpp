@@ -10,6 +10,7 @@
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/continuation.hpp"
+#include "run_state.hpp"
 
 namespace kirchhoff::cli {
 namespace {
@@ -32,25 +33,37 @@ std::map<std::string, double> columns(const ContinuationPoint& p, double EI) {
   return c;
 }
 
+// The CSV ends with its endpoint row: the branch was followed to its target.
+bool branch_complete(const std::filesystem::path& csv) {
+  std::ifstream in(csv);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  return last.find(",endpoint,") != std::string::npos;
+}
+
 }  // namespace
 
 PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, double slenderness, double turns_max,
-                                                 const std::string& csv_path, int progress_every,
-                                                 double max_step) {
+                                                 const std::string& csv_path, const PlectonemeRunOptions& options) {
   const auto started = std::chrono::steady_clock::now();
+  PlectonemeBranchSummary summary;
+  const std::filesystem::path state_path = csv_path + ".state.json";
+  const bool resuming = options.resume && std::filesystem::exists(state_path);
+  if (options.resume && branch_complete(csv_path)) {
+    summary.stop = "already complete";
+    return summary;
+  }
   const Case c = load_case(case_path, {{"slenderness", slenderness}});
   const double EI = c.definition.parameters.get("EI");
   ShootingProblem problem(c.definition);
-  const ShootingResult untwisted = solve(problem, problem.initial_unknowns(c.start_guess));
-  if (!untwisted.summary.converged())
-    throw std::runtime_error(case_path + ": the untwisted rod does not solve: " + untwisted.summary.brief_report());
   ContinuationOptions o;
   o.parameter = "turns";
   o.target = turns_max;
   // Forces, and with them the unknowns and the pseudo-arclength, scale as EI/R^2.
   const double scale = (slenderness / 100.0) * (slenderness / 100.0);
   o.initial_step = 1.0 * scale;
-  o.max_step = max_step * scale;
+  o.max_step = options.max_step * scale;
   o.max_points = 20000;
   o.derived = c.derived;
   o.samples = 10 * static_cast<int>(slenderness) + 1;  // R/10 apart on the half rod: the ply's pitch is 10-30 R
@@ -63,33 +76,57 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
   o.shrink_iterations = 10;
   o.reuse_jacobian_iterations = 8;
   o.detect_branch_points = false;  // the barrier's stiffness turns the determinant's sign into noise
-  std::ofstream csv(csv_path);
-  if (!csv) throw std::runtime_error("cannot write " + csv_path);
-  csv << std::setprecision(12) << "turns,type";
+
   const std::vector<std::string> names = [] {
     std::vector<std::string> n = kMeasured;
     for (const char* extra : {"T_rho2_over_EI", "eq61", "m3_eq58b"}) n.push_back(extra);
     return n;
   }();
-  for (const auto& n : names) csv << ',' << n;
-  csv << ",newton_iterations,step\n";
-  PlectonemeBranchSummary summary;
-  Continuation run(problem, o);
-  const ContinuationResult branch = run.run(untwisted.x, [&](const ContinuationPoint& p) {
+  RunState state;
+  if (resuming) {
+    state = load_state(state_path);
+    truncate_csv(csv_path, state.saved_row);
+  }
+  std::ofstream csv(csv_path, resuming ? std::ios::app : std::ios::trunc);
+  if (!csv) throw std::runtime_error("cannot write " + csv_path);
+  csv << std::setprecision(12);
+  if (!resuming) {
+    csv << "index,turns,type";
+    for (const auto& n : names) csv << ',' << n;
+    csv << ",newton_iterations,step\n";
+  }
+  auto sink = [&](const ContinuationPoint& p) {
     const auto row = columns(p, EI);
-    csv << p.parameter << ',' << to_string(p.type);
+    csv << ++state.row << ',' << p.parameter << ',' << to_string(p.type);
     for (const auto& n : names) csv << ',' << row.at(n);
     csv << ',' << p.newton_iterations << ',' << p.step << '\n' << std::flush;
+    if (resumable(p)) {
+      state.last = p;
+      state.last.jacobian.resize(0, 0);
+      state.saved_row = state.row;
+      save_state(state_path, state);
+    }
     ++summary.points;
     if (!std::isnan(row.at("eq61"))) {
       summary.last = row;
       summary.last["turns"] = p.parameter;
       summary.ply.push_back(summary.last);
     }
-    if (progress_every > 0 && summary.points % progress_every == 0)
-      std::cerr << "  L/2R = " << slenderness << "  point " << summary.points << "  turns = " << std::setprecision(6)
+    if (options.progress_every > 0 && summary.points % options.progress_every == 0)
+      std::cerr << "  L/2R = " << slenderness << "  point " << state.row << "  turns = " << std::setprecision(6)
                 << p.parameter << "\n";
-  });
+  };
+  Continuation run(problem, o);
+  ContinuationResult branch;
+  if (resuming) {
+    problem.set_parameter(o.parameter, state.last.parameter);
+    branch = run.resume(state.last, sink);
+  } else {
+    const ShootingResult untwisted = solve(problem, problem.initial_unknowns(c.start_guess));
+    if (!untwisted.summary.converged())
+      throw std::runtime_error(case_path + ": the untwisted rod does not solve: " + untwisted.summary.brief_report());
+    branch = run.run(untwisted.x, sink);
+  }
   summary.stop = to_string(branch.reason) + (branch.message.empty() ? "" : " (" + branch.message + ")");
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return summary;
@@ -108,7 +145,11 @@ int run_plectonemes(const PlectonemesArguments& args) {
     const std::string csv = args.out_dir + "/plectoneme_" + std::to_string(static_cast<int>(sl)) + ".csv";
     std::cerr << "L/2R = " << sl << ": turns 0 -> " << args.turns[k] << "\n";
     try {
-      const auto s = follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, 50, args.max_step);
+      PlectonemeRunOptions options;
+      options.progress_every = 50;
+      options.max_step = args.max_step;
+      options.resume = args.resume;
+      const auto s = follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, options);
       total += s.points;
       std::cout << "L/2R = " << sl << ": " << s.points << " points in " << std::setprecision(3) << s.seconds << " s ("
                 << s.points / s.seconds << " points/s), stopped: " << s.stop << ", " << csv << "\n";

@@ -21,13 +21,20 @@ struct PlectonemeBranchSummary {
   std::vector<std::map<std::string, double>> ply;  // the same at every point with a ply, in order
 };
 
+struct PlectonemeRunOptions {
+  int progress_every = 0;                 // a progress line on stderr every this many points (0: none)
+  double max_step = kPlectonemeMaxStep;   // at L/2R = 100, scaled with the forces (1/R^2)
+  // Continue a killed run from csv_path's state file (csv_path + ".state.json"); a branch whose
+  // CSV ends at its endpoint is left as it is. Without a state file the branch starts afresh.
+  bool resume = false;
+};
+
 // Follows cases/plectoneme.toml (at `case_path`) with slenderness set, from turns = 0 to
-// turns_max, writing one CSV row per point to csv_path (flushed as it goes). Progress every
-// `progress_every` points on stderr (0: none). Throws on a case that does not solve at turns = 0.
-// The largest pseudo-arclength step is max_step at L/2R = 100, scaled with the forces (1/R^2).
+// turns_max, writing one CSV row per point to csv_path (flushed as it goes) and the state to
+// resume from beside it. Throws on a case that does not solve at turns = 0. A resumed run's
+// summary counts (and its `ply` holds) only the points computed after resuming.
 PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, double slenderness, double turns_max,
-                                                 const std::string& csv_path, int progress_every,
-                                                 double max_step = kPlectonemeMaxStep);
+                                                 const std::string& csv_path, const PlectonemeRunOptions& options);
 
 struct PlectonemesArguments {
   std::string case_path;
@@ -35,6 +42,7 @@ struct PlectonemesArguments {
   std::vector<double> turns{10, 20, 20, 50};
   std::string out_dir = "plectonemes";
   double max_step = kPlectonemeMaxStep;
+  bool resume = false;
 };
 
 int run_plectonemes(const PlectonemesArguments& args);

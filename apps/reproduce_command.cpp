@@ -606,7 +606,7 @@ void plectonemes(const fs::path& cases, const fs::path& out, std::vector<ReportR
   for (auto& run : runs) {
     const std::string name = std::to_string(static_cast<int>(run.slenderness));
     run.branch = follow_plectoneme_branch((cases / "plectoneme.toml").string(), run.slenderness, run.turns,
-                                          (out / ("plectoneme_" + name + ".csv")).string(), 0);
+                                          (out / ("plectoneme_" + name + ".csv")).string(), {});
     if (run.branch.last.empty())
       throw std::runtime_error("plectoneme: no ply formed at L/2R = " + name + " (" + run.branch.stop + ")");
     const auto& ply = run.branch.last;
