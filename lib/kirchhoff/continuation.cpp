@@ -15,6 +15,8 @@ namespace {
 constexpr double kLambdaStep = 1e-6;
 // Step growth and shrink factors: the usual choices for predictor-corrector continuation.
 constexpr double kGrow = 1.5, kShrink = 0.5;
+// The located end point of a run with a target is accepted this close to it (relative).
+constexpr double kTargetTolerance = 1e-9;
 // Secant/Brent location stops when the step interval is this small relative to the step.
 constexpr double kLocateTolerance = 1e-12;
 constexpr int kLocateIterations = 60;
@@ -437,6 +439,13 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
     if (has_target && crossed(current.parameter - options_.target, candidate->parameter - options_.target)) {
       auto p = locate(current, ds, [&](const ContinuationPoint& q) { return q.parameter - options_.target; }, false,
                       PointType::Endpoint);
+      // A corrector that failed inside the step leaves locate with a point short of the target (or
+      // the whole step's, beyond it): retry with a shorter step rather than stop off the target.
+      if (p && std::abs(p->parameter - options_.target) > kTargetTolerance * std::max(1.0, std::abs(options_.target)) &&
+          ds * kShrink >= options_.min_step) {
+        ds *= kShrink;
+        continue;
+      }
       if (p) {
         special.push_back({(p->arclength - current.arclength), *p});
         stop = true;
