@@ -42,6 +42,30 @@ bool branch_complete(const std::filesystem::path& csv) {
   return last.find(",endpoint,") != std::string::npos;
 }
 
+// How a plectoneme branch is followed in `turns`, at any slenderness.
+ContinuationOptions continuation_options(const Case& c, double slenderness, double turns_max, double max_step) {
+  ContinuationOptions o;
+  o.parameter = "turns";
+  o.target = turns_max;
+  // Forces, and with them the unknowns and the pseudo-arclength, scale as EI/R^2.
+  const double scale = (slenderness / 100.0) * (slenderness / 100.0);
+  o.initial_step = 1.0 * scale;
+  o.max_step = max_step * scale;
+  o.max_points = 20000;
+  o.derived = c.derived;
+  o.samples = 10 * static_cast<int>(slenderness) + 1;  // R/10 apart on the half rod: the ply's pitch is 10-30 R
+  // A point's Jacobian (14 sensitivities per segment) and measures cost tens of residual
+  // evaluations: longer steps that take up to 9 chord iterations are cheaper per turn, and a
+  // point whose chord iterations converged keeps the previous matrix. Measured at L/2R = 200 to
+  // 10 turns: 215 s -> 77 s, the same end point to 12 digits.
+  o.corrector_max_iterations = 12;
+  o.grow_iterations = 6;
+  o.shrink_iterations = 10;
+  o.reuse_jacobian_iterations = 8;
+  o.detect_branch_points = false;  // the barrier's stiffness turns the determinant's sign into noise
+  return o;
+}
+
 }  // namespace
 
 PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, double slenderness, double turns_max,
@@ -57,25 +81,7 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
   const Case c = load_case(case_path, {{"slenderness", slenderness}});
   const double EI = c.definition.parameters.get("EI");
   ShootingProblem problem(c.definition);
-  ContinuationOptions o;
-  o.parameter = "turns";
-  o.target = turns_max;
-  // Forces, and with them the unknowns and the pseudo-arclength, scale as EI/R^2.
-  const double scale = (slenderness / 100.0) * (slenderness / 100.0);
-  o.initial_step = 1.0 * scale;
-  o.max_step = options.max_step * scale;
-  o.max_points = 20000;
-  o.derived = c.derived;
-  o.samples = 10 * static_cast<int>(slenderness) + 1;  // R/10 apart on the half rod: the ply's pitch is 10-30 R
-  // A point's Jacobian (14 sensitivities per segment) and measures cost tens of residual
-  // evaluations: longer steps that take up to 9 chord iterations are cheaper per turn, and a
-  // point whose chord iterations converged keeps the previous matrix. Measured at L/2R = 200 to
-  // 10 turns: 215 s -> 77 s, the same end point to 12 digits.
-  o.corrector_max_iterations = 12;
-  o.grow_iterations = 6;
-  o.shrink_iterations = 10;
-  o.reuse_jacobian_iterations = 8;
-  o.detect_branch_points = false;  // the barrier's stiffness turns the determinant's sign into noise
+  const ContinuationOptions o = continuation_options(c, slenderness, turns_max, options.max_step);
 
   const std::vector<std::string> names = [] {
     std::vector<std::string> n = kMeasured;
