@@ -2,29 +2,19 @@
 // resumed with --resume, which must reproduce the uninterrupted run without losing or
 // duplicating a point.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <chrono>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
 #include <string>
-#include <thread>
 #include <vector>
+
+#include "cli_run_support.hpp"
 
 namespace {
 
+using kirchhoff::testing::csv_field;
+using kirchhoff::testing::lines_of;
+using kirchhoff::testing::run_and_kill;
+using kirchhoff::testing::run_to_end;
 namespace fs = std::filesystem;
-
-std::vector<std::string> lines_of(const fs::path& p) {
-  std::ifstream in(p);
-  std::vector<std::string> out;
-  for (std::string line; std::getline(in, line);)
-    if (!line.empty()) out.push_back(line);
-  return out;
-}
 
 // The run: the Euler column from P = 1 along the straight branch, switching at the first
 // branch point onto the buckled branch up to theta0 = 3; many samples per point make it slow
@@ -35,35 +25,7 @@ std::vector<std::string> continue_args(const fs::path& csv) {
           "--max-step", "0.5", "--max-points", "2000", "--samples", "4001", "--out", csv.string()};
 }
 
-int run_to_end(std::vector<std::string> args, const fs::path& log) {
-  std::string cmd;
-  for (const auto& a : args) cmd += "'" + a + "' ";
-  return WEXITSTATUS(std::system((cmd + " 2> '" + log.string() + "'").c_str()));
-}
-
-pid_t start(const std::vector<std::string>& args, const fs::path& log) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    std::vector<char*> argv;
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    FILE* err = std::freopen(log.c_str(), "w", stderr);
-    (void)err;
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-class ContinueCli : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("kirchhoff_continue_" + std::to_string(getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
-};
+using ContinueCli = kirchhoff::testing::ScratchFolderTest;
 
 TEST_F(ContinueCli, KilledRunResumesWithoutLosingOrDuplicatingPoints) {
   const fs::path full = dir_ / "full.csv", killed = dir_ / "killed.csv";
@@ -72,14 +34,9 @@ TEST_F(ContinueCli, KilledRunResumesWithoutLosingOrDuplicatingPoints) {
   ASSERT_GT(expected.size(), 100u);
 
   // Kill the second run with SIGKILL once it has written a third of the points.
-  const pid_t pid = start(continue_args(killed), dir_ / "killed.log");
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (lines_of(killed).size() < expected.size() / 3 && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  kill(pid, SIGKILL);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  ASSERT_TRUE(WIFSIGNALED(status)) << "the run finished before it could be killed";
+  ASSERT_TRUE(run_and_kill(continue_args(killed), dir_ / "killed.log",
+                           [&] { return lines_of(killed).size() >= expected.size() / 3; }))
+      << "the run finished before it could be killed";
   const size_t written = lines_of(killed).size();
   ASSERT_LT(written, expected.size());
 
@@ -105,14 +62,8 @@ TEST_F(ContinueCli, KilledContactRunResumesOnTheSameBranch) {
   const fs::path full = dir_ / "wall_full.csv", killed = dir_ / "wall_killed.csv";
   ASSERT_EQ(run_to_end(args_for(full), dir_ / "wall_full.log"), 0);
   const auto expected = lines_of(full);
-  const pid_t pid = start(args_for(killed), dir_ / "wall_killed.log");
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (lines_of(killed).size() < expected.size() / 2 && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  kill(pid, SIGKILL);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  ASSERT_TRUE(WIFSIGNALED(status));
+  ASSERT_TRUE(run_and_kill(args_for(killed), dir_ / "wall_killed.log",
+                           [&] { return lines_of(killed).size() >= expected.size() / 2; }));
   const auto before = lines_of(killed);
   auto args = args_for(killed);
   args.push_back("--resume");
@@ -122,13 +73,8 @@ TEST_F(ContinueCli, KilledContactRunResumesOnTheSameBranch) {
   for (size_t i = 0; i + 3 < before.size(); ++i) EXPECT_EQ(after[i], before[i]) << "line " << i;
   for (size_t i = 1; i < after.size(); ++i)
     EXPECT_EQ(std::stoi(after[i].substr(0, after[i].find(','))), static_cast<int>(i - 1)) << "line " << i;
-  auto column = [](const std::string& line, int k) {
-    size_t pos = 0;
-    for (int i = 0; i < k; ++i) pos = line.find(',', pos) + 1;
-    return std::stod(line.substr(pos, line.find(',', pos) - pos));
-  };
   EXPECT_NE(after.back().find(",endpoint,"), std::string::npos);
-  EXPECT_NEAR(column(after.back(), 4) / column(expected.back(), 4), 1.0, 1e-8);  // P at Delta = 0.034
+  EXPECT_NEAR(csv_field(after.back(), 4) / csv_field(expected.back(), 4), 1.0, 1e-8);  // P at Delta = 0.034
 }
 
 TEST_F(ContinueCli, BranchCsvHasTheDocumentedColumnsAndPointTypes) {
