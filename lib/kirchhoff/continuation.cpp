@@ -414,9 +414,23 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
     if (sink) sink(result.points.back());
   };
 
+  // A point that kept an older matrix (reuse_jacobian_iterations) gets its own before the step
+  // is shrunk: the stale matrix, not the step, may be what failed the corrector or turned the
+  // tangent, and shrinking alone then crawls (seen at L/2R = 500: steps of 1e-6 for 1,400 points).
+  auto refresh_current = [&]() {
+    if (!current.jacobian_reused) return false;
+    auto fresh = point_at(join(current.x, current.parameter), current.tangent, current.type, current.index,
+                          current.arclength, current.newton_iterations);
+    if (!fresh) return false;
+    fresh->step = current.step;
+    current = std::move(*fresh);
+    return true;
+  };
+
   while (static_cast<int>(result.points.size()) < options_.max_points) {
     auto candidate = step_from(current, ds, PointType::Regular);
     if (!candidate) {
+      if (refresh_current()) continue;
       ds *= kShrink;
       if (ds < options_.min_step) {
         result.reason = StopReason::StepTooSmall;
@@ -427,6 +441,7 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
     }
     const double angle = std::acos(std::clamp(current.tangent.dot(candidate->tangent), -1.0, 1.0));
     if (angle > options_.max_tangent_angle && ds > options_.min_step) {
+      if (refresh_current()) continue;
       ds = std::max(ds * kShrink, options_.min_step);
       continue;
     }
