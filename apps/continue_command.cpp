@@ -191,10 +191,7 @@ int run_continue(const ContinueArguments& args) {
       if (resumable(p)) {
         state.branch = branch;
         state.phase_condition = phase;
-        state.last = p;
-        state.last.jacobian.resize(0, 0);  // not needed to resume
-        state.saved_row = state.row;
-        save_state(state_path, state);
+        save_resume_point(state_path, p, &state);
       }
       progress.point(state.row, p, branch);
       if (!args.profiles_dir.empty()) {
@@ -239,11 +236,8 @@ int run_continue(const ContinueArguments& args) {
         ++state.row;
         writer->write(state.row, p, 0);
         if (resumable(p)) {
-          state.last = p;
-          state.last.jacobian.resize(0, 0);
           state.contacts = active;
-          state.saved_row = state.row;
-          save_state(state_path, state);
+          save_resume_point(state_path, p, &state);
         }
         progress.point(state.row, p, 0);
       };

@@ -106,12 +106,7 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
     csv << ++state.row << ',' << p.parameter << ',' << to_string(p.type);
     for (const auto& n : names) csv << ',' << row.at(n);
     csv << ',' << p.newton_iterations << ',' << p.step << '\n' << std::flush;
-    if (resumable(p)) {
-      state.last = p;
-      state.last.jacobian.resize(0, 0);
-      state.saved_row = state.row;
-      save_state(state_path, state);
-    }
+    if (resumable(p)) save_resume_point(state_path, p, &state);
     ++summary.points;
     if (!std::isnan(row.at("eq61"))) {
       summary.last = row;

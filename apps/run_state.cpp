@@ -46,6 +46,13 @@ void save_state(const std::filesystem::path& path, const RunState& s) {
   fs::rename(tmp, path);  // atomic on POSIX: the state is always a complete point
 }
 
+void save_resume_point(const std::filesystem::path& path, const ContinuationPoint& p, RunState* state) {
+  state->last = p;
+  state->last.jacobian.resize(0, 0);  // not needed to resume
+  state->saved_row = state->row;
+  save_state(path, *state);
+}
+
 RunState load_state(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot resume: no state file " + path.string());

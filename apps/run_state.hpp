@@ -25,6 +25,8 @@ struct RunState {
 // Points a run can resume from (a special point is re-found by the resumed march, not restarted from).
 bool resumable(const ContinuationPoint& p);
 void save_state(const std::filesystem::path& path, const RunState& s);
+// Makes p, the point of the row last written, the one to resume from, and saves the state.
+void save_resume_point(const std::filesystem::path& path, const ContinuationPoint& p, RunState* state);
 RunState load_state(const std::filesystem::path& path);
 // Keeps the header and the rows whose first column (the row index) is at most `last_index`.
 void truncate_csv(const std::filesystem::path& path, int last_index);

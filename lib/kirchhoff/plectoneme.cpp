@@ -77,7 +77,7 @@ std::optional<SampledPair> closest_pair_within(const std::vector<Section>& rod, 
 }
 
 // Closest pair of sections more than `apart` apart along the rod: the closest sampled pair
-// (cubes from 2R up, doubling until a pair is that close; wider cubes look at fewer sections,
+// (cubes from 4R up, doubling until a pair is that close; wider cubes look at fewer sections,
 // as the refinement makes up for the coarser sampling), then alternating Brent minimisations in
 // each arclength on exact positions (sampling alone could miss the minimum between samples
 // and overstate the distance).
