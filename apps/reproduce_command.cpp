@@ -229,7 +229,7 @@ void wall(const fs::path& cases, const fs::path& out, std::vector<ReportRow>* ro
     rows->push_back({"Fig. 12, hard wall (wall.toml)", "contact force, active set from the free arch", 18.1,
                      exact.contact_force, sol.derived.at("contact_force"), exact.contact_force, 1e-8,
                      "contact found at s = " + format_short(sol.derived.at("contact_s"))});
-    const std::vector<PlaneObstacle> plane{{Vec3(0, 0.1, 0), Vec3(0, -1, 0), "wall"}};
+    const std::vector<Obstacle> plane{Obstacle::plane(Vec3(0, 0.1, 0), Vec3(0, -1, 0), "wall")};
     const double P200 = solve_discrete_clamped_elastica(1.0, 1.0, 0.026, plane, 200).P;
     const double P400 = solve_discrete_clamped_elastica(1.0, 1.0, 0.026, plane, 400).P;
     rows->push_back({"Fig. 12, hard wall, Ipopt", "error ratio in P, N = 200 -> 400 (second order: 4)", {}, 4.0,

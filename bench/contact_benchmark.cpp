@@ -48,7 +48,7 @@ int main() {
   std::printf("%-34s %12s %14s %12s %12s\n", "method", "median_ms", "rel_error_P", "time_ratio", "error_ratio");
   std::printf("%-34s %12.3f %14.2e %12s %12s\n", "shooting + active set (from free arch)", 1e3 * t_shooting,
               e_shooting, "1", "1");
-  const std::vector<PlaneObstacle> wall{{Vec3(0, 0.1, 0), Vec3(0, -1, 0), "wall"}};
+  const std::vector<Obstacle> wall{Obstacle::plane(Vec3(0, 0.1, 0), Vec3(0, -1, 0), "wall")};
   for (int N : {200, 1000}) {
     DiscreteElasticaResult d;
     const double t = median_seconds(N <= 200 ? 5 : 1, [&] { d = solve_discrete_clamped_elastica(1.0, 1.0, 0.026, wall, N); });

@@ -201,7 +201,7 @@ TEST_F(HangingFold, BlisterStartsAsTheStrutsFirstModeAwayFromTheWall) {
   std::vector<double> s;
   for (int i = 1; i < 20; ++i) s.push_back(c[0].s + l * i / 20.0);
   const auto profile = problem.sample(first.x, s);
-  const PlaneObstacle& wall = problem.definition().obstacles[0];
+  const Obstacle& wall = problem.definition().obstacles[0];
   const double depth = wall.gap(problem.sample(first.x, {mid}).front().r);
   ASSERT_GT(depth, 0.0);  // away from the wall
   // g(s) = depth (1 - cos(2 pi (s - s1) / l)) / 2 up to the nonlinear correction, O(k^2) with
@@ -277,7 +277,7 @@ TEST(DiscreteEnergy, IpoptConvergesToTheShootingSolutionAtSecondOrder) {
   ASSERT_TRUE(shooting.complementarity);
   const ShootingProblem problem(shooting.definition);
   const Solution exact = make_solution(problem, shooting.result, 101, {"P", "contact_force"});
-  const std::vector<PlaneObstacle> wall{{Vec3(0, 0.1, 0), Vec3(0, -1, 0), "wall"}};
+  const std::vector<Obstacle> wall{Obstacle::plane(Vec3(0, 0.1, 0), Vec3(0, -1, 0), "wall")};
   std::vector<double> error_P, error_F, P;
   for (int N : {50, 100, 200}) {
     const DiscreteElasticaResult d = solve_discrete_clamped_elastica(1.0, 1.0, 0.026, wall, N);

@@ -1,6 +1,7 @@
 #include "kirchhoff/case_file.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
@@ -98,6 +99,22 @@ class Reader {
     }
   }
 
+  // An expression of the parameters and the position x, y, z (a level set).
+  Expression position_expression(const Value& v, const std::string& key) const {
+    if (!v.is_string()) fail(v, key, "must be an expression string in x, y, z, got " + type_name(v));
+    std::vector<std::string> names = parameter_names_;
+    for (const char* axis : {"x", "y", "z"}) {
+      if (std::find(names.begin(), names.end(), axis) != names.end())
+        fail(v, key, std::string("x, y and z are the position here; rename the parameter '") + axis + "'");
+      names.push_back(axis);
+    }
+    try {
+      return Expression(v.as_string().str, names, false);
+    } catch (const std::invalid_argument& e) {
+      fail(v, key, e.what());
+    }
+  }
+
   std::array<Expression, 3> vector(const Value& v, const std::string& key, bool uses_s = false) const {
     if (!v.is_array() || (v.as_array().size() != 3 && v.as_array().size() != 2))
       fail(v, key, "must be an array of 2 or 3 numbers/expressions");
@@ -149,6 +166,66 @@ void check_rotation_axis(const Reader& reader, const Value& where, const std::st
     reader.fail(where, key, "a planar rod only turns about e_z = [0, 0, 1]");
   if (kind == RodKind::Spatial && track_turns && (axis - Vec3::UnitZ()).norm() > 1e-12)
     reader.fail(where, key, "turns are tracked about e3 = [0, 0, 1] only");
+}
+
+// One [[obstacles]] table. Positions are evaluated with the parameters' starting values.
+Obstacle read_obstacle(const Reader& reader, const Value& o, RodKind kind, const Parameters& parameters) {
+  reader.allow_keys(o, "obstacles", {"type", "name", "point", "normal", "centre", "axis", "radius", "gap", "step"});
+  const Value* type_value = Reader::find(o, "type");
+  const std::string type = type_value ? reader.string(*type_value, "obstacles.type") : "";
+  const std::string name = Reader::find(o, "name") ? reader.string(*Reader::find(o, "name"), "obstacles.name") : "";
+  auto required = [&](const char* key, const char* why) -> const Value& {
+    const Value* v = Reader::find(o, key);
+    if (!v) reader.fail(o, std::string("obstacles.") + key, std::string("a ") + type + " needs " + why);
+    return *v;
+  };
+  auto refuse_others = [&](const std::set<std::string>& own) {
+    for (const auto& [key, value] : o.as_table())
+      if (!own.count(key) && key != "type" && key != "name")
+        reader.fail(value, "obstacles." + key, "is not a key of a " + type + " (it takes: " + join(own) + ")");
+  };
+  if (type == "plane") {
+    refuse_others({"point", "normal"});
+    const Value& normal = required("normal", "a normal (towards the rod's side)");
+    const Vec3 n = reader.unit_vector(normal, "obstacles.normal");
+    if (kind == RodKind::Planar && std::abs(n.z()) > 1e-12)
+      reader.fail(normal, "obstacles.normal", "a planar rod meets walls whose normal lies in the plane");
+    const Vec3 point = vector_target(reader.vector(required("point", "a point on it"), "obstacles.point"))(parameters);
+    return Obstacle::plane(point, n, name);
+  }
+  if (type == "cylinder") {
+    refuse_others({"centre", "axis", "radius"});
+    const Vec3 axis = Reader::find(o, "axis") ? reader.unit_vector(*Reader::find(o, "axis"), "obstacles.axis") : Vec3::UnitZ();
+    if (kind == RodKind::Planar && std::abs(std::abs(axis.z()) - 1.0) > 1e-12)
+      reader.fail(*Reader::find(o, "axis"), "obstacles.axis", "a planar rod meets cylinders (discs) along e_z = [0, 0, 1]");
+    const Value& radius_value = required("radius", "a radius");
+    const double radius = reader.expression(radius_value, "obstacles.radius")(parameters);
+    if (!(radius > 0))
+      reader.fail(radius_value, "obstacles.radius", "must be > 0 (a sharp point is the limit of small radii)");
+    const Vec3 centre = vector_target(reader.vector(required("centre", "a centre"), "obstacles.centre"))(parameters);
+    return Obstacle::cylinder(centre, axis, radius, name);
+  }
+  if (type == "level_set") {
+    refuse_others({"gap", "step"});
+    const Value& gap_value = required("gap", "a gap expression g(x, y, z), >= 0 where the rod may be");
+    const Expression g = reader.position_expression(gap_value, "obstacles.gap");
+    double step = 1e-3;
+    if (const Value* v = Reader::find(o, "step")) {
+      step = reader.number(*v, "obstacles.step");
+      if (!(step > 0)) reader.fail(*v, "obstacles.step", "must be > 0");
+    }
+    Parameters at = parameters;
+    for (const char* axis : {"x", "y", "z"}) at.set(axis, 0.0);
+    const int ix = at.index_of("x");
+    auto function = [g, at, ix](const Vec3& r) mutable {
+      for (int i = 0; i < 3; ++i) at.value_at(ix + i) = r[i];
+      return g(at);
+    };
+    return Obstacle::level_set(function, g.text(), name, step);
+  }
+  reader.fail(type_value ? *type_value : o, "obstacles.type",
+              "must be \"plane\" (a wall; two make a cavity), \"cylinder\" (a pin, indenter or rounded "
+              "corner; a disc for planar rods) or \"level_set\" (any smooth gap g(x, y, z))");
 }
 
 EndCondition read_end(const Reader& reader, const Value& root, const std::string& name, RodKind kind,
@@ -494,25 +571,10 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
   d.start = read_end(reader, root, "start", d.kind, parameters);
   d.end = read_end(reader, root, "end", d.kind, parameters);
 
-  // [[obstacles]]: planes the rod must stay on the side of (frictionless, rigid).
+  // [[obstacles]]: rigid frictionless obstacles, as gap functions g(r) >= 0.
   if (const Value* list = Reader::find(root, "obstacles")) {
     if (!list->is_array()) reader.fail(*list, "obstacles", "must be an array of tables [[obstacles]]");
-    for (const auto& o : list->as_array()) {
-      reader.allow_keys(o, "obstacles", {"type", "point", "normal", "name"});
-      const Value* type = Reader::find(o, "type");
-      if (!type || reader.string(*type, "obstacles.type") != "plane")
-        reader.fail(type ? *type : o, "obstacles.type", "must be \"plane\" (a wall; two make a cavity)");
-      PlaneObstacle plane;
-      const Value* point = Reader::find(o, "point");
-      const Value* normal = Reader::find(o, "normal");
-      if (!point || !normal) reader.fail(o, "obstacles", "a plane needs a point and a normal (towards the rod's side)");
-      plane.point = vector_target(reader.vector(*point, "obstacles.point"))(parameters);
-      plane.normal = reader.unit_vector(*normal, "obstacles.normal");
-      if (d.kind == RodKind::Planar && std::abs(plane.normal.z()) > 1e-12)
-        reader.fail(*normal, "obstacles.normal", "a planar rod meets walls whose normal lies in the plane");
-      if (const Value* name = Reader::find(o, "name")) plane.name = reader.string(*name, "obstacles.name");
-      d.obstacles.push_back(plane);
-    }
+    for (const auto& o : list->as_array()) d.obstacles.push_back(read_obstacle(reader, o, d.kind, parameters));
   }
 
   // [solver]

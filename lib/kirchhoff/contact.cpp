@@ -18,7 +18,7 @@ struct SampledGap {
 };
 
 SampledGap smallest_gap(const ShootingProblem& problem, const Eigen::VectorXd& x,
-                        const std::vector<PlaneObstacle>& obstacles, int samples) {
+                        const std::vector<Obstacle>& obstacles, int samples) {
   SampledGap out;
   const double L = problem.length(problem.parameters_at(x));
   out.spacing = L / (samples - 1);
@@ -36,7 +36,7 @@ SampledGap smallest_gap(const ShootingProblem& problem, const Eigen::VectorXd& x
 
 // Where between the neighbouring samples the gap is smallest (Brent's method).
 double refined_gap_minimum(const ShootingProblem& problem, const Eigen::VectorXd& x,
-                           const std::vector<PlaneObstacle>& obstacles, const SampledGap& sampled) {
+                           const std::vector<Obstacle>& obstacles, const SampledGap& sampled) {
   const double L = problem.length(problem.parameters_at(x));
   auto gap_at = [&](double at) { return obstacles[sampled.obstacle].gap(problem.sample(x, {at}).front().r); };
   return boost::math::tools::brent_find_minima(gap_at, std::max(0.0, sampled.s - sampled.spacing),
@@ -186,7 +186,7 @@ Eigen::Vector2d blister_gap_and_centre(ShootingProblem problem, const std::strin
   const Eigen::VectorXd x = z.head(z.size() - 1);
   problem.set_parameter(parameter, z[z.size() - 1]);
   const auto contacts = problem.contacts_at(x);
-  const PlaneObstacle& obstacle = problem.definition().obstacles[contacts[k].obstacle];
+  const Obstacle& obstacle = problem.definition().obstacles[contacts[k].obstacle];
   const double centre = 0.5 * (contacts[k].s + contacts[k + 1].s);
   return {obstacle.gap(problem.sample(x, {centre}).front().r), centre};
 }
@@ -359,6 +359,16 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
         }
       }
       PointContact& c = d.contacts[which];
+      if (!d.obstacles[c.obstacle].is_flat()) {
+        // The rod's curvature has reached the obstacle's: beyond, it would wrap around it over an
+        // interval, which only planes model.
+        out.result.reason = StopReason::Inadmissible;
+        out.result.message = "the contact at s = " + std::to_string(c.s) + " starts to wrap around " +
+                             d.obstacles[c.obstacle].describe() +
+                             ": extended contact on curved obstacles is not implemented; the run stops here";
+        out.changes.push_back(change.str() + out.result.message);
+        return out;
+      }
       c.extended = true;
       c.s_end = c.s;
       c.force_end = 0.5 * c.force;

@@ -14,10 +14,12 @@ using Ipopt::Number;
 
 class ClampedElasticaNLP : public Ipopt::TNLP {
  public:
-  ClampedElasticaNLP(double L, double EI, double Delta, std::vector<PlaneObstacle> obstacles, int N, double amplitude,
+  ClampedElasticaNLP(double L, double EI, double Delta, std::vector<Obstacle> obstacles, int N, double amplitude,
                      DiscreteElasticaResult* out)
       : L_(L), EI_(EI), Delta_(Delta), obstacles_(std::move(obstacles)), N_(N), h_(L / N), amplitude_(amplitude),
-        out_(out) {}
+        out_(out) {
+    for (const auto& o : obstacles_) curved_ = curved_ || !o.is_flat();
+  }
 
   // Constraints: 0: x(L) = L - Delta, 1: y(L) = 0, then for each obstacle o and interior node
   // k = 1..N-1: gap_o(x_k, y_k) >= 0.
@@ -28,7 +30,8 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
     m = 2 + gap_rows();
     // Node k depends on the angles of segments 0..k-1.
     nnz_jac = 2 * N_ + static_cast<int>(obstacles_.size()) * (N_ - 1) * N_ / 2;
-    nnz_hess = 2 * N_ - 1;  // tridiagonal, lower triangle
+    // Lower triangle: tridiagonal with planes; curved obstacles couple every pair of angles.
+    nnz_hess = curved_ ? N_ * (N_ + 1) / 2 : 2 * N_ - 1;
     style = C_STYLE;
     return true;
   }
@@ -103,9 +106,10 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
       }
       e += 2;
     }
+    const auto nodes = values ? node_positions(t) : std::vector<Vec3>();
     for (size_t o = 0; o < obstacles_.size(); ++o) {
-      const Vec3 normal = obstacles_[o].normal;
-      for (Index k = 1; k < n; ++k)
+      for (Index k = 1; k < n; ++k) {
+        const Vec3 normal = values ? obstacles_[o].gradient(nodes[k]) : Vec3::Zero();
         for (Index i = 0; i < k; ++i, ++e) {
           if (values)
             values[e] = normal.x() * (-h_ * std::sin(t[i])) + normal.y() * (h_ * std::cos(t[i]));
@@ -114,6 +118,7 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
             cols[e] = i;
           }
         }
+      }
     }
     return true;
   }
@@ -122,33 +127,56 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
               Index* rows, Index* cols, Number* values) override {
     if (!values) {
       Index e = 0;
-      for (Index i = 0; i < n; ++i, ++e) rows[e] = cols[e] = i;
-      for (Index i = 1; i < n; ++i, ++e) {
-        rows[e] = i;
-        cols[e] = i - 1;
-      }
+      for (Index i = 0; i < n; ++i)
+        for (Index j = curved_ ? 0 : std::max<Index>(0, i - 1); j <= i; ++j, ++e) {
+          rows[e] = i;
+          cols[e] = j;
+        }
       return true;
     }
-    // Energy: tridiagonal. Constraints: each is a sum of functions of single angles, so their
-    // Hessians are diagonal; a gap row of node k involves the angles of segments 0..k-1.
-    std::vector<double> diag(n, 0.0);
-    for (Index i = 0; i < n; ++i) {
-      diag[i] = obj_factor * EI_ / h_ * ((i > 0 ? 1.0 : 2.0) + (i + 1 < n ? 1.0 : 2.0));
-      diag[i] += lambda[0] * (-h_ * std::cos(t[i])) + lambda[1] * (-h_ * std::sin(t[i]));
-    }
+    // A gap row of node k involves the angles of segments 0..k-1 through r_k = sum h (cos, sin):
+    // d2 g_k / dtheta_i dtheta_j = a_i^T Hess g a_j + delta_ij grad g . b_i, with
+    // a_i = h (-sin, cos) theta_i and b_i = -h (cos, sin) theta_i. Summed with the multipliers over
+    // the nodes k > max(i, j), as suffix sums of lambda_k grad g_k and lambda_k Hess g_k.
+    const auto nodes = node_positions(t);
+    std::vector<Vec3> gradient_tail(n, Vec3::Zero());
+    std::vector<Mat3> hessian_tail(n, Mat3::Zero());
     for (size_t o = 0; o < obstacles_.size(); ++o) {
-      const Vec3 normal = obstacles_[o].normal;
-      // Suffix sums of the multipliers: angle i appears in the gaps of nodes k = i+1..n-1.
-      double tail = 0.0;
+      Vec3 g_sum = Vec3::Zero();
+      Mat3 h_sum = Mat3::Zero();
       for (Index i = n - 1; i >= 0; --i) {
-        if (i + 1 <= n - 1) tail += lambda[2 + o * (n - 1) + i];
-        diag[i] += tail * (normal.x() * (-h_ * std::cos(t[i])) + normal.y() * (-h_ * std::sin(t[i])));
+        if (i + 1 <= n - 1) {
+          const double multiplier = lambda[2 + o * (n - 1) + i];  // node k = i + 1
+          g_sum += multiplier * obstacles_[o].gradient(nodes[i + 1]);
+          if (!obstacles_[o].is_flat()) h_sum += multiplier * obstacles_[o].hessian(nodes[i + 1]);
+        }
+        gradient_tail[i] += g_sum;
+        hessian_tail[i] += h_sum;
       }
     }
+    auto a = [&](Index i) { return Vec3(-h_ * std::sin(t[i]), h_ * std::cos(t[i]), 0.0); };
     Index e = 0;
-    for (Index i = 0; i < n; ++i, ++e) values[e] = diag[i];
-    for (Index i = 1; i < n; ++i, ++e) values[e] = -obj_factor * EI_ / h_;
+    for (Index i = 0; i < n; ++i) {
+      for (Index j = curved_ ? 0 : std::max<Index>(0, i - 1); j <= i; ++j, ++e) {
+        double value = curved_ ? a(i).dot(hessian_tail[i] * a(j)) : 0.0;
+        if (j + 1 == i) value += -obj_factor * EI_ / h_;
+        if (j == i) {
+          // Energy: tridiagonal; end constraints and gaps: b_i = -h (cos, sin) theta_i.
+          const Vec3 b(-h_ * std::cos(t[i]), -h_ * std::sin(t[i]), 0.0);
+          value += obj_factor * EI_ / h_ * ((i > 0 ? 1.0 : 2.0) + (i + 1 < n ? 1.0 : 2.0));
+          value += lambda[0] * b.x() + lambda[1] * b.y() + gradient_tail[i].dot(b);
+        }
+        values[e] = value;
+      }
+    }
     return true;
+  }
+
+  // Nodes 0..N from the segment angles.
+  std::vector<Vec3> node_positions(const Number* t) const {
+    std::vector<Vec3> out(N_ + 1, Vec3::Zero());
+    for (int k = 1; k <= N_; ++k) out[k] = out[k - 1] + h_ * Vec3(std::cos(t[k - 1]), std::sin(t[k - 1]), 0.0);
+    return out;
   }
 
   void finalize_solution(Ipopt::SolverReturn status, Index n, const Number* t, const Number*, const Number*,
@@ -166,39 +194,45 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
     }
     // Ipopt's Lagrangian is f + lambda^T g: the end constraints' multipliers are the end
     // reaction, n(L) = -lambda (the force the constraint applies to the rod's end).
+    // The gap rows' multipliers give the contact forces -lambda grad g, so that across the
+    // contacts n(0) = n(L) + sum (-lambda_k) grad g_k (n' = -f; eq. 63 for a wall).
     out_->P = lambda[0];
     out_->contact_force = 0.0;
     out_->node_forces.assign(n - 1, 0.0);
     out_->min_gap = INFINITY;
+    Vec3 n_start(-lambda[0], -lambda[1], 0.0);
+    std::vector<Vec3> nodes(n + 1);
+    for (Index k = 0; k <= n; ++k) nodes[k] = Vec3(out_->x[k], out_->y[k], 0.0);
     for (Index r = 2; r < m; ++r) {
-      out_->contact_force += -lambda[r];
+      const size_t o = static_cast<size_t>((r - 2) / (n - 1));
+      const Vec3 grad = obstacles_[o].gradient(nodes[(r - 2) % (n - 1) + 1]);
+      out_->contact_force += -lambda[r] * grad.norm();
+      n_start += -lambda[r] * grad;
       out_->min_gap = std::min(out_->min_gap, g[r]);
-      if (r - 2 < n - 1) out_->node_forces[r - 2] = -lambda[r];
+      if (r - 2 < n - 1) out_->node_forces[r - 2] = -lambda[r] * grad.norm();
     }
-    // n_y(L) = -lambda[1]; across the contacts n_y jumps up by the contact forces (eq. 63).
-    out_->n_y = -lambda[1] - out_->contact_force;
+    out_->n_y = n_start.y();
   }
 
  private:
   double L_, EI_, Delta_;
-  std::vector<PlaneObstacle> obstacles_;
+  std::vector<Obstacle> obstacles_;
   int N_;
   double h_, amplitude_;
+  bool curved_ = false;
   DiscreteElasticaResult* out_;
 };
 
 }  // namespace
 
 DiscreteElasticaResult solve_discrete_clamped_elastica(double L, double EI, double Delta,
-                                                       const std::vector<PlaneObstacle>& obstacles, int segments,
+                                                       const std::vector<Obstacle>& obstacles, int segments,
                                                        double amplitude) {
   if (!(L > 0) || !(EI > 0)) throw std::invalid_argument("discrete Elastica: L and EI must be > 0");
   if (!(Delta > 0 && Delta < L)) throw std::invalid_argument("discrete Elastica: Delta must lie in (0, L)");
   if (segments < 4) throw std::invalid_argument("discrete Elastica: at least 4 segments");
-  std::vector<PlaneObstacle> planes = obstacles;
-  for (auto& o : planes) o.normal.normalize();
   DiscreteElasticaResult out;
-  Ipopt::SmartPtr<Ipopt::TNLP> nlp = new ClampedElasticaNLP(L, EI, Delta, planes, segments, amplitude, &out);
+  Ipopt::SmartPtr<Ipopt::TNLP> nlp = new ClampedElasticaNLP(L, EI, Delta, obstacles, segments, amplitude, &out);
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
   app->Options()->SetIntegerValue("print_level", 0);
   app->Options()->SetStringValue("sb", "yes");

@@ -66,11 +66,10 @@ ShootingProblem::ShootingProblem(ProblemDefinition definition) : definition_(std
     for (const auto& c : definition_.contacts) {
       residual_count_ += c.unknowns();
       if (c.extended && !eq->is_planar()) throw std::invalid_argument("extended contact is for planar rods");
+      if (c.extended && !definition_.obstacles[c.obstacle].is_flat())
+        throw std::invalid_argument("extended contact on " + definition_.obstacles[c.obstacle].describe() +
+                                    ": only modelled on planes (wrapping around a curved obstacle is not implemented)");
     }
-  }
-  for (auto& o : definition_.obstacles) {
-    if (!(o.normal.norm() > 0)) throw std::invalid_argument("obstacle '" + o.name + "': the normal must be non-zero");
-    o.normal.normalize();
   }
   if (residual_count_ != size())
     throw std::invalid_argument("boundary conditions give " + std::to_string(residual_count_) +
@@ -85,7 +84,9 @@ int ShootingProblem::size() const {
 
 double ShootingProblem::contact_bending(const Eigen::VectorXd& x, const PointContact& contact) const {
   const RodPoint p = sample(x, {contact.s}).front();
-  return definition_.obstacles[contact.obstacle].normal.dot(p.R * p.u.cross(p.v));
+  const Obstacle& o = definition_.obstacles[contact.obstacle];
+  const Vec3 tangent = p.R * p.v;
+  return o.gradient(p.r).dot(p.R * p.u.cross(p.v)) + tangent.dot(o.hessian(p.r) * tangent);
 }
 
 double ShootingProblem::flat_contact_margin(const Eigen::VectorXd& x, const PointContact& contact) const {
@@ -354,13 +355,16 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
       y = flow.y;
       if (last) break;
       const Breakpoint& b = points[k];
-      const PlaneObstacle& o = definition_.obstacles[b.obstacle];
-      const Eigen::RowVectorXd dg = o.normal.transpose() * position;
-      const Eigen::VectorXd jump = -force.transpose() * o.normal;  // n jumps by -force * normal
+      const Obstacle& o = definition_.obstacles[b.obstacle];
+      const Vec3 r = position * y;
+      const Eigen::RowVectorXd dg = o.gradient(r).transpose() * position;
+      const Eigen::VectorXd jump = -force.transpose() * o.normal(r);  // n jumps by -force * nu(r)
       if (b.kind != Breakpoint::ExtendedEnd) {
-        // On the obstacle and tangent to it: g = 0 and g' = normal . r' = 0.
-        auto tangency = [&](const Eigen::VectorXd& state) { return dg.dot(eq->derivative(state, s1)); };
-        (*F)[row] = o.gap(position * y);
+        // On the obstacle and tangent to it: g = 0 and g' = grad g . r' = 0.
+        auto tangency = [&](const Eigen::VectorXd& state) {
+          return o.gradient(position * state).dot(position * eq->derivative(state, s1));
+        };
+        (*F)[row] = o.gap(r);
         (*F)[row + 1] = tangency(y);
         if (J) {
           J->row(row) = dg * S;
@@ -380,7 +384,7 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
       }
       if (b.kind == Breakpoint::ExtendedStart) {
         // Flat on the obstacle from here: no moment, and no normal force once the jump is applied.
-        const Eigen::RowVectorXd normal_force = o.normal.transpose() * force;
+        const Eigen::RowVectorXd normal_force = o.normal(r).transpose() * force;
         (*F)[row] = moment_z.dot(y);
         (*F)[row + 1] = normal_force.dot(y) - b.force;
         if (J) {
@@ -390,8 +394,12 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
         }
         row += 2;
       }
+      if (J) {
+        // On a curved obstacle the jump's direction turns with the contact point.
+        if (!o.is_flat()) S -= b.force * force.transpose() * o.normal_derivative(r) * position * S;
+        S.col(b.force_column) += jump;
+      }
       y += b.force * jump;
-      if (J) S.col(b.force_column) += jump;
       s0 = s1;
       s0_column = b.s_column;
     }
@@ -463,7 +471,8 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
       }
       if (last) break;
       y = eq->flow(y, s0, s1, false, definition_.options.integrator).y;
-      y -= points[c].force * force.transpose() * definition_.obstacles[points[c].obstacle].normal;
+      const Vec3 r = eq->slot_map(Slot::Position) * y;
+      y -= points[c].force * force.transpose() * definition_.obstacles[points[c].obstacle].normal(r);
       s0 = s1;
     }
     return out;

@@ -19,6 +19,7 @@
 #include "kirchhoff/boundary_conditions.hpp"
 #include "kirchhoff/integrator.hpp"
 #include "kirchhoff/newton.hpp"
+#include "kirchhoff/obstacle.hpp"
 #include "kirchhoff/parameters.hpp"
 #include "kirchhoff/rod_equations.hpp"
 
@@ -26,28 +27,20 @@ namespace kirchhoff {
 
 enum class RodKind { Spatial, Planar };
 
-// A rigid frictionless obstacle bounded by a plane: the rod must stay where
-// g(r) = (r - point).normal >= 0, the normal pointing into the admissible side. Two of them facing
-// each other make a cavity.
-struct PlaneObstacle {
-  Vec3 point = Vec3::Zero();
-  Vec3 normal = Vec3::UnitY();
-  std::string name;
-  double gap(const Vec3& r) const { return (r - point).dot(normal); }
-};
-
 // A point of the active contact set: the rod touches obstacle `obstacle` at arclength s and
-// receives the force `force` * normal there (0 <= g perp force >= 0). Both s and force are
-// unknowns of the problem; these are their guesses, or their values once solved. At the contact
-// the centreline is on the obstacle (g = 0) and tangent to it (g' = 0); n jumps by -force*normal.
+// receives the force `force` * nu there, nu the obstacle's unit normal at the contact
+// (0 <= g perp force >= 0). Both s and force are unknowns of the problem; these are their guesses,
+// or their values once solved. At the contact the centreline is on the obstacle (g = 0) and
+// tangent to it (g' = 0); n jumps by -force * nu.
 struct PointContact {
   int obstacle = 0;
   double s = 0.0;
   double force = 0.0;
-  // Extended contact (planar rods on a plane): the rod lies flat on the obstacle over [s, s_end],
-  // straight and free of moment, held by the forces `force` at s and `force_end` at s_end (a
-  // flat wall carries no distributed force there: n_y' = 0 and m = 0 on the interval). At s: g = 0,
-  // tangency, m = 0 and no normal force just after s; s_end and force_end are set by the rest.
+  // Extended contact (planar rods on a plane; not modelled on curved obstacles): the rod lies
+  // flat on the obstacle over [s, s_end], straight and free of moment, held by the forces `force`
+  // at s and `force_end` at s_end (a flat wall carries no distributed force there: n_y' = 0 and
+  // m = 0 on the interval). At s: g = 0, tangency, m = 0 and no normal force just after s; s_end
+  // and force_end are set by the rest.
   bool extended = false;
   double s_end = 0.0;
   double force_end = 0.0;
@@ -72,7 +65,7 @@ struct ProblemDefinition {
   Parameters parameters;                   // current values (guesses for the unknown ones)
   std::vector<std::string> unknown_parameters;
   ShootingOptions options;
-  std::vector<PlaneObstacle> obstacles;  // what the rod may touch (see solve_with_contacts)
+  std::vector<Obstacle> obstacles;       // what the rod may touch (see solve_with_contacts)
   std::vector<PointContact> contacts;    // the active set: point contacts solved for
 };
 
@@ -110,8 +103,9 @@ class ShootingProblem final : public NonlinearSystem {
   long rhs_evaluations() const { return rhs_evaluations_; }
   // The active contacts with their arclengths and forces taken from x.
   std::vector<PointContact> contacts_at(const Eigen::VectorXd& x) const;
-  // g'' at a point contact: how the rod curves away from the obstacle there (0: it flattens).
-  // g'' = normal . r'' with r'' = R (u x v) for an unshearable, inextensible rod.
+  // g'' at a point contact: how the rod curves away from the obstacle there (0: it flattens onto
+  // a plane, or starts to wrap around a curved obstacle). g'' = grad g . r'' + r'^T Hess g r',
+  // with r'' = R (u x v) for an unshearable, inextensible rod.
   double contact_bending(const Eigen::VectorXd& x, const PointContact& contact) const;
   // For an extended contact of length l: 4 pi^2 B2 / l^2 - P_flat, with P_flat = -n.d3 the
   // compression of the flat part. The flat part is a strut clamped by the obstacle at both ends;
