@@ -520,6 +520,57 @@ TEST_F(CaseFileTest, MissingTables) {
   expect_refused(no_end, "end", {"missing table [end]"});
 }
 
+// ---- obstacles and the starting active set --------------------------------------------------
+
+// The base with a disc obstacle and a starting contact on it, appended after [output].
+std::string with_disc(const std::string& disc = "type = \"cylinder\"\nname = \"pin\"\ncentre = [0.5, \"0.1 - 0.05\"]\nradius = 0.05\n",
+                      const std::string& contact = "") {
+  return std::string(kBase) + "\n[[obstacles]]\n" + disc + contact;
+}
+
+TEST_F(CaseFileTest, DiscObstacleAndStartingContactLoad) {
+  const std::string contact = "\n[[guess.contacts]]\nobstacle = \"pin\"\ns = \"L / 2\"\nforce = 3\n";
+  // [[guess.contacts]] after [output] is a sub-table of [guess]: the base's [guess] is extended.
+  const Case c = load_case(write(with_disc(replaced(
+                               "type = \"cylinder\"\nname = \"pin\"\ncentre = [0.5, \"0.1 - 0.05\"]\nradius = 0.05\n",
+                               "radius = 0.05", "radius = \"0.05 * L\""), contact)));
+  ASSERT_EQ(c.definition.obstacles.size(), 1u);
+  EXPECT_EQ(c.definition.obstacles[0].shape(), Obstacle::Shape::Cylinder);
+  EXPECT_DOUBLE_EQ(c.definition.obstacles[0].gap(Vec3(0.5, 0.2, 0)), 0.1);
+  // The radius uses L: the obstacle moves with it.
+  EXPECT_EQ(c.definition.obstacle_parameters, std::set<std::string>{"L"});
+  ASSERT_TRUE(c.definition.moving_obstacles);
+  Parameters longer = c.definition.parameters;
+  longer.set("L", 2.0);
+  EXPECT_DOUBLE_EQ(c.definition.moving_obstacles(longer)[0].radius(), 0.1);
+  ASSERT_EQ(c.definition.contacts.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.definition.contacts[0].s, 0.5);
+  EXPECT_DOUBLE_EQ(c.definition.contacts[0].force, 3.0);
+}
+
+TEST_F(CaseFileTest, BadObstaclesAreRefused) {
+  const std::string disc = "type = \"cylinder\"\nname = \"pin\"\ncentre = [0.5, \"0.1 - 0.05\"]\nradius = 0.05\n";
+  expect_refused(with_disc(replaced(disc, "cylinder", "sphere")), "obstacles.type", {"plane", "cylinder", "level_set"});
+  expect_refused(with_disc(replaced(disc, "radius = 0.05", "radius = 0")), "obstacles.radius", {"must be > 0"});
+  expect_refused(with_disc(replaced(disc, "radius = 0.05", "radius = \"-EI\"")), "obstacles.radius", {"must be > 0"});
+  expect_refused(with_disc(replaced(disc, "radius = 0.05\n", "")), "obstacles.radius", {"needs a radius"});
+  expect_refused(with_disc(disc + "axis = [1, 0, 0]\n"), "obstacles.axis", {"e_z"});
+  expect_refused(with_disc(disc + "normal = [0, 1, 0]\n"), "obstacles.normal", {"not a key of a cylinder"});
+  expect_refused(with_disc(disc + "radiu = 1\n"), "obstacles.radiu", {"unknown key"});
+  expect_refused(with_disc("type = \"level_set\"\ngap = \"y - q\"\n"), "obstacles.gap", {"unknown variable 'q'"});
+  expect_refused(with_disc("type = \"level_set\"\ngap = 3\n"), "obstacles.gap", {"expression string in x, y, z"});
+  expect_refused(with_disc("type = \"level_set\"\ngap = \"y\"\nstep = -1\n"), "obstacles.step", {"must be > 0"});
+  expect_refused(replaced(with_disc("type = \"level_set\"\ngap = \"y\"\n"), "theta0 = 1.0", "x = 1.0\ntheta0 = 1.0"),
+                 "obstacles.gap", {"rename the parameter 'x'"});
+  expect_refused(with_disc("type = \"plane\"\npoint = [0, 1]\nnormal = [0, 0, 1]\n"), "obstacles.normal",
+                 {"lies in the plane"});
+  expect_refused(with_disc(disc, "\n[[guess.contacts]]\nobstacle = \"peg\"\ns = 0.5\n"), "guess.contacts.obstacle",
+                 {"no obstacle named 'peg'"});
+  expect_refused(with_disc(disc, "\n[[guess.contacts]]\nobstacle = \"pin\"\ns = 1.5\n"), "guess.contacts.s",
+                 {"inside (0, L)"});
+  expect_refused(with_disc(disc, "\n[[guess.contacts]]\nobstacle = \"pin\"\n"), "guess.contacts", {"arclength s"});
+}
+
 // ---- every shipped case loads and its problem constructs -----------------------------------
 
 TEST(ShippedCases, EveryCaseLoadsAndConstructs) {

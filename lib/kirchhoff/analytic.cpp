@@ -86,6 +86,12 @@ double complete_E(double k) {
 
 // Incomplete integral of the second kind E(phi, k); GSL reduces phi modulo pi itself, so
 // negative amplitudes and |phi| slightly above pi/2 are fine.
+double incomplete_F(double phi, double k) {
+  gsl_sf_result r;
+  require_gsl_success(gsl_sf_ellint_F_e(phi, k, GSL_PREC_DOUBLE, &r), "gsl_sf_ellint_F_e");
+  return r.val;
+}
+
 double incomplete_E(double phi, double k) {
   gsl_sf_result r;
   require_gsl_success(gsl_sf_ellint_E_e(phi, k, GSL_PREC_DOUBLE, &r), "gsl_sf_ellint_E_e");
@@ -641,6 +647,24 @@ SecondModeArches second_mode_arches(double L, double EI, double a) {
   const PinnedElastica quarter{0.25 * L, EI, out.theta0};
   out.P = quarter.load();
   out.Delta = L - 4.0 * quarter.end_to_end();
+  return out;
+}
+
+ThreePointBending three_point_bending(double L, double EI, double theta_end) {
+  const char* where = "three_point_bending";
+  require_positive(where, "L", L);
+  require_positive(where, "EI", EI);
+  if (!(theta_end > -M_PI / 2 && theta_end < 0.0)) reject(where, "theta_end", "must lie in (-pi/2, 0)");
+  const double k = std::sin(0.5 * (M_PI / 2 - theta_end));
+  const double psi1 = std::asin(1.0 / (std::sqrt(2.0) * k));
+  const double dF = complete_K(k) - incomplete_F(psi1, k);
+  const double dE = complete_E(k) - incomplete_E(psi1, k);
+  ThreePointBending out;
+  const double half_load = EI * std::pow(dF / (0.5 * L), 2);  // F/2
+  out.force = 2.0 * half_load;
+  out.rise = std::sqrt(EI / half_load) * (dF - 2.0 * dE);
+  out.half_span = std::sqrt(2.0 * EI * (2.0 * k * k - 1.0) / half_load);
+  out.kappa_mid = -std::sqrt(2.0 * half_load * (-std::sin(theta_end)) / EI);
   return out;
 }
 

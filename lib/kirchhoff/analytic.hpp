@@ -198,4 +198,21 @@ struct SecondModeArches {
 };
 SecondModeArches second_mode_arches(double L, double EI, double a);
 
+// Three-point bending of the Elastica: a rod of length L on a pin and a roller at the same height
+// (no moment, no horizontal force), pushed at mid-span by a frictionless indenter with the force
+// F. Each half is a cantilever clamped horizontally at mid-span with the end load F/2 normal to
+// the clamp: EI theta'' = (F/2) cos theta, first integral EI theta'^2 / 2 = (F/2)(sin theta -
+// sin theta_e) with theta_e the slope at the supports. With chi = pi/2 - theta, k = sin(chi_e/2),
+// sin psi1 = 1 / (sqrt 2 k), and differences Delta F = K(k) - F(psi1, k), Delta E likewise:
+//   (L/2) sqrt(F / (2 EI)) = Delta F,  rise of mid-span = sqrt(2 EI / F) (Delta F - 2 Delta E),
+//   half-span = sqrt(4 EI (2 k^2 - 1) / F).
+// Domain: -pi/2 < theta_e < 0 (the slope at the supports, below the horizontal).
+struct ThreePointBending {
+  double force = 0.0;      // F, the indenter's force
+  double rise = 0.0;       // height of mid-span above the supports
+  double half_span = 0.0;  // horizontal distance from a support to mid-span
+  double kappa_mid = 0.0;  // curvature at mid-span, -sqrt(F (-sin theta_e) / EI)
+};
+ThreePointBending three_point_bending(double L, double EI, double theta_end);
+
 }  // namespace kirchhoff::analytic

@@ -168,8 +168,14 @@ void check_rotation_axis(const Reader& reader, const Value& where, const std::st
     reader.fail(where, key, "turns are tracked about e3 = [0, 0, 1] only");
 }
 
-// One [[obstacles]] table. Positions are evaluated with the parameters' starting values.
-Obstacle read_obstacle(const Reader& reader, const Value& o, RodKind kind, const Parameters& parameters) {
+// One [[obstacles]] table: the obstacle as a function of the parameters (its position and size
+// may be expressions, followed by continuation), and the parameters it uses.
+struct ObstacleSpec {
+  std::function<Obstacle(const Parameters&)> at;
+  std::set<std::string> parameters;
+};
+
+ObstacleSpec read_obstacle(const Reader& reader, const Value& o, RodKind kind, const Parameters& parameters) {
   reader.allow_keys(o, "obstacles", {"type", "name", "point", "normal", "centre", "axis", "radius", "gap", "step"});
   const Value* type_value = Reader::find(o, "type");
   const std::string type = type_value ? reader.string(*type_value, "obstacles.type") : "";
@@ -184,14 +190,20 @@ Obstacle read_obstacle(const Reader& reader, const Value& o, RodKind kind, const
       if (!own.count(key) && key != "type" && key != "name")
         reader.fail(value, "obstacles." + key, "is not a key of a " + type + " (it takes: " + join(own) + ")");
   };
+  ObstacleSpec spec;
+  auto uses = [&](const Expression& e) {
+    spec.parameters.insert(e.used_parameters().begin(), e.used_parameters().end());
+  };
   if (type == "plane") {
     refuse_others({"point", "normal"});
     const Value& normal = required("normal", "a normal (towards the rod's side)");
     const Vec3 n = reader.unit_vector(normal, "obstacles.normal");
     if (kind == RodKind::Planar && std::abs(n.z()) > 1e-12)
       reader.fail(normal, "obstacles.normal", "a planar rod meets walls whose normal lies in the plane");
-    const Vec3 point = vector_target(reader.vector(required("point", "a point on it"), "obstacles.point"))(parameters);
-    return Obstacle::plane(point, n, name);
+    const auto point = reader.vector(required("point", "a point on it"), "obstacles.point");
+    for (const auto& e : point) uses(e);
+    spec.at = [point = vector_target(point), n, name](const Parameters& p) { return Obstacle::plane(point(p), n, name); };
+    return spec;
   }
   if (type == "cylinder") {
     refuse_others({"centre", "axis", "radius"});
@@ -199,11 +211,16 @@ Obstacle read_obstacle(const Reader& reader, const Value& o, RodKind kind, const
     if (kind == RodKind::Planar && std::abs(std::abs(axis.z()) - 1.0) > 1e-12)
       reader.fail(*Reader::find(o, "axis"), "obstacles.axis", "a planar rod meets cylinders (discs) along e_z = [0, 0, 1]");
     const Value& radius_value = required("radius", "a radius");
-    const double radius = reader.expression(radius_value, "obstacles.radius")(parameters);
-    if (!(radius > 0))
+    const Expression radius = reader.expression(radius_value, "obstacles.radius");
+    if (!(radius(parameters) > 0))
       reader.fail(radius_value, "obstacles.radius", "must be > 0 (a sharp point is the limit of small radii)");
-    const Vec3 centre = vector_target(reader.vector(required("centre", "a centre"), "obstacles.centre"))(parameters);
-    return Obstacle::cylinder(centre, axis, radius, name);
+    const auto centre = reader.vector(required("centre", "a centre"), "obstacles.centre");
+    uses(radius);
+    for (const auto& e : centre) uses(e);
+    spec.at = [centre = vector_target(centre), axis, radius, name](const Parameters& p) {
+      return Obstacle::cylinder(centre(p), axis, radius(p), name);
+    };
+    return spec;
   }
   if (type == "level_set") {
     refuse_others({"gap", "step"});
@@ -214,18 +231,69 @@ Obstacle read_obstacle(const Reader& reader, const Value& o, RodKind kind, const
       step = reader.number(*v, "obstacles.step");
       if (!(step > 0)) reader.fail(*v, "obstacles.step", "must be > 0");
     }
-    Parameters at = parameters;
-    for (const char* axis : {"x", "y", "z"}) at.set(axis, 0.0);
-    const int ix = at.index_of("x");
-    auto function = [g, at, ix](const Vec3& r) mutable {
-      for (int i = 0; i < 3; ++i) at.value_at(ix + i) = r[i];
-      return g(at);
+    for (const auto& n : g.used_parameters())
+      if (n != "x" && n != "y" && n != "z") spec.parameters.insert(n);
+    spec.at = [g, step, name](const Parameters& p) {
+      Parameters at = p;
+      for (const char* axis : {"x", "y", "z"}) at.set(axis, 0.0);
+      const int ix = at.index_of("x");
+      auto function = [g, at, ix](const Vec3& r) mutable {
+        for (int i = 0; i < 3; ++i) at.value_at(ix + i) = r[i];
+        return g(at);
+      };
+      return Obstacle::level_set(function, g.text(), name, step);
     };
-    return Obstacle::level_set(function, g.text(), name, step);
+    return spec;
   }
   reader.fail(type_value ? *type_value : o, "obstacles.type",
               "must be \"plane\" (a wall; two make a cavity), \"cylinder\" (a pin, indenter or rounded "
               "corner; a disc for planar rods) or \"level_set\" (any smooth gap g(x, y, z))");
+}
+
+// All [[obstacles]]: fixed, or moving with the parameters their expressions use.
+void read_obstacles(const Reader& reader, const Value& list, RodKind kind, ProblemDefinition* d) {
+  if (!list.is_array()) reader.fail(list, "obstacles", "must be an array of tables [[obstacles]]");
+  std::vector<std::function<Obstacle(const Parameters&)>> specs;
+  for (const auto& o : list.as_array()) {
+    ObstacleSpec spec = read_obstacle(reader, o, kind, d->parameters);
+    try {
+      d->obstacles.push_back(spec.at(d->parameters));
+    } catch (const std::invalid_argument& e) {
+      reader.fail(o, "obstacles", e.what());
+    }
+    d->obstacle_parameters.insert(spec.parameters.begin(), spec.parameters.end());
+    specs.push_back(std::move(spec.at));
+  }
+  if (!d->obstacle_parameters.empty())
+    d->moving_obstacles = [specs](const Parameters& p) {
+      std::vector<Obstacle> out;
+      for (const auto& at : specs) out.push_back(at(p));
+      return out;
+    };
+}
+
+// [[guess.contacts]]: a starting active set {obstacle = "name", s = .., force = ..}, for problems
+// whose contact-free solution is admissible but not the one wanted (a rod to be found wrapped
+// over an obstacle rather than beside it).
+void read_contact_guesses(const Reader& reader, const Value& list, ProblemDefinition* d) {
+  if (!list.is_array()) reader.fail(list, "guess.contacts", "must be an array of tables [[guess.contacts]]");
+  for (const auto& t : list.as_array()) {
+    reader.allow_keys(t, "guess.contacts", {"obstacle", "s", "force"});
+    const Value* name = Reader::find(t, "obstacle");
+    const Value* s = Reader::find(t, "s");
+    if (!name || !s) reader.fail(t, "guess.contacts", "a contact needs the obstacle's name and an arclength s");
+    const std::string wanted = reader.string(*name, "guess.contacts.obstacle");
+    const auto it = std::find_if(d->obstacles.begin(), d->obstacles.end(), [&](const auto& o) { return o.name == wanted; });
+    if (it == d->obstacles.end()) reader.fail(*name, "guess.contacts.obstacle", "no obstacle named '" + wanted + "'");
+    PointContact c;
+    c.obstacle = static_cast<int>(it - d->obstacles.begin());
+    c.s = reader.expression(*s, "guess.contacts.s")(d->parameters);
+    const double L = d->model(d->parameters).length;
+    if (!(c.s > 0 && c.s < L)) reader.fail(*s, "guess.contacts.s", "must lie inside (0, L)");
+    if (const Value* f = Reader::find(t, "force")) c.force = reader.expression(*f, "guess.contacts.force")(d->parameters);
+    d->contacts.push_back(c);
+  }
+  std::sort(d->contacts.begin(), d->contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
 }
 
 EndCondition read_end(const Reader& reader, const Value& root, const std::string& name, RodKind kind,
@@ -572,10 +640,7 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
   d.end = read_end(reader, root, "end", d.kind, parameters);
 
   // [[obstacles]]: rigid frictionless obstacles, as gap functions g(r) >= 0.
-  if (const Value* list = Reader::find(root, "obstacles")) {
-    if (!list->is_array()) reader.fail(*list, "obstacles", "must be an array of tables [[obstacles]]");
-    for (const auto& o : list->as_array()) d.obstacles.push_back(read_obstacle(reader, o, d.kind, parameters));
-  }
+  if (const Value* list = Reader::find(root, "obstacles")) read_obstacles(reader, *list, d.kind, &d);
 
   // [solver]
   if (const Value* s = Reader::find(root, "solver")) {
@@ -631,7 +696,7 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
   // [guess]: the state at s = 0 before the start conditions are imposed on it.
   c.start_guess.R = d.kind == RodKind::Planar ? planar_reference_frame() : Mat3::Identity();
   if (const Value* g = Reader::find(root, "guess")) {
-    reader.allow_keys(*g, "guess", {"position", "orientation", "force", "moment"});
+    reader.allow_keys(*g, "guess", {"position", "orientation", "force", "moment", "contacts"});
     auto vec = [&](const char* key, Vec3* target) {
       if (const Value* v = Reader::find(*g, key)) *target = vector_target(reader.vector(*v, std::string("guess.") + key))(parameters);
     };
@@ -643,6 +708,7 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
       c.start_guess.R = Eigen::AngleAxisd(t.angle, t.axis).toRotationMatrix() * c.start_guess.R;
       c.start_guess.turn_angle = t.angle;
     }
+    if (const Value* v = Reader::find(*g, "contacts")) read_contact_guesses(reader, *v, &d);
   }
 
   // [output]

@@ -1,48 +1,14 @@
 #include "kirchhoff/contact.hpp"
 
 #include <algorithm>
-#include <boost/math/tools/minima.hpp>
 #include <cmath>
 #include <optional>
 #include <sstream>
 
+#include "kirchhoff/closest_approach.hpp"
+
 namespace kirchhoff {
 namespace {
-
-// The smallest gap to any obstacle over `samples` equally spaced points of the rod.
-struct SampledGap {
-  int obstacle = -1;
-  double s = 0.0;
-  double gap = INFINITY;
-  double spacing = 0.0;  // between samples
-};
-
-SampledGap smallest_gap(const ShootingProblem& problem, const Eigen::VectorXd& x,
-                        const std::vector<Obstacle>& obstacles, int samples) {
-  SampledGap out;
-  const double L = problem.length(problem.parameters_at(x));
-  out.spacing = L / (samples - 1);
-  std::vector<double> s(samples);
-  for (int i = 0; i < samples; ++i) s[i] = L * i / (samples - 1);
-  for (const auto& p : problem.sample(x, s))
-    for (size_t o = 0; o < obstacles.size(); ++o)
-      if (obstacles[o].gap(p.r) < out.gap) {
-        out.gap = obstacles[o].gap(p.r);
-        out.obstacle = static_cast<int>(o);
-        out.s = p.s;
-      }
-  return out;
-}
-
-// Where between the neighbouring samples the gap is smallest (Brent's method).
-double refined_gap_minimum(const ShootingProblem& problem, const Eigen::VectorXd& x,
-                           const std::vector<Obstacle>& obstacles, const SampledGap& sampled) {
-  const double L = problem.length(problem.parameters_at(x));
-  auto gap_at = [&](double at) { return obstacles[sampled.obstacle].gap(problem.sample(x, {at}).front().r); };
-  return boost::math::tools::brent_find_minima(gap_at, std::max(0.0, sampled.s - sampled.spacing),
-                                               std::min(L, sampled.s + sampled.spacing), 40)
-      .first;
-}
 
 // Unknowns before the contacts' (state and unknown parameters).
 int non_contact_unknowns(const ShootingProblem& problem) {
@@ -85,7 +51,7 @@ ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& gues
     for (const auto& condition : end.conditions()) {
       if (condition.slot != Slot::Position || condition.directions != Directions::All || condition.extra) continue;
       const Vec3 r = condition.value(d.parameters);
-      for (const auto& o : d.obstacles)
+      for (const auto& o : problem->obstacles(d.parameters))
         if (o.gap(r) < -options.penetration_tolerance)
           throw InfeasibleContact(std::string("the rod's ") + (at_start ? "start" : "end") + " is imposed inside obstacle '" +
                                   o.name + "' (gap " + std::to_string(o.gap(r)) + ")");
@@ -112,13 +78,13 @@ ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& gues
       d.contacts.erase(d.contacts.begin() + (weakest - solved.begin()));
     } else {
       // The deepest penetration of any obstacle, refined between samples.
-      const SampledGap deepest = smallest_gap(*problem, out.result.x, d.obstacles, options.samples);
+      const ClosestApproach deepest = closest_approach(*problem, out.result.x, options.samples);
       if (!(deepest.gap < -options.penetration_tolerance)) {
         out.complementarity = true;
         return out;
       }
       const int which = deepest.obstacle;
-      const double where = refined_gap_minimum(*problem, out.result.x, d.obstacles, deepest);
+      const double where = deepest.s;
       change << "add a contact with obstacle " << which << " at s = " << where << " (gap " << deepest.gap << ")";
       d.contacts.push_back({which, where, 0.0});
       std::sort(d.contacts.begin(), d.contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
@@ -186,7 +152,7 @@ Eigen::Vector2d blister_gap_and_centre(ShootingProblem problem, const std::strin
   const Eigen::VectorXd x = z.head(z.size() - 1);
   problem.set_parameter(parameter, z[z.size() - 1]);
   const auto contacts = problem.contacts_at(x);
-  const Obstacle& obstacle = problem.definition().obstacles[contacts[k].obstacle];
+  const Obstacle obstacle = problem.obstacles(problem.parameters_at(x))[contacts[k].obstacle];
   const double centre = 0.5 * (contacts[k].s + contacts[k + 1].s);
   return {obstacle.gap(problem.sample(x, {centre}).front().r), centre};
 }
@@ -382,7 +348,7 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
       d.contacts.erase(d.contacts.begin() + (weakest - contacts.begin()));
     } else {
       // Where the rod reaches an obstacle: the smallest gap, refined between samples.
-      const SampledGap reached = smallest_gap(here, at.x, d.obstacles, contact.samples);
+      const ClosestApproach reached = sampled_closest_approach(here, at.x, contact.samples);
       const int which = reached.obstacle;
       const double margin = 2.0 * reached.spacing;
       for (const auto& c : contacts)
@@ -393,7 +359,7 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
           out.changes.push_back(change.str() + out.result.message);
           return out;
         }
-      const double where = refined_gap_minimum(here, at.x, d.obstacles, reached);
+      const double where = closest_approach(here, at.x, contact.samples).s;
       change << "a contact appears with obstacle " << which << " at s = " << where;
       d.contacts = contacts;
       d.contacts.push_back({which, where, 0.0});

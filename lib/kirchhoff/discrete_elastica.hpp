@@ -8,7 +8,9 @@
 // EI/h theta^2 at the clamps; equality constraints on the end position; one inequality
 // gap >= 0 per interior node and obstacle. The Hessian of the Lagrangian is given exactly:
 // tridiagonal with planes, dense with curved obstacles (their curvature couples every pair of
-// angles up to a node). Second-order accurate: errors fall as 1/N^2.
+// angles up to a node). Second-order accurate: errors fall as 1/N^2 - on a curved obstacle only
+// where the contact falls on a node, since contact is imposed at nodes and its arclength is not an
+// unknown; elsewhere the forces converge at first order, irregularly (the energy still at second).
 #pragma once
 
 #include <string>

@@ -112,6 +112,23 @@ Mat3 Obstacle::normal_derivative(const Vec3& r) const {
   return (Mat3::Identity() - nu * nu.transpose()) * hessian(r) / size;
 }
 
+Obstacle::ContactConditions Obstacle::contact_conditions(const Vec3& r, const Vec3& tangent) const {
+  ContactConditions out;
+  if (shape_ != Shape::Cylinder) {
+    const Vec3 g = gradient(r);
+    out.gap = gap(r);
+    out.tangency = g.dot(tangent);
+    out.normal = g.normalized();
+    return out;
+  }
+  const Vec3 d = (r - point_) - (r - point_).dot(direction_) * direction_;
+  const Vec3 across = direction_.cross(tangent);
+  out.normal = (d.dot(across) >= 0 ? 1.0 : -1.0) * across.normalized();
+  out.gap = d.dot(out.normal) - radius_;
+  out.tangency = d.dot(tangent);
+  return out;
+}
+
 std::string Obstacle::describe() const {
   std::ostringstream out;
   out << "obstacle" << quoted_name(name) << " (";

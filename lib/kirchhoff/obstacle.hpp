@@ -42,6 +42,20 @@ class Obstacle {
   // d normal / d r: (I - nu nu^T) Hessian / |grad g|; zero for a plane.
   Mat3 normal_derivative(const Vec3& r) const;
 
+  // What a point contact at r with tangent t imposes, gap = 0 and tangency = 0, and the direction
+  // of its reaction. Planes and level sets: g, grad g . t and grad g / |grad g|. Cylinders use the
+  // rod's side instead of the centre's direction: nu = +-(axis x t) / |axis x t| (the side the rod
+  // is on), gap = d . nu - radius and tangency = d . t with d the radial offset of r from the
+  // axis. At the solution d = radius nu, the same point as before, but no row or jump divides by
+  // |d| ~ radius: small pins are as well conditioned as large ones (with grad g the residual's
+  // round-off floor grows like force / radius).
+  struct ContactConditions {
+    double gap = 0.0;
+    double tangency = 0.0;
+    Vec3 normal = Vec3::Zero();
+  };
+  ContactConditions contact_conditions(const Vec3& r, const Vec3& tangent) const;
+
   Shape shape() const { return shape_; }
   bool is_flat() const { return shape_ == Shape::Plane; }
   // "plane", "cylinder" or "level set", with its data, for messages and output.

@@ -71,6 +71,8 @@ ShootingProblem::ShootingProblem(ProblemDefinition definition) : definition_(std
                                     ": only modelled on planes (wrapping around a curved obstacle is not implemented)");
     }
   }
+  // Moving obstacles decide: `obstacles` is kept as their value at the current parameters.
+  if (definition_.moving_obstacles) definition_.obstacles = definition_.moving_obstacles(definition_.parameters);
   if (residual_count_ != size())
     throw std::invalid_argument("boundary conditions give " + std::to_string(residual_count_) +
                                 " equations for " + std::to_string(size()) + " unknowns");
@@ -82,9 +84,13 @@ int ShootingProblem::size() const {
   return n;
 }
 
+std::vector<Obstacle> ShootingProblem::obstacles(const Parameters& p) const {
+  return definition_.moving_obstacles ? definition_.moving_obstacles(p) : definition_.obstacles;
+}
+
 double ShootingProblem::contact_bending(const Eigen::VectorXd& x, const PointContact& contact) const {
   const RodPoint p = sample(x, {contact.s}).front();
-  const Obstacle& o = definition_.obstacles[contact.obstacle];
+  const Obstacle o = obstacles(parameters_at(x))[contact.obstacle];
   const Vec3 tangent = p.R * p.v;
   return o.gradient(p.r).dot(p.R * p.u.cross(p.v)) + tangent.dot(o.hessian(p.r) * tangent);
 }
@@ -138,10 +144,13 @@ Parameters ShootingProblem::parameters_at(const Eigen::VectorXd& x) const {
 
 void ShootingProblem::set_parameter(const std::string& name, double value) {
   definition_.parameters.set(name, value);
+  if (definition_.moving_obstacles && definition_.obstacle_parameters.count(name))
+    definition_.obstacles = definition_.moving_obstacles(definition_.parameters);
 }
 
-bool ShootingProblem::depends_on_model(int unknown) const {
-  return definition_.model_parameters.count(definition_.parameters.names()[unknown_index_[unknown]]) > 0;
+bool ShootingProblem::moves_beyond_conditions(int unknown) const {
+  const std::string& name = definition_.parameters.names()[unknown_index_[unknown]];
+  return definition_.model_parameters.count(name) > 0 || definition_.obstacle_parameters.count(name) > 0;
 }
 
 bool ShootingProblem::evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
@@ -157,7 +166,7 @@ bool ShootingProblem::parameter_derivative(const Eigen::VectorXd& x, const std::
   Parameters plus = parameters_at(x), minus = plus;
   plus.set(name, value + h);
   minus.set(name, value - h);
-  if (definition_.model_parameters.count(name)) {
+  if (definition_.model_parameters.count(name) || definition_.obstacle_parameters.count(name)) {
     Eigen::VectorXd Fp, Fm;
     if (!residual(x, plus, &Fp, nullptr, failure) || !residual(x, minus, &Fm, nullptr, failure)) return false;
     *dF = (Fp - Fm) / (2.0 * h);
@@ -198,7 +207,7 @@ bool ShootingProblem::evaluate_with_end(const Eigen::VectorXd& x, Eigen::VectorX
     Eigen::VectorXd xp = x, xm = x, Fp, Fm;
     xp[offset + j] += h;
     xm[offset + j] -= h;
-    if (depends_on_model(static_cast<int>(j))) {
+    if (moves_beyond_conditions(static_cast<int>(j))) {
       if (!residual(xp, parameters_at(xp), &Fp, nullptr, failure)) return false;
       if (!residual(xm, parameters_at(xm), &Fm, nullptr, failure)) return false;
       J->col(offset + j) = (Fp - Fm) / (2.0 * h);
@@ -321,6 +330,7 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
   const int n = state_size_, N = size();
   const double L = eq->model().length;
   const auto points = breakpoints(contacts_at(x), contact_columns());
+  const std::vector<Obstacle> obstacles_here = obstacles(p);
   for (size_t k = 0; k < points.size(); ++k) {
     const double previous = k == 0 ? 0.0 : points[k - 1].s;
     // An extended contact may have zero length (when it forms); otherwise strictly increasing.
@@ -355,36 +365,47 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
       y = flow.y;
       if (last) break;
       const Breakpoint& b = points[k];
-      const Obstacle& o = definition_.obstacles[b.obstacle];
-      const Vec3 r = position * y;
-      const Eigen::RowVectorXd dg = o.gradient(r).transpose() * position;
-      const Eigen::VectorXd jump = -force.transpose() * o.normal(r);  // n jumps by -force * nu(r)
+      const Obstacle& o = obstacles_here[b.obstacle];
+      // What the contact imposes, closed-form in the state here (and in s through r').
+      auto conditions = [&](const Eigen::VectorXd& state, double at) {
+        return o.contact_conditions(position * state, position * eq->derivative(state, at));
+      };
+      const Obstacle::ContactConditions here = conditions(y, s1);
+      const Eigen::VectorXd jump = -force.transpose() * here.normal;  // n jumps by -force * nu
+      // Their state derivatives by central differences.
+      Eigen::MatrixXd d_rows(2, n), d_normal = Eigen::MatrixXd::Zero(3, n);
+      if (J) {
+        for (int i = 0; i < n; ++i) {
+          const double h = 1e-7 * (1.0 + std::abs(y[i]));
+          Eigen::VectorXd yp = y, ym = y;
+          yp[i] += h;
+          ym[i] -= h;
+          const auto plus = conditions(yp, s1), minus = conditions(ym, s1);
+          d_rows(0, i) = (plus.gap - minus.gap) / (2 * h);
+          d_rows(1, i) = (plus.tangency - minus.tangency) / (2 * h);
+          d_normal.col(i) = (plus.normal - minus.normal) / (2 * h);
+        }
+        // A plane's gap is linear in the position: exact (the cavity's hanging fold runs so close
+        // to branch points that rounding in this row alone can send it onto another branch).
+        if (o.is_flat()) d_rows.row(0) = o.gradient(position * y).transpose() * position;
+      }
       if (b.kind != Breakpoint::ExtendedEnd) {
-        // On the obstacle and tangent to it: g = 0 and g' = grad g . r' = 0.
-        auto tangency = [&](const Eigen::VectorXd& state) {
-          return o.gradient(position * state).dot(position * eq->derivative(state, s1));
-        };
-        (*F)[row] = o.gap(r);
-        (*F)[row + 1] = tangency(y);
+        // On the obstacle and tangent to it.
+        (*F)[row] = here.gap;
+        (*F)[row + 1] = here.tangency;
         if (J) {
-          J->row(row) = dg * S;
-          // Gradient of the tangency by central differences of a closed-form function of the state.
-          Eigen::RowVectorXd dt(n);
-          for (int i = 0; i < n; ++i) {
-            const double h = 1e-7 * (1.0 + std::abs(y[i]));
-            Eigen::VectorXd yp = y, ym = y;
-            yp[i] += h;
-            ym[i] -= h;
-            dt[i] = (tangency(yp) - tangency(ym)) / (2 * h);
-          }
-          J->row(row + 1) = dt * S;
-          J->row(row + 1)[b.s_column] += dg.dot(eq->derivative(y, s1 + 1e-7) - eq->derivative(y, s1 - 1e-7)) / 2e-7;
+          J->row(row) = d_rows.row(0) * S;
+          J->row(row + 1) = d_rows.row(1) * S;
+          // r' depends on s itself where the natural strains do.
+          const auto after = conditions(y, s1 + 1e-7), before = conditions(y, s1 - 1e-7);
+          J->row(row)[b.s_column] += (after.gap - before.gap) / 2e-7;
+          J->row(row + 1)[b.s_column] += (after.tangency - before.tangency) / 2e-7;
         }
         row += 2;
       }
       if (b.kind == Breakpoint::ExtendedStart) {
         // Flat on the obstacle from here: no moment, and no normal force once the jump is applied.
-        const Eigen::RowVectorXd normal_force = o.normal(r).transpose() * force;
+        const Eigen::RowVectorXd normal_force = here.normal.transpose() * force;
         (*F)[row] = moment_z.dot(y);
         (*F)[row + 1] = normal_force.dot(y) - b.force;
         if (J) {
@@ -396,7 +417,7 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
       }
       if (J) {
         // On a curved obstacle the jump's direction turns with the contact point.
-        if (!o.is_flat()) S -= b.force * force.transpose() * o.normal_derivative(r) * position * S;
+        if (!o.is_flat()) S -= b.force * force.transpose() * d_normal * S;
         S.col(b.force_column) += jump;
       }
       y += b.force * jump;
@@ -455,6 +476,7 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
   if (!definition_.contacts.empty()) {
     // Piece by piece between breakpoints, applying the jump of n at each.
     const auto points = breakpoints(contacts_at(x), contact_columns());
+    const std::vector<Obstacle> obstacles_here = obstacles(p);
     const Eigen::MatrixXd force = eq->slot_map(Slot::Force);
     Eigen::VectorXd y = x.head(n);
     double s0 = 0.0;
@@ -471,8 +493,11 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
       }
       if (last) break;
       y = eq->flow(y, s0, s1, false, definition_.options.integrator).y;
-      const Vec3 r = eq->slot_map(Slot::Position) * y;
-      y -= points[c].force * force.transpose() * definition_.obstacles[points[c].obstacle].normal(r);
+      const Eigen::MatrixXd position = eq->slot_map(Slot::Position);
+      const Vec3 normal = obstacles_here[points[c].obstacle]
+                              .contact_conditions(position * y, position * eq->derivative(y, s1))
+                              .normal;
+      y -= points[c].force * force.transpose() * normal;
       s0 = s1;
     }
     return out;

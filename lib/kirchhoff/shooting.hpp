@@ -66,6 +66,12 @@ struct ProblemDefinition {
   std::vector<std::string> unknown_parameters;
   ShootingOptions options;
   std::vector<Obstacle> obstacles;       // what the rod may touch (see solve_with_contacts)
+  // When set, the obstacles for given parameter values: obstacles that move with parameters
+  // (an indenter's depth followed by continuation, or solved for). It overrides `obstacles`,
+  // which ShootingProblem keeps as its value at the current parameters (so a caller replacing
+  // `obstacles` clears this too); obstacle_parameters names the parameters it depends on.
+  std::function<std::vector<Obstacle>(const Parameters&)> moving_obstacles;
+  std::set<std::string> obstacle_parameters;
   std::vector<PointContact> contacts;    // the active set: point contacts solved for
 };
 
@@ -101,6 +107,8 @@ class ShootingProblem final : public NonlinearSystem {
   std::vector<RodPoint> sample(const Eigen::VectorXd& x, const std::vector<double>& s) const;
 
   long rhs_evaluations() const { return rhs_evaluations_; }
+  // The obstacles at these parameter values.
+  std::vector<Obstacle> obstacles(const Parameters& p) const;
   // The active contacts with their arclengths and forces taken from x.
   std::vector<PointContact> contacts_at(const Eigen::VectorXd& x) const;
   // g'' at a point contact: how the rod curves away from the obstacle there (0: it flattens onto
@@ -132,7 +140,9 @@ class ShootingProblem final : public NonlinearSystem {
   Eigen::VectorXd condition_rows(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end, const Parameters& p) const;
   // Scatters condition rows (start then end) into a full-length residual column.
   void place_condition_rows(const Eigen::VectorXd& rows, Eigen::VectorXd* column) const;
-  bool depends_on_model(int unknown) const;
+  // Whether an unknown parameter enters the rod model or moves an obstacle (its column then needs
+  // whole residuals, not only the boundary-condition rows).
+  bool moves_beyond_conditions(int unknown) const;
   int contact_offset() const { return segments() * state_size_ + static_cast<int>(unknown_index_.size()); }
   int contact_column(size_t k) const;  // first unknown of contact k
   std::vector<int> contact_columns() const;

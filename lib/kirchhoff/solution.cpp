@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "kirchhoff/closest_approach.hpp"
 #include "kirchhoff/plectoneme.hpp"
 
 namespace kirchhoff {
@@ -170,12 +171,8 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
     return sol.contacts.empty() ? NAN : problem.sample(x, {sol.contacts.front().s}).front().u[1];
   if (name == "contact_s") return sol.contacts.empty() ? NAN : sol.contacts.front().s;
   if (name == "min_gap") {
-    const auto& obstacles = problem.definition().obstacles;
-    if (obstacles.empty()) return NAN;
-    double smallest = INFINITY;
-    for (const auto& p : sol.profile)
-      for (const auto& o : obstacles) smallest = std::min(smallest, o.gap(p.r));
-    return smallest;
+    if (problem.definition().obstacles.empty()) return NAN;
+    return closest_approach(problem, x, static_cast<int>(sol.profile.size())).gap;
   }
   if (name == "kappa_mid") return problem.sample(x, {0.5 * b.s}).front().u[1];
   if (name == "h_spread") {
