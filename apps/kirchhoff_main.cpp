@@ -158,11 +158,18 @@ int main(int argc, char** argv) {
     const int status = app.exit(e);
     return status == 0 ? 0 : kExitBadInput;
   }
-  if (*solve_cmd) return run_solve(solve);
-  if (*check_cmd) return run_check(check_path, check_overrides);
-  if (*reproduce_cmd) return run_reproduce(out_dir, cases_dir);
-  if (*continue_cmd) return run_continue(cont);
-  if (*vibrate_cmd) return run_vibrate(vib);
-  if (*plectonemes_cmd) return run_plectonemes(plect);
+  try {
+    if (*solve_cmd) return run_solve(solve);
+    if (*check_cmd) return run_check(check_path, check_overrides);
+    if (*reproduce_cmd) return run_reproduce(out_dir, cases_dir);
+    if (*continue_cmd) return run_continue(cont);
+    if (*vibrate_cmd) return run_vibrate(vib);
+    if (*plectonemes_cmd) return run_plectonemes(plect);
+  } catch (const std::exception& e) {
+    // The commands report the errors they expect; anything else still ends with a message
+    // rather than an abort.
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
   return kExitBadInput;
 }

@@ -548,6 +548,11 @@ TEST_F(CaseFileTest, DiscObstacleAndStartingContactLoad) {
   EXPECT_DOUBLE_EQ(c.definition.contacts[0].force, 3.0);
 }
 
+TEST_F(CaseFileTest, PlectonemeQuantitiesNeedSelfContact) {
+  expect_refused(replaced(kBase, "derived = [\"P\", \"y_max\"]", "derived = [\"P\", \"m3\"]"), "output.derived",
+                 {"'m3' is a plectoneme quantity", "[rod.self_contact]"});
+}
+
 TEST_F(CaseFileTest, BadObstaclesAreRefused) {
   const std::string disc = "type = \"cylinder\"\nname = \"pin\"\ncentre = [0.5, \"0.1 - 0.05\"]\nradius = 0.05\n";
   expect_refused(with_disc(replaced(disc, "cylinder", "sphere")), "obstacles.type", {"plane", "cylinder", "level_set"});

@@ -191,6 +191,63 @@ TEST(DiscContact, ARodThatWouldWrapAroundTheDiscStopsTheRunWithAClearMessage) {
   EXPECT_NEAR(branch.points.back().derived.at("kappa_contact"), -2.0, 1e-6);
 }
 
+// --- 3D: a twisted anisotropic rod against a pole (cases/twisted_ribbon_pole.toml) ---------
+
+TEST(SpatialContact, PlanarWallCaseGivesTheSameForcesIn3D) {
+  // wall.toml as a spatial rod along e_z buckling towards a wall x = a: the 3D core meets the wall
+  // exactly as the planar restriction does.
+  const Case planar = load_case(testing::case_path("wall.toml"));
+  const ContactSolveResult expected = solve_with_contacts(planar.definition, planar.start_guess);
+  ASSERT_TRUE(expected.complementarity);
+  Case spatial = load_case(testing::case_path("twisted_ribbon_pole.toml"), {{"phi", 0.0}});
+  spatial.definition.obstacles = {Obstacle::plane(Vec3(0.1, 0, 0), Vec3(-1, 0, 0), "wall")};
+  spatial.definition.moving_obstacles = {};
+  spatial.definition.obstacle_parameters.clear();
+  spatial.definition.model = [inner = spatial.definition.model](const Parameters& p) {
+    RodModel m = inner(p);
+    m.B[1] = Profile(1.0);  // isotropic as wall.toml (its circle of copies is broken by phi = 0 and the wall)
+    return m;
+  };
+  const ContactSolveResult found = solve_with_contacts(spatial.definition, spatial.start_guess);
+  ASSERT_TRUE(found.complementarity) << found.message;
+  ASSERT_EQ(found.definition.contacts.size(), 1u);
+  // Two integrations at 1e-12 and Newton to 1e-12: 1e-9 is the bar.
+  EXPECT_NEAR(found.definition.contacts[0].force / expected.definition.contacts[0].force, 1.0, 1e-9);
+  EXPECT_NEAR(found.definition.contacts[0].s, expected.definition.contacts[0].s, 1e-9);
+}
+
+TEST(SpatialContact, TwistedRibbonLeansOnAPole) {
+  const Case c = load_case(testing::case_path("twisted_ribbon_pole.toml"));
+  const ContactSolveResult r = solve_with_contacts(c.definition, c.start_guess);
+  ASSERT_TRUE(r.result.summary.converged()) << r.result.summary.brief_report();
+  ASSERT_TRUE(r.complementarity) << r.message;
+  ASSERT_EQ(r.definition.contacts.size(), 1u);
+  const PointContact& contact = r.definition.contacts[0];
+  EXPECT_GT(contact.force, 0.1);
+  const ShootingProblem problem(r.definition);
+  const Solution sol = make_solution(problem, r.result, 401, {"min_gap", "H"});
+  const double s = contact.s;
+  // Either side of the contact (for n) and on it (for the geometry).
+  const auto at = problem.sample(r.result.x, {0.0, s - 1e-9, s, s + 1e-9, 1.0});
+  const RodPoint &start = at[0], &before = at[1], &on = at[2], &after = at[3], &end = at[4];
+  // Really three-dimensional: the contact is off the plane of the clamps' common axis and e_x.
+  EXPECT_GT(std::abs(on.r.y()), 1e-3);
+  // On the pole and tangent to it; the force along the offset from its axis.
+  const Vec3 centre(0.15, 0.0, 0.517), axis = Vec3::UnitY();
+  Vec3 d = on.r - centre;
+  d -= d.dot(axis) * axis;
+  EXPECT_NEAR(d.norm(), 0.1, 1e-11);
+  EXPECT_NEAR(d.dot(on.R.col(2)), 0.0, 1e-11);
+  EXPECT_LE((after.n - before.n + contact.force * d.normalized()).norm(), 1e-8 * contact.force);
+  // Global balance of moments about the contact point, through which the contact force passes;
+  // forces ~40 to 1e-12.
+  const Vec3 moment = (end.r - on.r).cross(end.n) + end.m - (start.r - on.r).cross(start.n) - start.m;
+  EXPECT_LE(moment.norm(), 1e-9);
+  // H is the same on both sides (the jump is normal to the tangent) and flat along the rod.
+  EXPECT_LE(sol.invariants.H.relative_spread(), 1e-10);
+  EXPECT_GE(sol.derived.at("min_gap"), -1e-10);
+}
+
 // --- Ipopt with a disc ------------------------------------------------------------------------
 
 TEST(DiscContact, IpoptConvergesToTheShootingSolutionAtSecondOrder) {

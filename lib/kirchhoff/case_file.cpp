@@ -11,6 +11,7 @@
 #include <toml.hpp>
 
 #include "kirchhoff/expression.hpp"
+#include "kirchhoff/plectoneme.hpp"
 #include "kirchhoff/self_contact.hpp"
 #include "kirchhoff/solution.hpp"
 
@@ -722,6 +723,10 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
           for (const auto& [n, meaning] : derived_catalogue()) names.insert(n);
           reader.fail(*v, "output.derived", "'" + name + "' is not a derived quantity (known: " + join(names) + ")");
         }
+      const bool self_contact = Reader::find(root, "rod") && Reader::find(*Reader::find(root, "rod"), "self_contact");
+      for (const auto& [name, meaning] : plectoneme_quantities())
+        if (!self_contact && std::find(c.derived.begin(), c.derived.end(), name) != c.derived.end())
+          reader.fail(*v, "output.derived", "'" + name + "' is a plectoneme quantity: it needs [rod.self_contact]");
     }
     if (const Value* v = Reader::find(*o, "samples")) {
       c.samples = static_cast<int>(reader.integer(*v, "output.samples"));
