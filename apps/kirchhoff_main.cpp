@@ -38,6 +38,22 @@ int main(int argc, char** argv) {
   solve_cmd->add_option("--profile", solve.profile_path,
                         "Write the solution along the rod as CSV: s, r, d1, d2, d3, n, m, u, H, m3, n.m, dH/ds");
 
+  std::string seed = "guess";
+  solve_cmd
+      ->add_option("--seed", seed,
+                   "Where Newton starts: 'guess' (the case's [guess] and [[guess.contacts]]), or 'ipopt':\n"
+                   "minimise the discretised energy first and start from its shape, end reactions and\n"
+                   "contact set (planar clamped-clamped rods; finds contact sets the active-set loop\n"
+                   "cannot reach from a contact-free guess)")
+      ->check(CLI::IsMember({"guess", "ipopt"}))
+      ->capture_default_str();
+  solve_cmd->add_option("--seed-segments", solve.seed.segments, "Segments of the discretised rod for --seed ipopt")
+      ->check(CLI::Range(4, 100000))
+      ->capture_default_str();
+  solve_cmd
+      ->add_option("--seed-amplitude", solve.seed.amplitude,
+                   "Amplitude of the buckling mode Ipopt starts from, as a fraction of L (its sign: the side)")
+      ->capture_default_str();
   solve_cmd
       ->add_option("--phase-condition", solve.phase_condition,
                    "Override [solver] phase_condition: 'axial' selects one buckled solution of an isotropic\n"
@@ -159,7 +175,10 @@ int main(int argc, char** argv) {
     return status == 0 ? 0 : kExitBadInput;
   }
   try {
-    if (*solve_cmd) return run_solve(solve);
+    if (*solve_cmd) {
+      solve.seed.ipopt = seed == "ipopt";
+      return run_solve(solve);
+    }
     if (*check_cmd) return run_check(check_path, check_overrides);
     if (*reproduce_cmd) return run_reproduce(out_dir, cases_dir);
     if (*continue_cmd) return run_continue(cont);

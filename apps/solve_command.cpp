@@ -1,5 +1,7 @@
 #include "solve_command.hpp"
 
+#include "kirchhoff/discrete_seed.hpp"
+
 #include <iostream>
 #include <nlohmann/json.hpp>
 
@@ -42,8 +44,28 @@ ParameterOverrides parse_overrides(const std::vector<std::string>& texts) {
   return out;
 }
 
+namespace {
+
+// The seeded solve, shaped as solve_definition's result.
+DefinitionSolve solve_seeded(const Case& c, const StartSeed& options) {
+  DiscreteSeed seed;
+  ContactSolveResult contact = solve_from_discrete_seed(c.definition, options.segments, options.amplitude, &seed);
+  std::cerr << "seed: " << seed.summary << "\n";
+  DefinitionSolve out;
+  out.problem = std::make_unique<ShootingProblem>(contact.definition);
+  out.result = std::move(contact.result);
+  out.contact_log = std::move(contact.log);
+  if (out.result.summary.converged() && !contact.complementarity) {
+    out.result.summary.status = SolverStatus::MaxIterations;
+    out.result.summary.message = contact.message;
+  }
+  return out;
+}
+
+}  // namespace
+
 int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
-                   const std::string& phase_condition, bool json, SolvedCase* out) {
+                   const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed) {
   Case& c = out->c;
   try {
     c = load_case(case_path, parse_overrides(overrides), phase_condition);
@@ -55,7 +77,7 @@ int load_and_solve(const std::string& case_path, const std::vector<std::string>&
   ShootingResult& result = out->result;
   std::vector<std::string> contact_log;
   try {
-    DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
+    DefinitionSolve solved = seed.ipopt ? solve_seeded(c, seed) : solve_definition(c.definition, c.start_guess);
     problem = std::move(solved.problem);
     result = std::move(solved.result);
     contact_log = std::move(solved.contact_log);
@@ -66,6 +88,14 @@ int load_and_solve(const std::string& case_path, const std::vector<std::string>&
   } catch (const IntegrationError& e) {
     std::cerr << "error: " << c.path << ": the initial guess cannot be integrated: " << e.what() << "\n";
     if (json) std::cout << failure_json(c, "integration_failed", 0, INFINITY, e.what()).dump(2) << "\n";
+    return kExitNotConverged;
+  } catch (const std::invalid_argument& e) {
+    // Only the seed refuses a case here (one it does not model).
+    std::cerr << "error: " << c.path << ": --seed ipopt: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const std::runtime_error& e) {
+    std::cerr << "error: " << c.path << ": --seed ipopt: " << e.what() << "\n";
+    if (json) std::cout << failure_json(c, "seed_failed", 0, INFINITY, e.what()).dump(2) << "\n";
     return kExitNotConverged;
   }
   if (!json)
@@ -84,7 +114,7 @@ int load_and_solve(const std::string& case_path, const std::vector<std::string>&
 
 int run_solve(const SolveArguments& args) {
   SolvedCase solved;
-  if (const int status = load_and_solve(args.case_path, args.overrides, args.phase_condition, args.json, &solved);
+  if (const int status = load_and_solve(args.case_path, args.overrides, args.phase_condition, args.json, &solved, args.seed);
       status != kExitOk)
     return status;
   const Case& c = solved.c;

@@ -14,8 +14,17 @@ constexpr int kExitOk = 0;
 constexpr int kExitNotConverged = 1;  // the solver ran and reported a failure status
 constexpr int kExitBadInput = 2;      // the case file or the command line was refused
 
+// Where the solver starts: the case's [guess], or Ipopt on the discretised energy
+// (discrete_seed.hpp), which also gives the initial contact set.
+struct StartSeed {
+  bool ipopt = false;
+  int segments = 200;
+  double amplitude = 0.05;  // the first mode's amplitude Ipopt starts from (its sign: the side)
+};
+
 struct SolveArguments {
   std::string case_path;
+  StartSeed seed;
   std::vector<std::string> overrides;  // NAME=VALUE
   bool json = false;
   std::string profile_path;
@@ -36,7 +45,7 @@ struct SolvedCase {
 // Loads and solves; on failure prints the reason (and, with json, a failure object on stdout)
 // and returns the exit status, else kExitOk.
 int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
-                   const std::string& phase_condition, bool json, SolvedCase* out);
+                   const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed = {});
 int run_check(const std::string& case_path, const std::vector<std::string>& overrides);
 
 }  // namespace kirchhoff::cli

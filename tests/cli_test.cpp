@@ -316,6 +316,24 @@ TEST_F(CliTest, NotConvergedExitsOneWithStatus) {
   EXPECT_EQ(run("solve " + quoted(relaxed) + " --set theta0=2.5").status, 0);
 }
 
+TEST_F(CliTest, IpoptSeedSolvesWhatTheGuessCannot) {
+  const std::string args = "solve " + quoted(case_path("cavity.toml")) + " --set Delta=0.05";
+  const CliRun plain = run(args);
+  EXPECT_EQ(plain.status, 1) << plain.err;  // from the free arch: not converged
+  const CliRun seeded = run(args + " --seed ipopt --json");
+  EXPECT_EQ(seeded.status, 0) << seeded.err;
+  EXPECT_THAT(seeded.err, HasSubstr("seed: Ipopt on 200 segments"));
+  const json j = parse(seeded);
+  EXPECT_EQ(j["status"], "converged");
+  EXPECT_EQ(j["contacts"].size(), 1u);
+  // A spatial case is refused with the reason; a bad segment count by the parser.
+  const CliRun spatial = run("solve " + quoted(case_path("twisted_ribbon_pole.toml")) + " --seed ipopt");
+  EXPECT_EQ(spatial.status, 2);
+  EXPECT_THAT(spatial.err, HasSubstr("planar clamped-clamped"));
+  EXPECT_EQ(run(args + " --seed ipopt --seed-segments 2").status, 2);
+  EXPECT_EQ(run(args + " --seed ipop").status, 2);
+}
+
 TEST_F(CliTest, AxialPhaseConditionOnTheStraightTwistedRodIsNotConverged) {
   // At the straight guess the axial phase condition is degenerate: the solver must not claim
   // an isolated solution there.

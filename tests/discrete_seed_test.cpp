@@ -1,0 +1,87 @@
+// Ipopt on the discretised energy as the shooting solver's starting point (discrete_seed.hpp):
+// from its shape, end reactions and gap multipliers the active-set shooting reaches equilibria
+// that it cannot reach from a contact-free guess, and they are the equilibria Ipopt found.
+#include <cmath>
+
+#include "kirchhoff/discrete_seed.hpp"
+#include "test_support.hpp"
+
+namespace kirchhoff {
+namespace {
+
+// Bending energy of a shooting solution, by the trapezoidal rule on 4001 samples (~1e-8).
+double bending_energy(const ShootingProblem& problem, const Eigen::VectorXd& x) {
+  std::vector<double> s;
+  for (int i = 0; i <= 4000; ++i) s.push_back(i / 4000.0);
+  const auto points = problem.sample(x, s);
+  double energy = 0.0;
+  for (size_t i = 0; i + 1 < points.size(); ++i)
+    energy += 0.25 * (std::pow(points[i].m.z(), 2) + std::pow(points[i + 1].m.z(), 2)) * (s[i + 1] - s[i]);
+  return energy;  // EI = 1: m^2 / 2
+}
+
+struct SeedCase {
+  double Delta, a;
+  int contacts;  // what the discrete minimum touches
+};
+
+TEST(DiscreteSeed, CavityEquilibriaBeyondTheActiveSetLoopsReach) {
+  // cases/cavity.toml: from its free-arch guess the active-set loop fails at these end shortenings
+  // (it adds contacts one by one where the free rod penetrates; the equilibria here are S-shaped,
+  // touching the walls where the free arch does not).
+  for (const SeedCase& sc : {SeedCase{0.05, 0.1, 1}, SeedCase{0.03, 0.05, 2}, SeedCase{0.3, 0.1, 3}}) {
+    SCOPED_TRACE("Delta = " + std::to_string(sc.Delta) + ", a = " + std::to_string(sc.a));
+    const Case c = load_case(testing::case_path("cavity.toml"), {{"Delta", sc.Delta}, {"a", sc.a}});
+    DiscreteSeed seed;
+    const ContactSolveResult r = solve_from_discrete_seed(c.definition, 200, 0.05, &seed);
+    ASSERT_TRUE(r.result.summary.converged()) << r.result.summary.brief_report();
+    ASSERT_TRUE(r.complementarity) << r.message;
+    EXPECT_EQ(static_cast<int>(seed.contacts.size()), sc.contacts) << seed.summary;
+    // The seed's contact set was right: the loop did not change it.
+    EXPECT_TRUE(r.log.empty()) << r.log.front();
+    ASSERT_EQ(r.definition.contacts.size(), seed.contacts.size());
+    for (size_t k = 0; k < seed.contacts.size(); ++k) {
+      EXPECT_EQ(r.definition.contacts[k].obstacle, seed.contacts[k].obstacle);
+      EXPECT_NEAR(r.definition.contacts[k].s, seed.contacts[k].s, 2.0 / 200);  // within two segments
+    }
+    const ShootingProblem problem(r.definition);
+    const Solution sol = make_solution(problem, r.result, 401, {"min_gap"});
+    EXPECT_GE(sol.derived.at("min_gap"), -1e-10);
+    EXPECT_LE(sol.invariants.H.relative_spread(), 1e-9);  // H across every contact
+    // The same equilibrium as Ipopt's: energies agree to the discretisation's O(h^2) (~5e-5 at
+    // N = 200 on wall.toml's rod).
+    EXPECT_NEAR(bending_energy(problem, r.result.x) / seed.discrete.energy, 1.0, 1e-3);
+  }
+}
+
+TEST(DiscreteSeed, StartStateIsCloseToTheSolution) {
+  // The seed's n(0) and m(0) are first-order approximations (h = 1/200) of the solved ones.
+  const Case c = load_case(testing::case_path("wall.toml"));
+  DiscreteSeed seed;
+  const ContactSolveResult r = solve_from_discrete_seed(c.definition, 200, 0.05, &seed);
+  ASSERT_TRUE(r.complementarity) << r.message;
+  const ShootingProblem problem(r.definition);
+  const RodPoint start = problem.sample(r.result.x, {0.0}).front();
+  EXPECT_LE((seed.start.n - start.n).norm() / start.n.norm(), 2e-2);
+  EXPECT_NEAR(seed.start.m.z(), start.m.z(), 2e-2 * std::abs(start.m.z()));
+  EXPECT_LE((seed.start.r - start.r).norm(), 1e-15);
+}
+
+TEST(DiscreteSeed, RefusesWhatTheDiscreteModelDoesNotDescribe) {
+  auto refused = [](const std::string& name, const std::string& reason) {
+    const Case c = load_case(testing::case_path(name));
+    try {
+      seed_from_discrete_energy(c.definition);
+      ADD_FAILURE() << name << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(reason), std::string::npos) << e.what();
+    }
+  };
+  refused("twisted_ribbon_pole.toml", "spatial");
+  refused("indenter.toml", "clamped");
+  refused("simply_supported.toml", "solves for parameters");
+  refused("heavy_cantilever.toml", "clamped");
+}
+
+}  // namespace
+}  // namespace kirchhoff
