@@ -1,5 +1,7 @@
 #include "continue_command.hpp"
 
+#include "kirchhoff/discrete_seed.hpp"
+
 #include <unistd.h>
 
 #include <cmath>
@@ -138,12 +140,22 @@ int run_continue(const ContinueArguments& args) {
     options.events = parse_events(args.stop_events, true);
     for (auto& e : parse_events(args.record_events, false)) options.events.push_back(e);
     if (std::string e = options.validate(); !e.empty()) throw CaseError(e);
+    if (args.seed.ipopt && !args.resume) {
+      // The first point from Ipopt's shape and contact set instead of the case's guess.
+      const DiscreteSeed seed = seed_from_discrete_energy(c.definition, args.seed.segments, args.seed.amplitude);
+      std::cerr << "seed: " << seed.summary << "\n";
+      c.definition.contacts = seed.contacts;
+      c.start_guess = seed.start;
+    }
   } catch (const CaseError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;
   } catch (const std::invalid_argument& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;
+  } catch (const std::runtime_error& e) {  // the seed's Ipopt did not converge
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitNotConverged;
   }
   for (const auto& e : options.events)
     if (std::find(options.derived.begin(), options.derived.end(), e.quantity) == options.derived.end())

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "solve_command.hpp"
+
 namespace kirchhoff::cli {
 
 struct ContinueArguments {
@@ -27,6 +29,7 @@ struct ContinueArguments {
   std::string profiles_dir;
   bool resume = false;
   int samples = 101;
+  StartSeed seed;             // where the first point is solved from (not used on --resume)
 };
 
 int run_continue(const ContinueArguments& args);

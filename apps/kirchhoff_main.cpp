@@ -8,6 +8,29 @@
 #include "solve_command.hpp"
 #include "vibrate_command.hpp"
 
+namespace {
+
+// --seed, --seed-segments, --seed-amplitude (solve and continue).
+void add_seed_options(CLI::App* command, std::string* choice, kirchhoff::cli::StartSeed* seed) {
+  command
+      ->add_option("--seed", *choice,
+                   "Where Newton starts: 'guess' (the case's [guess] and [[guess.contacts]]), or 'ipopt':\n"
+                   "minimise the discretised energy first and start from its shape, end reactions and\n"
+                   "contact set (planar clamped-clamped rods; finds contact sets the active-set loop\n"
+                   "cannot reach from a contact-free guess)")
+      ->check(CLI::IsMember({"guess", "ipopt"}))
+      ->capture_default_str();
+  command->add_option("--seed-segments", seed->segments, "Segments of the discretised rod for --seed ipopt")
+      ->check(CLI::Range(4, 100000))
+      ->capture_default_str();
+  command
+      ->add_option("--seed-amplitude", seed->amplitude,
+                   "Amplitude of the buckling mode Ipopt starts from, as a fraction of L (its sign: the side)")
+      ->capture_default_str();
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace kirchhoff::cli;
   CLI::App app{
@@ -38,22 +61,8 @@ int main(int argc, char** argv) {
   solve_cmd->add_option("--profile", solve.profile_path,
                         "Write the solution along the rod as CSV: s, r, d1, d2, d3, n, m, u, H, m3, n.m, dH/ds");
 
-  std::string seed = "guess";
-  solve_cmd
-      ->add_option("--seed", seed,
-                   "Where Newton starts: 'guess' (the case's [guess] and [[guess.contacts]]), or 'ipopt':\n"
-                   "minimise the discretised energy first and start from its shape, end reactions and\n"
-                   "contact set (planar clamped-clamped rods; finds contact sets the active-set loop\n"
-                   "cannot reach from a contact-free guess)")
-      ->check(CLI::IsMember({"guess", "ipopt"}))
-      ->capture_default_str();
-  solve_cmd->add_option("--seed-segments", solve.seed.segments, "Segments of the discretised rod for --seed ipopt")
-      ->check(CLI::Range(4, 100000))
-      ->capture_default_str();
-  solve_cmd
-      ->add_option("--seed-amplitude", solve.seed.amplitude,
-                   "Amplitude of the buckling mode Ipopt starts from, as a fraction of L (its sign: the side)")
-      ->capture_default_str();
+  std::string solve_seed = "guess";
+  add_seed_options(solve_cmd, &solve_seed, &solve.seed);
   solve_cmd
       ->add_option("--phase-condition", solve.phase_condition,
                    "Override [solver] phase_condition: 'axial' selects one buckled solution of an isotropic\n"
@@ -85,6 +94,8 @@ int main(int argc, char** argv) {
   continue_cmd->add_flag("--no-branch-points", cont.no_branch_points,
                          "Do not look for branch points: their test functions cost an SVD per point, most of a\n"
                          "run on multiple-shooting cases of hundreds of unknowns (plectonemes); folds are still found");
+  std::string continue_seed = "guess";
+  add_seed_options(continue_cmd, &continue_seed, &cont.seed);
   continue_cmd->add_option("--side", cont.switch_side, "Which side of the bifurcating branch: 1 or -1")
       ->capture_default_str();
   continue_cmd->add_option("--event", cont.stop_events, "Stop when a derived quantity crosses a value: NAME=VALUE");
@@ -176,12 +187,15 @@ int main(int argc, char** argv) {
   }
   try {
     if (*solve_cmd) {
-      solve.seed.ipopt = seed == "ipopt";
+      solve.seed.ipopt = solve_seed == "ipopt";
       return run_solve(solve);
     }
     if (*check_cmd) return run_check(check_path, check_overrides);
     if (*reproduce_cmd) return run_reproduce(out_dir, cases_dir);
-    if (*continue_cmd) return run_continue(cont);
+    if (*continue_cmd) {
+      cont.seed.ipopt = continue_seed == "ipopt";
+      return run_continue(cont);
+    }
     if (*vibrate_cmd) return run_vibrate(vib);
     if (*plectonemes_cmd) return run_plectonemes(plect);
   } catch (const std::exception& e) {

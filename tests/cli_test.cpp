@@ -332,6 +332,16 @@ TEST_F(CliTest, IpoptSeedSolvesWhatTheGuessCannot) {
   EXPECT_THAT(spatial.err, HasSubstr("planar clamped-clamped"));
   EXPECT_EQ(run(args + " --seed ipopt --seed-segments 2").status, 2);
   EXPECT_EQ(run(args + " --seed ipop").status, 2);
+  // A continuation starts from the seed as well.
+  const std::string csv = (dir_ / "cavity.csv").string();
+  const CliRun branch = run("continue " + quoted(case_path("cavity.toml")) +
+                            " --param Delta --set Delta=0.05 --to 0.06 --seed ipopt --out " + quoted(csv));
+  EXPECT_EQ(branch.status, 0) << branch.err;
+  EXPECT_THAT(branch.err, HasSubstr("seed: Ipopt"));
+  EXPECT_THAT(branch.err, HasSubstr("reached_target"));
+  const CliRun unseeded = run("continue " + quoted(case_path("cavity.toml")) + " --param Delta --set Delta=0.05 --to 0.06 --out " +
+                              quoted((dir_ / "unseeded.csv").string()));
+  EXPECT_EQ(unseeded.status, 1) << unseeded.err;  // no admissible starting point from the guess
 }
 
 TEST_F(CliTest, AxialPhaseConditionOnTheStraightTwistedRodIsNotConverged) {
