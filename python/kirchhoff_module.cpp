@@ -26,6 +26,7 @@
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/continuation.hpp"
+#include "kirchhoff/discrete_seed.hpp"
 #include "kirchhoff/invariants.hpp"
 #include "kirchhoff/shooting.hpp"
 #include "kirchhoff/solution.hpp"
@@ -167,10 +168,13 @@ PyCase py_load_case(const std::string& path, const py::object& set, const std::s
   return out;
 }
 
-PySolution py_solve(const PyCase& pc, const py::object& samples_arg) {
+PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::string& seed, int seed_segments) {
   const Case& c = pc.c;
   const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
   if (samples < 2) throw py::value_error("samples must be >= 2 (got " + std::to_string(samples) + ")");
+  if (seed != "guess" && seed != "ipopt") throw py::value_error("seed must be 'guess' or 'ipopt' (got '" + seed + "')");
+  if (seed_segments < 4) throw py::value_error("seed_segments must be >= 4");
+  std::string seed_refused;  // raised as ValueError once the GIL is back
 
   PySolution out;
   std::unique_ptr<ShootingProblem> problem;
@@ -181,10 +185,21 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg) {
     py::gil_scoped_release release;
     ShootingResult solved_result;
     try {
-      // As the CLI: plain shooting, or the active-set loop when the case has obstacles.
-      DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
-      problem = std::move(solved.problem);
-      solved_result = std::move(solved.result);
+      if (seed == "ipopt") {
+        // As `kirchhoff solve --seed ipopt`.
+        const ContactSolveResult seeded = solve_from_discrete_seed(c.definition, seed_segments);
+        problem = std::make_unique<ShootingProblem>(seeded.definition);
+        solved_result = seeded.result;
+        if (solved_result.summary.converged() && !seeded.complementarity) {
+          solved_result.summary.status = SolverStatus::MaxIterations;
+          solved_result.summary.message = seeded.message;
+        }
+      } else {
+        // As the CLI: plain shooting, or the active-set loop when the case has obstacles.
+        DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
+        problem = std::move(solved.problem);
+        solved_result = std::move(solved.result);
+      }
     } catch (const InfeasibleContact& e) {
       integration_failed = true;
       failed.summary.status = SolverStatus::MaxIterations;
@@ -196,7 +211,15 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg) {
       failed.summary.iterations = 0;
       failed.summary.residual_norm = INFINITY;
       failed.summary.message = std::string("the initial guess cannot be integrated: ") + e.what();
+    } catch (const std::invalid_argument& e) {  // a case the Ipopt seed does not model
+      seed_refused = e.what();
+    } catch (const std::runtime_error& e) {     // the seed's Ipopt did not converge
+      integration_failed = true;
+      failed.summary.status = SolverStatus::MaxIterations;
+      failed.summary.residual_norm = INFINITY;
+      failed.summary.message = e.what();
     }
+    if (!seed_refused.empty()) integration_failed = true;
     if (!integration_failed) {
       ShootingResult result = std::move(solved_result);
       if (result.summary.converged())
@@ -205,6 +228,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg) {
         failed = std::move(result);
     }
   }
+  if (!seed_refused.empty()) throw py::value_error(seed_refused);
   const ShootingResult& r = sol ? sol->result : failed;
   out.status = to_string(r.summary.status);
   out.converged = r.summary.converged();
@@ -533,10 +557,15 @@ Attributes:
       .def_property_readonly("derived_names", [](const PyCase& p) { return p.c.derived; })
       .def_property_readonly("samples", [](const PyCase& p) { return p.c.samples; })
       .def_readonly("phase_condition", &PyCase::phase_condition)
-      .def("solve", &py_solve, py::arg("samples") = py::none(), R"doc(Solves the case by shooting.
+      .def("solve", &py_solve, py::arg("samples") = py::none(), py::kw_only(), py::arg("seed") = "guess",
+           py::arg("seed_segments") = 200, R"doc(Solves the case by shooting.
 
 Args:
     samples (int, optional): profile points (>= 2); default the case's [output] samples.
+    seed (str): 'guess' starts from the case's [guess]; 'ipopt' from Ipopt's minimum of the
+        discretised energy, its shape and contact set (planar clamped-clamped rods; ValueError
+        for other cases).
+    seed_segments (int): segments of that discretised rod.
 
 Returns:
     Solution. Non-convergence is reported in Solution.status, not raised.)doc")

@@ -145,6 +145,19 @@ class ContactTest(unittest.TestCase):
         self.assertAlmostEqual(sol.contacts[0]["s"], 0.5, places=9)
         self.assertGreaterEqual(sol.derived["min_gap"], -1e-10)
 
+    def test_ipopt_seed_reaches_what_the_guess_cannot(self):
+        case = kirchhoff.load_case(case_path("cavity.toml"), set={"Delta": 0.05})
+        self.assertFalse(case.solve().converged)  # from the free-arch guess
+        sol = case.solve(seed="ipopt")
+        self.assertEqual(sol.status, "converged")
+        self.assertEqual(len(sol.contacts), 1)
+        self.assertGreater(sol.contacts[0]["force"], 0.0)
+        self.assertGreaterEqual(sol.derived["min_gap"], -1e-10)
+        with self.assertRaisesRegex(ValueError, "seed must be"):
+            case.solve(seed="ipop")
+        with self.assertRaisesRegex(ValueError, "planar clamped-clamped"):
+            kirchhoff.load_case(case_path("indenter.toml")).solve(seed="ipopt")
+
     def test_infeasible_wall_is_a_status(self):
         sol = kirchhoff.load_case(case_path("wall.toml"), set={"a": -0.01}).solve()
         self.assertFalse(sol.converged)
