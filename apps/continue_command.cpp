@@ -161,9 +161,8 @@ int run_continue(const ContinueArguments& args) {
     if (std::find(options.derived.begin(), options.derived.end(), e.quantity) == options.derived.end())
       options.derived.push_back(e.quantity);
 
-  if (!c.definition.obstacles.empty() && (args.switch_at_bp > 0 || !args.profiles_dir.empty())) {
-    std::cerr << "error: " << args.case_path
-              << ": --switch-at-bp and --profiles are not implemented for cases with obstacles yet\n";
+  if (!c.definition.obstacles.empty() && args.switch_at_bp > 0) {
+    std::cerr << "error: " << args.case_path << ": --switch-at-bp is not implemented for cases with obstacles yet\n";
     return kExitBadInput;
   }
   const fs::path csv(args.out_path), state_path(args.out_path + ".state.json");
@@ -194,6 +193,21 @@ int run_continue(const ContinueArguments& args) {
     return std::make_unique<ShootingProblem>(d);
   };
 
+  // DIR/point_NNNNN.csv for --profiles: the point's solution along the rod, in its problem.
+  auto write_profile = [&](const ShootingProblem& problem, const ContinuationPoint& p) {
+    if (args.profiles_dir.empty()) return;
+    ShootingProblem copy = problem;
+    copy.set_parameter(args.parameter, p.parameter);
+    ShootingResult r;
+    r.x = p.x;
+    r.parameters = copy.parameters_at(p.x);
+    const Solution s = make_solution(copy, r, args.samples, {});
+    std::ostringstream name;
+    name << "point_" << std::setw(5) << std::setfill('0') << state.row << ".csv";
+    write_profile_csv((fs::path(args.profiles_dir) / name.str()).string(), copy.equations(r.parameters)->model(),
+                      s.profile);
+  };
+
   auto sink_for = [&](const ShootingProblem& problem, int branch, const std::string& phase) {
     return [&, branch, phase](const ContinuationPoint& p) {
       ++state.row;
@@ -206,18 +220,7 @@ int run_continue(const ContinueArguments& args) {
         save_resume_point(state_path, p, &state);
       }
       progress.point(state.row, p, branch);
-      if (!args.profiles_dir.empty()) {
-        ShootingProblem copy = problem;
-        copy.set_parameter(args.parameter, p.parameter);
-        ShootingResult r;
-        r.x = p.x;
-        r.parameters = copy.parameters_at(p.x);
-        const Solution s = make_solution(copy, r, args.samples, {});
-        std::ostringstream name;
-        name << "point_" << std::setw(5) << std::setfill('0') << state.row << ".csv";
-        write_profile_csv((fs::path(args.profiles_dir) / name.str()).string(),
-                          copy.equations(r.parameters)->model(), s.profile);
-      }
+      write_profile(problem, p);
     };
   };
 
@@ -252,6 +255,12 @@ int run_continue(const ContinueArguments& args) {
           save_resume_point(state_path, p, &state);
         }
         progress.point(state.row, p, 0);
+        if (!args.profiles_dir.empty()) {
+          // The point's problem has the active set of the leg it belongs to.
+          ProblemDefinition d = c.definition;
+          d.contacts = active;
+          write_profile(ShootingProblem(d), p);
+        }
       };
       auto on_active_set = [&](const std::vector<PointContact>& contacts) { active = contacts; };
       ContactContinuationResult r;

@@ -3,6 +3,8 @@
 // duplicating a point.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -118,6 +120,37 @@ TEST_F(ContinueCli, BranchPointsCanBeSkippedButNotSwitchedAt) {
   const auto log = lines_of(dir_ / "r.log");
   ASSERT_FALSE(log.empty());
   EXPECT_NE(log.front().find("--no-branch-points"), std::string::npos);
+}
+
+// --profiles on a contact run: one profile per row, each solved with its leg's active set. The
+// indenter rises into the rod; the last profile touches the disc at mid-span (where n_y jumps
+// by the contact force) and stays outside it everywhere.
+TEST_F(ContinueCli, ContactRunWritesEveryPointsProfile) {
+  const fs::path csv = dir_ / "indenter.csv", profiles = dir_ / "profiles";
+  const std::vector<std::string> args = {KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/indenter.toml",
+                                         "--param", "rise", "--set", "rise=-0.02", "--to", "0.1969039464300978",
+                                         "--max-step", "1", "--samples", "1001", "--profiles", profiles.string(),
+                                         "--out", csv.string()};
+  ASSERT_EQ(run_to_end(args, dir_ / "indenter.log"), 0);
+  const auto rows = lines_of(csv);
+  ASSERT_GT(rows.size(), 10u);
+  size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(profiles)) files += entry.path().extension() == ".csv";
+  EXPECT_EQ(files, rows.size() - 1);
+  char name[32];
+  std::snprintf(name, sizeof name, "point_%05zu.csv", rows.size() - 2);
+  const auto profile = lines_of(profiles / name);
+  ASSERT_EQ(profile.size(), 1002u);  // header and 1001 samples
+  // Columns: s, x, y, ..., nx (13), ny (14). The disc: centre (half_span, rise - 0.05), radius 0.05.
+  const double cx = 0.45072123252074, cy = 0.1969039464300978 - 0.05;
+  double closest = INFINITY, ny_jump = 0.0;
+  for (size_t i = 1; i < profile.size(); ++i) {
+    closest = std::min(closest, std::hypot(csv_field(profile[i], 1) - cx, csv_field(profile[i], 2) - cy) - 0.05);
+    if (i > 1) ny_jump = std::max(ny_jump, std::abs(csv_field(profile[i], 14) - csv_field(profile[i - 1], 14)));
+  }
+  EXPECT_GE(closest, -1e-10);
+  EXPECT_LE(closest, 1e-6);                 // touching (the samples straddle the contact)
+  EXPECT_NEAR(ny_jump, 11.2936742817, 1e-6);  // the closed-form contact force
 }
 
 TEST_F(ContinueCli, ContinuingAnUnknownParameterIsRefused) {
