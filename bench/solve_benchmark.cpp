@@ -34,6 +34,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "kirchhoff/case_file.hpp"
@@ -320,6 +321,8 @@ void jacobian_breakdown(const CaseSpec& spec, int reps) {
               f_fd.first, f_fd.second, problem.size(), f_var.first / f_fd.first, jac_diff);
 }
 
+void threads_ratio();
+
 int run_summary(int runs_planar, int runs_3d) {
   const std::vector<Scenario> all = scenarios();
   std::map<std::string, Stats> results;
@@ -371,7 +374,31 @@ int run_summary(int runs_planar, int runs_3d) {
 
   std::printf("\nOne evaluation at the solution (median of repeated calls):\n");
   for (const CaseSpec& spec : case_specs()) jacobian_breakdown(spec, spec.planar ? runs_planar : runs_3d);
+  threads_ratio();
   return 0;
+}
+
+// Multiple shooting's segments integrated by one thread and by the machine's threads
+// (ShootingOptions::threads), same process: plectoneme.toml at L/2R = 200 (40 segments, 574
+// unknowns), F + J at its starting guess.
+void threads_ratio() {
+  std::printf("\nMultiple shooting, segments on one thread / on all (%u) hardware threads:\n",
+              std::thread::hardware_concurrency());
+  Case c = load_case(std::string(KIRCHHOFF_CASES_DIR) + "/plectoneme.toml", {{"slenderness", 200.0}});
+  std::map<int, std::pair<double, double>> times;
+  for (int threads : {1, 0}) {
+    c.definition.options.threads = threads;
+    const ShootingProblem problem(c.definition);
+    const Eigen::VectorXd x = problem.initial_unknowns(c.start_guess);
+    Eigen::VectorXd F(problem.size());
+    Eigen::MatrixXd J(problem.size(), problem.size());
+    times[threads] = time_call(problem, 5, [&] { problem.evaluate(x, &F, &J, nullptr); });
+    const auto f_only = time_call(problem, 20, [&] { problem.evaluate(x, &F, nullptr, nullptr); });
+    times[threads + 10] = f_only;
+  }
+  std::printf("  %-28s F + J %9.0f / %9.0f us  ratio %.2f   F %7.0f / %7.0f us  ratio %.2f\n",
+              "plectoneme, L/2R = 200", times[1].first, times[0].first, times[1].first / times[0].first,
+              times[11].first, times[10].first, times[11].first / times[10].first);
 }
 
 int positive_int(const char* text, const char* flag) {

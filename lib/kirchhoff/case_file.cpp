@@ -646,7 +646,8 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
   // [solver]
   if (const Value* s = Reader::find(root, "solver")) {
     reader.allow_keys(*s, "solver", {"unknowns", "segments", "stepper", "abs_tol", "rel_tol", "tolerance",
-                                     "max_iterations", "jacobian", "fallback_search", "phase_condition"});
+                                     "max_iterations", "jacobian", "fallback_search", "phase_condition",
+                                     "threads"});
     ShootingOptions& o = d.options;
     if (const Value* v = Reader::find(*s, "unknowns")) {
       d.unknown_parameters = reader.strings(*v, "solver.unknowns");
@@ -662,6 +663,10 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
       if (o.segments < 1) reader.fail(*v, "solver.segments", "must be >= 1");
       if (o.segments > 1 && !d.obstacles.empty())
         reader.fail(*v, "solver.segments", "contact with obstacles needs single shooting (segments = 1)");
+    }
+    if (const Value* v = Reader::find(*s, "threads")) {
+      o.threads = static_cast<int>(reader.integer(*v, "solver.threads"));
+      if (o.threads < 0) reader.fail(*v, "solver.threads", "must be >= 0 (0: the machine's hardware concurrency)");
     }
     if (const Value* v = Reader::find(*s, "stepper")) {
       const std::string name = reader.string(*v, "solver.stepper");

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <exception>
+#include <functional>
+#include <thread>
 
 #include "kirchhoff/jacobian_lu.hpp"
 
@@ -22,6 +25,7 @@ struct ConditionRows {
 
 std::string ShootingOptions::validate() const {
   if (segments < 1) return "segments must be >= 1";
+  if (threads < 0) return "threads must be >= 0 (0: the hardware concurrency)";
   if (std::string e = integrator.validate(); !e.empty()) return e;
   return newton.validate();
 }
@@ -131,8 +135,57 @@ std::shared_ptr<const RodEquations> ShootingProblem::equations(const Parameters&
     cached_equations_ = definition_.kind == RodKind::Planar ? make_planar_equations(std::move(model))
                                                             : make_spatial_equations(std::move(model));
     cached_model_values_ = key;
+    worker_equations_.clear();
   }
   return cached_equations_;
+}
+
+void ShootingProblem::for_each_segment(const Parameters& p, const std::function<void(int, const RodEquations&)>& work,
+                                       bool parallel) const {
+  const auto eq = equations(p);
+  const int M = segments();
+  const int requested = definition_.options.threads > 0 ? definition_.options.threads
+                                                        : static_cast<int>(std::thread::hardware_concurrency());
+  const int workers = parallel && M >= 8 ? std::clamp(requested, 1, M / 4) : 1;
+  while (static_cast<int>(worker_equations_.size()) < workers - 1) {
+    RodModel model = definition_.model(p);
+    worker_equations_.push_back(definition_.kind == RodKind::Planar ? make_planar_equations(std::move(model))
+                                                                    : make_spatial_equations(std::move(model)));
+  }
+  // Worker w takes the segments w, w + workers, ... (neighbouring segments cost alike).
+  std::vector<std::exception_ptr> errors(workers);
+  auto run = [&](int w) {
+    const RodEquations& equations = w == 0 ? *eq : *worker_equations_[w - 1];
+    try {
+      for (int i = w; i < M; i += workers) work(i, equations);
+    } catch (...) {
+      errors[w] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int w = 1; w < workers; ++w) threads.emplace_back(run, w);
+  run(0);
+  for (auto& t : threads) t.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+bool ShootingProblem::integrate_segments(const Eigen::VectorXd& x, const Parameters& p, bool sensitivities,
+                                         std::vector<SegmentFlow>* flows, std::string* failure) const {
+  const int n = state_size_, M = segments();
+  const double L = length(p);
+  flows->assign(M, SegmentFlow{});
+  try {
+    for_each_segment(p, [&](int i, const RodEquations& equations) {
+      (*flows)[i] = equations.flow(x.segment(i * n, n), L * i / M, L * (i + 1) / M, sensitivities,
+                                   definition_.options.integrator);
+    });
+  } catch (const IntegrationError& e) {
+    if (failure) *failure = e.what();
+    return false;
+  }
+  for (const auto& flow : *flows) rhs_evaluations_ += flow.rhs_evaluations;
+  return true;
 }
 
 Parameters ShootingProblem::parameters_at(const Eigen::VectorXd& x) const {
@@ -255,31 +308,20 @@ bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Ei
   if (!definition_.contacts.empty()) return residual_with_contacts(x, p, F, J, failure, y_end);
   const auto eq = equations(p);
   const int n = state_size_, M = segments();
-  const double L = eq->model().length;
   const Eigen::VectorXd y0 = x.head(n);
   int row = start_rows(*eq, y0, p, F, J);
 
-  SegmentFlow last;
-  try {
-    for (int i = 0; i < M; ++i) {
-      const double s0 = L * i / M, s1 = L * (i + 1) / M;
-      SegmentFlow flow = eq->flow(x.segment(i * n, n), s0, s1, J != nullptr, definition_.options.integrator);
-      rhs_evaluations_ += flow.rhs_evaluations;
-      if (i + 1 < M) {
-        F->segment(row, n) = flow.y - x.segment((i + 1) * n, n);
-        if (J) {
-          J->block(row, i * n, n, n) = flow.Phi;
-          J->block(row, (i + 1) * n, n, n) = -Eigen::MatrixXd::Identity(n, n);
-        }
-        row += n;
-      } else {
-        last = std::move(flow);
-      }
+  std::vector<SegmentFlow> flows;
+  if (!integrate_segments(x, p, J != nullptr, &flows, failure)) return false;
+  for (int i = 0; i + 1 < M; ++i) {
+    F->segment(row, n) = flows[i].y - x.segment((i + 1) * n, n);
+    if (J) {
+      J->block(row, i * n, n, n) = flows[i].Phi;
+      J->block(row, (i + 1) * n, n, n) = -Eigen::MatrixXd::Identity(n, n);
     }
-  } catch (const IntegrationError& e) {
-    if (failure) *failure = e.what();
-    return false;
+    row += n;
   }
+  const SegmentFlow& last = flows.back();
 
   if (y_end) *y_end = last.y;
   ConditionRows end;
@@ -502,14 +544,20 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
     }
     return out;
   }
+  // Each segment samples the arclengths in it, from its own start state.
+  std::vector<std::vector<double>> local(M);
   for (int i = 0; i < M; ++i) {
     const double s0 = L * i / M, s1 = L * (i + 1) / M;
-    std::vector<double> local{s0};
-    while (k < s.size() && (s[k] < s1 || i + 1 == M)) local.push_back(std::min(s[k++], s1));
-    if (local.size() == 1) continue;
-    const auto states = eq->sample(x.segment(i * n, n), local, definition_.options.integrator);
-    for (size_t j = 1; j < states.size(); ++j) out.push_back(eq->point(states[j], local[j]));
+    local[i] = {s0};
+    while (k < s.size() && (s[k] < s1 || i + 1 == M)) local[i].push_back(std::min(s[k++], s1));
   }
+  std::vector<std::vector<RodPoint>> points(M);
+  for_each_segment(p, [&](int i, const RodEquations& equations) {
+    if (local[i].size() == 1) return;
+    const auto states = equations.sample(x.segment(i * n, n), local[i], definition_.options.integrator);
+    for (size_t j = 1; j < states.size(); ++j) points[i].push_back(equations.point(states[j], local[i][j]));
+  }, s.size() >= 64);
+  for (auto& segment : points) out.insert(out.end(), segment.begin(), segment.end());
   return out;
 }
 

@@ -51,6 +51,10 @@ using ModelFunction = std::function<RodModel(const Parameters&)>;
 
 struct ShootingOptions {
   int segments = 1;  // multiple shooting when > 1 (long or strongly loaded rods)
+  // Threads integrating the segments of multiple shooting (they are independent): 0 takes the
+  // machine's hardware concurrency. Used from 8 segments on; each extra thread has its own copy
+  // of the equations (material profiles evaluate muParser expressions, which are not reentrant).
+  int threads = 0;
   IntegratorOptions integrator;
   NewtonOptions newton;
   std::string validate() const;
@@ -155,8 +159,19 @@ class ShootingProblem final : public NonlinearSystem {
   int residual_count_ = 0;
   int start_condition_count_ = 0;
   std::vector<int> unknown_index_;  // index of each unknown parameter in Parameters
+  // Calls work(i, equations) for every segment i of multiple shooting, in parallel (see
+  // ShootingOptions::threads); each thread has its own equations. Rethrows the first exception.
+  // (Serially when `parallel` is false: starting threads costs more than a few samples.)
+  void for_each_segment(const Parameters& p, const std::function<void(int, const RodEquations&)>& work,
+                        bool parallel = true) const;
+  // The flows of all segments.
+  bool integrate_segments(const Eigen::VectorXd& x, const Parameters& p, bool sensitivities,
+                          std::vector<SegmentFlow>* flows, std::string* failure) const;
+
   mutable std::vector<double> cached_model_values_;
   mutable std::shared_ptr<const RodEquations> cached_equations_;
+  // Copies of the equations for the extra threads, built with cached_equations_.
+  mutable std::vector<std::shared_ptr<const RodEquations>> worker_equations_;
   mutable long rhs_evaluations_ = 0;
 };
 
