@@ -51,15 +51,7 @@ DefinitionSolve solve_seeded(const Case& c, const StartSeed& options) {
   DiscreteSeed seed;
   ContactSolveResult contact = solve_from_discrete_seed(c.definition, options.segments, options.amplitude, &seed);
   std::cerr << "seed: " << seed.summary << "\n";
-  DefinitionSolve out;
-  out.problem = std::make_unique<ShootingProblem>(contact.definition);
-  out.result = std::move(contact.result);
-  out.contact_log = std::move(contact.log);
-  if (out.result.summary.converged() && !contact.complementarity) {
-    out.result.summary.status = SolverStatus::MaxIterations;
-    out.result.summary.message = contact.message;
-  }
-  return out;
+  return as_definition_solve(std::move(contact));
 }
 
 }  // namespace

@@ -185,21 +185,13 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
     py::gil_scoped_release release;
     ShootingResult solved_result;
     try {
-      if (seed == "ipopt") {
-        // As `kirchhoff solve --seed ipopt`.
-        const ContactSolveResult seeded = solve_from_discrete_seed(c.definition, seed_segments);
-        problem = std::make_unique<ShootingProblem>(seeded.definition);
-        solved_result = seeded.result;
-        if (solved_result.summary.converged() && !seeded.complementarity) {
-          solved_result.summary.status = SolverStatus::MaxIterations;
-          solved_result.summary.message = seeded.message;
-        }
-      } else {
-        // As the CLI: plain shooting, or the active-set loop when the case has obstacles.
-        DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
-        problem = std::move(solved.problem);
-        solved_result = std::move(solved.result);
-      }
+      // As the CLI: plain shooting, or the active-set loop when the case has obstacles, from the
+      // case's guess or from Ipopt's seed.
+      DefinitionSolve solved = seed == "ipopt"
+                                   ? as_definition_solve(solve_from_discrete_seed(c.definition, seed_segments))
+                                   : solve_definition(c.definition, c.start_guess);
+      problem = std::move(solved.problem);
+      solved_result = std::move(solved.result);
     } catch (const InfeasibleContact& e) {
       integration_failed = true;
       failed.summary.status = SolverStatus::MaxIterations;

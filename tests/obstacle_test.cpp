@@ -59,6 +59,23 @@ TEST(Obstacle, RefusesDegenerateShapes) {
   EXPECT_THROW(Obstacle::level_set([](const Vec3&) { return 0.0; }, "0", "", 0.0), std::invalid_argument);
 }
 
+// A definition whose obstacles are replaced by fixed ones.
+void replace_obstacles(ProblemDefinition* d, std::vector<Obstacle> obstacles) {
+  d->obstacles = std::move(obstacles);
+  d->moving_obstacles = {};
+  d->obstacle_parameters.clear();
+}
+
+// The active-set loop on `d` finds one contact, with the force and arclength of `expected`.
+void expect_single_contact_like(const ProblemDefinition& d, const RodPoint& guess, const PointContact& expected,
+                                double tolerance) {
+  const ContactSolveResult found = solve_with_contacts(d, guess);
+  ASSERT_TRUE(found.complementarity) << found.message;
+  ASSERT_EQ(found.definition.contacts.size(), 1u);
+  EXPECT_NEAR(found.definition.contacts[0].force / expected.force, 1.0, tolerance);
+  EXPECT_NEAR(found.definition.contacts[0].s, expected.s, tolerance);
+}
+
 // --- three-point bending by a disc (cases/indenter.toml) ----------------------------------
 
 struct IndenterRun {
@@ -129,15 +146,9 @@ TEST(DiscContact, TheSameDiscAsALevelSetGivesTheSameSolution) {
   Case c = load_case(testing::case_path("indenter.toml"), {{"radius", 0.1}});
   const Vec3 centre = c.definition.obstacles[0].point();
   const auto g = [centre](const Vec3& r) { return std::hypot(r.x() - centre.x(), r.y() - centre.y()) - 0.1; };
-  c.definition.obstacles = {Obstacle::level_set(g, "disc", "indenter", 1e-4)};
-  c.definition.moving_obstacles = {};
-  c.definition.obstacle_parameters.clear();
-  const ContactSolveResult level = solve_with_contacts(c.definition, c.start_guess);
-  ASSERT_TRUE(level.complementarity) << level.message;
-  ASSERT_EQ(level.definition.contacts.size(), 1u);
+  replace_obstacles(&c.definition, {Obstacle::level_set(g, "disc", "indenter", 1e-4)});
   // Fourth-order differences with h = 1e-4 on a radius 0.1: gradient error ~1e-11.
-  EXPECT_NEAR(level.definition.contacts[0].force / cylinder.solution.contacts[0].force, 1.0, 1e-9);
-  EXPECT_NEAR(level.definition.contacts[0].s, cylinder.solution.contacts[0].s, 1e-9);
+  expect_single_contact_like(c.definition, c.start_guess, cylinder.solution.contacts[0], 1e-9);
 }
 
 TEST(DiscContact, ContinuationInTheIndentersHeightFromFirstContact) {
@@ -200,20 +211,14 @@ TEST(SpatialContact, PlanarWallCaseGivesTheSameForcesIn3D) {
   const ContactSolveResult expected = solve_with_contacts(planar.definition, planar.start_guess);
   ASSERT_TRUE(expected.complementarity);
   Case spatial = load_case(testing::case_path("twisted_ribbon_pole.toml"), {{"phi", 0.0}});
-  spatial.definition.obstacles = {Obstacle::plane(Vec3(0.1, 0, 0), Vec3(-1, 0, 0), "wall")};
-  spatial.definition.moving_obstacles = {};
-  spatial.definition.obstacle_parameters.clear();
+  replace_obstacles(&spatial.definition, {Obstacle::plane(Vec3(0.1, 0, 0), Vec3(-1, 0, 0), "wall")});
   spatial.definition.model = [inner = spatial.definition.model](const Parameters& p) {
     RodModel m = inner(p);
     m.B[1] = Profile(1.0);  // isotropic as wall.toml (its circle of copies is broken by phi = 0 and the wall)
     return m;
   };
-  const ContactSolveResult found = solve_with_contacts(spatial.definition, spatial.start_guess);
-  ASSERT_TRUE(found.complementarity) << found.message;
-  ASSERT_EQ(found.definition.contacts.size(), 1u);
   // Two integrations at 1e-12 and Newton to 1e-12: 1e-9 is the bar.
-  EXPECT_NEAR(found.definition.contacts[0].force / expected.definition.contacts[0].force, 1.0, 1e-9);
-  EXPECT_NEAR(found.definition.contacts[0].s, expected.definition.contacts[0].s, 1e-9);
+  expect_single_contact_like(spatial.definition, spatial.start_guess, expected.definition.contacts[0], 1e-9);
 }
 
 TEST(SpatialContact, TwistedRibbonLeansOnAPole) {
@@ -260,8 +265,7 @@ TEST(DiscContact, IpoptConvergesToTheShootingSolutionAtSecondOrder) {
   const double radius = 0.1, centre_x = 0.5 * (1.0 - 0.026);
   Case c = load_case(testing::case_path("wall.toml"));
   const Obstacle disc = Obstacle::cylinder(Vec3(centre_x, 0.1 + radius, 0.0), Vec3::UnitZ(), radius, "disc");
-  c.definition.obstacles = {disc};
-  c.definition.moving_obstacles = {};  // wall.toml's wall follows its parameter a
+  replace_obstacles(&c.definition, {disc});  // (wall.toml's wall follows its parameter a)
   const ContactSolveResult shooting = solve_with_contacts(c.definition, c.start_guess);
   ASSERT_TRUE(shooting.complementarity) << shooting.message;
   ASSERT_EQ(shooting.definition.contacts.size(), 1u);

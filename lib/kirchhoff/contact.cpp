@@ -106,7 +106,11 @@ DefinitionSolve solve_definition(const ProblemDefinition& definition, const RodP
     out.result = solve(*out.problem, out.problem->initial_unknowns(guess));
     return out;
   }
-  ContactSolveResult contact = solve_with_contacts(definition, guess);
+  return as_definition_solve(solve_with_contacts(definition, guess));
+}
+
+DefinitionSolve as_definition_solve(ContactSolveResult contact) {
+  DefinitionSolve out;
   out.problem = std::make_unique<ShootingProblem>(contact.definition);
   out.result = std::move(contact.result);
   out.contact_log = std::move(contact.log);

@@ -62,6 +62,8 @@ struct DefinitionSolve {
   std::vector<std::string> contact_log;
 };
 DefinitionSolve solve_definition(const ProblemDefinition& definition, const RodPoint& guess);
+// An active-set loop's result as such a solve (a loop that did not settle: max_iterations).
+DefinitionSolve as_definition_solve(ContactSolveResult contact);
 
 // Continuation through changes of the active contact set. Each leg is an ordinary Continuation
 // with the set fixed and stopping events, at which the set changes, the change is recorded as an
