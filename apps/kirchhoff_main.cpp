@@ -178,6 +178,12 @@ int main(int argc, char** argv) {
       ->add_option("--max-step", plect.max_step,
                    "Largest pseudo-arclength step at L/2R = 100 (scaled by (L/2R / 100)^2 with the forces)")
       ->capture_default_str();
+  plectonemes_cmd
+      ->add_option("--reuse-jacobian", plect.reuse_jacobian,
+                   "A point whose chord iterations converged within this many keeps the previous point's\n"
+                   "Jacobian (-1: every point computes its own)")
+      ->check(CLI::Range(-1, 100))
+      ->capture_default_str();
 
   try {
     app.parse(argc, argv);

@@ -43,7 +43,8 @@ bool branch_complete(const std::filesystem::path& csv) {
 }
 
 // How a plectoneme branch is followed in `turns`, at any slenderness.
-ContinuationOptions continuation_options(const Case& c, double slenderness, double turns_max, double max_step) {
+ContinuationOptions continuation_options(const Case& c, double slenderness, double turns_max, double max_step,
+                                         int reuse_jacobian) {
   ContinuationOptions o;
   o.parameter = "turns";
   o.target = turns_max;
@@ -61,7 +62,7 @@ ContinuationOptions continuation_options(const Case& c, double slenderness, doub
   o.corrector_max_iterations = 12;
   o.grow_iterations = 6;
   o.shrink_iterations = 10;
-  o.reuse_jacobian_iterations = 8;
+  o.reuse_jacobian_iterations = reuse_jacobian;
   o.detect_branch_points = false;  // the barrier's stiffness turns the determinant's sign into noise
   return o;
 }
@@ -81,7 +82,8 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
   const Case c = load_case(case_path, {{"slenderness", slenderness}});
   const double EI = c.definition.parameters.get("EI");
   ShootingProblem problem(c.definition);
-  const ContinuationOptions o = continuation_options(c, slenderness, turns_max, options.max_step);
+  const ContinuationOptions o =
+      continuation_options(c, slenderness, turns_max, options.max_step, options.reuse_jacobian);
 
   const std::vector<std::string> names = [] {
     std::vector<std::string> n = kMeasured;
@@ -149,6 +151,7 @@ int run_plectonemes(const PlectonemesArguments& args) {
       PlectonemeRunOptions options;
       options.progress_every = 50;
       options.max_step = args.max_step;
+      options.reuse_jacobian = args.reuse_jacobian;
       options.resume = args.resume;
       const auto s = follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, options);
       total += s.points;

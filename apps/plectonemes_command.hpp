@@ -12,6 +12,7 @@ namespace kirchhoff::cli {
 // Largest pseudo-arclength step at L/2R = 100: the unknowns are dominated by forces of 1e2-1e4
 // there, so steps of tens are small.
 inline constexpr double kPlectonemeMaxStep = 60.0;
+inline constexpr int kPlectonemeReuseJacobian = 8;
 
 struct PlectonemeBranchSummary {
   int points = 0;
@@ -24,6 +25,9 @@ struct PlectonemeBranchSummary {
 struct PlectonemeRunOptions {
   int progress_every = 0;                 // a progress line on stderr every this many points (0: none)
   double max_step = kPlectonemeMaxStep;   // at L/2R = 100, scaled with the forces (1/R^2)
+  // A point whose chord iterations converged within this many keeps the previous Jacobian
+  // (ContinuationOptions::reuse_jacobian_iterations; -1: every point computes its own).
+  int reuse_jacobian = kPlectonemeReuseJacobian;
   // Continue a killed run from csv_path's state file (csv_path + ".state.json"); a branch whose
   // CSV ends at its endpoint is left as it is. Without a state file the branch starts afresh.
   bool resume = false;
@@ -42,6 +46,7 @@ struct PlectonemesArguments {
   std::vector<double> turns{10, 20, 20, 50};
   std::string out_dir = "plectonemes";
   double max_step = kPlectonemeMaxStep;
+  int reuse_jacobian = kPlectonemeReuseJacobian;
   bool resume = false;
 };
 
