@@ -44,8 +44,16 @@ nlohmann::json solution_json(const Case& c, const ShootingProblem& problem, cons
   j["ends"] = {{"start", end_json(sol.profile.front())}, {"end", end_json(sol.profile.back())}};
   j["rhs_evaluations"] = problem.rhs_evaluations();
   j["contacts"] = nlohmann::json::array();
-  for (const auto& c : sol.contacts)
-    j["contacts"].push_back({{"s", c.s}, {"s_end", c.s}, {"force", c.force}, {"obstacle", c.obstacle}});
+  for (const auto& c : report_contacts(problem, sol))
+    j["contacts"].push_back({{"obstacle", c.obstacle},
+                             {"obstacle_name", c.obstacle_name},
+                             {"extended", c.extended},
+                             {"s", c.s},
+                             {"s_end", c.s_end},
+                             {"force", c.force},
+                             {"force_end", c.force_end},
+                             {"H_before", c.H_before},
+                             {"H_after", c.H_after}});
   if (sol.result.summary.used_fallback_search) j["note"] = "starting point from the NLopt fallback search";
   return j;
 }

@@ -25,9 +25,16 @@ void print_human(const Case& c, const Solution& sol) {
     std::cout << "  m3 = " << sol.invariants.m3.mean << " (spread " << sol.invariants.m3.spread << ")\n";
   if (sol.invariants.n_dot_m.applies)
     std::cout << "  n.m = " << sol.invariants.n_dot_m.mean << " (spread " << sol.invariants.n_dot_m.spread << ")\n";
-  for (const auto& contact : sol.contacts)
-    std::cout << "  contact with obstacle " << contact.obstacle << " at s = " << contact.s << ", force " << contact.force
-              << "\n";
+  for (const auto& contact : sol.contacts) {
+    std::cout << "  contact with obstacle " << contact.obstacle;
+    if (const std::string& name = c.definition.obstacles[contact.obstacle].name; !name.empty())
+      std::cout << " (" << name << ")";
+    if (contact.extended)
+      std::cout << " over [" << contact.s << ", " << contact.s_end << "], end forces " << contact.force << ", "
+                << contact.force_end << "\n";
+    else
+      std::cout << " at s = " << contact.s << ", force " << contact.force << "\n";
+  }
 }
 
 }  // namespace

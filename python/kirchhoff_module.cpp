@@ -134,7 +134,7 @@ struct PySolution {
   long rhs_evaluations = 0;
   std::vector<double> history;
   py::dict parameters, derived, invariants, profile;
-  py::list contacts;  // [{"s", "s_end", "force", "obstacle"}], as the CLI's JSON
+  py::list contacts;  // as the CLI's JSON: report_contacts
 };
 
 struct PyBranch {
@@ -239,12 +239,17 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   for (const auto& name : c.derived) out.derived[py::str(name)] = sol->derived.at(name);
   out.invariants = invariants_dict(sol->invariants);
   out.profile = profile_dict(problem->equations(sol->result.parameters)->model(), sol->profile);
-  for (const auto& contact : sol->contacts) {
+  for (const auto& contact : report_contacts(*problem, *sol)) {
     py::dict d;
-    d["s"] = contact.s;
-    d["s_end"] = contact.s;
-    d["force"] = contact.force;
     d["obstacle"] = contact.obstacle;
+    d["obstacle_name"] = contact.obstacle_name;
+    d["extended"] = contact.extended;
+    d["s"] = contact.s;
+    d["s_end"] = contact.s_end;
+    d["force"] = contact.force;
+    d["force_end"] = contact.force_end;
+    d["H_before"] = contact.H_before;
+    d["H_after"] = contact.H_after;
     out.contacts.append(d);
   }
   return out;
@@ -488,7 +493,7 @@ Attributes:
       .def_readonly("message", &PySolution::message)
       .def_readonly("used_fallback_search", &PySolution::used_fallback_search)
       .def_readonly("rhs_evaluations", &PySolution::rhs_evaluations)
-      .def_readonly("contacts", &PySolution::contacts, "Point contacts: list of {s, s_end, force, obstacle}")
+      .def_readonly("contacts", &PySolution::contacts, "Contacts: list of {obstacle, obstacle_name, extended, s, s_end, force, force_end, H_before, H_after}")
       .def_readonly("history", &PySolution::history)
       .def_readonly("parameters", &PySolution::parameters)
       .def_readonly("derived", &PySolution::derived)

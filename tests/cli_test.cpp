@@ -325,7 +325,16 @@ TEST_F(CliTest, IpoptSeedSolvesWhatTheGuessCannot) {
   EXPECT_THAT(seeded.err, HasSubstr("seed: Ipopt on 200 segments"));
   const json j = parse(seeded);
   EXPECT_EQ(j["status"], "converged");
-  EXPECT_EQ(j["contacts"].size(), 1u);
+  ASSERT_EQ(j["contacts"].size(), 1u);
+  const json& contact = j["contacts"][0];
+  EXPECT_EQ(contact["obstacle_name"], "upper wall");
+  EXPECT_FALSE(contact["extended"].get<bool>());
+  EXPECT_EQ(contact["s_end"].get<double>(), contact["s"].get<double>());
+  EXPECT_EQ(contact["force_end"].get<double>(), 0.0);
+  // H on both sides of the contact: the same (section 6.3), and the rod's H.
+  const double H = j["derived"]["H"].get<double>();
+  EXPECT_NEAR(contact["H_before"].get<double>(), H, 1e-9 * std::abs(H));
+  EXPECT_NEAR(contact["H_after"].get<double>(), H, 1e-9 * std::abs(H));
   // A spatial case is refused with the reason; a bad segment count by the parser.
   const CliRun spatial = run("solve " + quoted(case_path("twisted_ribbon_pole.toml")) + " --seed ipopt");
   EXPECT_EQ(spatial.status, 2);

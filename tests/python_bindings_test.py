@@ -143,6 +143,9 @@ class ContactTest(unittest.TestCase):
         # The elliptic-function value (tests/contact_test.cpp): F_c = 18.2038121699.
         self.assertAlmostEqual(sol.contacts[0]["force"], 18.2038121699, places=8)
         self.assertAlmostEqual(sol.contacts[0]["s"], 0.5, places=9)
+        self.assertEqual(sol.contacts[0]["obstacle_name"], "wall")
+        self.assertFalse(sol.contacts[0]["extended"])
+        self.assertAlmostEqual(sol.contacts[0]["H_before"] / sol.contacts[0]["H_after"], 1.0, places=9)
         self.assertGreaterEqual(sol.derived["min_gap"], -1e-10)
 
     def test_ipopt_seed_reaches_what_the_guess_cannot(self):

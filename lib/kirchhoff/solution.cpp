@@ -203,6 +203,27 @@ const std::map<std::string, std::string>& derived_catalogue() {
   return all;
 }
 
+std::vector<ContactReport> report_contacts(const ShootingProblem& problem, const Solution& sol) {
+  std::vector<ContactReport> out;
+  const auto obstacles = problem.obstacles(sol.result.parameters);
+  const RodModel& model = problem.equations(sol.result.parameters)->model();
+  for (const auto& c : sol.contacts) {
+    ContactReport r;
+    r.obstacle = c.obstacle;
+    r.obstacle_name = obstacles[c.obstacle].name;
+    r.extended = c.extended;
+    r.s = c.s;
+    r.s_end = c.extended ? c.s_end : c.s;
+    r.force = c.force;
+    r.force_end = c.extended ? c.force_end : 0.0;
+    const auto sides = problem.sample(sol.result.x, {r.s - 1e-9, r.s_end + 1e-9});
+    r.H_before = hamiltonian(model, sides[0]);
+    r.H_after = hamiltonian(model, sides[1]);
+    out.push_back(r);
+  }
+  return out;
+}
+
 Solution make_solution(const ShootingProblem& problem, ShootingResult result, int n_samples,
                        const std::vector<std::string>& derived_names) {
   if (n_samples < 2) throw std::invalid_argument("need at least 2 profile samples");

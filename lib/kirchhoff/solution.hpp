@@ -23,6 +23,18 @@ struct Solution {
 Solution make_solution(const ShootingProblem& problem, ShootingResult result, int n_samples,
                        const std::vector<std::string>& derived_names);
 
+// What the outputs (CLI JSON, Python) say of each contact: where, how hard, and H just before it
+// and just after it (after the flat part of an extended contact), which section 6.3 says agree.
+struct ContactReport {
+  int obstacle = 0;
+  std::string obstacle_name;
+  bool extended = false;
+  double s = 0.0, s_end = 0.0;         // s_end = s for a point contact
+  double force = 0.0, force_end = 0.0;  // force_end = 0 for a point contact
+  double H_before = 0.0, H_after = 0.0;
+};
+std::vector<ContactReport> report_contacts(const ShootingProblem& problem, const Solution& sol);
+
 // Names accepted in a case's derived list, with a one-line meaning each.
 const std::map<std::string, std::string>& derived_catalogue();
 
