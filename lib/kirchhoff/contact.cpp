@@ -330,11 +330,14 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
       }
       PointContact& c = d.contacts[which];
       if (!d.obstacles[c.obstacle].is_flat()) {
-        // The rod's curvature has reached the obstacle's: beyond, it would wrap around it over an
-        // interval, which only planes model.
+        // The rod's curvature has reached the obstacle's: beyond, it would lie on it over an
+        // interval (the disc's analogue of a flat contact: n along the tangent inside, in tension,
+        // forces at the ends), which only planes model. (A Newton jump onto two point contacts
+        // either side was tried here and found solutions, but that is not the branch the flat case
+        // says the rod takes, so it is not offered.)
         out.result.reason = StopReason::Inadmissible;
         out.result.message = "the contact at s = " + std::to_string(c.s) + " starts to wrap around " +
-                             d.obstacles[c.obstacle].describe() +
+                             here.definition().obstacles[c.obstacle].describe() +
                              ": extended contact on curved obstacles is not implemented; the run stops here";
         out.changes.push_back(change.str() + out.result.message);
         return out;
