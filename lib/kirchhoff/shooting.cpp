@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <exception>
 #include <functional>
+#include <stdexcept>
 #include <thread>
 
 #include "kirchhoff/jacobian_lu.hpp"
