@@ -120,6 +120,7 @@ std::vector<ContinuationEvent> parse_events(const std::vector<std::string>& text
 int run_continue(const ContinueArguments& args) {
   Case c;
   ContinuationOptions options;
+  Eigen::VectorXd start_point;  // --start-from: the unknowns to start from
   try {
     ParameterOverrides overrides;
     for (const auto& t : args.overrides) overrides.push_back(parse_override(t));
@@ -140,6 +141,21 @@ int run_continue(const ContinueArguments& args) {
     options.events = parse_events(args.stop_events, true);
     for (auto& e : parse_events(args.record_events, false)) options.events.push_back(e);
     if (std::string e = options.validate(); !e.empty()) throw CaseError(e);
+    if (!args.start_from.empty()) {
+      if (args.resume || args.seed.ipopt) throw CaseError("--start-from does not combine with --resume or --seed");
+      if (!c.definition.obstacles.empty())
+        throw CaseError("--start-from is not implemented for cases with obstacles (their active set)");
+      const RunState from = load_state(args.start_from);
+      const std::string name = from.parameter_name.empty() ? args.start_param : from.parameter_name;
+      if (name.empty())
+        throw CaseError(args.start_from + " does not name its parameter: give it with --start-param");
+      if (!c.definition.parameters.contains(name))
+        throw CaseError(args.start_from + ": its parameter '" + name + "' is not a parameter of the case");
+      if (name != args.parameter) c.definition.parameters.set(name, from.last.parameter);
+      start_point = from.last.x;
+      std::cerr << "start: the point at " << name << " = " << std::setprecision(15) << from.last.parameter << " of "
+                << args.start_from << "\n" << std::setprecision(6);
+    }
     if (args.seed.ipopt && !args.resume) {
       // The first point from Ipopt's shape and contact set instead of the case's guess.
       const DiscreteSeed seed = seed_from_discrete_energy(c.definition, args.seed.segments, args.seed.amplitude);
@@ -170,11 +186,13 @@ int run_continue(const ContinueArguments& args) {
   Progress progress(args.parameter);
   RunState state;
   state.phase_condition = args.phase_condition.empty() ? "none" : args.phase_condition;
+  state.parameter_name = args.parameter;
   std::unique_ptr<BranchWriter> writer;
 
   try {
     if (args.resume) {
       state = load_state(state_path);
+      state.parameter_name = args.parameter;
       truncate_csv(csv, state.row);
     }
     std::vector<std::string> columns = c.definition.unknown_parameters;  // solved-for parameters first
@@ -291,6 +309,12 @@ int run_continue(const ContinueArguments& args) {
   }
   try {
     auto problem = problem_for(state.phase_condition);
+    if (start_point.size() > 0 && start_point.size() != problem->size()) {
+      progress.done();
+      std::cerr << "error: " << args.start_from << ": its point has " << start_point.size() << " unknowns, the case "
+                << problem->size() << " (set the parameters that fix the segments as in that run)\n";
+      return kExitBadInput;
+    }
     ContinuationOptions first = options;
     if (branch == 0 && args.switch_at_bp > 0)
       first.stop_at_branch_point = args.switch_at_bp - (args.resume ? count_branch_points(csv) : 0);
@@ -302,7 +326,8 @@ int run_continue(const ContinueArguments& args) {
     Continuation run(*problem, first);
     // (A resume never starts on a branch point: only points the march goes on from are saved.)
     result = args.resume ? run.resume(state.last, sink_for(*problem, branch, state.phase_condition))
-                         : run.run(problem->initial_unknowns(c.start_guess), sink_for(*problem, 0, state.phase_condition));
+                         : run.run(start_point.size() > 0 ? start_point : problem->initial_unknowns(c.start_guess),
+                                   sink_for(*problem, 0, state.phase_condition));
     if (branch == 0 && args.switch_at_bp > 0) {
       if (result.reason != StopReason::BranchPointStop) {
         progress.done();

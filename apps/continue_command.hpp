@@ -30,6 +30,11 @@ struct ContinueArguments {
   bool resume = false;
   int samples = 101;
   StartSeed seed;             // where the first point is solved from (not used on --resume)
+  // Start from the last resumable point of another run's state file (e.g. a ply found by
+  // continuation in turns, now continued in slenderness); that run's parameter is set to the
+  // point's value. start_param names it for state files written before they recorded it.
+  std::string start_from;
+  std::string start_param;
 };
 
 int run_continue(const ContinueArguments& args);

@@ -94,6 +94,14 @@ int main(int argc, char** argv) {
   continue_cmd->add_flag("--no-branch-points", cont.no_branch_points,
                          "Do not look for branch points: their test functions cost an SVD per point, most of a\n"
                          "run on multiple-shooting cases of hundreds of unknowns (plectonemes); folds are still found");
+  continue_cmd
+      ->add_option("--start-from", cont.start_from,
+                   "Start from the last saved point of another run (its CSV's .state.json), e.g. a ply\n"
+                   "followed in turns, continued now in slenderness; that run's parameter is set to the\n"
+                   "point's value (same --set otherwise, so that the unknowns match)")
+      ->check(CLI::ExistingFile);
+  continue_cmd->add_option("--start-param", cont.start_param,
+                           "The parameter of a --start-from state file that does not name it");
   std::string continue_seed = "guess";
   add_seed_options(continue_cmd, &continue_seed, &cont.seed);
   continue_cmd->add_option("--side", cont.switch_side, "Which side of the bifurcating branch: 1 or -1")

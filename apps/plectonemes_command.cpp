@@ -95,6 +95,7 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
     state = load_state(state_path);
     truncate_csv(csv_path, state.saved_row);
   }
+  state.parameter_name = "turns";
   std::ofstream csv(csv_path, resuming ? std::ios::app : std::ios::trunc);
   if (!csv) throw std::runtime_error("cannot write " + csv_path);
   csv << std::setprecision(12);

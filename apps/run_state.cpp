@@ -33,6 +33,7 @@ void save_state(const std::filesystem::path& path, const RunState& s) {
                       {"arclength", s.last.arclength}, {"step", s.last.step},
                       {"x", to_json(s.last.x)},    {"tangent", to_json(s.last.tangent)},
                       {"type", to_string(s.last.type)}};
+  j["parameter_name"] = s.parameter_name;
   j["contacts"] = nlohmann::json::array();
   for (const auto& c : s.contacts)
     j["contacts"].push_back({{"obstacle", c.obstacle}, {"s", c.s}, {"force", c.force}, {"extended", c.extended},
@@ -61,6 +62,7 @@ RunState load_state(const std::filesystem::path& path) {
   s.row = s.saved_row = j.at("row");
   s.branch = j.at("branch");
   s.phase_condition = j.at("phase_condition");
+  s.parameter_name = j.value("parameter_name", "");
   s.last.index = j.at("index");
   s.last.parameter = j.at("parameter");
   s.last.arclength = j.at("arclength");

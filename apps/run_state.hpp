@@ -18,6 +18,7 @@ struct RunState {
   int saved_row = -1;             // the row of `last`, the point a resume starts from
   int branch = 0;                 // 0: the starting branch, 1: after --switch-at-bp
   std::string phase_condition;    // of the problem the branch belongs to
+  std::string parameter_name;     // the parameter continued in (empty in files older than it)
   ContinuationPoint last;
   std::vector<PointContact> contacts;  // the active set of `last` (contact runs)
 };

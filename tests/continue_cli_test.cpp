@@ -153,6 +153,41 @@ TEST_F(ContinueCli, ContactRunWritesEveryPointsProfile) {
   EXPECT_NEAR(ny_jump, 11.2936742817, 1e-6);  // the closed-form contact force
 }
 
+// --start-from: a run in one parameter starts where another run (in another parameter) stopped.
+// The straight twisted rod followed in phi to 8, then from there in tension: its first point is
+// the first run's last saved one (twisting moment M = GJ phi / L at that phi).
+TEST_F(ContinueCli, StartsFromAnotherRunsSavedPoint) {
+  const std::string twisted = std::string(KIRCHHOFF_CASES_DIR) + "/twisted_clamped.toml";
+  const fs::path first = dir_ / "phi.csv", second = dir_ / "tension.csv";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", twisted, "--param", "phi", "--to", "8", "--max-step", "0.5",
+                        "--no-branch-points", "--samples", "21", "--out", first.string()},
+                       dir_ / "phi.log"),
+            0);
+  const fs::path state = first.string() + ".state.json";
+  ASSERT_TRUE(fs::exists(state));
+  const std::vector<std::string> args = {KIRCHHOFF_CLI, "continue", twisted, "--param", "tension", "--to", "1",
+                                         "--start-from", state.string(), "--no-branch-points", "--samples", "21",
+                                         "--out", second.string()};
+  ASSERT_EQ(run_to_end(args, dir_ / "tension.log"), 0);
+  const auto log = lines_of(dir_ / "tension.log");
+  ASSERT_FALSE(log.empty());
+  EXPECT_NE(log.front().find("start: the point at phi = "), std::string::npos) << log.front();
+  const double phi = std::stod(log.front().substr(log.front().find("phi = ") + 6));
+  EXPECT_GT(phi, 7.0);
+  const auto rows = lines_of(second);
+  ASSERT_GT(rows.size(), 2u);
+  EXPECT_EQ(csv_field(rows[1], 2), 0.0);  // tension starts at the case's value
+  EXPECT_NEAR(csv_field(rows[1], 4), 0.769230769230769 * phi, 1e-9);  // M of the straight rod there
+  EXPECT_NE(rows.back().find(",endpoint,"), std::string::npos);
+  // A state from another case is refused (its parameter is not this case's).
+  const std::string plectoneme = std::string(KIRCHHOFF_CASES_DIR) + "/plectoneme.toml";
+  EXPECT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", plectoneme, "--param", "turns", "--to", "1", "--start-from",
+                        state.string(), "--out", (dir_ / "p.csv").string()},
+                       dir_ / "p.log"),
+            2);
+  EXPECT_NE(lines_of(dir_ / "p.log").back().find("'phi' is not a parameter"), std::string::npos);
+}
+
 TEST_F(ContinueCli, ContinuingAnUnknownParameterIsRefused) {
   const std::vector<std::string> args = {KIRCHHOFF_CLI, "continue",
                                          std::string(KIRCHHOFF_CASES_DIR) + "/simply_supported.toml", "--param",
