@@ -36,11 +36,7 @@ JacobianLU::JacobianLU(const Eigen::MatrixXd& unscaled) {
   rcond_ = largest > 0 ? std::min(dense_.rcond(), pivots.minCoeff() / largest) : 0.0;
 }
 
-Eigen::VectorXd JacobianLU::solve(const Eigen::VectorXd& b) const {
-  const Eigen::VectorXd scaled = row_scale_.cwiseProduct(b);
-  if (sparse_) return sparse_->solve(scaled);
-  return dense_.solve(scaled);
-}
+Eigen::VectorXd JacobianLU::solve(const Eigen::VectorXd& b) const { return solve_scaled(row_scale_.cwiseProduct(b)); }
 
 Eigen::VectorXd JacobianLU::solve_scaled(const Eigen::VectorXd& b) const {
   if (sparse_) return sparse_->solve(b);

@@ -126,14 +126,18 @@ std::vector<PointContact> ShootingProblem::contacts_at(const Eigen::VectorXd& x)
   return out;
 }
 
+std::shared_ptr<const RodEquations> ShootingProblem::build_equations(const Parameters& p) const {
+  RodModel model = definition_.model(p);
+  return definition_.kind == RodKind::Planar ? make_planar_equations(std::move(model))
+                                             : make_spatial_equations(std::move(model));
+}
+
 std::shared_ptr<const RodEquations> ShootingProblem::equations(const Parameters& p) const {
   std::vector<double> key;
   for (const auto& name : definition_.model_parameters)
     if (p.contains(name)) key.push_back(p.get(name));
   if (!cached_equations_ || key != cached_model_values_) {
-    RodModel model = definition_.model(p);
-    cached_equations_ = definition_.kind == RodKind::Planar ? make_planar_equations(std::move(model))
-                                                            : make_spatial_equations(std::move(model));
+    cached_equations_ = build_equations(p);
     cached_model_values_ = key;
     worker_equations_.clear();
   }
@@ -147,11 +151,7 @@ void ShootingProblem::for_each_segment(const Parameters& p, const std::function<
   const int requested = definition_.options.threads > 0 ? definition_.options.threads
                                                         : static_cast<int>(std::thread::hardware_concurrency());
   const int workers = parallel && M >= 8 ? std::clamp(requested, 1, M / 4) : 1;
-  while (static_cast<int>(worker_equations_.size()) < workers - 1) {
-    RodModel model = definition_.model(p);
-    worker_equations_.push_back(definition_.kind == RodKind::Planar ? make_planar_equations(std::move(model))
-                                                                    : make_spatial_equations(std::move(model)));
-  }
+  while (static_cast<int>(worker_equations_.size()) < workers - 1) worker_equations_.push_back(build_equations(p));
   // Worker w takes the segments w, w + workers, ... (neighbouring segments cost alike).
   std::vector<std::exception_ptr> errors(workers);
   auto run = [&](int w) {

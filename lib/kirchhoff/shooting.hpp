@@ -159,6 +159,8 @@ class ShootingProblem final : public NonlinearSystem {
   int residual_count_ = 0;
   int start_condition_count_ = 0;
   std::vector<int> unknown_index_;  // index of each unknown parameter in Parameters
+  // A new equations object for these parameters (uncached; a thread's own copy).
+  std::shared_ptr<const RodEquations> build_equations(const Parameters& p) const;
   // Calls work(i, equations) for every segment i of multiple shooting, in parallel (see
   // ShootingOptions::threads); each thread has its own equations. Rethrows the first exception.
   // (Serially when `parallel` is false: starting threads costs more than a few samples.)
