@@ -1,7 +1,5 @@
 #include "continue_command.hpp"
 
-#include "kirchhoff/discrete_seed.hpp"
-
 #include <unistd.h>
 
 #include <cmath>
@@ -16,6 +14,7 @@
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/continuation.hpp"
+#include "kirchhoff/discrete_seed.hpp"
 #include "kirchhoff/solution.hpp"
 #include "run_state.hpp"
 #include "solve_command.hpp"
@@ -186,15 +185,14 @@ int run_continue(const ContinueArguments& args) {
   Progress progress(args.parameter);
   RunState state;
   state.phase_condition = args.phase_condition.empty() ? "none" : args.phase_condition;
-  state.parameter_name = args.parameter;
   std::unique_ptr<BranchWriter> writer;
 
   try {
     if (args.resume) {
       state = load_state(state_path);
-      state.parameter_name = args.parameter;
       truncate_csv(csv, state.row);
     }
+    state.parameter_name = args.parameter;
     std::vector<std::string> columns = c.definition.unknown_parameters;  // solved-for parameters first
     columns.insert(columns.end(), options.derived.begin(), options.derived.end());
     writer = std::make_unique<BranchWriter>(csv, args.parameter, columns, args.resume);
@@ -265,6 +263,7 @@ int run_continue(const ContinueArguments& args) {
     // Contact: the active set changes along the branch (each change is an event row).
     try {
       std::vector<PointContact> active;
+      std::unique_ptr<ShootingProblem> leg_problem;  // for --profiles
       auto sink = [&](const ContinuationPoint& p) {
         ++state.row;
         writer->write(state.row, p, 0);
@@ -273,14 +272,16 @@ int run_continue(const ContinueArguments& args) {
           save_resume_point(state_path, p, &state);
         }
         progress.point(state.row, p, 0);
-        if (!args.profiles_dir.empty()) {
-          // The point's problem has the active set of the leg it belongs to.
-          ProblemDefinition d = c.definition;
-          d.contacts = active;
-          write_profile(ShootingProblem(d), p);
-        }
+        if (leg_problem) write_profile(*leg_problem, p);
       };
-      auto on_active_set = [&](const std::vector<PointContact>& contacts) { active = contacts; };
+      auto on_active_set = [&](const std::vector<PointContact>& contacts) {
+        active = contacts;
+        if (args.profiles_dir.empty()) return;
+        // The points that follow belong to this leg's problem (its active set).
+        ProblemDefinition d = c.definition;
+        d.contacts = contacts;
+        leg_problem = std::make_unique<ShootingProblem>(d);
+      };
       ContactContinuationResult r;
       if (args.resume) {
         ProblemDefinition d = c.definition;

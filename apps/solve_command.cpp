@@ -1,12 +1,11 @@
 #include "solve_command.hpp"
 
-#include "kirchhoff/discrete_seed.hpp"
-
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/contact.hpp"
+#include "kirchhoff/discrete_seed.hpp"
 #include "kirchhoff/solution.hpp"
 #include "result_json.hpp"
 
