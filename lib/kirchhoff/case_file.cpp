@@ -208,9 +208,10 @@ ObstacleSpec read_obstacle(const Reader& reader, const Value& o, RodKind kind, c
   }
   if (type == "cylinder") {
     refuse_others({"centre", "axis", "radius"});
-    const Vec3 axis = Reader::find(o, "axis") ? reader.unit_vector(*Reader::find(o, "axis"), "obstacles.axis") : Vec3::UnitZ();
+    const Value* axis_value = Reader::find(o, "axis");
+    const Vec3 axis = axis_value ? reader.unit_vector(*axis_value, "obstacles.axis") : Vec3::UnitZ();
     if (kind == RodKind::Planar && std::abs(std::abs(axis.z()) - 1.0) > 1e-12)
-      reader.fail(*Reader::find(o, "axis"), "obstacles.axis", "a planar rod meets cylinders (discs) along e_z = [0, 0, 1]");
+      reader.fail(*axis_value, "obstacles.axis", "a planar rod meets cylinders (discs) along e_z = [0, 0, 1]");
     const Value& radius_value = required("radius", "a radius");
     const Expression radius = reader.expression(radius_value, "obstacles.radius");
     if (!(radius(parameters) > 0))
