@@ -574,6 +574,14 @@ TEST_F(CaseFileTest, BadObstaclesAreRefused) {
   expect_refused(with_disc(disc, "\n[[guess.contacts]]\nobstacle = \"pin\"\ns = 1.5\n"), "guess.contacts.s",
                  {"inside (0, L)"});
   expect_refused(with_disc(disc, "\n[[guess.contacts]]\nobstacle = \"pin\"\n"), "guess.contacts", {"arclength s"});
+  // Extended contacts: s_end after s, force_end only with s_end, and only where they are modelled.
+  expect_refused(with_disc(disc, "\n[[guess.contacts]]\nobstacle = \"pin\"\ns = 0.5\ns_end = 0.4\n"),
+                 "guess.contacts.s_end", {"inside (s, L)"});
+  expect_refused(with_disc(disc, "\n[[guess.contacts]]\nobstacle = \"pin\"\ns = 0.5\nforce_end = 1\n"),
+                 "guess.contacts.force_end", {"give s_end too"});
+  expect_refused(with_disc("type = \"level_set\"\nname = \"bump\"\ngap = \"y + 0.2\"\n",
+                           "\n[[guess.contacts]]\nobstacle = \"bump\"\ns = 0.4\ns_end = 0.6\n"),
+                 "guess.contacts.s_end", {"not implemented", "discs"});
 }
 
 // ---- every shipped case loads and its problem constructs -----------------------------------

@@ -183,23 +183,163 @@ TEST(DiscContact, ContinuationInTheIndentersHeightFromFirstContact) {
   EXPECT_NEAR(last.derived.at("contact_s"), 0.5, 1e-9);
 }
 
-TEST(DiscContact, ARodThatWouldWrapAroundTheDiscStopsTheRunWithAClearMessage) {
-  // A disc of radius 0.5: the rod's curvature at the contact reaches 1/0.5 = 2 before the
-  // closed-form end (2.55), where it would start to lie on the disc over an interval.
-  Case c = load_case(testing::case_path("indenter.toml"), {{"rise", -0.02}, {"radius", 0.5}});
-  c.definition.contacts.clear();
+// --- wrapping around a disc (cases/wrapped_indenter.toml) --------------------------------
+
+TEST(DiscWrap, ClosedFormStartsWhereThePointContactsCurvatureReachesTheDisc) {
+  // At the radius 1 / |kappa_mid| of the point-contact solution the wrap has zero length: the
+  // wrapped closed form continues the point-contact one (difference ~ the radius' offset, 1e-7).
+  const auto point = analytic::three_point_bending(1.0, 1.0, kSupportSlope);
+  const double onset = 1.0 / std::abs(point.kappa_mid);
+  const auto wrapped = analytic::three_point_bending_wrapped(1.0, 1.0, onset * (1 + 1e-7), kSupportSlope);
+  EXPECT_NEAR(wrapped.force / point.force, 1.0, 1e-6);
+  EXPECT_NEAR(wrapped.contact_start, 0.5, 1e-6);
+  EXPECT_NEAR(wrapped.half_span, point.half_span, 1e-6);
+  EXPECT_NEAR(wrapped.rise, point.rise, 1e-6);
+  EXPECT_THROW(analytic::three_point_bending_wrapped(1.0, 1.0, onset * (1 - 1e-7), kSupportSlope), std::invalid_argument);
+  EXPECT_THROW(analytic::three_point_bending_wrapped(1.0, 1.0, 1.0, kSupportSlope), std::invalid_argument);  // longer than L/2
+}
+
+// The wrap of a solved indenter: on the disc, curved as it, n along the tangent, and the
+// concentrated and distributed reactions in global equilibrium with the supports.
+void expect_admissible_wrap(const ShootingProblem& problem, const Eigen::VectorXd& x, const PointContact& wrap,
+                            const Vec3& centre, double radius) {
+  ASSERT_TRUE(wrap.extended);
+  EXPECT_GT(wrap.force, 0.0);
+  EXPECT_GT(wrap.force_end, 0.0);
+  std::vector<double> s;
+  for (int i = 0; i <= 20; ++i) s.push_back(wrap.s + (wrap.s_end - wrap.s) * i / 20.0);
+  const auto on = problem.sample(x, s);
+  const double tension = on[10].n.dot(on[10].R.col(2));
+  EXPECT_GT(tension, 0.0);
+  for (size_t i = 0; i < on.size(); ++i) {
+    // The wrap's closed form is a rotation: exact to round-off on quantities ~1 (forces ~10).
+    const RodPoint& p = on[i];
+    EXPECT_NEAR((p.r - centre).norm(), radius, 1e-12);
+    EXPECT_NEAR((p.r - centre).dot(p.R.col(2)), 0.0, 1e-12);
+    EXPECT_NEAR(std::abs(p.u[1]), 1.0 / radius, 1e-12);
+    if (i + 1 == on.size()) break;  // sampled at s_end, n is the state after that edge's force
+    EXPECT_NEAR(p.n.dot(p.R.col(2)), tension, 1e-12);
+    // The entry's "no normal force" row, solved by Newton to 1e-10.
+    EXPECT_NEAR(p.n.dot(p.R.col(0)), 0.0, 1e-9);
+  }
+  // Global balance: every reaction of the disc is radial, so the end reactions have no moment about
+  // its centre; and n(L) - n(0) = -(F1 nu1 + F2 nu2) + N (t2 - t1), the pressure's resultant.
+  const auto ends = problem.sample(x, {0.0, 1.0});
+  const Vec3 nu1 = (on.front().r - centre) / radius, nu2 = (on.back().r - centre) / radius;
+  const Vec3 resultant = -wrap.force * nu1 - wrap.force_end * nu2 + tension * (on.back().R.col(2) - on.front().R.col(2));
+  EXPECT_LE((ends[1].n - ends[0].n - resultant).norm(), 1e-9);
+  const double moment = (ends[1].r - centre).cross(ends[1].n).z() - (ends[0].r - centre).cross(ends[0].n).z();
+  EXPECT_NEAR(moment, 0.0, 1e-9);
+}
+
+TEST(DiscWrap, CaseAgreesWithTheEllipticSolution) {
+  // Two radii and slopes; the case's guess is the same rough wrap [0.45, 0.55] for both.
+  for (const auto& [radius, slope_deg] : {std::pair{0.5, -35.0}, std::pair{0.25, -70.0}}) {
+    SCOPED_TRACE(radius);
+    const auto exact = analytic::three_point_bending_wrapped(1.0, 1.0, radius, slope_deg * M_PI / 180.0);
+    const Case c = load_case(testing::case_path("wrapped_indenter.toml"),
+                             {{"radius", radius}, {"half_span", exact.half_span}, {"rise", exact.rise}});
+    const ContactSolveResult r = solve_with_contacts(c.definition, c.start_guess);
+    ASSERT_TRUE(r.complementarity) << r.message;
+    const ShootingProblem problem(r.definition);
+    const Solution sol = make_solution(problem, r.result, 401, {"n_y", "min_wrap_tension", "min_gap"});
+    ASSERT_EQ(sol.contacts.size(), 1u);
+    const PointContact& wrap = sol.contacts[0];
+    // Newton to 1e-10 with RK tolerances ~1e-12 on forces ~10: 1e-9 relative is the bar.
+    EXPECT_NEAR(wrap.s, exact.contact_start, 1e-9);
+    EXPECT_NEAR(wrap.s_end, 1.0 - exact.contact_start, 1e-9);  // symmetry, not imposed
+    EXPECT_NEAR(wrap.force / exact.edge_force, 1.0, 1e-9);
+    EXPECT_NEAR(wrap.force_end / exact.edge_force, 1.0, 1e-9);
+    EXPECT_NEAR(sol.derived.at("min_wrap_tension") / exact.tension, 1.0, 1e-9);
+    EXPECT_NEAR(sol.derived.at("n_y") / (0.5 * exact.force), 1.0, 1e-9);
+    EXPECT_GE(sol.derived.at("min_gap"), -1e-10);
+    EXPECT_LE(sol.invariants.H.relative_spread(), 1e-9);  // H across both edges and the wrap
+    expect_admissible_wrap(problem, r.result.x, wrap, Vec3(exact.half_span, exact.rise - radius, 0.0), radius);
+  }
+}
+
+ContinuationOptions rising_indenter(double target) {
   ContinuationOptions o;
   o.parameter = "rise";
-  o.target = analytic::three_point_bending(1.0, 1.0, kSupportSlope).rise;
+  o.target = target;
   o.initial_step = 0.01;
   o.max_step = 1.0;
-  o.max_points = 400;
-  o.derived = {"contact_force", "kappa_contact"};
-  const testing::ContactBranch branch = testing::follow_contacts(c, o);
+  o.max_points = 600;
+  o.derived = {"contact_force", "kappa_contact", "contact_length", "min_gap", "min_contact_force", "min_wrap_tension"};
+  return o;
+}
+
+TEST(DiscWrap, ContinuationFromFirstContactIntoTheWrap) {
+  // A disc of radius 0.5 a little right of the rod's middle rises from below: the rod touches it,
+  // its curvature at the contact reaches 2, and the contact spreads around the disc in tension.
+  const double radius = 0.5, centre_x = 0.5, target = 0.18;
+  Case c = load_case(testing::case_path("wrapped_indenter.toml"),
+                     {{"radius", radius}, {"half_span", centre_x}, {"rise", -0.02}});
+  c.definition.contacts.clear();
+  const testing::ContactBranch branch = testing::follow_contacts(c, rising_indenter(target));
+  ASSERT_EQ(branch.result.result.reason, StopReason::ReachedTarget) << branch.result.result.message;
+  ASSERT_EQ(branch.result.changes.size(), 2u);
+  EXPECT_NE(branch.result.changes[0].find("a contact appears"), std::string::npos) << branch.result.changes[0];
+  EXPECT_NE(branch.result.changes[1].find("starts to wrap"), std::string::npos) << branch.result.changes[1];
+  bool wrapped = false;
+  double previous_length = 0.0;
+  for (const auto& p : branch.points) {
+    EXPECT_GE(p.derived.at("min_gap"), -1e-9) << p.parameter;
+    if (std::isfinite(p.derived.at("min_contact_force"))) EXPECT_GE(p.derived.at("min_contact_force"), -1e-9);
+    if (!p.event.empty() && p.event.find("wrap") != std::string::npos) {
+      // Located where the curvature at the contact is the disc's (the event's tolerance).
+      EXPECT_NEAR(p.derived.at("kappa_contact"), -1.0 / radius, 1e-8);
+      wrapped = true;
+      continue;
+    }
+    if (!wrapped) continue;
+    EXPECT_GT(p.derived.at("min_wrap_tension"), 0.0) << p.parameter;
+    EXPECT_GE(p.derived.at("contact_length"), previous_length) << p.parameter;  // it only spreads here
+    previous_length = p.derived.at("contact_length");
+  }
+  ASSERT_TRUE(wrapped);
+  EXPECT_GT(previous_length, 0.1);
+  // The end point: an admissible wrap, and the same solution the active-set loop finds from the
+  // case's rough guess at that height (two independent paths).
+  const ContinuationPoint& last = branch.points.back();
+  const ShootingProblem& problem = *branch.problems.back();
+  const auto contacts = problem.contacts_at(last.x);
+  ASSERT_EQ(contacts.size(), 1u);
+  expect_admissible_wrap(problem, last.x, contacts[0], Vec3(centre_x, target - radius, 0.0), radius);
+  const Case direct = load_case(testing::case_path("wrapped_indenter.toml"),
+                                {{"radius", radius}, {"half_span", centre_x}, {"rise", target}});
+  const ContactSolveResult r = solve_with_contacts(direct.definition, direct.start_guess);
+  ASSERT_TRUE(r.complementarity) << r.message;
+  ASSERT_EQ(r.definition.contacts.size(), 1u);
+  EXPECT_NEAR(r.definition.contacts[0].s, contacts[0].s, 1e-9);
+  EXPECT_NEAR(r.definition.contacts[0].s_end, contacts[0].s_end, 1e-9);
+  EXPECT_NEAR(r.definition.contacts[0].force, contacts[0].force, 1e-8);
+  EXPECT_NEAR(r.definition.contacts[0].force_end, contacts[0].force_end, 1e-8);
+}
+
+TEST(DiscWrap, ReachingTheDiscsCurvatureInCompressionStopsWithAClearMessage) {
+  // Disc left of the rod's middle: the contact is on the rod's rising side, where n.t < 0; a wrap
+  // there would pull on the disc (pressure = tension / radius), so the rod would touch it at two
+  // points instead - not modelled, and said so.
+  Case c = load_case(testing::case_path("wrapped_indenter.toml"), {{"half_span", 0.4}, {"rise", -0.02}});
+  c.definition.contacts.clear();
+  const testing::ContactBranch branch = testing::follow_contacts(c, rising_indenter(0.3));
   EXPECT_EQ(branch.result.result.reason, StopReason::Inadmissible);
-  EXPECT_NE(branch.result.result.message.find("wrap around"), std::string::npos) << branch.result.result.message;
+  EXPECT_NE(branch.result.result.message.find("in compression"), std::string::npos) << branch.result.result.message;
   EXPECT_NE(branch.result.result.message.find("not implemented"), std::string::npos);
   EXPECT_NEAR(branch.points.back().derived.at("kappa_contact"), -2.0, 1e-6);
+}
+
+TEST(DiscWrap, OnlyDiscsAndPlanesTakeExtendedContacts) {
+  // A level-set disc: same shape, but the wrap's closed form is the cylinder's; refused with why.
+  Case c = load_case(testing::case_path("wrapped_indenter.toml"));
+  replace_obstacles(&c.definition, {Obstacle::level_set([](const Vec3& r) { return r.norm() - 0.5; }, "|r| - 0.5")});
+  try {
+    const ShootingProblem problem(c.definition);
+    ADD_FAILURE() << "an extended contact on a level set was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("not implemented"), std::string::npos) << e.what();
+  }
 }
 
 // --- 3D: a twisted anisotropic rod against a pole (cases/twisted_ribbon_pole.toml) ---------

@@ -668,4 +668,44 @@ ThreePointBending three_point_bending(double L, double EI, double theta_end) {
   return out;
 }
 
+WrappedThreePointBending three_point_bending_wrapped(double L, double EI, double radius, double theta_end) {
+  const char* where = "three_point_bending_wrapped";
+  require_positive(where, "L", L);
+  require_positive(where, "EI", EI);
+  require_positive(where, "radius", radius);
+  if (!(theta_end > -M_PI / 2 && theta_end < 0.0)) reject(where, "theta_end", "must lie in (-pi/2, 0)");
+  const double phi_e = -theta_end;
+  const double k = std::sin(0.5 * (M_PI / 2 + phi_e));
+  const double K = complete_K(k), E = complete_E(k);
+  struct Arc {
+    double alpha, psi, scale;  // wrap angle, its elliptic amplitude, sqrt(EI / R0)
+  };
+  const auto arc = [&](double R0) {
+    const double alpha = std::asin(std::sin(phi_e) - EI / (2.0 * R0 * radius * radius));
+    return Arc{alpha, std::asin(std::min(1.0, std::sin(0.5 * (M_PI / 2 + alpha)) / k)), std::sqrt(EI / R0)};
+  };
+  const auto excess = [&](double R0) {  // l + rho alpha - L/2
+    const Arc a = arc(R0);
+    return a.scale * (K - incomplete_F(a.psi, k)) + radius * a.alpha - 0.5 * L;
+  };
+  const double onset = EI / (2.0 * radius * radius * std::sin(phi_e));  // R0 where alpha = 0
+  if (!(excess(onset) > 0.0))
+    reject(where, "radius", "is too small for the rod to wrap at this support slope (the point contact's curvature stays below 1/radius)");
+  if (!(radius * phi_e < 0.5 * L)) reject(where, "radius", "is too large: the wrap alone would be longer than the rod");
+  double hi = 2.0 * onset;
+  while (excess(hi) > 0.0) hi *= 2.0;
+  const double R0 = brent_root(excess, onset, hi);
+  const Arc a = arc(R0);
+  WrappedThreePointBending out;
+  out.force = 2.0 * R0;
+  out.wrap_angle = a.alpha;
+  out.contact_start = a.scale * (K - incomplete_F(a.psi, k));
+  out.half_span = radius * std::sin(a.alpha) + EI / (radius * R0);
+  out.rise = radius * (1.0 - std::cos(a.alpha)) +
+             a.scale * ((K - incomplete_F(a.psi, k)) - 2.0 * (E - incomplete_E(a.psi, k)));
+  out.tension = R0 * std::sin(a.alpha);
+  out.edge_force = R0 * std::cos(a.alpha);
+  return out;
+}
+
 }  // namespace kirchhoff::analytic

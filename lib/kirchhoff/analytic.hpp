@@ -215,4 +215,28 @@ struct ThreePointBending {
 };
 ThreePointBending three_point_bending(double L, double EI, double theta_end);
 
+// The same three-point bending over a disc of radius rho large enough for the rod to wrap around
+// it: the middle part lies on the disc over the angle 2 alpha (curvature 1/rho, tension N, pressure
+// N / rho), each free part is the arc of the point-contact solution from the support (slope
+// theta_e) to where its curvature reaches 1/rho. With R0 = F/2 the support's reaction and
+// phi = -theta (the slope below the horizontal, from mid-span outwards), the free arc has
+// EI phi'^2 / 2 = R0 (sin phi_e - sin phi); k = sin((pi/2 + phi_e)/2) and sin psi = sin((pi/2 +
+// phi)/2) / k turn it into elliptic integrals:
+//   sin alpha = sin phi_e - EI / (2 R0 rho^2)                (the curvature 1/rho where it meets the disc)
+//   free length l = sqrt(EI / R0) (K(k) - F(psi_alpha, k)),  and L/2 = l + rho alpha  (solved for R0),
+//   half-span = rho sin alpha + EI / (rho R0),  rise = rho (1 - cos alpha) + sqrt(EI / R0) (Delta F - 2 Delta E),
+//   tension N = R0 sin alpha, force at each edge of the wrap R0 cos alpha.
+// Throws std::invalid_argument where the rod does not wrap at this slope (its curvature at
+// mid-span stays below 1/rho: three_point_bending applies) or is too short to reach the supports.
+struct WrappedThreePointBending {
+  double force = 0.0;         // F = 2 R0, the disc's total reaction
+  double wrap_angle = 0.0;    // alpha: the wrap covers [-alpha, alpha] around the top
+  double contact_start = 0.0; // s where the wrap begins, l; it ends at L - l
+  double half_span = 0.0;
+  double rise = 0.0;          // height of the disc's top above the supports
+  double tension = 0.0;       // N on the wrap
+  double edge_force = 0.0;    // the concentrated force at each end of the wrap
+};
+WrappedThreePointBending three_point_bending_wrapped(double L, double EI, double radius, double theta_end);
+
 }  // namespace kirchhoff::analytic

@@ -280,7 +280,7 @@ void read_obstacles(const Reader& reader, const Value& list, RodKind kind, Probl
 void read_contact_guesses(const Reader& reader, const Value& list, ProblemDefinition* d) {
   if (!list.is_array()) reader.fail(list, "guess.contacts", "must be an array of tables [[guess.contacts]]");
   for (const auto& t : list.as_array()) {
-    reader.allow_keys(t, "guess.contacts", {"obstacle", "s", "force"});
+    reader.allow_keys(t, "guess.contacts", {"obstacle", "s", "force", "s_end", "force_end"});
     const Value* name = Reader::find(t, "obstacle");
     const Value* s = Reader::find(t, "s");
     if (!name || !s) reader.fail(t, "guess.contacts", "a contact needs the obstacle's name and an arclength s");
@@ -293,6 +293,21 @@ void read_contact_guesses(const Reader& reader, const Value& list, ProblemDefini
     const double L = d->model(d->parameters).length;
     if (!(c.s > 0 && c.s < L)) reader.fail(*s, "guess.contacts.s", "must lie inside (0, L)");
     if (const Value* f = Reader::find(t, "force")) c.force = reader.expression(*f, "guess.contacts.force")(d->parameters);
+    // With s_end, an extended contact over [s, s_end]: flat on a plane, wrapped around a disc.
+    if (const Value* e = Reader::find(t, "s_end")) {
+      c.extended = true;
+      c.s_end = reader.expression(*e, "guess.contacts.s_end")(d->parameters);
+      if (!(c.s_end > c.s && c.s_end < L)) reader.fail(*e, "guess.contacts.s_end", "must lie inside (s, L)");
+      c.force_end = c.force;
+      if (const Value* f = Reader::find(t, "force_end"))
+        c.force_end = reader.expression(*f, "guess.contacts.force_end")(d->parameters);
+      const RodModel model = d->model(d->parameters);
+      const auto equations = d->kind == RodKind::Planar ? make_planar_equations(model) : make_spatial_equations(model);
+      if (const std::string why = extended_contact_unsupported(*equations, d->obstacles[c.obstacle]); !why.empty())
+        reader.fail(*e, "guess.contacts.s_end", why);
+    } else if (Reader::find(t, "force_end")) {
+      reader.fail(t, "guess.contacts.force_end", "is for extended contacts: give s_end too");
+    }
     d->contacts.push_back(c);
   }
   std::sort(d->contacts.begin(), d->contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });

@@ -123,6 +123,11 @@ DefinitionSolve as_definition_solve(ContactSolveResult contact) {
 
 namespace {
 
+bool has_wrap(const ProblemDefinition& d) {
+  return std::any_of(d.contacts.begin(), d.contacts.end(),
+                     [&](const auto& c) { return c.extended && !d.obstacles[c.obstacle].is_flat(); });
+}
+
 // Which extended contact buckles at a flat_contact_buckles event: the one with the smallest margin.
 size_t buckling_flat_contact(const ShootingProblem& problem, const Eigen::VectorXd& x,
                              const std::vector<PointContact>& contacts) {
@@ -224,6 +229,8 @@ std::string complementarity_violation(const ContinuationPoint& p, const ContactO
     what << "the rod penetrates an obstacle (min_gap " << value("min_gap") << ")";
   else if (value("min_contact_force") < -1e3 * contact.force_tolerance)
     what << "a contact pulls (force " << value("min_contact_force") << ")";
+  else if (value("min_wrap_tension") < -1e3 * contact.force_tolerance)
+    what << "a wrapped part pulls on its disc (tension " << value("min_wrap_tension") << ")";
   else
     return "";
   what << " at " << p.parameter;
@@ -263,6 +270,9 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
       leg.events.push_back({"flat_contact_margin", 0.0, true, "flat_contact_buckles"});
     }
     if (has_point && d.kind == RodKind::Planar) leg.events.push_back({"contact_bending", 0.0, true, "contact_flattens"});
+    // A wrapped part presses on its disc with tension / radius: where the tension would turn to
+    // compression the rod leaves the disc inside the wrap.
+    if (has_wrap(d)) leg.events.push_back({"min_wrap_tension", 0.0, true, "wrap_tension_vanishes"});
     const ShootingProblem problem(d);
     if (active_set_sink) active_set_sink(d.contacts);
     // A leg starts on the previous leg's last point, which is already reported. A point that
@@ -305,6 +315,13 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     std::ostringstream change;
     change << options.parameter << " = " << at.parameter << ": ";
     const auto contacts = here.contacts_at(at.x);
+    if (at.event == "wrap_tension_vanishes") {
+      out.result.reason = StopReason::Inadmissible;
+      out.result.message = "the tension of a wrapped part vanishes: beyond, it would pull on the disc and lift off inside "
+                           "the wrap, which is not modelled; the run stops here";
+      out.changes.push_back(change.str() + out.result.message);
+      return out;
+    }
     if (at.event == "flat_contact_buckles") {
       // Beyond, the flat branch is unstable: the flat part buckles away from the obstacle into a
       // hanging fold, two point contacts with a blister between them.
@@ -329,24 +346,35 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
         }
       }
       PointContact& c = d.contacts[which];
-      if (!d.obstacles[c.obstacle].is_flat()) {
-        // The rod's curvature has reached the obstacle's: beyond, it would lie on it over an
-        // interval (the disc's analogue of a flat contact: n along the tangent inside, in tension,
-        // forces at the ends), which only planes model. (A Newton jump onto two point contacts
-        // either side was tried here and found solutions, but that is not the branch the flat case
-        // says the rod takes, so it is not offered.)
+      const Obstacle o = here.obstacles(here.parameters_at(at.x))[c.obstacle];
+      if (const std::string e = extended_contact_unsupported(*here.equations(here.parameters_at(at.x)), o); !e.empty()) {
+        // The rod's curvature has reached the obstacle's: beyond, it would lie on it over an interval.
         out.result.reason = StopReason::Inadmissible;
-        out.result.message = "the contact at s = " + std::to_string(c.s) + " starts to wrap around " +
-                             here.definition().obstacles[c.obstacle].describe() +
-                             ": extended contact on curved obstacles is not implemented; the run stops here";
+        out.result.message = "the contact at s = " + std::to_string(c.s) + " starts to wrap around " + o.describe() +
+                             ": " + e + "; the run stops here";
         out.changes.push_back(change.str() + out.result.message);
         return out;
+      }
+      if (!o.is_flat()) {
+        // A wrap presses on the disc with its tension / radius: in compression the rod cannot lie
+        // on the disc, it would touch it at two points either side instead.
+        const RodPoint p = here.sample(at.x, {c.s}).front();
+        const double tension = p.n.dot(p.R.col(2));
+        if (tension < -contact.force_tolerance) {
+          out.result.reason = StopReason::Inadmissible;
+          out.result.message = "the contact at s = " + std::to_string(c.s) + " reaches the curvature of " + o.describe() +
+                               " in compression (n.t = " + std::to_string(tension) +
+                               "): it would touch the disc at two points either side, which is not implemented; "
+                               "the run stops here";
+          out.changes.push_back(change.str() + out.result.message);
+          return out;
+        }
       }
       c.extended = true;
       c.s_end = c.s;
       c.force_end = 0.5 * c.force;
       c.force *= 0.5;
-      change << "the contact at s = " << c.s << " flattens into an extended contact";
+      change << "the contact at s = " << c.s << (o.is_flat() ? " flattens into an extended contact" : " starts to wrap around the obstacle");
     } else if (at.event == "contact_lifts_off") {
       auto weakest = std::min_element(contacts.begin(), contacts.end(),
                                       [](const auto& a, const auto& b) { return a.force < b.force; });

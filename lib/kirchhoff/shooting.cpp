@@ -4,6 +4,7 @@
 #include <cmath>
 #include <exception>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -67,16 +68,14 @@ ShootingProblem::ShootingProblem(ProblemDefinition definition) : definition_(std
     for (const auto& c : definition_.contacts)
       if (c.obstacle < 0 || c.obstacle >= static_cast<int>(definition_.obstacles.size()))
         throw std::invalid_argument("contact on obstacle " + std::to_string(c.obstacle) + ", which does not exist");
-    for (const auto& c : definition_.contacts) {
-      residual_count_ += c.unknowns();
-      if (c.extended && !eq->is_planar()) throw std::invalid_argument("extended contact is for planar rods");
-      if (c.extended && !definition_.obstacles[c.obstacle].is_flat())
-        throw std::invalid_argument("extended contact on " + definition_.obstacles[c.obstacle].describe() +
-                                    ": only modelled on planes (wrapping around a curved obstacle is not implemented)");
-    }
+    for (const auto& c : definition_.contacts) residual_count_ += c.unknowns();
   }
   // Moving obstacles decide: `obstacles` is kept as their value at the current parameters.
   if (definition_.moving_obstacles) definition_.obstacles = definition_.moving_obstacles(definition_.parameters);
+  for (const auto& c : definition_.contacts)
+    if (c.extended)
+      if (std::string e = extended_contact_unsupported(*eq, definition_.obstacles[c.obstacle]); !e.empty())
+        throw std::invalid_argument(e);
   if (residual_count_ != size())
     throw std::invalid_argument("boundary conditions give " + std::to_string(residual_count_) +
                                 " equations for " + std::to_string(size()) + " unknowns");
@@ -101,9 +100,16 @@ double ShootingProblem::contact_bending(const Eigen::VectorXd& x, const PointCon
 
 double ShootingProblem::flat_contact_margin(const Eigen::VectorXd& x, const PointContact& contact) const {
   if (!contact.extended || !(contact.s_end > contact.s)) return NAN;
+  if (!obstacles(parameters_at(x))[contact.obstacle].is_flat()) return NAN;
   const RodPoint p = sample(x, {0.5 * (contact.s + contact.s_end)}).front();
   const double l = contact.s_end - contact.s;
   return 4.0 * M_PI * M_PI * equations(parameters_at(x))->model().B[1](p.s) / (l * l) + p.n.dot(p.R.col(2));
+}
+
+double ShootingProblem::wrap_tension(const Eigen::VectorXd& x, const PointContact& contact) const {
+  if (!contact.extended || obstacles(parameters_at(x))[contact.obstacle].is_flat()) return NAN;
+  const RodPoint p = sample(x, {0.5 * (contact.s + contact.s_end)}).front();
+  return p.n.dot(p.R.col(2));
 }
 
 int ShootingProblem::contact_column(size_t k) const {
@@ -344,6 +350,43 @@ struct Breakpoint {
   enum Kind { Point, ExtendedStart, ExtendedEnd } kind;
 };
 
+// The part of a planar rod wrapped around a disc (see PointContact): each section's state is the
+// entry state turned rigidly about the disc's centre by phi = curvature * (s - s_entry) - position,
+// tangent and internal force alike, the moment unchanged. That is the exact solution of the
+// constrained equations for a uniform inextensible rod: constant curvature gives m' = 0, so n stays
+// along the tangent (n = N t), and n' = N t' is the disc's pressure N / radius along its normal.
+struct DiscWrap {
+  Vec3 centre;
+  double curvature = 0.0;  // theta' on the disc, +-1 / radius: the disc on the rod's concave side
+
+  // The state `length` further along the disc, with its derivatives in the state and the length.
+  Eigen::VectorXd advance(const RodEquations& eq, const Eigen::VectorXd& y, double length,
+                          Eigen::MatrixXd* d_state = nullptr, Eigen::VectorXd* d_length = nullptr) const {
+    const Eigen::MatrixXd position = eq.slot_map(Slot::Position), force = eq.slot_map(Slot::Force);
+    const Eigen::VectorXd angle = eq.slot_map(Slot::Orientation).row(2).transpose();
+    const double phi = curvature * length;
+    const Mat3 turn = Eigen::AngleAxisd(phi, Vec3::UnitZ()).toRotationMatrix();
+    const Vec3 arm = position * y - centre, n = force * y;
+    Eigen::VectorXd out = y + position.transpose() * (turn * arm - arm) + force.transpose() * (turn * n - n) + angle * phi;
+    if (d_state) {
+      const Mat3 I = Mat3::Identity();
+      *d_state = Eigen::MatrixXd::Identity(y.size(), y.size()) + position.transpose() * (turn - I) * position +
+                 force.transpose() * (turn - I) * force;
+    }
+    if (d_length) {
+      const auto spin = [&](const Vec3& w) { return Vec3(Vec3::UnitZ().cross(turn * w)); };  // d(turn w)/dphi
+      *d_length = curvature * (position.transpose() * spin(arm) + force.transpose() * spin(n) + angle);
+    }
+    return out;
+  }
+};
+
+// The wrap that starts where the rod, with tangent t, touches the disc o with reaction normal nu
+// (pointing from the disc to the rod): the rod turns towards the centre, theta' = -(t x nu).e_z / radius.
+DiscWrap disc_wrap(const Obstacle& o, const Vec3& tangent, const Vec3& normal) {
+  return {o.point(), (tangent.cross(normal).z() > 0 ? -1.0 : 1.0) / o.radius()};
+}
+
 std::vector<Breakpoint> breakpoints(const std::vector<PointContact>& contacts, const std::vector<int>& columns) {
   std::vector<Breakpoint> out;
   for (size_t k = 0; k < contacts.size(); ++k) {
@@ -393,18 +436,31 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
   Eigen::VectorXd y = y0;
   double s0 = 0.0;
   int s0_column = -1;  // the unknown that s0 is, if any
+  std::optional<DiscWrap> wrap;  // set when [s0, next breakpoint] lies on a disc
   try {
     for (size_t k = 0; k <= points.size(); ++k) {
       const bool last = k == points.size();
       const double s1 = last ? L : points[k].s;
-      SegmentFlow flow = eq->flow(y, s0, s1, J != nullptr, definition_.options.integrator);
-      rhs_evaluations_ += flow.rhs_evaluations;
-      if (J) {
-        S = flow.Phi * S;
-        if (s0_column >= 0) S.col(s0_column) -= flow.Phi * eq->derivative(y, s0);
-        if (!last) S.col(points[k].s_column) += eq->derivative(flow.y, s1);
+      if (wrap) {
+        Eigen::MatrixXd d_state;
+        Eigen::VectorXd d_length;
+        y = wrap->advance(*eq, y, s1 - s0, J ? &d_state : nullptr, J ? &d_length : nullptr);
+        if (J) {
+          S = d_state * S;
+          S.col(s0_column) -= d_length;
+          S.col(points[k].s_column) += d_length;
+        }
+        wrap.reset();
+      } else {
+        SegmentFlow flow = eq->flow(y, s0, s1, J != nullptr, definition_.options.integrator);
+        rhs_evaluations_ += flow.rhs_evaluations;
+        if (J) {
+          S = flow.Phi * S;
+          if (s0_column >= 0) S.col(s0_column) -= flow.Phi * eq->derivative(y, s0);
+          if (!last) S.col(points[k].s_column) += eq->derivative(flow.y, s1);
+        }
+        y = flow.y;
       }
-      y = flow.y;
       if (last) break;
       const Breakpoint& b = points[k];
       const Obstacle& o = obstacles_here[b.obstacle];
@@ -446,9 +502,13 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
         row += 2;
       }
       if (b.kind == Breakpoint::ExtendedStart) {
-        // Flat on the obstacle from here: no moment, and no normal force once the jump is applied.
+        // On the obstacle from here: its curvature (none on a plane), and no normal force once the
+        // jump is applied.
+        if (!o.is_flat()) wrap = disc_wrap(o, position * eq->derivative(y, s1), here.normal);
+        const double kappa = wrap ? wrap->curvature : 0.0;
+        const RodModel& model = eq->model();
         const Eigen::RowVectorXd normal_force = here.normal.transpose() * force;
-        (*F)[row] = moment_z.dot(y);
+        (*F)[row] = moment_z.dot(y) - model.B[1](s1) * (kappa - model.u_hat[1](s1));
         (*F)[row + 1] = normal_force.dot(y) - b.force;
         if (J) {
           J->row(row) = moment_z * S;
@@ -522,6 +582,7 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
     const Eigen::MatrixXd force = eq->slot_map(Slot::Force);
     Eigen::VectorXd y = x.head(n);
     double s0 = 0.0;
+    std::optional<DiscWrap> wrap;  // set when [s0, next breakpoint] lies on a disc
     for (size_t c = 0; c <= points.size(); ++c) {
       const bool last = c == points.size();
       const double s1 = last ? L : points[c].s;
@@ -529,16 +590,23 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
       // The last piece takes every remaining point: an arclength computed as L * i / n can exceed
       // L by an ulp.
       while (k < s.size() && (s[k] < s1 || last)) local.push_back(std::min(s[k++], s1));
-      if (local.size() > 1) {
-        const auto states = eq->sample(y, local, definition_.options.integrator);
-        for (size_t j = 1; j < states.size(); ++j) out.push_back(eq->point(states[j], local[j]));
+      if (wrap) {
+        for (size_t j = 1; j < local.size(); ++j) out.push_back(eq->point(wrap->advance(*eq, y, local[j] - s0), local[j]));
+        y = wrap->advance(*eq, y, s1 - s0);
+        wrap.reset();
+      } else {
+        if (local.size() > 1) {
+          const auto states = eq->sample(y, local, definition_.options.integrator);
+          for (size_t j = 1; j < states.size(); ++j) out.push_back(eq->point(states[j], local[j]));
+        }
+        if (!last) y = eq->flow(y, s0, s1, false, definition_.options.integrator).y;
       }
       if (last) break;
-      y = eq->flow(y, s0, s1, false, definition_.options.integrator).y;
+      const Obstacle& o = obstacles_here[points[c].obstacle];
       const Eigen::MatrixXd position = eq->slot_map(Slot::Position);
-      const Vec3 normal = obstacles_here[points[c].obstacle]
-                              .contact_conditions(position * y, position * eq->derivative(y, s1))
-                              .normal;
+      const Vec3 tangent = position * eq->derivative(y, s1);
+      const Vec3 normal = o.contact_conditions(position * y, tangent).normal;
+      if (points[c].kind == Breakpoint::ExtendedStart && !o.is_flat()) wrap = disc_wrap(o, tangent, normal);
       y -= points[c].force * force.transpose() * normal;
       s0 = s1;
     }
@@ -559,6 +627,20 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
   }, s.size() >= 64);
   for (auto& segment : points) out.insert(out.end(), segment.begin(), segment.end());
   return out;
+}
+
+std::string extended_contact_unsupported(const RodEquations& equations, const Obstacle& obstacle) {
+  if (!equations.is_planar())
+    return "extended contact is modelled for planar rods only (a spatial rod lying on an obstacle is not implemented)";
+  if (obstacle.is_flat()) return "";
+  const std::string what = "wrapping around " + obstacle.describe();
+  if (obstacle.shape() != Obstacle::Shape::Cylinder || std::abs(std::abs(obstacle.direction().z()) - 1.0) > 1e-12)
+    return what + " is not implemented: of the curved obstacles, only discs (cylinders along e_z) are modelled";
+  const RodModel& model = equations.model();
+  if (model.extensible || !model.is_uniform() || model.field)
+    return what + " is modelled for uniform, inextensible rods without an external field (its closed form); "
+                  "not implemented for this rod";
+  return "";
 }
 
 void add_axial_phase_condition(ProblemDefinition& d) {

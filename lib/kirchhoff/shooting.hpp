@@ -36,16 +36,25 @@ struct PointContact {
   int obstacle = 0;
   double s = 0.0;
   double force = 0.0;
-  // Extended contact (planar rods on a plane; not modelled on curved obstacles): the rod lies
-  // flat on the obstacle over [s, s_end], straight and free of moment, held by the forces `force`
-  // at s and `force_end` at s_end (a flat wall carries no distributed force there: n_y' = 0 and
-  // m = 0 on the interval). At s: g = 0, tangency, m = 0 and no normal force just after s; s_end
-  // and force_end are set by the rest.
+  // Extended contact (planar rods): the rod lies on the obstacle over [s, s_end], held by the
+  // forces `force` at s and `force_end` at s_end. On a plane it is straight and free of moment,
+  // and a flat wall carries no distributed force there (n_y' = 0 and m = 0 on the interval). On a
+  // disc (a cylinder along e_z) it wraps around it: curvature 1/radius, constant moment, n along
+  // the tangent with a constant tension N, pressing on the disc with p = N / radius (admissible
+  // while N >= 0). At s: g = 0, tangency, the obstacle's curvature (m = B2 (kappa - u_hat2)) and
+  // no normal force just after s; s_end and force_end are set by the rest.
   bool extended = false;
   double s_end = 0.0;
   double force_end = 0.0;
   int unknowns() const { return extended ? 4 : 2; }
 };
+
+// Why an extended contact on this obstacle is not modelled for this rod, or "" when it is: planes
+// for planar rods; discs for uniform, inextensible planar rods without an external field, where
+// the wrapped part is known in closed form (the section turns rigidly about the disc's centre).
+// Wrapping a spatial rod around a cylinder, or a tapered or extensible rod around a disc, would
+// need the constrained equations on the interval (a differential-algebraic system).
+std::string extended_contact_unsupported(const RodEquations& equations, const Obstacle& obstacle);
 
 using ModelFunction = std::function<RodModel(const Parameters&)>;
 
@@ -124,6 +133,10 @@ class ShootingProblem final : public NonlinearSystem {
   // its first mode 1 - cos(2 pi (s - s1) / l) leaves the obstacle, so it buckles (a hanging fold
   // forms) where this margin reaches 0. NaN for a point contact or a flat part of zero length.
   double flat_contact_margin(const Eigen::VectorXd& x, const PointContact& contact) const;
+  // Tension n.d3 in the middle of an extended contact on a curved obstacle: the wrapped part
+  // presses on the disc with tension / radius, so it must not be negative. NaN for a point
+  // contact or a flat one (whose tension is the flat_contact_margin's business).
+  double wrap_tension(const Eigen::VectorXd& x, const PointContact& contact) const;
 
   // dF/d(parameter) at x, for a known (not solved-for) parameter: from the closed-form boundary
   // conditions when the parameter does not enter the rod model, else by central differences of

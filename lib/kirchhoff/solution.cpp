@@ -79,6 +79,7 @@ const std::map<std::string, std::string> kCatalogue = {
     {"contact_bending", "smallest g'' at the point contacts: how the rod curves away from the obstacle (0: it flattens)"},
     {"contact_length", "total length of the extended contacts"},
     {"flat_contact_margin", "smallest 4 pi^2 B2 / l^2 - P_flat over extended contacts: < 0 once a flat part would buckle away"},
+    {"min_wrap_tension", "smallest tension n.d3 of the parts wrapped around discs (the disc's pressure is tension / radius; NaN without)"},
     {"kappa_contact", "curvature u2 at the first point contact (signed, planar)"},
     {"contact_s", "arclength of the first point contact"},
     {"min_gap", "smallest distance to the obstacles along the rod"},
@@ -146,6 +147,14 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
     for (const auto& c : sol.contacts) {
       const double margin = problem.flat_contact_margin(x, c);
       if (std::isfinite(margin)) smallest = std::isnan(smallest) ? margin : std::min(smallest, margin);
+    }
+    return smallest;
+  }
+  if (name == "min_wrap_tension") {
+    double smallest = NAN;
+    for (const auto& c : sol.contacts) {
+      const double tension = problem.wrap_tension(x, c);
+      if (std::isfinite(tension)) smallest = std::isnan(smallest) ? tension : std::min(smallest, tension);
     }
     return smallest;
   }
