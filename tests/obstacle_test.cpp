@@ -317,6 +317,40 @@ TEST(DiscWrap, ContinuationFromFirstContactIntoTheWrap) {
   EXPECT_NEAR(r.definition.contacts[0].force_end, contacts[0].force_end, 1e-8);
 }
 
+TEST(DiscWrap, LoweringTheDiscUnwindsTheWrapAndTheContactLiftsOff) {
+  // The way back from the end of the run above: from the wrap the active-set loop finds at
+  // rise = 0.18, the disc is lowered below the rod. The wrap shrinks to a point where the forward
+  // run saw it start, and the point contact lifts off where the forward run's first touched.
+  const double radius = 0.5, centre_x = 0.5;
+  Case c = load_case(testing::case_path("wrapped_indenter.toml"),
+                     {{"radius", radius}, {"half_span", centre_x}, {"rise", 0.18}});
+  const testing::ContactBranch back = testing::follow_contacts(c, rising_indenter(-0.01));
+  ASSERT_EQ(back.result.result.reason, StopReason::ReachedTarget) << back.result.result.message;
+  ASSERT_EQ(back.result.changes.size(), 2u);
+  EXPECT_NE(back.result.changes[0].find("shrinks to a point"), std::string::npos) << back.result.changes[0];
+  EXPECT_NE(back.result.changes[1].find("lifts off"), std::string::npos) << back.result.changes[1];
+  std::vector<double> at;
+  for (const auto& p : back.points) {
+    if (!p.event.empty()) at.push_back(p.parameter);
+    EXPECT_GE(p.derived.at("min_gap"), -1e-9) << p.parameter;
+    if (std::isfinite(p.derived.at("min_contact_force"))) EXPECT_GE(p.derived.at("min_contact_force"), -1e-9);
+    if (std::isfinite(p.derived.at("min_wrap_tension"))) EXPECT_GT(p.derived.at("min_wrap_tension"), 0.0);
+  }
+  ASSERT_EQ(at.size(), 2u);
+  // The forward run, for the heights of its events.
+  Case up = c;
+  up.definition.parameters.set("rise", -0.02);
+  up.definition.contacts.clear();
+  const testing::ContactBranch forward = testing::follow_contacts(up, rising_indenter(0.18));
+  std::vector<double> forward_at;
+  for (const auto& p : forward.points)
+    if (!p.event.empty()) forward_at.push_back(p.parameter);
+  ASSERT_EQ(forward_at.size(), 2u);
+  // Events are located by secant steps on smooth functions of the height: to ~1e-10 here.
+  EXPECT_NEAR(at[0], forward_at[1], 1e-8);  // unwound where it started to wrap
+  EXPECT_NEAR(at[1], forward_at[0], 2e-9);  // lifted off where it touched (both at 0 up to the gap event's 1e-9)
+}
+
 TEST(DiscWrap, ReachingTheDiscsCurvatureInCompressionStopsWithAClearMessage) {
   // Disc left of the rod's middle: the contact is on the rod's rising side, where n.t < 0; a wrap
   // there would pull on the disc (pressure = tension / radius), so the rod would touch it at two

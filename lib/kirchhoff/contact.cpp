@@ -246,6 +246,7 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
   // Set when a flat contact has just buckled: the next leg leaves the flat branch along the fold.
   std::optional<ContinuationPoint> fold_onset;
   size_t fold_contact = 0;  // the first of the fold's two contacts
+  std::optional<double> unwound_bending;  // g'' of a contact that has just shrunk to a point
   while (true) {
     ContinuationOptions leg = options;
     leg.max_points = max_points - static_cast<int>(out.result.points.size()) + (first_leg ? 0 : 1);
@@ -268,8 +269,13 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     if (has_extended_contact(d.contacts)) {
       leg.detect_branch_points = false;
       leg.events.push_back({"flat_contact_margin", 0.0, true, "flat_contact_buckles"});
+      leg.events.push_back({"min_contact_length", 0.0, true, "contact_shrinks_to_a_point"});
     }
-    if (has_point && d.kind == RodKind::Planar) leg.events.push_back({"contact_bending", 0.0, true, "contact_flattens"});
+    // After a contact shrank to a point its g'' starts at ~0 (to the event's location, not
+    // exactly): the event is armed at that start value, so the start is not a crossing.
+    if (has_point && d.kind == RodKind::Planar)
+      leg.events.push_back({"contact_bending", unwound_bending.value_or(0.0), true, "contact_flattens"});
+    unwound_bending.reset();
     // A wrapped part presses on its disc with tension / radius: where the tension would turn to
     // compression the rod leaves the disc inside the wrap.
     if (has_wrap(d)) leg.events.push_back({"min_wrap_tension", 0.0, true, "wrap_tension_vanishes"});
@@ -322,7 +328,23 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
       out.changes.push_back(change.str() + out.result.message);
       return out;
     }
-    if (at.event == "flat_contact_buckles") {
+    if (at.event == "contact_shrinks_to_a_point") {
+      // The reverse of contact_flattens: the extended contact becomes a point contact carrying both
+      // edge forces (at zero length they act at the same point, along the same normal).
+      d.contacts = contacts;
+      const auto shortest = std::min_element(d.contacts.begin(), d.contacts.end(), [](const auto& a, const auto& b) {
+        return (a.extended ? a.s_end - a.s : INFINITY) < (b.extended ? b.s_end - b.s : INFINITY);
+      });
+      change << "the extended contact at s = " << shortest->s << " shrinks to a point contact";
+      shortest->extended = false;
+      shortest->force += shortest->force_end;
+      shortest->s_end = shortest->s;
+      shortest->force_end = 0.0;
+      ProblemDefinition point = d;
+      point.parameters.set(options.parameter, at.parameter);
+      const ShootingProblem unwound(point);
+      unwound_bending = unwound.contact_bending(carry_over(problem, at.x, unwound), *shortest);
+    } else if (at.event == "flat_contact_buckles") {
       // Beyond, the flat branch is unstable: the flat part buckles away from the obstacle into a
       // hanging fold, two point contacts with a blister between them.
       const size_t which = buckling_flat_contact(here, at.x, contacts);

@@ -5,8 +5,8 @@
 //   - releases the contact with the most negative force, if any (the obstacle would pull), or
 //   - adds a contact where the rod penetrates an obstacle most (refined by Brent's method),
 // until 0 <= g(r(s)) everywhere and every force is >= 0: 0 <= g perp force >= 0.
-// Point contacts and, for planar rods on flat obstacles, extended contacts (the rod lying flat
-// over an interval; see PointContact).
+// Point contacts and, for planar rods on planes and discs, extended contacts (the rod lying on
+// the obstacle over an interval; see PointContact).
 #pragma once
 
 #include <functional>
@@ -71,7 +71,12 @@ DefinitionSolve as_definition_solve(ContactSolveResult contact);
 //   - obstacle_reached: min_gap crosses 0, a point contact appears where the rod touches;
 //   - contact_lifts_off: min_contact_force crosses 0, that contact is released;
 //   - contact_flattens (planar): a point contact's curvature away from the obstacle vanishes, it
-//     becomes an extended contact of zero length that then spreads;
+//     becomes an extended contact of zero length that then spreads (flat on a plane, wrapped
+//     around a disc - a disc only where the rod is in tension there, see PointContact);
+//   - contact_shrinks_to_a_point: a wrap's length reaches 0, it becomes a point contact carrying
+//     both edge forces (flat contacts are not followed below zero length, so a shrinking flat
+//     contact ends its run with the step too small);
+//   - wrap_tension_vanishes: a wrapped part would pull on its disc; the run stops (not modelled);
 //   - flat_contact_buckles: an extended contact's flat part reaches its clamped-clamped Euler
 //     load, P l^2 = 4 pi^2 EI; it becomes a hanging fold, point contacts at its two ends with a
 //     blister between them, and the next leg leaves the (now unstable) flat branch along the

@@ -418,8 +418,16 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
   const std::vector<Obstacle> obstacles_here = obstacles(p);
   for (size_t k = 0; k < points.size(); ++k) {
     const double previous = k == 0 ? 0.0 : points[k - 1].s;
-    // An extended contact may have zero length (when it forms); otherwise strictly increasing.
-    const bool ok = points[k].kind == Breakpoint::ExtendedEnd ? points[k].s >= previous : points[k].s > previous;
+    // Strictly increasing, except that an extended contact may have zero length (when it forms),
+    // and a wrap a negative one (traversed backwards: not a rod, but the residual stays smooth
+    // where a wrap shrinks to a point, so that event is located by crossing). Flat contacts are
+    // kept >= 0: their legs are degenerate (see run_legs in contact.cpp), and allowed a negative
+    // length the first step after flattening goes that way.
+    const bool wrap_end = points[k].kind == Breakpoint::ExtendedEnd && !obstacles_here[points[k].obstacle].is_flat();
+    const double before_contact = k >= 2 ? points[k - 2].s : 0.0;
+    const bool ok = wrap_end ? points[k].s > before_contact
+                    : points[k].kind == Breakpoint::ExtendedEnd ? points[k].s >= previous
+                                                                : points[k].s > previous;
     if (!ok || !(points[k].s < L)) {
       if (failure) *failure = "contact arclengths must increase inside (0, L)";
       return false;

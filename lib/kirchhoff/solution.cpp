@@ -78,6 +78,7 @@ const std::map<std::string, std::string> kCatalogue = {
     {"min_contact_force", "smallest point-contact force (NaN without contacts)"},
     {"contact_bending", "smallest g'' at the point contacts: how the rod curves away from the obstacle (0: it flattens)"},
     {"contact_length", "total length of the extended contacts"},
+    {"min_contact_length", "smallest s_end - s over extended contacts (NaN without): 0 where one shrinks to a point"},
     {"flat_contact_margin", "smallest 4 pi^2 B2 / l^2 - P_flat over extended contacts: < 0 once a flat part would buckle away"},
     {"min_wrap_tension", "smallest tension n.d3 of the parts wrapped around discs (the disc's pressure is tension / radius; NaN without)"},
     {"kappa_contact", "curvature u2 at the first point contact (signed, planar)"},
@@ -141,6 +142,12 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
     double total = 0.0;
     for (const auto& c : sol.contacts) total += c.extended ? c.s_end - c.s : 0.0;
     return total;
+  }
+  if (name == "min_contact_length") {
+    double smallest = NAN;
+    for (const auto& c : sol.contacts)
+      if (c.extended) smallest = std::isnan(smallest) ? c.s_end - c.s : std::min(smallest, c.s_end - c.s);
+    return smallest;
   }
   if (name == "flat_contact_margin") {
     double smallest = NAN;
