@@ -179,6 +179,18 @@ int main(int argc, char** argv) {
   plectonemes_cmd->add_option("--turns", plect.turns, "Largest end rotation (turns), one per slenderness")
       ->delimiter(',')->capture_default_str();
   plectonemes_cmd->add_option("--out", plect.out_dir, "Output folder (created)")->capture_default_str();
+  plectonemes_cmd
+      ->add_option("--from-ply", plect.from_ply,
+                   "Slendernesses reached from the ply of the previous one in --slenderness (by continuation in\n"
+                   "L/2R, then in the barrier's log_softness), then followed in turns up to their --turns and down\n"
+                   "to --turns-min: at L/2R = 1000 the branch from the untwisted rod never forms a ply")
+      ->delimiter(',')
+      ->capture_default_str();
+  plectonemes_cmd->add_option("--turns-min", plect.turns_min, "Where --from-ply branches end on the way down")
+      ->capture_default_str();
+  plectonemes_cmd->add_option("--ply-log-softness", plect.ply_log_softness,
+                              "log10 of the self-contact barrier's strength on --from-ply branches")
+      ->capture_default_str();
   plectonemes_cmd->add_flag("--resume", plect.resume,
                             "Pick a killed sweep up where it stopped: finished branches are kept, an unfinished one\n"
                             "continues from its last point (DIR/plectoneme_<L/2R>.csv.state.json)");

@@ -1,5 +1,6 @@
 #include "plectonemes_command.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -69,70 +70,201 @@ ContinuationOptions continuation_options(const Case& c, double slenderness, doub
 
 }  // namespace
 
+namespace {
+
+const std::vector<std::string>& csv_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n = kMeasured;
+    for (const char* extra : {"T_rho2_over_EI", "eq61", "m3_eq58b"}) n.push_back(extra);
+    return n;
+  }();
+  return names;
+}
+
+// One slenderness's CSV, written point by point (flushed), with the state to resume from beside it.
+class BranchCsv {
+ public:
+  BranchCsv(const std::string& csv_path, double EI, double slenderness, const PlectonemeRunOptions& options,
+            PlectonemeBranchSummary* summary)
+      : state_path_(csv_path + ".state.json"), EI_(EI), slenderness_(slenderness), options_(options), summary_(summary) {
+    const bool resuming = options.resume && std::filesystem::exists(state_path_);
+    if (resuming) {
+      state_ = load_state(state_path_);
+      truncate_csv(csv_path, state_.saved_row);
+    }
+    state_.parameter_name = "turns";
+    csv_.open(csv_path, resuming ? std::ios::app : std::ios::trunc);
+    if (!csv_) throw std::runtime_error("cannot write " + csv_path);
+    csv_ << std::setprecision(12);
+    if (!resuming) {
+      csv_ << "index,turns,type";
+      for (const auto& n : csv_names()) csv_ << ',' << n;
+      csv_ << ",newton_iterations,step\n";
+    }
+    resumed_ = resuming;
+  }
+
+  bool resumed() const { return resumed_; }
+  RunState& state() { return state_; }
+
+  void operator()(const ContinuationPoint& p) {
+    const auto row = columns(p, EI_);
+    csv_ << ++state_.row << ',' << p.parameter << ',' << to_string(p.type);
+    for (const auto& n : csv_names()) csv_ << ',' << row.at(n);
+    csv_ << ',' << p.newton_iterations << ',' << p.step << '\n' << std::flush;
+    if (resumable(p)) save_resume_point(state_path_, p, &state_);
+    ++summary_->points;
+    if (!std::isnan(row.at("eq61"))) {
+      summary_->last = row;
+      summary_->last["turns"] = p.parameter;
+      summary_->ply.push_back(summary_->last);
+    }
+    if (options_.progress_every > 0 && summary_->points % options_.progress_every == 0)
+      std::cerr << "  L/2R = " << slenderness_ << "  point " << state_.row << "  turns = " << std::setprecision(6)
+                << p.parameter << "\n";
+  }
+
+ private:
+  std::filesystem::path state_path_;
+  double EI_, slenderness_;
+  PlectonemeRunOptions options_;
+  PlectonemeBranchSummary* summary_;
+  RunState state_;
+  std::ofstream csv_;
+  bool resumed_ = false;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+std::string stop_text(const ContinuationResult& r) {
+  return to_string(r.reason) + (r.message.empty() ? "" : " (" + r.message + ")");
+}
+
+}  // namespace
+
 PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, double slenderness, double turns_max,
                                                  const std::string& csv_path, const PlectonemeRunOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   PlectonemeBranchSummary summary;
-  const std::filesystem::path state_path = csv_path + ".state.json";
-  const bool resuming = options.resume && std::filesystem::exists(state_path);
   if (options.resume && branch_complete(csv_path)) {
     summary.stop = "already complete";
     return summary;
   }
   const Case c = load_case(case_path, {{"slenderness", slenderness}});
-  const double EI = c.definition.parameters.get("EI");
   ShootingProblem problem(c.definition);
   const ContinuationOptions o =
       continuation_options(c, slenderness, turns_max, options.max_step, options.reuse_jacobian);
-
-  const std::vector<std::string> names = [] {
-    std::vector<std::string> n = kMeasured;
-    for (const char* extra : {"T_rho2_over_EI", "eq61", "m3_eq58b"}) n.push_back(extra);
-    return n;
-  }();
-  RunState state;
-  if (resuming) {
-    state = load_state(state_path);
-    truncate_csv(csv_path, state.saved_row);
-  }
-  state.parameter_name = "turns";
-  std::ofstream csv(csv_path, resuming ? std::ios::app : std::ios::trunc);
-  if (!csv) throw std::runtime_error("cannot write " + csv_path);
-  csv << std::setprecision(12);
-  if (!resuming) {
-    csv << "index,turns,type";
-    for (const auto& n : names) csv << ',' << n;
-    csv << ",newton_iterations,step\n";
-  }
-  auto sink = [&](const ContinuationPoint& p) {
-    const auto row = columns(p, EI);
-    csv << ++state.row << ',' << p.parameter << ',' << to_string(p.type);
-    for (const auto& n : names) csv << ',' << row.at(n);
-    csv << ',' << p.newton_iterations << ',' << p.step << '\n' << std::flush;
-    if (resumable(p)) save_resume_point(state_path, p, &state);
-    ++summary.points;
-    if (!std::isnan(row.at("eq61"))) {
-      summary.last = row;
-      summary.last["turns"] = p.parameter;
-      summary.ply.push_back(summary.last);
-    }
-    if (options.progress_every > 0 && summary.points % options.progress_every == 0)
-      std::cerr << "  L/2R = " << slenderness << "  point " << state.row << "  turns = " << std::setprecision(6)
-                << p.parameter << "\n";
-  };
+  BranchCsv csv(csv_path, c.definition.parameters.get("EI"), slenderness, options, &summary);
+  auto sink = [&](const ContinuationPoint& p) { csv(p); };
   Continuation run(problem, o);
   ContinuationResult branch;
-  if (resuming) {
-    problem.set_parameter(o.parameter, state.last.parameter);
-    branch = run.resume(state.last, sink);
+  if (csv.resumed()) {
+    problem.set_parameter(o.parameter, csv.state().last.parameter);
+    branch = run.resume(csv.state().last, sink);
   } else {
     const ShootingResult untwisted = solve(problem, problem.initial_unknowns(c.start_guess));
     if (!untwisted.summary.converged())
       throw std::runtime_error(case_path + ": the untwisted rod does not solve: " + untwisted.summary.brief_report());
     branch = run.run(untwisted.x, sink);
   }
-  summary.stop = to_string(branch.reason) + (branch.message.empty() ? "" : " (" + branch.message + ")");
-  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  summary.stop = stop_text(branch);
+  summary.seconds = seconds_since(started);
+  return summary;
+}
+
+namespace {
+
+// Follows `problem` in `parameter` from x (at its current value) to `target`, with progress on
+// stderr; returns the end point. No measures are taken on the way (only the end matters).
+ContinuationPoint move_ply(ShootingProblem& problem, const std::string& parameter, const Eigen::VectorXd& x,
+                           double target, double scale, const PlectonemeRunOptions& options) {
+  ContinuationOptions o;
+  o.parameter = parameter;
+  o.target = target;
+  o.initial_step = 1.0 * scale;
+  o.max_step = options.max_step * scale;
+  o.max_points = 20000;
+  o.samples = 11;
+  o.corrector_max_iterations = 12;
+  o.grow_iterations = 6;
+  o.shrink_iterations = 10;
+  o.reuse_jacobian_iterations = options.reuse_jacobian;
+  o.detect_branch_points = false;
+  int points = 0;
+  auto progress = [&](const ContinuationPoint& p) {
+    if (options.progress_every > 0 && ++points % options.progress_every == 0)
+      std::cerr << "  " << parameter << " = " << std::setprecision(6) << p.parameter << "\n";
+  };
+  const ContinuationResult r = Continuation(problem, o).run(x, progress);
+  if (r.reason != StopReason::ReachedTarget || r.points.empty())
+    throw std::runtime_error("the ply did not reach " + parameter + " = " + std::to_string(target) + ": " +
+                             stop_text(r));
+  problem.set_parameter(parameter, target);
+  return r.points.back();
+}
+
+}  // namespace
+
+PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std::string& base_state_path,
+                                        double base_slenderness, double slenderness, double turns_min,
+                                        double turns_max, const std::string& csv_path,
+                                        const PlectonemeRunOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  PlectonemeBranchSummary summary;
+  const std::string start_path = csv_path + ".start.json";
+  if (options.resume && branch_complete(csv_path) && std::filesystem::exists(csv_path + ".state.json") &&
+      load_state(csv_path + ".state.json").branch == 1) {
+    summary.stop = "already complete";
+    return summary;
+  }
+  // The unknowns are those of the base run: its segments (L/2R / 5 of the base slenderness).
+  const Case c = load_case(case_path, {{"slenderness", base_slenderness}});
+  ShootingProblem problem(c.definition);
+  const double scale = (slenderness / 100.0) * (slenderness / 100.0);
+  RunState start;
+  if (options.resume && std::filesystem::exists(start_path)) {
+    start = load_state(start_path);
+  } else {
+    const RunState base = load_state(base_state_path);
+    if (base.parameter_name != "turns")
+      throw std::runtime_error(base_state_path + ": not the end of a plectoneme branch followed in turns");
+    problem.set_parameter("turns", base.last.parameter);
+    std::cerr << "  from the L/2R = " << base_slenderness << " ply at turns = " << base.last.parameter << "\n";
+    ContinuationPoint p = move_ply(problem, "slenderness", base.last.x, slenderness, scale, options);
+    p = move_ply(problem, "log_softness", p.x, options.ply_log_softness, scale, options);
+    start.parameter_name = "turns";
+    start.last = p;
+    start.last.parameter = base.last.parameter;
+    start.last.jacobian.resize(0, 0);
+    save_state(start_path, start);
+  }
+  problem.set_parameter("slenderness", slenderness);
+  problem.set_parameter("log_softness", options.ply_log_softness);
+  problem.set_parameter("turns", start.last.parameter);
+  BranchCsv csv(csv_path, c.definition.parameters.get("EI"), slenderness, options, &summary);
+  auto sink = [&](const ContinuationPoint& p) { csv(p); };
+  // Branch 0: up to turns_max; branch 1: from the same start down to turns_min.
+  const int first_leg = csv.resumed() ? csv.state().branch : 0;
+  std::vector<std::string> stops;
+  for (int leg = first_leg; leg < 2; ++leg) {
+    const ContinuationOptions o = continuation_options(c, slenderness, leg == 0 ? turns_max : turns_min,
+                                                       options.max_step, options.reuse_jacobian);
+    const bool resume_leg = csv.resumed() && leg == first_leg;
+    csv.state().branch = leg;
+    ContinuationResult r;
+    if (resume_leg) {
+      problem.set_parameter("turns", csv.state().last.parameter);
+      r = Continuation(problem, o).resume(csv.state().last, sink);
+    } else {
+      problem.set_parameter("turns", start.last.parameter);
+      r = Continuation(problem, o).run(start.last.x, sink);
+    }
+    stops.push_back((leg == 0 ? "up: " : "down: ") + stop_text(r));
+  }
+  for (const auto& stop : stops) summary.stop += (summary.stop.empty() ? "" : "; ") + stop;
+  summary.seconds = seconds_since(started);
   return summary;
 }
 
@@ -143,18 +275,34 @@ int run_plectonemes(const PlectonemesArguments& args) {
   }
   std::filesystem::create_directories(args.out_dir);
   const auto started = std::chrono::steady_clock::now();
+  const auto csv_of = [&](double sl) {
+    return args.out_dir + "/plectoneme_" + std::to_string(static_cast<int>(sl)) + ".csv";
+  };
   int total = 0;
   for (size_t k = 0; k < args.slenderness.size(); ++k) {
     const double sl = args.slenderness[k];
-    const std::string csv = args.out_dir + "/plectoneme_" + std::to_string(static_cast<int>(sl)) + ".csv";
-    std::cerr << "L/2R = " << sl << ": turns 0 -> " << args.turns[k] << "\n";
+    const bool via_ply = std::count(args.from_ply.begin(), args.from_ply.end(), sl) > 0;
+    if (via_ply && (k == 0 || !(args.slenderness[k - 1] < sl))) {
+      std::cerr << "error: L/2R = " << sl << " is reached from the ply of the slenderness before it in --slenderness, "
+                << "which must be smaller\n";
+      return 2;
+    }
+    const std::string csv = csv_of(sl);
+    if (via_ply)
+      std::cerr << "L/2R = " << sl << ": from the L/2R = " << args.slenderness[k - 1] << " ply, then turns up to "
+                << args.turns[k] << " and down to " << args.turns_min << "\n";
+    else
+      std::cerr << "L/2R = " << sl << ": turns 0 -> " << args.turns[k] << "\n";
     try {
       PlectonemeRunOptions options;
       options.progress_every = 50;
       options.max_step = args.max_step;
       options.reuse_jacobian = args.reuse_jacobian;
       options.resume = args.resume;
-      const auto s = follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, options);
+      options.ply_log_softness = args.ply_log_softness;
+      const auto s = via_ply ? follow_from_ply(args.case_path, csv_of(args.slenderness[k - 1]) + ".state.json",
+                                               args.slenderness[k - 1], sl, args.turns_min, args.turns[k], csv, options)
+                             : follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, options);
       total += s.points;
       std::cout << "L/2R = " << sl << ": " << s.points << " points in " << std::setprecision(3) << s.seconds << " s ("
                 << s.points / s.seconds << " points/s), stopped: " << s.stop << ", " << csv << "\n";

@@ -31,6 +31,10 @@ struct PlectonemeRunOptions {
   // Continue a killed run from csv_path's state file (csv_path + ".state.json"); a branch whose
   // CSV ends at its endpoint is left as it is. Without a state file the branch starts afresh.
   bool resume = false;
+  // log10 of the self-contact barrier's strength on a branch reached from a thicker rod's ply (see
+  // follow_from_ply): at L/2R = 1000 the case's -4 lets the thinner ply's strands 36 % of R apart,
+  // -6 keeps them 4-6 % apart, as the case's default does at L/2R = 100-500.
+  double ply_log_softness = -6.0;
 };
 
 // Follows cases/plectoneme.toml (at `case_path`) with slenderness set, from turns = 0 to
@@ -40,10 +44,26 @@ struct PlectonemeRunOptions {
 PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, double slenderness, double turns_max,
                                                  const std::string& csv_path, const PlectonemeRunOptions& options);
 
+// For a slenderness whose branch from the untwisted rod never forms a ply (at L/2R = 1000 it folds
+// back every two turns with the strands beyond the barrier's reach, passing through each other
+// between points): starts from the last point of a thicker rod's branch (base_state_path, a ply at
+// its largest turns), continues it in slenderness to `slenderness` and in log_softness to
+// options.ply_log_softness, then in turns up to turns_max (CSV branch 0) and from the same start
+// down to turns_min (branch 1). The start is saved beside the CSV (csv_path + ".start.json"), so a
+// resumed run skips those moves, and resumes the turns leg it was in.
+PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std::string& base_state_path,
+                                        double base_slenderness, double slenderness, double turns_min,
+                                        double turns_max, const std::string& csv_path,
+                                        const PlectonemeRunOptions& options);
+
 struct PlectonemesArguments {
   std::string case_path;
   std::vector<double> slenderness{100, 200, 500, 1000};
   std::vector<double> turns{10, 20, 20, 50};
+  // Slendernesses reached from the ply of the one before them in the list (follow_from_ply).
+  std::vector<double> from_ply{1000};
+  double turns_min = 4.0;  // where branches reached from a ply end on the way down
+  double ply_log_softness = -6.0;
   std::string out_dir = "plectonemes";
   double max_step = kPlectonemeMaxStep;
   int reuse_jacobian = kPlectonemeReuseJacobian;
