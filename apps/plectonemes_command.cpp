@@ -43,6 +43,15 @@ bool branch_complete(const std::filesystem::path& csv) {
   return last.find(",endpoint,") != std::string::npos;
 }
 
+// The case's tolerance is for L/2R = 100 (forces up to ~1e3); forces scale as EI/R^2, and at
+// L/2R = 1000 (forces ~1e4) a fixed 1e-8 is below the residual's round-off (1.8e-8 measured near
+// 37 turns): Newton's line search fails and the continuation's steps collapse. So the solver's
+// tolerance (and the corrector's, below) scale like the forces.
+ProblemDefinition with_scaled_tolerance(ProblemDefinition d, double slenderness) {
+  d.options.newton.residual_tolerance *= (slenderness / 100.0) * (slenderness / 100.0);
+  return d;
+}
+
 // How a plectoneme branch is followed in `turns`, at any slenderness.
 ContinuationOptions continuation_options(const Case& c, double slenderness, double turns_max, double max_step,
                                          int reuse_jacobian) {
@@ -53,6 +62,7 @@ ContinuationOptions continuation_options(const Case& c, double slenderness, doub
   const double scale = (slenderness / 100.0) * (slenderness / 100.0);
   o.initial_step = 1.0 * scale;
   o.max_step = max_step * scale;
+  o.corrector_tolerance = std::max(1e-10, c.definition.options.newton.residual_tolerance) * scale;
   o.max_points = 20000;
   o.derived = c.derived;
   o.samples = 10 * static_cast<int>(slenderness) + 1;  // R/10 apart on the half rod: the ply's pitch is 10-30 R
@@ -153,7 +163,7 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
     return summary;
   }
   const Case c = load_case(case_path, {{"slenderness", slenderness}});
-  ShootingProblem problem(c.definition);
+  ShootingProblem problem(with_scaled_tolerance(c.definition, slenderness));
   const ContinuationOptions o =
       continuation_options(c, slenderness, turns_max, options.max_step, options.reuse_jacobian);
   BranchCsv csv(csv_path, c.definition.parameters.get("EI"), slenderness, options, &summary);
@@ -221,7 +231,7 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
   }
   // The unknowns are those of the base run: its segments (L/2R / 5 of the base slenderness).
   const Case c = load_case(case_path, {{"slenderness", base_slenderness}});
-  ShootingProblem problem(c.definition);
+  ShootingProblem problem(with_scaled_tolerance(c.definition, slenderness));
   const double scale = (slenderness / 100.0) * (slenderness / 100.0);
   RunState start;
   if (options.resume && std::filesystem::exists(start_path)) {
@@ -304,8 +314,11 @@ int run_plectonemes(const PlectonemesArguments& args) {
                                                args.slenderness[k - 1], sl, args.turns_min, args.turns[k], csv, options)
                              : follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, options);
       total += s.points;
-      std::cout << "L/2R = " << sl << ": " << s.points << " points in " << std::setprecision(3) << s.seconds << " s ("
-                << s.points / s.seconds << " points/s), stopped: " << s.stop << ", " << csv << "\n";
+      std::cout << "L/2R = " << sl << ": " << s.points << " points in " << std::setprecision(3) << s.seconds << " s";
+      if (s.points > 0) std::cout << " (" << s.points / s.seconds << " points/s)";
+      std::cout << std::setprecision(6);
+      // Flushed: a sweep killed later keeps the lines of the branches it finished.
+      std::cout << ", stopped: " << s.stop << ", " << csv << std::endl;
     } catch (const std::exception& e) {
       std::cerr << "L/2R = " << sl << ": " << e.what() << "\n";
       return 1;

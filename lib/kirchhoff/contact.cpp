@@ -321,13 +321,16 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     std::ostringstream change;
     change << options.parameter << " = " << at.parameter << ": ";
     const auto contacts = here.contacts_at(at.x);
-    if (at.event == "wrap_tension_vanishes") {
+    // Ends the run at this event, for a change of the active set that is not modelled.
+    const auto stop_here = [&](const std::string& why) {
       out.result.reason = StopReason::Inadmissible;
-      out.result.message = "the tension of a wrapped part vanishes: beyond, it would pull on the disc and lift off inside "
-                           "the wrap, which is not modelled; the run stops here";
+      out.result.message = why + "; the run stops here";
       out.changes.push_back(change.str() + out.result.message);
       return out;
-    }
+    };
+    if (at.event == "wrap_tension_vanishes")
+      return stop_here("the tension of a wrapped part vanishes: beyond, it would pull on the disc and lift off inside "
+                       "the wrap, which is not modelled");
     if (at.event == "contact_shrinks_to_a_point") {
       // The reverse of contact_flattens: the extended contact becomes a point contact carrying both
       // edge forces (at zero length they act at the same point, along the same normal).
@@ -369,28 +372,18 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
       }
       PointContact& c = d.contacts[which];
       const Obstacle o = here.obstacles(here.parameters_at(at.x))[c.obstacle];
-      if (const std::string e = extended_contact_unsupported(*here.equations(here.parameters_at(at.x)), o); !e.empty()) {
-        // The rod's curvature has reached the obstacle's: beyond, it would lie on it over an interval.
-        out.result.reason = StopReason::Inadmissible;
-        out.result.message = "the contact at s = " + std::to_string(c.s) + " starts to wrap around " + o.describe() +
-                             ": " + e + "; the run stops here";
-        out.changes.push_back(change.str() + out.result.message);
-        return out;
-      }
+      // The rod's curvature has reached the obstacle's: beyond, it would lie on it over an interval.
+      if (const std::string e = extended_contact_unsupported(*here.equations(here.parameters_at(at.x)), o); !e.empty())
+        return stop_here("the contact at s = " + std::to_string(c.s) + " starts to wrap around " + o.describe() + ": " + e);
       if (!o.is_flat()) {
         // A wrap presses on the disc with its tension / radius: in compression the rod cannot lie
         // on the disc, it would touch it at two points either side instead.
         const RodPoint p = here.sample(at.x, {c.s}).front();
         const double tension = p.n.dot(p.R.col(2));
-        if (tension < -contact.force_tolerance) {
-          out.result.reason = StopReason::Inadmissible;
-          out.result.message = "the contact at s = " + std::to_string(c.s) + " reaches the curvature of " + o.describe() +
-                               " in compression (n.t = " + std::to_string(tension) +
-                               "): it would touch the disc at two points either side, which is not implemented; "
-                               "the run stops here";
-          out.changes.push_back(change.str() + out.result.message);
-          return out;
-        }
+        if (tension < -contact.force_tolerance)
+          return stop_here("the contact at s = " + std::to_string(c.s) + " reaches the curvature of " + o.describe() +
+                           " in compression (n.t = " + std::to_string(tension) +
+                           "): it would touch the disc at two points either side, which is not implemented");
       }
       c.extended = true;
       c.s_end = c.s;

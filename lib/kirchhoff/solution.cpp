@@ -143,46 +143,25 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
     for (const auto& c : sol.contacts) total += c.extended ? c.s_end - c.s : 0.0;
     return total;
   }
-  if (name == "min_contact_length") {
-    double smallest = NAN;
-    for (const auto& c : sol.contacts)
-      if (c.extended) smallest = std::isnan(smallest) ? c.s_end - c.s : std::min(smallest, c.s_end - c.s);
-    return smallest;
-  }
-  if (name == "flat_contact_margin") {
-    double smallest = NAN;
+  // The smallest of a per-contact quantity, over the contacts where it is defined (NaN elsewhere).
+  const auto smallest = [&](const std::function<double(const PointContact&)>& value) {
+    double out = NAN;
     for (const auto& c : sol.contacts) {
-      const double margin = problem.flat_contact_margin(x, c);
-      if (std::isfinite(margin)) smallest = std::isnan(smallest) ? margin : std::min(smallest, margin);
+      const double v = value(c);
+      if (std::isfinite(v)) out = std::isnan(out) ? v : std::min(out, v);
     }
-    return smallest;
-  }
-  if (name == "min_wrap_tension") {
-    double smallest = NAN;
-    for (const auto& c : sol.contacts) {
-      const double tension = problem.wrap_tension(x, c);
-      if (std::isfinite(tension)) smallest = std::isnan(smallest) ? tension : std::min(smallest, tension);
-    }
-    return smallest;
-  }
-  if (name == "contact_bending") {
-    double smallest = NAN;
-    for (const auto& c : sol.contacts) {
-      if (c.extended) continue;
-      const double g2 = problem.contact_bending(x, c);
-      smallest = std::isnan(smallest) ? g2 : std::min(smallest, g2);
-    }
-    return smallest;
-  }
+    return out;
+  };
+  if (name == "min_contact_length")
+    return smallest([](const PointContact& c) { return c.extended ? c.s_end - c.s : NAN; });
+  if (name == "flat_contact_margin")
+    return smallest([&](const PointContact& c) { return problem.flat_contact_margin(x, c); });
+  if (name == "min_wrap_tension") return smallest([&](const PointContact& c) { return problem.wrap_tension(x, c); });
+  if (name == "contact_bending")
+    return smallest([&](const PointContact& c) { return c.extended ? NAN : problem.contact_bending(x, c); });
   if (name == "contact_count") return static_cast<double>(sol.contacts.size());
-  if (name == "min_contact_force") {
-    double smallest = NAN;
-    for (const auto& c : sol.contacts) {
-      const double f = c.extended ? std::min(c.force, c.force_end) : c.force;
-      smallest = std::isnan(smallest) ? f : std::min(smallest, f);
-    }
-    return smallest;
-  }
+  if (name == "min_contact_force")
+    return smallest([](const PointContact& c) { return c.extended ? std::min(c.force, c.force_end) : c.force; });
   if (name == "kappa_contact")
     return sol.contacts.empty() ? NAN : problem.sample(x, {sol.contacts.front().s}).front().u[1];
   if (name == "contact_s") return sol.contacts.empty() ? NAN : sol.contacts.front().s;
