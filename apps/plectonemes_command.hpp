@@ -32,9 +32,11 @@ struct PlectonemeRunOptions {
   // CSV ends at its endpoint is left as it is. Without a state file the branch starts afresh.
   bool resume = false;
   // log10 of the self-contact barrier's strength on a branch reached from a thicker rod's ply (see
-  // follow_from_ply): at L/2R = 1000 the case's -4 lets the thinner ply's strands 36 % of R apart,
-  // -6 keeps them 4-6 % apart, as the case's default does at L/2R = 100-500.
-  double ply_log_softness = -6.0;
+  // follow_from_ply): at L/2R = 1000 the case's -4 lets the thinner ply's strands 36 % of R apart at
+  // 20 turns; -5 gives 20 % there and 5 % at 50 turns, like the case's -4 at L/2R = 100-500. (-6
+  // gave 6 % at 20 turns; that run's steps collapsed near 29 turns, before the tolerances were
+  // scaled with the forces - not retried since.)
+  double ply_log_softness = -5.0;
 };
 
 // Follows cases/plectoneme.toml (at `case_path`) with slenderness set, from turns = 0 to
@@ -63,7 +65,7 @@ struct PlectonemesArguments {
   // Slendernesses reached from the ply of the one before them in the list (follow_from_ply).
   std::vector<double> from_ply{1000};
   double turns_min = 4.0;  // where branches reached from a ply end on the way down
-  double ply_log_softness = -6.0;
+  double ply_log_softness = -5.0;
   std::string out_dir = "plectonemes";
   double max_step = kPlectonemeMaxStep;
   int reuse_jacobian = kPlectonemeReuseJacobian;

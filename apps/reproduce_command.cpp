@@ -574,10 +574,11 @@ void cavity(const fs::path& cases, const fs::path& out, std::vector<ReportRow>* 
 
 // (helix angle, T_ext) along the established ply (turns > 3.5, where the branch is single-valued
 // in the angle), by increasing angle.
-std::vector<std::pair<double, double>> established_ply(const std::vector<std::map<std::string, double>>& ply) {
+std::vector<std::pair<double, double>> established_ply(const std::vector<std::map<std::string, double>>& ply,
+                                                       const std::string& column = "T_ext") {
   std::vector<std::pair<double, double>> points;
   for (const auto& p : ply)
-    if (p.at("turns") > 3.5) points.push_back({p.at("helix_angle"), p.at("T_ext")});
+    if (p.at("turns") > 3.5) points.push_back({p.at("helix_angle"), p.at(column)});
   std::sort(points.begin(), points.end());
   return points;
 }
@@ -593,20 +594,34 @@ double tension_at(const std::vector<std::pair<double, double>>& ply, double thet
 }
 
 // Section 7.6 / Fig. 11: plectoneme branches for L/2R = 100 (to 6 turns) and 200 (to 13), from
-// the untwisted rod into the ply; at each branch's last point the helix formulas (58b) and (61)
-// against the computed ply, with its helix radius rho (R plus the self-contact barrier's gap)
-// and angle, and H_A = H_B (eqs. 59-60); across the two, the 1/R^2 scaling of T_ext at a common
-// helix angle.
-void plectonemes(const fs::path& cases, const fs::path& out, std::vector<ReportRow>* rows) {
+// the untwisted rod into the ply (with `full`: the whole sweep of `kirchhoff plectonemes`, 100,
+// 200, 500 to 10, 20, 20 turns and 1000 from the 500 ply to 50 and down to 4, ~30 minutes); at each
+// branch's last ply point the helix formulas (58b) and (61) against the computed ply, with its
+// helix radius rho (R plus the self-contact barrier's gap) and angle, and H_A = H_B (eqs. 59-60);
+// across slendernesses, the 1/R^2 scaling of T_ext at a common helix angle.
+void plectonemes(const fs::path& cases, const fs::path& out, bool full, std::vector<ReportRow>* rows) {
   struct Run {
     double slenderness, turns;
+    bool from_ply = false;  // reached from the previous run's ply (follow_from_ply)
     PlectonemeBranchSummary branch;
   };
-  std::vector<Run> runs = {{100.0, 6.0, {}}, {200.0, 13.0, {}}};
-  for (auto& run : runs) {
+  std::vector<Run> runs = {{100.0, 6.0}, {200.0, 13.0}};
+  if (full) runs = {{100.0, 10.0}, {200.0, 20.0}, {500.0, 20.0}, {1000.0, 50.0, true}};
+  const std::string case_path = (cases / "plectoneme.toml").string();
+  const auto csv_of = [&](double slenderness) {
+    return (out / ("plectoneme_" + std::to_string(static_cast<int>(slenderness)) + ".csv")).string();
+  };
+  for (size_t k = 0; k < runs.size(); ++k) {
+    Run& run = runs[k];
     const std::string name = std::to_string(static_cast<int>(run.slenderness));
-    run.branch = follow_plectoneme_branch((cases / "plectoneme.toml").string(), run.slenderness, run.turns,
-                                          (out / ("plectoneme_" + name + ".csv")).string(), {});
+    if (full) progress("  L/2R = " + name);
+    PlectonemeRunOptions options;
+    options.progress_every = full ? 250 : 0;
+    run.branch = run.from_ply ? follow_from_ply(case_path, csv_of(runs[k - 1].slenderness) + ".state.json",
+                                                runs[k - 1].slenderness, run.slenderness, 4.0, run.turns,
+                                                csv_of(run.slenderness), options)
+                              : follow_plectoneme_branch(case_path, run.slenderness, run.turns, csv_of(run.slenderness),
+                                                         options);
     if (run.branch.last.empty())
       throw std::runtime_error("plectoneme: no ply formed at L/2R = " + name + " (" + run.branch.stop + ")");
     const auto& ply = run.branch.last;
@@ -639,6 +654,18 @@ void plectonemes(const fs::path& cases, const fs::path& out, std::vector<ReportR
                    "theta = " + format_short(theta * 180.0 / M_PI) +
                        " deg; 1/R^2 (eq. 61 with rho = R); the barrier's gap makes rho/R differ by up to ~4 % "
                        "between the two, hence the bar"});
+  // The whole sweep: with rho in place of R (the barrier's gap differs between slendernesses, up to
+  // rho/R = 1.20 at 500 against 1.08 at 1000), T_ext rho^2 at equal helix angle, pair by pair.
+  for (size_t k = 1; full && k < runs.size(); ++k) {
+    const auto a = established_ply(runs[k - 1].branch.ply, "T_rho2_over_EI");
+    const auto b = established_ply(runs[k].branch.ply, "T_rho2_over_EI");
+    const double at = a.empty() || b.empty() ? NAN : std::min(a.back().first, b.back().first);
+    const std::string pair = "L/2R = " + std::to_string(static_cast<int>(runs[k].slenderness)) + " / " +
+                             std::to_string(static_cast<int>(runs[k - 1].slenderness));
+    rows->push_back({"Fig. 11, scaling", "T_ext rho^2, " + pair + ", at equal helix angle", {}, 1.0,
+                     tension_at(b, at) / tension_at(a, at), 1.0, 0.05,
+                     "theta = " + format_short(at * 180.0 / M_PI) + " deg; 1/rho^2 with rho the computed helix radius"});
+  }
 }
 
 std::string format(const std::optional<double>& v) {
@@ -681,7 +708,7 @@ void write_report(const fs::path& out, const std::vector<ReportRow>& rows, doubl
 
 }  // namespace
 
-int run_reproduce(const std::string& out_dir, const std::string& cases_dir) {
+int run_reproduce(const std::string& out_dir, const std::string& cases_dir, bool full) {
   const auto start = std::chrono::steady_clock::now();
   const fs::path out(out_dir), cases(cases_dir);
   fs::create_directories(out / "profiles");
@@ -704,9 +731,10 @@ int run_reproduce(const std::string& out_dir, const std::string& cases_dir) {
     vibrations(cases, out / "profiles", &rows);
     progress("Section 7.2 / Fig. 5: the Elastica in a cavity, hanging fold");
     cavity(cases, out / "profiles", &rows);
-    progress("Section 7.6 / Fig. 11: plectonemes at L/2R = 100 and 200, from the untwisted rod into the ply "
-             "(about 2 minutes)");
-    plectonemes(cases, out / "profiles", &rows);
+    progress(full ? "Section 7.6 / Fig. 11: plectonemes at L/2R = 100, 200, 500 and 1000 (about half an hour)"
+                  : "Section 7.6 / Fig. 11: plectonemes at L/2R = 100 and 200, from the untwisted rod into the ply "
+                    "(about 2 minutes; --full adds 500 and 1000)");
+    plectonemes(cases, out / "profiles", full, &rows);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitNotConverged;

@@ -7,6 +7,7 @@
 
 namespace kirchhoff::cli {
 
-int run_reproduce(const std::string& out_dir, const std::string& cases_dir);
+// `full` adds Fig. 11's L/2R = 500 and 1000 (the whole `kirchhoff plectonemes` sweep, ~30 minutes).
+int run_reproduce(const std::string& out_dir, const std::string& cases_dir, bool full = false);
 
 }  // namespace kirchhoff::cli

@@ -311,6 +311,14 @@ int ShootingProblem::start_rows(const RodEquations& eq, const Eigen::VectorXd& y
 
 bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
                                Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const {
+  // A Newton or corrector iterate may take a parameter outside the model's domain (a slenderness
+  // whose radius is <= 0): that point cannot be evaluated, like one that cannot be integrated.
+  try {
+    equations(p);
+  } catch (const std::invalid_argument& e) {
+    if (failure) *failure = std::string("the rod model is not defined there: ") + e.what();
+    return false;
+  }
   if (!definition_.contacts.empty()) return residual_with_contacts(x, p, F, J, failure, y_end);
   const auto eq = equations(p);
   const int n = state_size_, M = segments();
