@@ -7,10 +7,12 @@
 // Hessian too.
 //
 // Shapes:
-//   - plane: g = (r - point) . normal; a wall, two of them a cavity. The only shape an extended
-//     contact (the rod lying on the obstacle over an interval) is modelled on.
+//   - plane: g = (r - point) . normal; a wall, two of them a cavity. A planar rod may lie flat on
+//     it over an interval (an extended contact, see PointContact).
 //   - cylinder: g = |(r - centre) x axis| - radius, radius > 0; for a planar rod with the axis
-//     normal to its plane, a disc: a pin, an indenter, the rounded edge of a table or a corner.
+//     normal to its plane, a disc: a pin, an indenter, the rounded edge of a table or a corner. A
+//     uniform planar rod may wrap around a disc (the extended contact's curved form); see
+//     extended_contact_unsupported for what is not modelled.
 //     A sharp point is the limit radius -> 0 (the contact conditions are singular at radius 0, so
 //     it is refused: take a radius small against the rod's length).
 //   - level set: any smooth g(x, y, z) (a case-file expression), its gradient and Hessian by
