@@ -43,29 +43,28 @@ bool branch_complete(const std::filesystem::path& csv) {
   return last.find(",endpoint,") != std::string::npos;
 }
 
-// The case's tolerance is for L/2R = 100 (forces up to ~1e3); forces scale as EI/R^2, and at
-// L/2R = 1000 (forces ~1e4) a fixed 1e-8 is below the residual's round-off (1.8e-8 measured near
-// 37 turns): Newton's line search fails and the continuation's steps collapse. So the solver's
-// tolerance (and the corrector's, below) scale like the forces.
+// Forces, and with them the unknowns, the pseudo-arclength and the residual's round-off, scale as
+// EI/R^2: relative to L/2R = 100, for which the case and the step defaults are set.
+double force_scale(double slenderness) { return (slenderness / 100.0) * (slenderness / 100.0); }
+
+// The case's tolerance is for L/2R = 100 (forces up to ~1e3); at L/2R = 1000 (forces ~1e4) a fixed
+// 1e-8 is below the residual's round-off (1.8e-8 measured near 37 turns): Newton's line search
+// fails and the continuation's steps collapse. So the solver's tolerance (and the corrector's,
+// below) scale like the forces.
 ProblemDefinition with_scaled_tolerance(ProblemDefinition d, double slenderness) {
-  d.options.newton.residual_tolerance *= (slenderness / 100.0) * (slenderness / 100.0);
+  d.options.newton.residual_tolerance *= force_scale(slenderness);
   return d;
 }
 
-// How a plectoneme branch is followed in `turns`, at any slenderness.
-ContinuationOptions continuation_options(const Case& c, double slenderness, double turns_max, double max_step,
-                                         int reuse_jacobian) {
+// How a ply is followed in any parameter at this slenderness (steps scaled with the forces).
+ContinuationOptions ply_continuation(const std::string& parameter, double target, double slenderness,
+                                     const PlectonemeRunOptions& options) {
   ContinuationOptions o;
-  o.parameter = "turns";
-  o.target = turns_max;
-  // Forces, and with them the unknowns and the pseudo-arclength, scale as EI/R^2.
-  const double scale = (slenderness / 100.0) * (slenderness / 100.0);
-  o.initial_step = 1.0 * scale;
-  o.max_step = max_step * scale;
-  o.corrector_tolerance = std::max(1e-10, c.definition.options.newton.residual_tolerance) * scale;
+  o.parameter = parameter;
+  o.target = target;
+  o.initial_step = 1.0 * force_scale(slenderness);
+  o.max_step = options.max_step * force_scale(slenderness);
   o.max_points = 20000;
-  o.derived = c.derived;
-  o.samples = 10 * static_cast<int>(slenderness) + 1;  // R/10 apart on the half rod: the ply's pitch is 10-30 R
   // A point's Jacobian (14 sensitivities per segment) and measures cost tens of residual
   // evaluations: longer steps that take up to 9 chord iterations are cheaper per turn, and a
   // point whose chord iterations converged keeps the previous matrix. Measured at L/2R = 200 to
@@ -73,8 +72,18 @@ ContinuationOptions continuation_options(const Case& c, double slenderness, doub
   o.corrector_max_iterations = 12;
   o.grow_iterations = 6;
   o.shrink_iterations = 10;
-  o.reuse_jacobian_iterations = reuse_jacobian;
+  o.reuse_jacobian_iterations = options.reuse_jacobian;
   o.detect_branch_points = false;  // the barrier's stiffness turns the determinant's sign into noise
+  return o;
+}
+
+// How a plectoneme branch is followed in `turns`, with the case's measures at every point.
+ContinuationOptions continuation_options(const Case& c, double slenderness, double turns_max,
+                                         const PlectonemeRunOptions& options) {
+  ContinuationOptions o = ply_continuation("turns", turns_max, slenderness, options);
+  o.corrector_tolerance = std::max(1e-10, c.definition.options.newton.residual_tolerance) * force_scale(slenderness);
+  o.derived = c.derived;
+  o.samples = 10 * static_cast<int>(slenderness) + 1;  // R/10 apart on the half rod: the ply's pitch is 10-30 R
   return o;
 }
 
@@ -164,8 +173,7 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
   }
   const Case c = load_case(case_path, {{"slenderness", slenderness}});
   ShootingProblem problem(with_scaled_tolerance(c.definition, slenderness));
-  const ContinuationOptions o =
-      continuation_options(c, slenderness, turns_max, options.max_step, options.reuse_jacobian);
+  const ContinuationOptions o = continuation_options(c, slenderness, turns_max, options);
   BranchCsv csv(csv_path, c.definition.parameters.get("EI"), slenderness, options, &summary);
   auto sink = [&](const ContinuationPoint& p) { csv(p); };
   Continuation run(problem, o);
@@ -189,19 +197,9 @@ namespace {
 // Follows `problem` in `parameter` from x (at its current value) to `target`, with progress on
 // stderr; returns the end point. No measures are taken on the way (only the end matters).
 ContinuationPoint move_ply(ShootingProblem& problem, const std::string& parameter, const Eigen::VectorXd& x,
-                           double target, double scale, const PlectonemeRunOptions& options) {
-  ContinuationOptions o;
-  o.parameter = parameter;
-  o.target = target;
-  o.initial_step = 1.0 * scale;
-  o.max_step = options.max_step * scale;
-  o.max_points = 20000;
+                           double target, double slenderness, const PlectonemeRunOptions& options) {
+  ContinuationOptions o = ply_continuation(parameter, target, slenderness, options);
   o.samples = 11;
-  o.corrector_max_iterations = 12;
-  o.grow_iterations = 6;
-  o.shrink_iterations = 10;
-  o.reuse_jacobian_iterations = options.reuse_jacobian;
-  o.detect_branch_points = false;
   int points = 0;
   auto progress = [&](const ContinuationPoint& p) {
     if (options.progress_every > 0 && ++points % options.progress_every == 0)
@@ -232,7 +230,6 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
   // The unknowns are those of the base run: its segments (L/2R / 5 of the base slenderness).
   const Case c = load_case(case_path, {{"slenderness", base_slenderness}});
   ShootingProblem problem(with_scaled_tolerance(c.definition, slenderness));
-  const double scale = (slenderness / 100.0) * (slenderness / 100.0);
   RunState start;
   if (options.resume && std::filesystem::exists(start_path)) {
     start = load_state(start_path);
@@ -242,8 +239,8 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
       throw std::runtime_error(base_state_path + ": not the end of a plectoneme branch followed in turns");
     problem.set_parameter("turns", base.last.parameter);
     std::cerr << "  from the L/2R = " << base_slenderness << " ply at turns = " << base.last.parameter << "\n";
-    ContinuationPoint p = move_ply(problem, "slenderness", base.last.x, slenderness, scale, options);
-    p = move_ply(problem, "log_softness", p.x, options.ply_log_softness, scale, options);
+    ContinuationPoint p = move_ply(problem, "slenderness", base.last.x, slenderness, slenderness, options);
+    p = move_ply(problem, "log_softness", p.x, options.ply_log_softness, slenderness, options);
     start.parameter_name = "turns";
     start.last = p;
     start.last.parameter = base.last.parameter;
@@ -259,8 +256,7 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
   const int first_leg = csv.resumed() ? csv.state().branch : 0;
   std::vector<std::string> stops;
   for (int leg = first_leg; leg < 2; ++leg) {
-    const ContinuationOptions o = continuation_options(c, slenderness, leg == 0 ? turns_max : turns_min,
-                                                       options.max_step, options.reuse_jacobian);
+    const ContinuationOptions o = continuation_options(c, slenderness, leg == 0 ? turns_max : turns_min, options);
     const bool resume_leg = csv.resumed() && leg == first_leg;
     csv.state().branch = leg;
     ContinuationResult r;

@@ -247,6 +247,7 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
   std::optional<ContinuationPoint> fold_onset;
   size_t fold_contact = 0;  // the first of the fold's two contacts
   std::optional<double> unwound_bending;  // g'' of a contact that has just shrunk to a point
+  std::optional<size_t> unwound_contact;  // which one, set at the event
   while (true) {
     ContinuationOptions leg = options;
     leg.max_points = max_points - static_cast<int>(out.result.points.size()) + (first_leg ? 0 : 1);
@@ -343,10 +344,7 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
       shortest->force += shortest->force_end;
       shortest->s_end = shortest->s;
       shortest->force_end = 0.0;
-      ProblemDefinition point = d;
-      point.parameters.set(options.parameter, at.parameter);
-      const ShootingProblem unwound(point);
-      unwound_bending = unwound.contact_bending(carry_over(problem, at.x, unwound), *shortest);
+      unwound_contact = static_cast<size_t>(shortest - d.contacts.begin());
     } else if (at.event == "flat_contact_buckles") {
       // Beyond, the flat branch is unstable: the flat part buckles away from the obstacle into a
       // hanging fold, two point contacts with a blister between them.
@@ -422,6 +420,8 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     next_definition.parameters.set(options.parameter, at.parameter);
     const ShootingProblem next(next_definition);
     x = carry_over(problem, at.x, next);
+    if (unwound_contact) unwound_bending = next.contact_bending(x, next.contacts_at(x)[*unwound_contact]);
+    unwound_contact.reset();
     d = next_definition;
   }
 }
