@@ -100,21 +100,31 @@ class SpatialEquations final : public RodEquations {
     dy[kChi] = 2.0 * (w * dy[kQ + 3] - qz * dy[kQ]) / (w * w + qz * qz);
   }
 
+  // The full Phi from the seeded columns of a partial flow; the others are unit vectors.
+  template <std::size_t K>
+  static SegmentFlow with_unit_columns(SegmentFlow partial, const std::array<int, K>& seeds) {
+    Eigen::MatrixXd Phi = Eigen::MatrixXd::Identity(kStateSize, kStateSize);
+    for (std::size_t j = 0; j < K; ++j) Phi.col(seeds[j]) = partial.Phi.col(static_cast<Eigen::Index>(j));
+    partial.Phi = std::move(Phi);
+    return partial;
+  }
+
   SegmentFlow flow(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities,
                    const IntegratorOptions& options) const override {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     if (!sensitivities) return detail::flow_state<kStateSize>(f, y0, s0, s1, options);
-    if (model_.field) return detail::flow_with_sensitivities<kStateSize>(f, y0, s0, s1, options);
-    // Without a field nothing depends on r(s0) or chi(s0): their columns of Phi are unit vectors,
-    // and only the ten directions of q, n, m are carried by the dual numbers.
+    // Nothing depends on chi(s0), and without a field nothing depends on r(s0) either: their
+    // columns of Phi are unit vectors, and only the other directions are carried by the dual
+    // numbers (13 with a field - self-contact, gravity -, 10 without).
+    if (model_.field) {
+      constexpr std::array<int, 13> kSeeds{kR,     kR + 1, kR + 2, kQ,     kQ + 1, kQ + 2, kQ + 3,
+                                           kN,     kN + 1, kN + 2, kM,     kM + 1, kM + 2};
+      return with_unit_columns(detail::flow_with_partial_sensitivities<kStateSize, 13>(f, y0, s0, s1, options, kSeeds),
+                               kSeeds);
+    }
     constexpr std::array<int, 10> kSeeds{kQ, kQ + 1, kQ + 2, kQ + 3, kN, kN + 1, kN + 2, kM, kM + 1, kM + 2};
-    SegmentFlow partial = detail::flow_with_partial_sensitivities<kStateSize, 10>(f, y0, s0, s1, options, kSeeds);
-    Eigen::MatrixXd Phi = Eigen::MatrixXd::Zero(kStateSize, kStateSize);
-    for (int j = 0; j < 10; ++j) Phi.col(kSeeds[j]) = partial.Phi.col(j);
-    for (int i = 0; i < 3; ++i) Phi(kR + i, kR + i) = 1.0;
-    Phi(kChi, kChi) = 1.0;
-    partial.Phi = std::move(Phi);
-    return partial;
+    return with_unit_columns(detail::flow_with_partial_sensitivities<kStateSize, 10>(f, y0, s0, s1, options, kSeeds),
+                             kSeeds);
   }
 
   std::vector<Eigen::VectorXd> sample(const Eigen::VectorXd& y0, const std::vector<double>& s,
