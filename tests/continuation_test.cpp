@@ -1,6 +1,7 @@
 // Pseudo-arclength continuation: branch points, folds, branch switching, the double branch
 // point of the isotropic twisted rod, invariants along branches.
 #include <cmath>
+#include <iostream>
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/continuation.hpp"
@@ -85,15 +86,19 @@ ContinuationOptions buckled_options(double theta_end) {
   return o;
 }
 
-// The straight column up to its first branch point, then the branch bifurcating there.
-ContinuationResult first_buckled_branch(const ContinuationOptions& buckled) {
+// The straight column up to its first branch point, then the branch bifurcating there (and the
+// evaluations that branch took, in `count`).
+ContinuationResult first_buckled_branch(const ContinuationOptions& buckled,
+                                        Continuation::EvaluationCount* count = nullptr) {
   ContinuationOptions o = euler_options();
   o.target = 12.0;
   o.stop_at_branch_point = 1;
   BranchRun run = continue_case("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, o);
   EXPECT_EQ(run.result.reason, StopReason::BranchPointStop);
   Continuation branch(*run.problem, buckled);
-  return branch.switch_branch(run.result.points.back());
+  ContinuationResult r = branch.switch_branch(run.result.points.back());
+  if (count) *count = branch.evaluations();
+  return r;
 }
 
 TEST(EulerColumn, FirstBuckledBranchMatchesTheElasticaToThetaThree) {
@@ -142,6 +147,40 @@ TEST(EulerColumn, ReusedJacobiansGiveTheSameBuckledBranch) {
   EXPECT_GT(compared, 20);
   EXPECT_GT(reused, compared / 4);
   EXPECT_NEAR(r.points.back().derived.at("theta0"), 2.5, 1e-9);
+}
+
+// Modified Newton keeps a corrector's matrix while the residual halves: the correctors take
+// more (cheap) iterations and fewer matrices, the equilibria are the same. Long steps (max_step
+// 4) make the chord on the previous point's matrix fail often, so Newton runs.
+TEST(EulerColumn, ModifiedNewtonTakesFewerMatricesForTheSameBranch) {
+  ContinuationOptions full = buckled_options(2.5);
+  full.max_step = 4.0;
+  full.grow_iterations = 8;
+  full.shrink_iterations = 16;
+  full.corrector_max_iterations = 20;
+  ContinuationOptions modified = full;
+  modified.modified_newton = true;
+  Continuation::EvaluationCount full_count, modified_count;
+  const ContinuationResult a = first_buckled_branch(full, &full_count);
+  const ContinuationResult b = first_buckled_branch(modified, &modified_count);
+  ASSERT_EQ(a.reason, StopReason::EventStop) << a.message;
+  ASSERT_EQ(b.reason, StopReason::EventStop) << b.message;
+  int compared = 0;
+  for (const auto& p : b.points) {
+    const double theta0 = p.derived.at("theta0");
+    // The branch point where the ends touch is singular: its position along the null direction
+    // is ~sqrt(corrector tolerance) (FirstBuckledBranchMatchesTheElasticaToThetaThree).
+    if (theta0 < 1e-3 || p.type == PointType::BranchPoint) continue;
+    const double exact = analytic::PinnedElastica{1.0, 1.0, theta0}.load();
+    EXPECT_NEAR(p.parameter / exact, 1.0, kLocated) << theta0;
+    ++compared;
+  }
+  EXPECT_GT(compared, 5);
+  EXPECT_NEAR(b.points.back().parameter / a.points.back().parameter, 1.0, kLocated);
+  EXPECT_LT(modified_count.matrices, full_count.matrices);
+  EXPECT_GT(modified_count.residuals, full_count.residuals);
+  std::cout << "matrices " << full_count.matrices << " -> " << modified_count.matrices << ", residuals "
+            << full_count.residuals << " -> " << modified_count.residuals << "\n";
 }
 
 ContinuationOptions twist_options() {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <boost/math/tools/minima.hpp>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "kirchhoff/jacobian_lu.hpp"
@@ -22,6 +23,10 @@ constexpr double kLocateTolerance = 1e-12;
 constexpr int kLocateIterations = 60;
 // Chord iterations continue while each one reduces the residual at least by this factor.
 constexpr double kChordContraction = 0.3;
+// Modified Newton keeps its matrix while each iteration reduces the residual at least by this
+// factor (it converges linearly at that rate, still cheaper than a new matrix when one costs
+// tens of residuals).
+constexpr double kModifiedNewtonContraction = 0.5;
 // H is flagged as not flat above this fraction of its scale (the standard).
 constexpr double kFlatH = 1e-9;
 
@@ -96,7 +101,11 @@ bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen:
   const double lambda = z[n_];
   const Eigen::VectorXd x = z.head(n_);
   problem_.set_parameter(options_.parameter, lambda);
-  if (!A) return problem_.evaluate(x, F, nullptr, failure);
+  if (!A) {
+    ++evaluations_.residuals;
+    return problem_.evaluate(x, F, nullptr, failure);
+  }
+  ++evaluations_.matrices;
   Eigen::MatrixXd J;
   Eigen::VectorXd y_end, F_lambda;
   if (!problem_.evaluate_with_end(x, F, &J, &y_end, failure)) return false;
@@ -137,32 +146,48 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
       if (!z.allFinite()) z = z_start;
     }
   }
-  double best = INFINITY;
+  double best = INFINITY, previous = INFINITY;
+  std::optional<JacobianLU> lu;  // the matrix of the current (modified) Newton iteration
   for (; it <= 2 * options_.corrector_max_iterations; ++it) {
-    if (!evaluate(z, &F, &A, &failure)) {
-      last_corrector_failure_ = failure;
-      return false;
+    if (lu) {
+      if (!evaluate(z, &F, nullptr, &failure)) {
+        last_corrector_failure_ = failure;
+        return false;
+      }
+      G << F, normal.dot(z - z_predicted);
+      if (!(G.lpNorm<Eigen::Infinity>() <= kModifiedNewtonContraction * previous)) lu.reset();
     }
-    G << F, normal.dot(z - z_predicted);
+    if (!lu) {
+      if (!evaluate(z, &F, &A, &failure)) {
+        last_corrector_failure_ = failure;
+        return false;
+      }
+      G << F, normal.dot(z - z_predicted);
+    }
     if (!G.allFinite()) {
       last_corrector_failure_ = "the residual is not finite";
       return false;
     }
-    best = std::min(best, G.lpNorm<Eigen::Infinity>());
-    if (G.lpNorm<Eigen::Infinity>() <= options_.corrector_tolerance) {
+    const double norm = G.lpNorm<Eigen::Infinity>();
+    best = std::min(best, norm);
+    if (norm <= options_.corrector_tolerance) {
       *iterations = it;
       return true;
     }
-    M << A, normal.transpose();
-    const JacobianLU lu(M);
-    if (!(lu.reciprocal_condition() > 1e-15)) {
-      std::ostringstream os;
-      os << "singular bordered matrix (reciprocal condition " << lu.reciprocal_condition() << ", residual "
-         << G.lpNorm<Eigen::Infinity>() << ")";
-      last_corrector_failure_ = os.str();
-      return false;
+    if (!lu) {
+      M << A, normal.transpose();
+      lu.emplace(M);
+      if (!(lu->reciprocal_condition() > 1e-15)) {
+        std::ostringstream os;
+        os << "singular bordered matrix (reciprocal condition " << lu->reciprocal_condition() << ", residual " << norm
+           << ")";
+        last_corrector_failure_ = os.str();
+        return false;
+      }
     }
-    z -= lu.solve(G);
+    z -= lu->solve(G);
+    previous = norm;
+    if (!options_.modified_newton) lu.reset();
   }
   std::ostringstream os;
   os << "no convergence, best residual " << best;
@@ -236,6 +261,8 @@ std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint
   if (!correct(z, z_pred, from.tangent, &iterations, &from.jacobian, &by_chord)) return std::nullopt;
   // A corrector that converged quickly on the previous matrix shows that matrix still serves:
   // the new point keeps it for its tangent and the next chord instead of paying for its own.
+  // (Not a modified-Newton matrix from an iterate of this corrector: tried at L/2R = 200, its
+  // tangents cost three times the run time in harder correctors.)
   const bool reuse = by_chord && iterations <= options_.reuse_jacobian_iterations && from.jacobian.rows() == n_;
   return point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations,
                   reuse ? &from.jacobian : nullptr);

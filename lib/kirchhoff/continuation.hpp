@@ -60,6 +60,11 @@ struct ContinuationOptions {
   // its own - the variational equations are most of a point's cost on long multiple-shooting
   // rods. -1: every point evaluates its own (needed for branch points and exact tangents).
   int reuse_jacobian_iterations = -1;
+  // Modified Newton in the corrector: a matrix, once evaluated, is kept for the following
+  // iterations while each reduces the residual by half, instead of one matrix per iteration.
+  // Where the matrix costs tens of residuals (the variational equations of long multiple-shooting
+  // rods) this is far cheaper per point.
+  bool modified_newton = false;
   // On max |F| and |arclength condition|; NaN: 1e-10, or the problem's Newton residual tolerance
   // (a case's [solver] tolerance) when that is looser - rods with large forces need it.
   double corrector_tolerance = std::numeric_limits<double>::quiet_NaN();
@@ -146,12 +151,20 @@ class Continuation {
 
   const ShootingProblem& problem() const { return problem_; }
   const ContinuationOptions& options() const { return options_; }
+  // Evaluations of F alone and of F with its matrix [F_x F_lambda] (the variational equations)
+  // so far: the cost of a branch on long rods, where a matrix costs tens of residuals.
+  struct EvaluationCount {
+    long residuals = 0;
+    long matrices = 0;
+  };
+  const EvaluationCount& evaluations() const { return evaluations_; }
 
  private:
   bool evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure);
   // Newton on [F; normal.(z - z_predicted)] = 0. With `chord` (the Jacobian at a nearby point)
   // it first iterates with that fixed matrix, one integration without sensitivities per
-  // iteration, and turns to full Newton only if those iterations stop contracting.
+  // iteration, and turns to (modified, with options_.modified_newton) Newton only if those
+  // iterations stop contracting.
   bool correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
                int* iterations, const Eigen::MatrixXd* chord = nullptr, bool* by_chord = nullptr);
   // Tangent at z oriented by `previous`, with the test functions, as a point (derived
@@ -174,6 +187,7 @@ class Continuation {
   ShootingProblem problem_;
   ContinuationOptions options_;
   int n_ = 0;  // number of shooting unknowns
+  EvaluationCount evaluations_;
   std::string last_corrector_failure_;  // why the last failed corrector failed, for the stop message
 };
 
