@@ -65,10 +65,17 @@ ContinuationOptions ply_continuation(const std::string& parameter, double target
   o.initial_step = 1.0 * force_scale(slenderness);
   o.max_step = options.max_step * force_scale(slenderness);
   o.max_points = 20000;
-  // A point's Jacobian (14 sensitivities per segment) and measures cost tens of residual
-  // evaluations: longer steps that take up to 9 chord iterations are cheaper per turn, and a
-  // point whose chord iterations converged keeps the previous matrix. Measured at L/2R = 200 to
-  // 10 turns: 215 s -> 77 s, the same end point to 12 digits.
+  // A point's Jacobian (13 sensitivities per segment) costs about fifty residual evaluations
+  // (perf at L/2R = 200: 85 % of a run in the variational equations, 2 % in residuals): longer
+  // steps that take up to 9 chord iterations are cheaper per turn, and a point whose chord
+  // iterations converged keeps the previous matrix. Measured at L/2R = 200 to 10 turns: 215 s ->
+  // 77 s, the same end point to 12 digits.
+  // Not modified Newton (ContinuationOptions::modified_newton): with steps growing up to 10
+  // iterations it took L/2R = 200 to 8 turns in 33 s instead of 145 s (the same branch), but at
+  // 500, with these steps too, it carried the branch past the point near 3 turns where the end
+  // loop's strands come within the soft barrier's reach - onto the contact-free branch, where
+  // the strands pass through each other - and the ply formed two turns late (T_ext at 20 turns
+  // 2353 instead of 3051).
   o.corrector_max_iterations = 12;
   o.grow_iterations = 6;
   o.shrink_iterations = 10;
