@@ -313,14 +313,14 @@ bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Ei
                                Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const {
   // A Newton or corrector iterate may take a parameter outside the model's domain (a slenderness
   // whose radius is <= 0): that point cannot be evaluated, like one that cannot be integrated.
+  std::shared_ptr<const RodEquations> eq;
   try {
-    equations(p);
+    eq = equations(p);
   } catch (const std::invalid_argument& e) {
     if (failure) *failure = std::string("the rod model is not defined there: ") + e.what();
     return false;
   }
   if (!definition_.contacts.empty()) return residual_with_contacts(x, p, F, J, failure, y_end);
-  const auto eq = equations(p);
   const int n = state_size_, M = segments();
   const Eigen::VectorXd y0 = x.head(n);
   int row = start_rows(*eq, y0, p, F, J);
