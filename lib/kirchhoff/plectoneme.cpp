@@ -2,32 +2,15 @@
 
 #include <boost/math/tools/minima.hpp>
 #include <cmath>
-#include <cstdint>
 #include <optional>
-#include <unordered_map>
 #include <stdexcept>
 
 #include "kirchhoff/invariants.hpp"
 #include "kirchhoff/self_contact.hpp"
+#include "kirchhoff/spatial_bins.hpp"
 
 namespace kirchhoff {
 namespace {
-
-// A cross-section of the whole rod: its arclength along the whole rod and its centre.
-struct Section {
-  double s_whole;
-  Vec3 r;
-};
-
-// The whole rod from the half rod: the half [0, L_h] followed by its image under the half-turn,
-// traversed backwards (r(2 L_h - s) = S r(s)).
-std::vector<Section> whole_rod(const std::vector<RodPoint>& half, const HalfTurnSelfContact& contact) {
-  std::vector<Section> out;
-  const double Lh = half.back().s;
-  for (const auto& p : half) out.push_back({p.s, p.r});
-  for (auto it = half.rbegin() + 1; it != half.rend(); ++it) out.push_back({2.0 * Lh - it->s, contact.image(it->r)});
-  return out;
-}
 
 // Position on the whole rod at arclength s (exact, by integrating the half rod).
 Vec3 whole_position(const ShootingProblem& problem, const Eigen::VectorXd& x, const HalfTurnSelfContact& contact,
@@ -42,37 +25,18 @@ struct SampledPair {
 };
 
 // Closest pair of every stride-th section closer than `cell` in space and more than `apart`
-// along the rod, if any: sections are binned in cubes of side `cell`, so only the 27 cubes
-// around each one need looking at (linear in the sections where all pairs would be quadratic:
-// 2e8 pairs per point at L/2R = 1000).
-std::optional<SampledPair> closest_pair_within(const std::vector<Section>& rod, double apart, double cell,
+// along the rod, if any.
+std::optional<SampledPair> closest_pair_within(const std::vector<WholeRodSection>& rod, double apart, double cell,
                                                size_t stride) {
-  auto cube = [&](const Vec3& r) {
-    return Eigen::Vector3i(static_cast<int>(std::floor(r.x() / cell)), static_cast<int>(std::floor(r.y() / cell)),
-                           static_cast<int>(std::floor(r.z() / cell)));
-  };
-  // Cubes that share a hash share a bin: more pairs get checked, none is missed.
-  auto key = [](const Eigen::Vector3i& c) {
-    return (static_cast<int64_t>(c.x()) * 73856093) ^ (static_cast<int64_t>(c.y()) * 19349663) ^
-           (static_cast<int64_t>(c.z()) * 83492791);
-  };
-  std::unordered_map<int64_t, std::vector<size_t>> bins;
-  for (size_t i = 0; i < rod.size(); i += stride) bins[key(cube(rod[i].r))].push_back(i);
+  std::vector<Vec3> centres;
+  centres.reserve(rod.size());
+  for (const auto& section : rod) centres.push_back(section.r);
   std::optional<SampledPair> best;
-  for (size_t i = 0; i < rod.size(); i += stride) {
-    const Eigen::Vector3i c = cube(rod[i].r);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const auto bin = bins.find(key(c + Eigen::Vector3i(dx, dy, dz)));
-          if (bin == bins.end()) continue;
-          for (const size_t j : bin->second) {
-            if (j <= i || rod[j].s_whole - rod[i].s_whole <= apart) continue;
-            const double d = (rod[i].r - rod[j].r).norm();
-            if (d < cell && (!best || d < best->distance)) best = SampledPair{i, j, d};
-          }
-        }
-  }
+  for_each_near_pair(centres, cell, stride, [&](size_t i, size_t j) {
+    if (rod[j].s_whole - rod[i].s_whole <= apart) return;
+    const double d = (rod[i].r - rod[j].r).norm();
+    if (d < cell && (!best || d < best->distance)) best = SampledPair{i, j, d};
+  });
   return best;
 }
 
@@ -82,7 +46,7 @@ std::optional<SampledPair> closest_pair_within(const std::vector<Section>& rod, 
 // each arclength on exact positions (sampling alone could miss the minimum between samples
 // and overstate the distance).
 double smallest_self_distance(const ShootingProblem& problem, const Eigen::VectorXd& x,
-                              const HalfTurnSelfContact& contact, const std::vector<Section>& rod, double apart,
+                              const HalfTurnSelfContact& contact, const std::vector<WholeRodSection>& rod, double apart,
                               double radius) {
   const double spacing = rod[1].s_whole - rod[0].s_whole;
   double extent = 0.0;
@@ -164,7 +128,7 @@ PlectonemeMeasures measure_plectoneme(const ShootingProblem& problem, const Eige
     m.contact_pressure = pressure_sum / count;
     m.H_A = hamiltonian(model, problem.sample(x, {0.5 * (m.contact_start + m.contact_end)}).front());
   }
-  m.self_distance = smallest_self_distance(problem, x, *contact, whole_rod(profile, *contact), M_PI * o.radius, o.radius) /
+  m.self_distance = smallest_self_distance(problem, x, *contact, contact->whole_rod(profile), M_PI * o.radius, o.radius) /
                     (2.0 * o.radius);
   return m;
 }

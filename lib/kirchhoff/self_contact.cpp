@@ -31,6 +31,15 @@ double HalfTurnSelfContact::distance_to_axis(const Vec3& r) const { return radia
 
 Vec3 HalfTurnSelfContact::image(const Vec3& r) const { return r - 2.0 * radial(r); }
 
+std::vector<WholeRodSection> HalfTurnSelfContact::whole_rod(const std::vector<RodPoint>& half) const {
+  std::vector<WholeRodSection> out;
+  out.reserve(2 * half.size());
+  const double Lh = half.back().s;
+  for (const auto& p : half) out.push_back({p.s, p.r});
+  for (auto it = half.rbegin() + 1; it != half.rend(); ++it) out.push_back({2.0 * Lh - it->s, image(it->r)});
+  return out;
+}
+
 double HalfTurnSelfContact::weight(double s) const {
   const double off = options_.symmetry_s - options_.adjacent;
   const double on = options_.symmetry_s - 2.0 * options_.adjacent;

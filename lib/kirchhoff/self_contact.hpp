@@ -26,9 +26,18 @@
 // 4 ranges the Gaussian has fallen by 1e-7).
 #pragma once
 
+#include <vector>
+
+#include "kirchhoff/rod_equations.hpp"
 #include "kirchhoff/rod_model.hpp"
 
 namespace kirchhoff {
+
+// A cross-section of the whole rod: its arclength along the whole rod and its centre.
+struct WholeRodSection {
+  double s_whole = 0.0;
+  Vec3 r = Vec3::Zero();
+};
 
 struct HalfTurnSelfContactOptions {
   double radius = 0.0;          // R, the cross-section radius: centrelines stay 2R apart
@@ -53,6 +62,9 @@ class HalfTurnSelfContact final : public ExternalField {
 
   // The image S r of a point under the half-turn.
   Vec3 image(const Vec3& r) const;
+  // The whole rod from samples of the half rod [0, L/2]: the half followed by its image,
+  // traversed backwards (r(L - s) = S r(s)).
+  std::vector<WholeRodSection> whole_rod(const std::vector<RodPoint>& half) const;
   double distance_to_axis(const Vec3& r) const;
   // The weight w(s) that switches contact off near the end loop.
   double weight(double s) const;
