@@ -183,6 +183,28 @@ TEST(EulerColumn, ModifiedNewtonTakesFewerMatricesForTheSameBranch) {
             << full_count.residuals << " -> " << modified_count.residuals << "\n";
 }
 
+// A step_check that refuses steps longer than 2 in P: the run shortens its steps and goes on
+// (every accepted step within the limit, the same target reached); one that refuses every step
+// stops the run as inadmissible with its reason.
+TEST(EulerColumn, StepCheckShortensRefusedStepsOrStopsTheRun) {
+  ContinuationOptions o = euler_options();
+  o.detect_branch_points = false;
+  o.step_check = [](const ContinuationPoint& from, const ContinuationPoint& to) {
+    return std::abs(to.parameter - from.parameter) > 2.0 ? std::string("too long") : std::string();
+  };
+  const BranchRun limited = continue_case("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, o);
+  ASSERT_EQ(limited.result.reason, StopReason::ReachedTarget) << limited.result.message;
+  for (size_t k = 1; k < limited.result.points.size(); ++k)
+    EXPECT_LE(limited.result.points[k].parameter - limited.result.points[k - 1].parameter, 2.0 + 1e-12);
+  EXPECT_NEAR(limited.result.points.back().parameter, 100.0, 1e-9);
+  EXPECT_GT(limited.result.refused_steps, 0);  // max_step 5 in arclength allows longer ones
+  o.step_check = [](const ContinuationPoint&, const ContinuationPoint&) { return std::string("never"); };
+  const BranchRun refused = continue_case("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, o);
+  EXPECT_EQ(refused.result.reason, StopReason::Inadmissible);
+  EXPECT_NE(refused.result.message.find("never"), std::string::npos) << refused.result.message;
+  EXPECT_EQ(refused.result.points.size(), 1u);
+}
+
 ContinuationOptions twist_options() {
   ContinuationOptions o;
   o.parameter = "phi";

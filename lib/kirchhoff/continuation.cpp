@@ -472,6 +472,19 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
       ds = std::max(ds * kShrink, options_.min_step);
       continue;
     }
+    if (options_.step_check) {
+      const std::string refusal = options_.step_check(current, *candidate);
+      if (!refusal.empty()) {
+        ++result.refused_steps;
+        if (ds * kShrink < options_.min_step) {
+          result.reason = StopReason::Inadmissible;
+          result.message = refusal + " (refused down to the minimum step)";
+          return result;
+        }
+        ds *= kShrink;
+        continue;
+      }
+    }
 
     // Special points inside this step, each with its position h along it.
     std::vector<std::pair<double, ContinuationPoint>> special;

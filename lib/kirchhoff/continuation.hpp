@@ -36,6 +36,8 @@ struct ContinuationEvent {
   std::string label;     // recorded in the point's `event` (default: "quantity=value")
 };
 
+struct ContinuationPoint;
+
 struct ContinuationOptions {
   std::string parameter;                                      // the continued parameter
   double target = std::numeric_limits<double>::quiet_NaN();   // stop on reaching it (NaN: no target)
@@ -79,6 +81,10 @@ struct ContinuationOptions {
   std::vector<std::string> derived;   // computed at every point (and available to events)
   int samples = 101;                  // profile points for invariants and derived quantities
   bool compute_invariants = true;     // false skips sampling (derived from events need it)
+  // A check of each step that a converged corrector cannot make (that the rod did not pass
+  // through itself: SelfPassageGuard): a non-empty answer refuses the step, which is retried
+  // shorter; refused at the minimum step, the run stops as Inadmissible with that answer.
+  std::function<std::string(const ContinuationPoint& from, const ContinuationPoint& to)> step_check;
 
   std::string validate() const;
 };
@@ -121,6 +127,7 @@ struct ContinuationResult {
   std::vector<ContinuationPoint> points;
   StopReason reason = StopReason::MaxPoints;
   std::string message;
+  int refused_steps = 0;  // steps the options' step_check refused (each retried shorter)
 };
 
 // Called for every accepted point, in order, as soon as it is known (CSV writers, progress).
