@@ -14,6 +14,7 @@
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/continuation.hpp"
+#include "kirchhoff/self_passage.hpp"
 #include "kirchhoff/discrete_seed.hpp"
 #include "kirchhoff/solution.hpp"
 #include "run_state.hpp"
@@ -317,6 +318,8 @@ int run_continue(const ContinueArguments& args) {
       return kExitBadInput;
     }
     ContinuationOptions first = options;
+    // A rod with self-contact: steps that would carry it through itself are refused.
+    if (guard_self_passage(*problem, &first)) std::cerr << "self-contact: steps through the rod itself are refused\n";
     if (branch == 0 && args.switch_at_bp > 0)
       first.stop_at_branch_point = args.switch_at_bp - (args.resume ? count_branch_points(csv) : 0);
     if (args.resume) {
@@ -346,7 +349,9 @@ int run_continue(const ContinueArguments& args) {
   progress.done();
   std::cerr << "stopped: " << to_string(result.reason) << (result.message.empty() ? "" : " (" + result.message + ")")
             << "; " << state.row + 1 << " points (last on branch " << branch << ") in " << args.out_path << "\n";
-  const bool ok = result.reason != StopReason::StartFailed && result.reason != StopReason::StepTooSmall;
+  if (result.refused_steps > 0) std::cerr << result.refused_steps << " steps refused and retried shorter\n";
+  const bool ok = result.reason != StopReason::StartFailed && result.reason != StopReason::StepTooSmall &&
+                  result.reason != StopReason::Inadmissible;
   return ok ? kExitOk : kExitNotConverged;
 }
 

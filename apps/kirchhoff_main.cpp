@@ -208,6 +208,9 @@ int main(int argc, char** argv) {
                    "Jacobian (-1: every point computes its own)")
       ->check(CLI::Range(-1, 100))
       ->capture_default_str();
+  plectonemes_cmd->add_flag("!--full-newton", plect.modified_newton,
+                            "A new Jacobian at every corrector iteration, with shorter steps (by default the\n"
+                            "corrector keeps a Jacobian while the residual halves, on longer steps)");
 
   try {
     app.parse(argc, argv);

@@ -11,6 +11,7 @@
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/continuation.hpp"
+#include "kirchhoff/self_passage.hpp"
 #include "run_state.hpp"
 
 namespace kirchhoff::cli {
@@ -66,19 +67,25 @@ ContinuationOptions ply_continuation(const std::string& parameter, double target
   o.max_step = options.max_step * force_scale(slenderness);
   o.max_points = 20000;
   // A point's Jacobian (13 sensitivities per segment) costs about fifty residual evaluations
-  // (perf at L/2R = 200: 85 % of a run in the variational equations, 2 % in residuals): longer
-  // steps that take up to 9 chord iterations are cheaper per turn, and a point whose chord
-  // iterations converged keeps the previous matrix. Measured at L/2R = 200 to 10 turns: 215 s ->
-  // 77 s, the same end point to 12 digits.
-  // Not modified Newton (ContinuationOptions::modified_newton): with steps growing up to 10
-  // iterations it took L/2R = 200 to 8 turns in 33 s instead of 145 s (the same branch), but at
-  // 500, with these steps too, it carried the branch past the point near 3 turns where the end
-  // loop's strands come within the soft barrier's reach - onto the contact-free branch, where
-  // the strands pass through each other - and the ply formed two turns late (T_ext at 20 turns
-  // 2353 instead of 3051).
-  o.corrector_max_iterations = 12;
-  o.grow_iterations = 6;
-  o.shrink_iterations = 10;
+  // (perf at L/2R = 200: 85 % of a run in the variational equations, 2 % in residuals), so the
+  // steps are long and a corrector's iterations cheap: a point whose chord iterations converged
+  // keeps the previous matrix (reuse_jacobian), and modified Newton keeps a matrix while the
+  // residual halves, on steps that grow while they take up to 10 iterations (L/2R = 200 to 8
+  // turns: 145 s -> 33 s, the same end point to 12 digits). Long steps are safe only with the
+  // SelfPassageGuard the callers attach: at L/2R = 500 the branch folds sharply at 1.034 turns,
+  // and a step that suits the rest of the branch crosses that fold onto the sheet where the rod
+  // has passed through itself (every run before the guard, full or modified Newton, did: their
+  // ply formed two turns late, T_ext at 20 turns 3063 instead of 3882).
+  if (options.modified_newton) {
+    o.modified_newton = true;
+    o.corrector_max_iterations = 16;
+    o.grow_iterations = 10;
+    o.shrink_iterations = 14;
+  } else {
+    o.corrector_max_iterations = 12;
+    o.grow_iterations = 6;
+    o.shrink_iterations = 10;
+  }
   o.reuse_jacobian_iterations = options.reuse_jacobian;
   o.detect_branch_points = false;  // the barrier's stiffness turns the determinant's sign into noise
   return o;
@@ -180,7 +187,8 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
   }
   const Case c = load_case(case_path, {{"slenderness", slenderness}});
   ShootingProblem problem(with_scaled_tolerance(c.definition, slenderness));
-  const ContinuationOptions o = continuation_options(c, slenderness, turns_max, options);
+  ContinuationOptions o = continuation_options(c, slenderness, turns_max, options);
+  guard_self_passage(problem, &o);
   BranchCsv csv(csv_path, c.definition.parameters.get("EI"), slenderness, options, &summary);
   auto sink = [&](const ContinuationPoint& p) { csv(p); };
   Continuation run(problem, o);
@@ -195,6 +203,7 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
     branch = run.run(untwisted.x, sink);
   }
   summary.stop = stop_text(branch);
+  summary.refused_steps = branch.refused_steps;
   summary.seconds = seconds_since(started);
   return summary;
 }
@@ -207,6 +216,7 @@ ContinuationPoint move_ply(ShootingProblem& problem, const std::string& paramete
                            double target, double slenderness, const PlectonemeRunOptions& options) {
   ContinuationOptions o = ply_continuation(parameter, target, slenderness, options);
   o.samples = 11;
+  guard_self_passage(problem, &o);
   int points = 0;
   auto progress = [&](const ContinuationPoint& p) {
     if (options.progress_every > 0 && ++points % options.progress_every == 0)
@@ -263,7 +273,8 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
   const int first_leg = csv.resumed() ? csv.state().branch : 0;
   std::vector<std::string> stops;
   for (int leg = first_leg; leg < 2; ++leg) {
-    const ContinuationOptions o = continuation_options(c, slenderness, leg == 0 ? turns_max : turns_min, options);
+    ContinuationOptions o = continuation_options(c, slenderness, leg == 0 ? turns_max : turns_min, options);
+    guard_self_passage(problem, &o);
     const bool resume_leg = csv.resumed() && leg == first_leg;
     csv.state().branch = leg;
     ContinuationResult r;
@@ -275,6 +286,7 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
       r = Continuation(problem, o).run(start.last.x, sink);
     }
     stops.push_back((leg == 0 ? "up: " : "down: ") + stop_text(r));
+    summary.refused_steps += r.refused_steps;
   }
   for (const auto& stop : stops) summary.stop += (summary.stop.empty() ? "" : "; ") + stop;
   summary.seconds = seconds_since(started);
@@ -311,6 +323,7 @@ int run_plectonemes(const PlectonemesArguments& args) {
       options.progress_every = 50;
       options.max_step = args.max_step;
       options.reuse_jacobian = args.reuse_jacobian;
+      options.modified_newton = args.modified_newton;
       options.resume = args.resume;
       options.ply_log_softness = args.ply_log_softness;
       const auto s = via_ply ? follow_from_ply(args.case_path, csv_of(args.slenderness[k - 1]) + ".state.json",
@@ -319,7 +332,7 @@ int run_plectonemes(const PlectonemesArguments& args) {
       total += s.points;
       std::cout << "L/2R = " << sl << ": " << s.points << " points in " << std::setprecision(3) << s.seconds << " s";
       if (s.points > 0) std::cout << " (" << s.points / s.seconds << " points/s)";
-      std::cout << std::setprecision(6);
+      std::cout << std::setprecision(6) << ", " << s.refused_steps << " steps refused (through itself)";
       // Flushed: a sweep killed later keeps the lines of the branches it finished.
       std::cout << ", stopped: " << s.stop << ", " << csv << std::endl;
     } catch (const std::exception& e) {

@@ -18,6 +18,7 @@ struct PlectonemeBranchSummary {
   int points = 0;
   double seconds = 0.0;
   std::string stop;                         // the continuation's stop reason
+  int refused_steps = 0;                    // steps that would have carried the rod through itself
   std::map<std::string, double> last;       // the CSV columns at the last point with a ply
   std::vector<std::map<std::string, double>> ply;  // the same at every point with a ply, in order
 };
@@ -28,6 +29,9 @@ struct PlectonemeRunOptions {
   // A point whose chord iterations converged within this many keeps the previous Jacobian
   // (ContinuationOptions::reuse_jacobian_iterations; -1: every point computes its own).
   int reuse_jacobian = kPlectonemeReuseJacobian;
+  // The corrector keeps a matrix while the residual halves (ContinuationOptions::modified_newton),
+  // with steps that grow while it takes up to 10 iterations; false: a matrix per iteration.
+  bool modified_newton = true;
   // Continue a killed run from csv_path's state file (csv_path + ".state.json"); a branch whose
   // CSV ends at its endpoint is left as it is. Without a state file the branch starts afresh.
   bool resume = false;
@@ -69,6 +73,7 @@ struct PlectonemesArguments {
   std::string out_dir = "plectonemes";
   double max_step = kPlectonemeMaxStep;
   int reuse_jacobian = kPlectonemeReuseJacobian;
+  bool modified_newton = true;
   bool resume = false;
 };
 

@@ -26,6 +26,7 @@
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/continuation.hpp"
+#include "kirchhoff/self_passage.hpp"
 #include "kirchhoff/discrete_seed.hpp"
 #include "kirchhoff/invariants.hpp"
 #include "kirchhoff/shooting.hpp"
@@ -397,6 +398,7 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
     const ShootingProblem problem(d);
     ContinuationOptions first = options;
     first.stop_at_branch_point = switch_at_bp;
+    guard_self_passage(problem, &first);  // self-contact: no step through the rod itself
     Continuation run(problem, first);
     ContinuationResult result;
     try {

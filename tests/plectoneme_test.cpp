@@ -15,6 +15,7 @@
 #include "kirchhoff/integrator.hpp"
 #include "kirchhoff/plectoneme.hpp"
 #include "kirchhoff/self_contact.hpp"
+#include "kirchhoff/self_passage.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {
@@ -173,6 +174,64 @@ TEST(Plectoneme, TwistingWindsAPlyThatFollowsTheHelixFormulas) {
   EXPECT_LT(rho / 0.005, 1.3);  // the strands touch: rho = R plus a gap
   EXPECT_NEAR(ply.at("m3") / analytic::helix_twisting_moment(theta, EI, rho), 1.0, 0.04);
   EXPECT_NEAR(ply.at("T_ext") * rho * rho / EI / analytic::plectoneme_end_tension(theta, 1.0, 1.0), 1.0, 0.12);
+}
+
+// At L/2R = 500 the branch from the untwisted rod folds at 1.77 turns and again, sharply, at
+// 1.034 (T_ext = 62.7147, m3 = 0.2044). A step of the length that suits the rest of the branch
+// (the plectonemes command's modified-Newton steps: arclength 25-1500 here) crosses
+// that fold onto the neighbouring sheet: m3 changes sign and the run continues through the mirror
+// fold (0.2296 turns) to the untwisted Elastica's shape at 2 turns - the rod has passed through
+// itself. With the SelfPassageGuard the same run refuses that step and turns at the fold.
+TEST(Plectoneme, SelfPassageGuardKeepsTheBranchAtTheSharpFold) {
+  Case c = load_case(testing::case_path("plectoneme.toml"), {{"slenderness", 500.0}});
+  const double scale = 25.0;  // forces ~ 1/R^2, relative to L/2R = 100 (the case's tolerance)
+  c.definition.options.newton.residual_tolerance *= scale;
+  ShootingProblem problem(c.definition);
+  const ShootingResult start = solve(problem, problem.initial_unknowns(c.start_guess));
+  ASSERT_TRUE(start.summary.converged());
+  ContinuationOptions o;
+  o.parameter = "turns";
+  o.initial_step = 1.0 * scale;
+  o.max_step = 60.0 * scale;
+  o.max_points = 26;
+  o.corrector_tolerance = 1e-8 * scale;
+  o.modified_newton = true;
+  o.corrector_max_iterations = 16;
+  o.grow_iterations = 10;
+  o.shrink_iterations = 14;
+  o.reuse_jacobian_iterations = 8;
+  o.detect_branch_points = false;
+  o.derived = {"T_ext", "m3"};
+  o.samples = 101;
+  const ContinuationResult unguarded = Continuation(problem, o).run(start.x);
+  ContinuationOptions guarded_options = o;
+  ASSERT_TRUE(guard_self_passage(problem, &guarded_options));
+  const ContinuationResult guarded = Continuation(problem, guarded_options).run(start.x);
+  auto after_first_fold = [](const ContinuationResult& r) {
+    std::vector<ContinuationPoint> out;
+    bool folded = false;
+    for (const auto& p : r.points) {
+      if (folded) out.push_back(p);
+      folded |= p.type == PointType::Fold;
+    }
+    return out;
+  };
+  bool jumped = false;
+  for (const auto& p : after_first_fold(unguarded)) jumped |= p.derived.at("m3") < 0.0;
+  EXPECT_TRUE(jumped) << "the unguarded run no longer crosses the fold: this test's premise is gone";
+  EXPECT_GT(guarded.refused_steps, 0);
+  int folds = 0;
+  for (const auto& p : after_first_fold(guarded)) {
+    EXPECT_GT(p.derived.at("m3"), 0.2) << "turns " << p.parameter;
+    if (p.type != PointType::Fold) continue;
+    ++folds;
+    // Where the fold is located depends on the steps that bracket it: 1.0338034 and T_ext
+    // 62.714307 with the full-Newton steps (on the sheet reached through the rod, 2 turns on),
+    // 1.0338315 and 62.714653 with these. The bars take in both.
+    EXPECT_NEAR(p.parameter, 1.03383, 1e-4);
+    EXPECT_NEAR(p.derived.at("T_ext"), 62.7145, 1e-3);
+  }
+  EXPECT_EQ(folds, 1);
 }
 
 // cases/plectoneme.toml with one piece of its text replaced, written to a temporary file.
