@@ -42,7 +42,9 @@ TEST(SelfPassage, StrandsSwappingSidesMeetOnTheWay) {
 TEST(SelfPassage, SlidingAndTurningPliesKeepTheirDistance) {
   const Vec3 above(0.0, 0.0, 2.2 * kR);
   const Vec3 centre = 0.5 * above;
-  auto about_axis = [&](double degrees) { return Eigen::AngleAxisd(degrees * M_PI / 180.0, Vec3::UnitX()).toRotationMatrix(); };
+  auto about_axis = [&](double degrees) {
+    return Eigen::AngleAxisd(degrees * M_PI / 180.0, Vec3::UnitX()).toRotationMatrix();
+  };
   EXPECT_EQ(closest_approach_in_motion(hairpin(above), hairpin(above + Vec3(5 * kR, 0, 0)), M_PI * kR, kR).distance,
             INFINITY);
   // Turning about the line half-way between the strands: shift, turn, shift back.

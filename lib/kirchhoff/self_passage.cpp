@@ -52,7 +52,8 @@ std::vector<WholeRodSection> SelfPassageGuard::whole_rod_at(const ContinuationPo
   const double Lh = contact.options().symmetry_s;
   std::vector<double> s(intervals + 1);
   for (int k = 0; k <= intervals; ++k) s[k] = Lh * k / intervals;
-  newest_ = std::make_shared<Sampled>(Sampled{point.parameter, point.x, intervals, contact.whole_rod(problem_->sample(point.x, s))});
+  auto rod = contact.whole_rod(problem_->sample(point.x, s));
+  newest_ = std::make_shared<Sampled>(Sampled{point.parameter, point.x, intervals, std::move(rod)});
   return newest_->rod;
 }
 
