@@ -57,9 +57,10 @@ ProblemDefinition with_scaled_tolerance(ProblemDefinition d, double slenderness)
   return d;
 }
 
-// How a ply is followed in any parameter at this slenderness (steps scaled with the forces).
-ContinuationOptions ply_continuation(const std::string& parameter, double target, double slenderness,
-                                     const PlectonemeRunOptions& options) {
+// How a ply of `problem` (at its current parameters) is followed in any parameter at this
+// slenderness (steps scaled with the forces), every step checked for passing the rod through itself.
+ContinuationOptions ply_continuation(const ShootingProblem& problem, const std::string& parameter, double target,
+                                     double slenderness, const PlectonemeRunOptions& options) {
   ContinuationOptions o;
   o.parameter = parameter;
   o.target = target;
@@ -72,7 +73,7 @@ ContinuationOptions ply_continuation(const std::string& parameter, double target
   // keeps the previous matrix (reuse_jacobian), and modified Newton keeps a matrix while the
   // residual halves, on steps that grow while they take up to 10 iterations (L/2R = 200 to 8
   // turns: 145 s -> 33 s, the same end point to 12 digits). Long steps are safe only with the
-  // SelfPassageGuard the callers attach: at L/2R = 500 the branch folds sharply at 1.034 turns,
+  // SelfPassageGuard attached below: at L/2R = 500 the branch folds sharply at 1.034 turns,
   // and a step that suits the rest of the branch crosses that fold onto the sheet where the rod
   // has passed through itself (every run before the guard, full or modified Newton, did: their
   // ply formed two turns late, T_ext at 20 turns 3063 instead of 3882).
@@ -88,13 +89,14 @@ ContinuationOptions ply_continuation(const std::string& parameter, double target
   }
   o.reuse_jacobian_iterations = options.reuse_jacobian;
   o.detect_branch_points = false;  // the barrier's stiffness turns the determinant's sign into noise
+  guard_self_passage(problem, &o);
   return o;
 }
 
 // How a plectoneme branch is followed in `turns`, with the case's measures at every point.
-ContinuationOptions continuation_options(const Case& c, double slenderness, double turns_max,
-                                         const PlectonemeRunOptions& options) {
-  ContinuationOptions o = ply_continuation("turns", turns_max, slenderness, options);
+ContinuationOptions continuation_options(const ShootingProblem& problem, const Case& c, double slenderness,
+                                         double turns_max, const PlectonemeRunOptions& options) {
+  ContinuationOptions o = ply_continuation(problem, "turns", turns_max, slenderness, options);
   o.corrector_tolerance = std::max(1e-10, c.definition.options.newton.residual_tolerance) * force_scale(slenderness);
   o.derived = c.derived;
   o.samples = 10 * static_cast<int>(slenderness) + 1;  // R/10 apart on the half rod: the ply's pitch is 10-30 R
@@ -187,8 +189,7 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
   }
   const Case c = load_case(case_path, {{"slenderness", slenderness}});
   ShootingProblem problem(with_scaled_tolerance(c.definition, slenderness));
-  ContinuationOptions o = continuation_options(c, slenderness, turns_max, options);
-  guard_self_passage(problem, &o);
+  const ContinuationOptions o = continuation_options(problem, c, slenderness, turns_max, options);
   BranchCsv csv(csv_path, c.definition.parameters.get("EI"), slenderness, options, &summary);
   auto sink = [&](const ContinuationPoint& p) { csv(p); };
   Continuation run(problem, o);
@@ -214,9 +215,8 @@ namespace {
 // stderr; returns the end point. No measures are taken on the way (only the end matters).
 ContinuationPoint move_ply(ShootingProblem& problem, const std::string& parameter, const Eigen::VectorXd& x,
                            double target, double slenderness, const PlectonemeRunOptions& options) {
-  ContinuationOptions o = ply_continuation(parameter, target, slenderness, options);
+  ContinuationOptions o = ply_continuation(problem, parameter, target, slenderness, options);
   o.samples = 11;
-  guard_self_passage(problem, &o);
   int points = 0;
   auto progress = [&](const ContinuationPoint& p) {
     if (options.progress_every > 0 && ++points % options.progress_every == 0)
@@ -273,8 +273,8 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
   const int first_leg = csv.resumed() ? csv.state().branch : 0;
   std::vector<std::string> stops;
   for (int leg = first_leg; leg < 2; ++leg) {
-    ContinuationOptions o = continuation_options(c, slenderness, leg == 0 ? turns_max : turns_min, options);
-    guard_self_passage(problem, &o);
+    const ContinuationOptions o =
+        continuation_options(problem, c, slenderness, leg == 0 ? turns_max : turns_min, options);
     const bool resume_leg = csv.resumed() && leg == first_leg;
     csv.state().branch = leg;
     ContinuationResult r;

@@ -60,8 +60,8 @@ std::vector<WholeRodSection> SelfPassageGuard::whole_rod_at(const ContinuationPo
 std::string SelfPassageGuard::operator()(const ContinuationPoint& from, const ContinuationPoint& to) {
   // The thinner rod's radius (a step in the slenderness changes it) and its sampling for both.
   const double R_from = contact_at(from).options().radius;
-  const double R = std::min(R_from, contact_at(to).options().radius);
-  const double Lh = contact_at(to).options().symmetry_s;
+  const HalfTurnSelfContactOptions at_to = contact_at(to).options();
+  const double R = std::min(R_from, at_to.radius), Lh = at_to.symmetry_s;
   // R/2 apart: two sections that meet between samples have sampled neighbours within ~R/2.
   const int intervals = static_cast<int>(std::ceil(Lh / (0.5 * R)));
   const std::vector<WholeRodSection> a = whole_rod_at(from, intervals);
