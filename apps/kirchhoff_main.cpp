@@ -211,6 +211,17 @@ int main(int argc, char** argv) {
   plectonemes_cmd->add_flag("!--full-newton", plect.modified_newton,
                             "A new Jacobian at every corrector iteration, with shorter steps (by default the\n"
                             "corrector keeps a Jacobian while the residual halves, on longer steps)");
+  plectonemes_cmd
+      ->add_option("--hard-contact-every", plect.hard_contact_every,
+                   "Re-solve ply points this many turns apart (and each branch's end) with hard, complementarity\n"
+                   "self-contact (Ipopt on the discretised half rod, seeded by the barrier solution): strands\n"
+                   "exactly 2R apart, contact forces the constraints' multipliers; DIR/plectoneme_<L/2R>_hard.csv\n"
+                   "(0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  plectonemes_cmd->add_option("--hard-spacing", plect.hard_spacing, "Node spacing of the hard-contact rod, in R")
+      ->check(CLI::Range(0.01, 1.0))
+      ->capture_default_str();
 
   try {
     app.parse(argc, argv);

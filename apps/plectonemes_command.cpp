@@ -7,10 +7,12 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/continuation.hpp"
+#include "kirchhoff/hard_self_contact.hpp"
 #include "kirchhoff/self_passage.hpp"
 #include "run_state.hpp"
 
@@ -116,6 +118,63 @@ const std::vector<std::string>& csv_names() {
   return names;
 }
 
+// The hard-contact re-solutions of a branch's ply points (opt-in): one row per re-solved point,
+// keyed by the branch CSV's row index so that a resume truncates both alike.
+class HardContactCsv {
+ public:
+  HardContactCsv(const std::string& path, double EI, const PlectonemeRunOptions& options, int resumed_row,
+                 PlectonemeBranchSummary* summary)
+      : EI_(EI), options_(options), summary_(summary) {
+    const bool resuming = resumed_row >= 0 && std::filesystem::exists(path);
+    if (resuming) truncate_csv(path, resumed_row);
+    csv_.open(path, resuming ? std::ios::app : std::ios::trunc);
+    if (!csv_) throw std::runtime_error("cannot write " + path);
+    csv_ << std::setprecision(12);
+    if (!resuming)
+      csv_ << "index,turns,T_ext_barrier,T_ext,helix_angle,T_R2_over_EI,eq61,m3,m3_eq58b,contact_pressure,"
+              "contact_start,contact_end,min_gap,min_force,complementarity,energy,segments,rounds,iterations,"
+              "seconds,status\n";
+  }
+
+  // Re-solves point p (row `row` of the branch CSV, a point of `problem`'s branch in turns) when it
+  // has a ply and is far enough from the last re-solved point, or ends the branch.
+  void consider(const ShootingProblem& problem, const ContinuationPoint& p, int row,
+                const std::map<std::string, double>& barrier) {
+    const bool ply = !std::isnan(barrier.at("eq61"));
+    const bool due = std::isnan(last_turns_) || std::abs(p.parameter - last_turns_) >= options_.hard_contact_every ||
+                     p.type == PointType::Endpoint;
+    if (!ply || !due) return;
+    const auto started = std::chrono::steady_clock::now();
+    ShootingProblem at = problem;
+    at.set_parameter("turns", p.parameter);
+    HardSelfContactOptions o;
+    o.spacing = options_.hard_spacing;
+    const HardSelfContactPlectoneme h = solve_hard_self_contact(at, p.x, o);
+    const double R = h.radius;
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    const double theta = h.helix_angle;
+    const bool helix = h.converged && theta > 0.0 && theta < 0.25 * M_PI;
+    csv_ << row << ',' << p.parameter << ',' << barrier.at("T_ext") << ',' << h.T_ext << ',' << theta << ','
+         << h.T_ext * R * R / EI_ << ',' << (helix ? analytic::plectoneme_end_tension(theta, 1.0, 1.0) : NAN) << ','
+         << h.m3 << ',' << (helix ? analytic::helix_twisting_moment(theta, EI_, R) : NAN) << ',' << h.contact_pressure
+         << ',' << h.contact_start << ',' << h.contact_end << ',' << h.min_gap << ',' << h.min_force << ','
+         << h.complementarity << ',' << h.energy << ',' << h.segments << ',' << h.rounds << ',' << h.iterations << ','
+         << seconds << ",\"" << h.status << "\"\n"
+         << std::flush;
+    last_turns_ = p.parameter;
+    ++summary_->hard_points;
+    summary_->hard_failures += h.converged ? 0 : 1;
+    summary_->hard_seconds += seconds;
+  }
+
+ private:
+  double EI_;
+  PlectonemeRunOptions options_;
+  PlectonemeBranchSummary* summary_;
+  std::ofstream csv_;
+  double last_turns_ = NAN;
+};
+
 // One slenderness's CSV, written point by point (flushed), with the state to resume from beside it.
 class BranchCsv {
  public:
@@ -142,11 +201,21 @@ class BranchCsv {
   bool resumed() const { return resumed_; }
   RunState& state() { return state_; }
 
+  // With options.hard_contact_every > 0, ply points of `problem`'s branch in turns are re-solved
+  // with hard self-contact into the _hard.csv beside this one.
+  void follow_hard_contact(const std::string& csv_path, const ShootingProblem& problem) {
+    if (!(options_.hard_contact_every > 0)) return;
+    const std::string path = csv_path.substr(0, csv_path.size() - 4) + "_hard.csv";
+    hard_.emplace(path, EI_, options_, resumed_ ? state_.saved_row : -1, summary_);
+    problem_ = &problem;
+  }
+
   void operator()(const ContinuationPoint& p) {
     const auto row = columns(p, EI_);
     csv_ << ++state_.row << ',' << p.parameter << ',' << to_string(p.type);
     for (const auto& n : csv_names()) csv_ << ',' << row.at(n);
     csv_ << ',' << p.newton_iterations << ',' << p.step << '\n' << std::flush;
+    if (hard_) hard_->consider(*problem_, p, state_.row, row);
     if (resumable(p)) save_resume_point(state_path_, p, &state_);
     ++summary_->points;
     if (!std::isnan(row.at("eq61"))) {
@@ -167,6 +236,8 @@ class BranchCsv {
   RunState state_;
   std::ofstream csv_;
   bool resumed_ = false;
+  std::optional<HardContactCsv> hard_;
+  const ShootingProblem* problem_ = nullptr;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
@@ -191,6 +262,7 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
   ShootingProblem problem(with_scaled_tolerance(c.definition, slenderness));
   const ContinuationOptions o = continuation_options(problem, c, slenderness, turns_max, options);
   BranchCsv csv(csv_path, c.definition.parameters.get("EI"), slenderness, options, &summary);
+  csv.follow_hard_contact(csv_path, problem);
   auto sink = [&](const ContinuationPoint& p) { csv(p); };
   Continuation run(problem, o);
   ContinuationResult branch;
@@ -268,6 +340,7 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
   problem.set_parameter("log_softness", options.ply_log_softness);
   problem.set_parameter("turns", start.last.parameter);
   BranchCsv csv(csv_path, c.definition.parameters.get("EI"), slenderness, options, &summary);
+  csv.follow_hard_contact(csv_path, problem);
   auto sink = [&](const ContinuationPoint& p) { csv(p); };
   // Branch 0: up to turns_max; branch 1: from the same start down to turns_min.
   const int first_leg = csv.resumed() ? csv.state().branch : 0;
@@ -326,6 +399,8 @@ int run_plectonemes(const PlectonemesArguments& args) {
       options.modified_newton = args.modified_newton;
       options.resume = args.resume;
       options.ply_log_softness = args.ply_log_softness;
+      options.hard_contact_every = args.hard_contact_every;
+      options.hard_spacing = args.hard_spacing;
       const auto s = via_ply ? follow_from_ply(args.case_path, csv_of(args.slenderness[k - 1]) + ".state.json",
                                                args.slenderness[k - 1], sl, args.turns_min, args.turns[k], csv, options)
                              : follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, options);
@@ -333,6 +408,9 @@ int run_plectonemes(const PlectonemesArguments& args) {
       std::cout << "L/2R = " << sl << ": " << s.points << " points in " << std::setprecision(3) << s.seconds << " s";
       if (s.points > 0) std::cout << " (" << s.points / s.seconds << " points/s)";
       std::cout << std::setprecision(6) << ", " << s.refused_steps << " steps refused (through itself)";
+      if (s.hard_points > 0)
+        std::cout << ", " << s.hard_points << " points re-solved with hard contact (" << s.hard_failures
+                  << " failed) in " << std::setprecision(3) << s.hard_seconds << " s" << std::setprecision(6);
       // Flushed: a sweep killed later keeps the lines of the branches it finished.
       std::cout << ", stopped: " << s.stop << ", " << csv << std::endl;
     } catch (const std::exception& e) {

@@ -21,6 +21,9 @@ struct PlectonemeBranchSummary {
   int refused_steps = 0;                    // steps that would have carried the rod through itself
   std::map<std::string, double> last;       // the CSV columns at the last point with a ply
   std::vector<std::map<std::string, double>> ply;  // the same at every point with a ply, in order
+  int hard_points = 0;                      // ply points re-solved with hard self-contact
+  int hard_failures = 0;                    // of those, the ones Ipopt did not solve (rows say why)
+  double hard_seconds = 0.0;                // time spent in them
 };
 
 struct PlectonemeRunOptions {
@@ -41,6 +44,11 @@ struct PlectonemeRunOptions {
   // gave 6 % at 20 turns; that run's steps collapsed near 29 turns, before the tolerances were
   // scaled with the forces - not retried since.)
   double ply_log_softness = -5.0;
+  // > 0: ply points at least this many turns apart (and each branch's end) are re-solved with
+  // hard, complementarity self-contact (hard_self_contact.hpp) at node spacing hard_spacing R,
+  // into csv_path with "_hard.csv" for ".csv".
+  double hard_contact_every = 0.0;
+  double hard_spacing = 0.25;
 };
 
 // Follows cases/plectoneme.toml (at `case_path`) with slenderness set, from turns = 0 to
@@ -76,6 +84,8 @@ struct PlectonemesArguments {
   int reuse_jacobian = kPlectonemeReuseJacobian;
   bool modified_newton = true;
   bool resume = false;
+  double hard_contact_every = 0.0;
+  double hard_spacing = 0.25;
 };
 
 int run_plectonemes(const PlectonemesArguments& args);
