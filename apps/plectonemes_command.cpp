@@ -25,15 +25,25 @@ const std::vector<std::string> kMeasured = {"T_ext", "helix_angle", "helix_radiu
                                             "contact_start", "contact_end", "H_A", "H_B", "self_distance",
                                             "loop_clearance"};
 
+// The closed forms of a ply of helix angle theta and radius rho (the R of eqs. 58-61): T rho^2/EI by
+// (61) and m3 by (58b); NaN when there is no ply (theta outside (0, pi/4)).
+struct HelixFormulas {
+  double eq61 = NAN, m3_eq58b = NAN;
+};
+HelixFormulas helix_formulas(double theta, double rho, double EI) {
+  if (!(theta > 0.0 && theta < 0.25 * M_PI && rho > 0.0)) return {};
+  return {analytic::plectoneme_end_tension(theta, 1.0, 1.0), analytic::helix_twisting_moment(theta, EI, rho)};
+}
+
 std::map<std::string, double> columns(const ContinuationPoint& p, double EI) {
   std::map<std::string, double> c;
   for (const auto& name : kMeasured) c[name] = p.derived.count(name) ? p.derived.at(name) : NAN;
   const double theta = c["helix_angle"], rho = c["helix_radius"];
-  const bool ply = theta > 0.0 && theta < 0.25 * M_PI && rho > 0.0;
   // rho, the strands' distance to the axis, is the helix radius R of eqs. (58)-(61).
   c["T_rho2_over_EI"] = c["T_ext"] * rho * rho / EI;
-  c["eq61"] = ply ? analytic::plectoneme_end_tension(theta, 1.0, 1.0) : NAN;  // T rho^2/EI by (61)
-  c["m3_eq58b"] = ply ? analytic::helix_twisting_moment(theta, EI, rho) : NAN;
+  const HelixFormulas formulas = helix_formulas(theta, rho, EI);
+  c["eq61"] = formulas.eq61;
+  c["m3_eq58b"] = formulas.m3_eq58b;
   return c;
 }
 
@@ -122,9 +132,9 @@ const std::vector<std::string>& csv_names() {
 // keyed by the branch CSV's row index so that a resume truncates both alike.
 class HardContactCsv {
  public:
-  HardContactCsv(const std::string& path, double EI, const PlectonemeRunOptions& options, int resumed_row,
-                 PlectonemeBranchSummary* summary)
-      : EI_(EI), options_(options), summary_(summary) {
+  HardContactCsv(const std::string& path, const ShootingProblem& problem, double EI, const PlectonemeRunOptions& options,
+                 int resumed_row, PlectonemeBranchSummary* summary)
+      : problem_(problem), EI_(EI), options_(options), summary_(summary) {
     const bool resuming = resumed_row >= 0 && std::filesystem::exists(path);
     if (resuming) truncate_csv(path, resumed_row);
     csv_.open(path, resuming ? std::ios::app : std::ios::trunc);
@@ -136,27 +146,25 @@ class HardContactCsv {
               "seconds,status\n";
   }
 
-  // Re-solves point p (row `row` of the branch CSV, a point of `problem`'s branch in turns) when it
-  // has a ply and is far enough from the last re-solved point, or ends the branch.
-  void consider(const ShootingProblem& problem, const ContinuationPoint& p, int row,
-                const std::map<std::string, double>& barrier) {
+  // Re-solves point p (row `row` of the branch CSV, a point of the problem's branch in turns) when
+  // it has a ply and is far enough from the last re-solved point, or ends the branch.
+  void consider(const ContinuationPoint& p, int row, const std::map<std::string, double>& barrier) {
     const bool ply = !std::isnan(barrier.at("eq61"));
     const bool due = std::isnan(last_turns_) || std::abs(p.parameter - last_turns_) >= options_.hard_contact_every ||
                      p.type == PointType::Endpoint;
     if (!ply || !due) return;
     const auto started = std::chrono::steady_clock::now();
-    ShootingProblem at = problem;
+    ShootingProblem at = problem_;
     at.set_parameter("turns", p.parameter);
     HardSelfContactOptions o;
     o.spacing = options_.hard_spacing;
     const HardSelfContactPlectoneme h = solve_hard_self_contact(at, p.x, o);
     const double R = h.radius;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    const double theta = h.helix_angle;
-    const bool helix = h.converged && theta > 0.0 && theta < 0.25 * M_PI;
-    csv_ << row << ',' << p.parameter << ',' << barrier.at("T_ext") << ',' << h.T_ext << ',' << theta << ','
-         << h.T_ext * R * R / EI_ << ',' << (helix ? analytic::plectoneme_end_tension(theta, 1.0, 1.0) : NAN) << ','
-         << h.m3 << ',' << (helix ? analytic::helix_twisting_moment(theta, EI_, R) : NAN) << ',' << h.contact_pressure
+    const HelixFormulas formulas = h.converged ? helix_formulas(h.helix_angle, R, EI_) : HelixFormulas{};
+    csv_ << row << ',' << p.parameter << ',' << barrier.at("T_ext") << ',' << h.T_ext << ',' << h.helix_angle << ','
+         << h.T_ext * R * R / EI_ << ',' << formulas.eq61 << ',' << h.m3 << ',' << formulas.m3_eq58b << ','
+         << h.contact_pressure
          << ',' << h.contact_start << ',' << h.contact_end << ',' << h.min_gap << ',' << h.min_force << ','
          << h.complementarity << ',' << h.energy << ',' << h.segments << ',' << h.rounds << ',' << h.iterations << ','
          << seconds << ",\"" << h.status << "\"\n"
@@ -168,6 +176,7 @@ class HardContactCsv {
   }
 
  private:
+  const ShootingProblem& problem_;
   double EI_;
   PlectonemeRunOptions options_;
   PlectonemeBranchSummary* summary_;
@@ -206,8 +215,7 @@ class BranchCsv {
   void follow_hard_contact(const std::string& csv_path, const ShootingProblem& problem) {
     if (!(options_.hard_contact_every > 0)) return;
     const std::string path = csv_path.substr(0, csv_path.size() - 4) + "_hard.csv";
-    hard_.emplace(path, EI_, options_, resumed_ ? state_.saved_row : -1, summary_);
-    problem_ = &problem;
+    hard_.emplace(path, problem, EI_, options_, resumed_ ? state_.saved_row : -1, summary_);
   }
 
   void operator()(const ContinuationPoint& p) {
@@ -215,7 +223,7 @@ class BranchCsv {
     csv_ << ++state_.row << ',' << p.parameter << ',' << to_string(p.type);
     for (const auto& n : csv_names()) csv_ << ',' << row.at(n);
     csv_ << ',' << p.newton_iterations << ',' << p.step << '\n' << std::flush;
-    if (hard_) hard_->consider(*problem_, p, state_.row, row);
+    if (hard_) hard_->consider(p, state_.row, row);
     if (resumable(p)) save_resume_point(state_path_, p, &state_);
     ++summary_->points;
     if (!std::isnan(row.at("eq61"))) {
@@ -237,7 +245,6 @@ class BranchCsv {
   std::ofstream csv_;
   bool resumed_ = false;
   std::optional<HardContactCsv> hard_;
-  const ShootingProblem* problem_ = nullptr;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t) {

@@ -193,7 +193,7 @@ class HardContactNLP : public Ipopt::TNLP {
       return true;
     }
     std::fill(values, values + hessian_rows_.size(), 0.0);
-    auto add = [&](int row0, int col0, const Eigen::MatrixXd& block, double weight) {
+    auto add = [&](int row0, int col0, const auto& block, double weight) {
       for (int r = 0; r < block.rows(); ++r)
         for (int c = 0; c < block.cols(); ++c)
           if (row0 + r >= col0 + c) values[hessian_index_.at(key(row0 + r, col0 + c))] += weight * block(r, c);
@@ -474,7 +474,7 @@ HardSelfContactPlectoneme solve_hard_self_contact(const ShootingProblem& problem
     app->OptimizeTNLP(nlp);
     if (Ipopt::IsValid(app->Statistics())) iterations += app->Statistics()->IterationCount();
     out.iterations = iterations;
-    if (out.status != "converged" || out.box_active == 0) break;
+    if (!out.converged || out.box_active == 0) break;
     rod.seed_nodes.assign(out.nodes.begin(), out.nodes.end());
     rod.seed_frames = out.frames;
   }

@@ -52,7 +52,7 @@ struct HardSelfContactPlectoneme {
   double spacing = 0.0;      // h
   double energy = 0.0;       // of the half rod
   // As in PlectonemeMeasures (plectoneme.hpp), here with exact contact:
-  double T_ext = 0.0;        // n.d3 on the first edge
+  double T_ext = 0.0;        // n.d3(0): the first edge's force along the clamp's d3
   double m3 = 0.0;           // twisting moment B3 u3 in the middle of the half rod
   double contact_start = NAN, contact_end = NAN;  // nodes pressed with >= kContactFraction of the largest force
   double helix_angle = NAN;  // mean angle between d3 and the axis over the central half of the contact region
