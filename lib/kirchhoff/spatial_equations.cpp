@@ -14,33 +14,25 @@
 // decomposition, 2 atan2(q.e3, w)) integrated continuously so that imposed end rotations count
 // whole turns; it feeds nothing back into the mechanics.
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "kirchhoff/field_eval.hpp"
 #include "kirchhoff/integrator_impl.hpp"
 #include "kirchhoff/rod_equations.hpp"
+#include "kirchhoff/rod_on_cylinder_impl.hpp"
+#include "kirchhoff/spatial_state.hpp"
 
 namespace kirchhoff {
 namespace {
 
-constexpr int kStateSize = 14;
-enum Index { kR = 0, kQ = 3, kN = 7, kM = 10, kChi = 13 };
-
-// Rotation matrix of a (not necessarily unit) quaternion, row-major in R[3][3].
-template <class T>
-void rotation_from_quaternion(const T* q, T R[3][3]) {
-  const T w = q[0], x = q[1], y = q[2], z = q[3];
-  const T inv = 1.0 / (w * w + x * x + y * y + z * z);
-  R[0][0] = (w * w + x * x - y * y - z * z) * inv;
-  R[0][1] = 2.0 * (x * y - w * z) * inv;
-  R[0][2] = 2.0 * (x * z + w * y) * inv;
-  R[1][0] = 2.0 * (x * y + w * z) * inv;
-  R[1][1] = (w * w - x * x + y * y - z * z) * inv;
-  R[1][2] = 2.0 * (y * z - w * x) * inv;
-  R[2][0] = 2.0 * (x * z - w * y) * inv;
-  R[2][1] = 2.0 * (y * z + w * x) * inv;
-  R[2][2] = (w * w - x * x - y * y + z * z) * inv;
-}
+constexpr int kStateSize = detail::kSpatialStateSize;
+using detail::kChi;
+using detail::kM;
+using detail::kN;
+using detail::kQ;
+using detail::kR;
+using detail::rotation_from_quaternion;
 
 Eigen::Vector4d quaternion_from_rotation(const Mat3& R) {
   const Eigen::Quaterniond q(R);
@@ -49,7 +41,8 @@ Eigen::Vector4d quaternion_from_rotation(const Mat3& R) {
 
 class SpatialEquations final : public RodEquations {
  public:
-  explicit SpatialEquations(RodModel model) : model_(std::move(model)) {}
+  explicit SpatialEquations(RodModel model, std::optional<CylinderSupport> support = std::nullopt)
+      : model_(std::move(model)), support_(std::move(support)) {}
 
   int state_size() const override { return kStateSize; }
   const RodModel& model() const override { return model_; }
@@ -79,7 +72,12 @@ class SpatialEquations final : public RodEquations {
     dy[kQ + 1] = 0.5 * (w * u[0] + qy * u[2] - qz * u[1]);
     dy[kQ + 2] = 0.5 * (w * u[1] + qz * u[0] - qx * u[2]);
     dy[kQ + 3] = 0.5 * (w * u[2] + qx * u[1] - qy * u[0]);
-    if (model_.field) {
+    if (support_) {
+      // Lying on a cylinder: its pressure along e (rod_on_cylinder.hpp).
+      detail::V3<T> e;
+      const T p = detail::cylinder_pressure(*support_, model_.B[0](s), y, &e);
+      for (int i = 0; i < 3; ++i) dy[kN + i] = -p * e[i];
+    } else if (model_.field) {
       T f[3];
       detail::field_force(*model_.field, s, y + kR, f);
       for (int i = 0; i < 3; ++i) dy[kN + i] = -f[i];
@@ -113,10 +111,10 @@ class SpatialEquations final : public RodEquations {
                    const IntegratorOptions& options) const override {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     if (!sensitivities) return detail::flow_state<kStateSize>(f, y0, s0, s1, options);
-    // Nothing depends on chi(s0), and without a field nothing depends on r(s0) either: their
-    // columns of Phi are unit vectors, and only the other directions are carried by the dual
-    // numbers (13 with a field - self-contact, gravity -, 10 without).
-    if (model_.field) {
+    // Nothing depends on chi(s0), and without a field or a cylinder nothing depends on r(s0)
+    // either: their columns of Phi are unit vectors, and only the other directions are carried by
+    // the dual numbers (13 with a field - self-contact, gravity - or a cylinder, 10 without).
+    if (model_.field || support_) {
       constexpr std::array<int, 13> kSeeds{kR,     kR + 1, kR + 2, kQ,     kQ + 1, kQ + 2, kQ + 3,
                                            kN,     kN + 1, kN + 2, kM,     kM + 1, kM + 2};
       return with_unit_columns(detail::flow_with_partial_sensitivities<kStateSize, 13>(f, y0, s0, s1, options, kSeeds),
@@ -235,6 +233,7 @@ class SpatialEquations final : public RodEquations {
 
  private:
   RodModel model_;
+  std::optional<CylinderSupport> support_;  // set: the rod lies on this cylinder
 };
 
 }  // namespace
@@ -252,6 +251,15 @@ const char* to_string(Slot slot) {
 std::shared_ptr<const RodEquations> make_spatial_equations(RodModel model) {
   model.validate();
   return std::make_shared<SpatialEquations>(std::move(model));
+}
+
+std::shared_ptr<const RodEquations> make_spatial_equations_on_cylinder(RodModel model, CylinderSupport support) {
+  model.validate();
+  if (std::string why = rod_on_cylinder_unsupported(model); !why.empty()) throw std::invalid_argument(why);
+  if (!(support.radius > 0.0)) throw std::invalid_argument("a supporting cylinder needs a radius > 0");
+  if (!(support.axis.norm() > 0.0)) throw std::invalid_argument("a supporting cylinder needs a non-zero axis");
+  support.axis.normalize();
+  return std::make_shared<SpatialEquations>(std::move(model), std::move(support));
 }
 
 }  // namespace kirchhoff
