@@ -86,6 +86,41 @@ TEST(PointContact, JacobianThroughTheContactEqualsFiniteDifferences) {
   EXPECT_LE((J - J_fd).cwiseAbs().maxCoeff(), 1e-6 * std::max(1.0, J.cwiseAbs().maxCoeff()));
 }
 
+// Multiple shooting through the contact: the segments of each piece move with the contact point,
+// the jump sits between the pieces. Started from the single-shooting solution's states at its nodes
+// (unknowns_from) with the contact 0.01 away and its force 10 % off. Same solution as single shooting to Newton's tolerance (1e-12
+// on the residual; the loads are O(10-100), so 1e-9 relative), and its Jacobian - node blocks,
+// the contact's arclength moving every node of both pieces - equals finite differences.
+TEST(PointContact, MultipleShootingThroughTheContactAgreesWithSingleShooting) {
+  const ContactRun single = run();
+  ASSERT_TRUE(single.solve.complementarity);
+  for (int segments : {2, 5}) {
+    ProblemDefinition d = single.solve.definition;
+    d.contacts = single.problem->contacts_at(single.solve.result.x);
+    d.contacts[0].s += 0.01;  // start elsewhere: the nodes move with it
+    d.contacts[0].force *= 0.9;
+    d.options.segments = segments;
+    const ShootingProblem problem(d);
+    ASSERT_EQ(problem.piece_segments().size(), 2u);
+    const ShootingResult r =
+        solve(problem, problem.unknowns_from(single.problem->sample(single.solve.result.x, problem.node_arclengths())));
+    ASSERT_TRUE(r.summary.converged()) << segments << ": " << r.summary.brief_report();
+    const Solution s = make_solution(problem, r, 401, single.c.derived);
+    EXPECT_NEAR(s.derived.at("P") / single.solution.derived.at("P"), 1.0, 1e-9) << segments;
+    EXPECT_NEAR(s.contacts[0].s, single.solution.contacts[0].s, 1e-9) << segments;
+    EXPECT_NEAR(s.contacts[0].force / single.solution.contacts[0].force, 1.0, 1e-9) << segments;
+    EXPECT_LE(s.invariants.H.relative_spread(), 1e-9);
+    Eigen::VectorXd x = r.x;
+    for (int i = 0; i < x.size(); ++i) x[i] += 0.01 * std::sin(1.0 + 2.3 * i);
+    Eigen::VectorXd F;
+    Eigen::MatrixXd J, J_fd;
+    std::string failure;
+    ASSERT_TRUE(problem.evaluate(x, &F, &J, &failure)) << failure;
+    ASSERT_TRUE(finite_difference_jacobian(problem, x, 1e-6, &J_fd));
+    EXPECT_LE((J - J_fd).cwiseAbs().maxCoeff(), 1e-6 * std::max(1.0, J.cwiseAbs().maxCoeff())) << segments;
+  }
+}
+
 ContactContinuationResult continue_wall(double to) {
   const Case c = load_case(testing::case_path("wall.toml"), {{"Delta", 0.005}, {"m_guess", 0.9}});
   ContinuationOptions o;

@@ -59,7 +59,7 @@ TEST(HalfTurnSelfContact, ForceIsMinusGradientOfPotential) {
 TEST(HalfTurnSelfContact, ImageDistanceAndSwitchOff) {
   const HalfTurnSelfContact contact(contact_options());
   const Vec3 r(0.3, 0.004, -0.012);
-  EXPECT_NEAR((r - contact.image(r)).norm(), 2.0 * contact.distance_to_axis(r), 1e-16);
+  EXPECT_NEAR((r - contact.geometry().image(r)).norm(), 2.0 * contact.geometry().distance_to_axis(r), 1e-16);
   EXPECT_EQ(contact.weight(0.0), 1.0);
   EXPECT_EQ(contact.weight(0.5 - 0.04), 1.0);
   EXPECT_EQ(contact.weight(0.5 - 0.02), 0.0);

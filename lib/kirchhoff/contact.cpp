@@ -373,6 +373,10 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
       // The rod's curvature has reached the obstacle's: beyond, it would lie on it over an interval.
       if (const std::string e = extended_contact_unsupported(*here.equations(here.parameters_at(at.x)), o); !e.empty())
         return stop_here("the contact at s = " + std::to_string(c.s) + " starts to wrap around " + o.describe() + ": " + e);
+      if (!here.equations(here.parameters_at(at.x))->is_planar())
+        return stop_here("the contact at s = " + std::to_string(c.s) + " starts to wrap around " + o.describe() +
+                         ": a spatial rod lying on a cylinder is solved by multiple shooting (rod_on_cylinder.hpp), "
+                         "and contact continuation is single shooting - following the wrap here is not implemented");
       if (!o.is_flat()) {
         // A wrap presses on the disc with its tension / radius: in compression the rod cannot lie
         // on the disc, it would touch it at two points either side instead.

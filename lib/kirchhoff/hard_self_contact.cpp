@@ -485,4 +485,38 @@ HardSelfContactPlectoneme solve_hard_self_contact(const ShootingProblem& problem
   return out;
 }
 
+std::vector<PointContact> ply_contacts(const HardSelfContactPlectoneme& solution) {
+  const auto& f = solution.node_force;
+  const double largest = f.empty() ? 0.0 : *std::max_element(f.begin(), f.end());
+  // Inactive constraints' multipliers are ~1e-8 of the active ones' (Ipopt's interior point).
+  const double pressed = 1e-6 * largest;
+  std::vector<PointContact> out;
+  const double h = solution.spacing;
+  for (size_t i = 0; i < f.size();) {
+    if (!(f[i] > pressed)) {
+      ++i;
+      continue;
+    }
+    size_t j = i;
+    while (j + 1 < f.size() && f[j + 1] > pressed) ++j;
+    PointContact c;
+    c.obstacle = 0;
+    if (static_cast<int>(j - i + 1) <= kPointContactNodes) {
+      double total = 0.0, moment = 0.0;
+      for (size_t k = i; k <= j; ++k) total += f[k], moment += f[k] * k * h;
+      c.s = moment / total;
+      c.force = total;
+    } else {
+      c.extended = true;
+      c.s = i * h;
+      c.s_end = j * h;
+      c.force = std::max(0.0, f[i] - f[i + 1]);
+      c.force_end = std::max(0.0, f[j] - f[j - 1]);
+    }
+    out.push_back(c);
+    i = j + 1;
+  }
+  return out;
+}
+
 }  // namespace kirchhoff

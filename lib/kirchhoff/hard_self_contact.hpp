@@ -69,6 +69,15 @@ struct HardSelfContactPlectoneme {
   std::vector<Eigen::Vector4d> frames;  // the edges' unit quaternions (w, x, y, z)
 };
 
+// The contact set of a discretised solution as shooting contacts on the self-contact cylinder
+// (obstacle 0 of hard_ply_definition, plectoneme.hpp): runs of consecutive pressed nodes, a run of
+// at most kPointContactNodes nodes a point contact (its forces summed, at their centroid), a longer
+// one a line contact over its nodes, with the excess of its end nodes over their neighbours as the
+// edge forces. The ply's ends are such isolated points beside its line contact (measured at
+// L/2R = 100, 5 turns: point, gap of 0.5 % of R, line, gap, point).
+std::vector<PointContact> ply_contacts(const HardSelfContactPlectoneme& solution);
+inline constexpr int kPointContactNodes = 3;
+
 // Re-solves the half rod of `problem` at the solution x with hard self-contact, seeded by x.
 // Throws std::invalid_argument when the problem has no half-turn self-contact, is not an
 // inextensible, unshearable spatial rod, or when the options are out of range.

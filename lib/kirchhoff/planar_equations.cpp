@@ -103,6 +103,8 @@ class PlanarEquations final : public RodEquations {
     return p;
   }
 
+  int turn_angle_index() const override { return kTheta; }
+
   Eigen::VectorXd state(const RodPoint& p) const override {
     Eigen::VectorXd y(kStateSize);
     y << p.r.x(), p.r.y(), std::atan2(p.R(1, 2), p.R(0, 2)), p.n.x(), p.n.y(), p.m.z();

@@ -1,15 +1,51 @@
-// What a symmetric plectoneme (section 7.6, Fig. 10) is measured by: the quantities of eqs.
-// (58)-(61) read off a solved half rod whose end s = L/2 is a half-turn symmetry point and whose
-// self-contact is a HalfTurnSelfContact (see self_contact.hpp and cases/plectoneme.toml).
+// The symmetric plectoneme (section 7.6, Fig. 10): the quantities of eqs. (58)-(61) read off a
+// solved half rod whose end s = L/2 is a half-turn symmetry point, and its two self-contact
+// formulations - a barrier (HalfTurnSelfContact, self_contact.hpp; cases/plectoneme.toml), which
+// continuation follows from the untwisted rod through the loop's closing into the ply, and hard
+// contact in the shooting core (hard_ply_definition below), the ply lying exactly on the cylinder
+// of radius R about the axis, with complementarity.
 #pragma once
 
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "kirchhoff/self_contact.hpp"
 #include "kirchhoff/shooting.hpp"
 
 namespace kirchhoff {
+
+// The obstacle a hard-contact plectoneme lies on (hard_ply_definition) is named this.
+inline constexpr const char* kHalfTurnContactName = "half-turn self-contact";
+
+// The half-turn geometry of a plectoneme problem at parameters p: its barrier's, or that of the
+// cylinder its hard contact lies on; empty for other problems.
+std::optional<HalfTurnGeometry> half_turn_geometry(const ShootingProblem& problem, const Parameters& p);
+
+// Hard self-contact: the barrier problem `barrier` (a HalfTurnSelfContact in its rod) with the
+// barrier removed and the half rod touching the cylinder of radius R about the half-turn axis
+// where `contacts` say (obstacle 0, in order along the rod): at points, and over intervals where
+// it lies on the cylinder with the pressure that keeps it there and concentrated forces at both
+// ends (rod_on_cylinder.hpp). The ply of a plectoneme is a line contact with an isolated contact
+// point beside it at each end (ply_contacts, hard_self_contact.hpp, reads the set off the
+// discretised hard solution). The strands of the whole rod then touch exactly (rho = R, not R +
+// the barrier's gap); complementarity off the contacts is checked, not imposed (min_contact_force,
+// min_wrap_pressure, ply_clearance, self_distance). Multiple shooting as the barrier's, the
+// segments shared among the pieces between contacts in proportion to their lengths. The cylinder
+// moves with the parameters (the slenderness sets R). Throws std::invalid_argument when the barrier
+// problem has no half-turn self-contact or its rod has another field besides, or the contacts are
+// out of order.
+ProblemDefinition hard_ply_definition(const ProblemDefinition& barrier, const std::vector<PointContact>& contacts);
+
+// The hard-contact problem for a solved barrier plectoneme with the contact set given, and its
+// unknowns from the barrier solution's states at its nodes. Newton takes it from there to the
+// hard solution.
+struct HardPlyStart {
+  ProblemDefinition definition;
+  Eigen::VectorXd x;
+};
+HardPlyStart hard_ply_from_barrier(const ShootingProblem& barrier, const Eigen::VectorXd& x,
+                                   const std::vector<PointContact>& contacts);
 
 struct PlectonemeMeasures {
   double T_ext = 0.0;             // tension at the clamp, n(0).d3(0) (the pull on the end B)
@@ -29,8 +65,15 @@ struct PlectonemeMeasures {
   // pi R apart along it, in units of 2R: >= 1 when no two parts of the rod interpenetrate.
   double self_distance = NAN;
   // Smallest (rho - R)/c where the contact is being switched off near the end loop: H drifts
-  // there by ~ exp(-loop_clearance^2) times the barrier's scale, negligible beyond ~4.
+  // there by ~ exp(-loop_clearance^2) times the barrier's scale, negligible beyond ~4. NaN with
+  // hard contact.
   double loop_clearance = NAN;
+  // Hard contact only (NaN with the barrier): the smallest (rho - R)/R at the gaps between the
+  // ply's contacts (a point contact beside the line contact at each end of the ply, say); where
+  // it reaches 0 a new contact forms. NaN when the ply has no such gap. (The contacts' forces and
+  // pressures are the derived quantities min_contact_force and min_wrap_pressure.)
+  bool hard = false;
+  double ply_clearance = NAN;
 };
 
 // Cross-sections pressed with less than this fraction of the largest contact force per length

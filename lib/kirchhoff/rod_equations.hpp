@@ -57,6 +57,9 @@ class RodEquations {
   virtual Eigen::VectorXd derivative(const Eigen::VectorXd& y, double s) const = 0;
 
   virtual RodPoint point(const Eigen::VectorXd& y, double s) const = 0;
+  // The state entry that is RodPoint::turn_angle: counted continuously along the rod (state()
+  // sets it in (-pi, pi] from the frame alone).
+  virtual int turn_angle_index() const = 0;
   // State from lab-frame data (used to build initial guesses); the frame must be admissible.
   virtual Eigen::VectorXd state(const RodPoint& p) const = 0;
 

@@ -8,8 +8,22 @@
 
 namespace kirchhoff {
 
+Vec3 HalfTurnGeometry::radial(const Vec3& r) const {
+  const Vec3 d = r - origin;
+  return d - axis * axis.dot(d);
+}
+
+std::vector<WholeRodSection> HalfTurnGeometry::whole_rod(const std::vector<RodPoint>& half) const {
+  std::vector<WholeRodSection> out;
+  out.reserve(2 * half.size());
+  const double Lh = half.back().s;
+  for (const auto& p : half) out.push_back({p.s, p.r});
+  for (auto it = half.rbegin() + 1; it != half.rend(); ++it) out.push_back({2.0 * Lh - it->s, image(it->r)});
+  return out;
+}
+
 HalfTurnSelfContact::HalfTurnSelfContact(const HalfTurnSelfContactOptions& options)
-    : options_(options), axis_(options.axis.normalized()) {
+    : options_(options), geometry_{options.origin, options.axis.normalized(), options.radius, options.symmetry_s} {
   auto require = [](bool ok, const std::string& what) {
     if (!ok) throw std::invalid_argument(what);
   };
@@ -20,24 +34,6 @@ HalfTurnSelfContact::HalfTurnSelfContact(const HalfTurnSelfContactOptions& optio
   require(options.axis.norm() > 0.0, "self-contact axis must be a non-zero vector");
   require(options.symmetry_s > 2.0 * options.adjacent,
           "self-contact: the rod is shorter than twice the adjacent length");
-}
-
-Vec3 HalfTurnSelfContact::radial(const Vec3& r) const {
-  const Vec3 d = r - options_.origin;
-  return d - axis_ * axis_.dot(d);
-}
-
-double HalfTurnSelfContact::distance_to_axis(const Vec3& r) const { return radial(r).norm(); }
-
-Vec3 HalfTurnSelfContact::image(const Vec3& r) const { return r - 2.0 * radial(r); }
-
-std::vector<WholeRodSection> HalfTurnSelfContact::whole_rod(const std::vector<RodPoint>& half) const {
-  std::vector<WholeRodSection> out;
-  out.reserve(2 * half.size());
-  const double Lh = half.back().s;
-  for (const auto& p : half) out.push_back({p.s, p.r});
-  for (auto it = half.rbegin() + 1; it != half.rend(); ++it) out.push_back({2.0 * Lh - it->s, image(it->r)});
-  return out;
 }
 
 double HalfTurnSelfContact::weight(double s) const {
@@ -53,7 +49,7 @@ HalfTurnSelfContact::Barrier HalfTurnSelfContact::barrier(double s, const Vec3& 
   Barrier b;
   b.w = weight(s);
   if (b.w == 0.0) return b;
-  b.d = radial(r);
+  b.d = geometry_.radial(r);
   b.rho = b.d.norm();
   const double g = b.rho - options_.radius;
   if (!(g > 0.0))
@@ -82,13 +78,13 @@ Mat3 HalfTurnSelfContact::force_gradient(double s, const Vec3& r) const {
   const Barrier b = barrier(s, r);
   if (b.w == 0.0) return Mat3::Zero();
   const Vec3 e = b.d / b.rho;
-  const Mat3 across = Mat3::Identity() - axis_ * axis_.transpose() - e * e.transpose();
+  const Mat3 across = Mat3::Identity() - geometry_.axis * geometry_.axis.transpose() - e * e.transpose();
   return -b.w * (b.ddphi * e * e.transpose() + b.dphi * across / b.rho);
 }
 
 double HalfTurnSelfContact::gap(double s, const Vec3& r) const {
   if (weight(s) == 0.0) return std::numeric_limits<double>::quiet_NaN();
-  return distance_to_axis(r) - options_.radius;
+  return geometry_.distance_to_axis(r) - options_.radius;
 }
 
 const HalfTurnSelfContact* find_half_turn_self_contact(const RodModel& model) {

@@ -39,6 +39,26 @@ struct WholeRodSection {
   Vec3 r = Vec3::Zero();
 };
 
+// The half-turn S about an axis through `origin` that relates the two halves of a symmetric
+// plectoneme (r(L - s) = S r(s)), with the cross-section radius R: the strands touch where the
+// half rod is R from the axis. What the barrier (below) and the hard contact (a cylinder of
+// radius R about the axis, plectoneme.hpp) have in common.
+struct HalfTurnGeometry {
+  Vec3 origin = Vec3::Zero();
+  Vec3 axis = Vec3::UnitX();  // unit
+  double radius = 0.0;        // R
+  double symmetry_s = 0.0;    // arclength of the point on the axis (the end of the half rod)
+
+  // Component of r - origin across the axis.
+  Vec3 radial(const Vec3& r) const;
+  double distance_to_axis(const Vec3& r) const { return radial(r).norm(); }
+  // The image S r of a point under the half-turn.
+  Vec3 image(const Vec3& r) const { return r - 2.0 * radial(r); }
+  // The whole rod from samples of the half rod [0, L/2]: the half followed by its image,
+  // traversed backwards (r(L - s) = S r(s)).
+  std::vector<WholeRodSection> whole_rod(const std::vector<RodPoint>& half) const;
+};
+
 struct HalfTurnSelfContactOptions {
   double radius = 0.0;          // R, the cross-section radius: centrelines stay 2R apart
   Vec3 axis = Vec3::UnitX();    // the half-turn axis, through `origin`
@@ -60,19 +80,12 @@ class HalfTurnSelfContact final : public ExternalField {
   // rho - R where the contact acts, NaN near the end loop where it does not.
   double gap(double s, const Vec3& r) const override;
 
-  // The image S r of a point under the half-turn.
-  Vec3 image(const Vec3& r) const;
-  // The whole rod from samples of the half rod [0, L/2]: the half followed by its image,
-  // traversed backwards (r(L - s) = S r(s)).
-  std::vector<WholeRodSection> whole_rod(const std::vector<RodPoint>& half) const;
-  double distance_to_axis(const Vec3& r) const;
+  const HalfTurnGeometry& geometry() const { return geometry_; }
   // The weight w(s) that switches contact off near the end loop.
   double weight(double s) const;
   const HalfTurnSelfContactOptions& options() const { return options_; }
 
  private:
-  // Component of r - origin across the axis.
-  Vec3 radial(const Vec3& r) const;
   // The barrier at a cross-section: weight w(s), radial vector d and |d|, and phi(g) with its
   // first two derivatives. Throws IntegrationError when g <= 0 where the barrier acts (the rod
   // would pass through itself, which a Newton iterate may try: the step is then shortened).
@@ -84,7 +97,7 @@ class HalfTurnSelfContact final : public ExternalField {
   Barrier barrier(double s, const Vec3& r) const;
 
   HalfTurnSelfContactOptions options_;
-  Vec3 axis_;
+  HalfTurnGeometry geometry_;
 };
 
 // The half-turn self-contact among a model's fields (directly or in a FieldSum), or null.

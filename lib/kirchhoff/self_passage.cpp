@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "kirchhoff/plectoneme.hpp"
 #include "kirchhoff/spatial_bins.hpp"
 
 namespace kirchhoff {
@@ -35,32 +36,31 @@ SelfPassage closest_approach_in_motion(const std::vector<WholeRodSection>& from,
 
 SelfPassageGuard::SelfPassageGuard(const ShootingProblem& problem, std::string parameter)
     : problem_(std::make_shared<ShootingProblem>(problem)), parameter_(std::move(parameter)) {
-  if (!find_half_turn_self_contact(problem.equations(problem.parameters())->model()))
+  if (!half_turn_geometry(problem, problem.parameters()))
     throw std::invalid_argument("the self-passage guard needs a rod with [rod.self_contact]");
 }
 
-const HalfTurnSelfContact& SelfPassageGuard::contact_at(const ContinuationPoint& point) {
+HalfTurnGeometry SelfPassageGuard::geometry_at(const ContinuationPoint& point) {
   problem_->set_parameter(parameter_, point.parameter);
-  equations_ = problem_->equations(problem_->parameters_at(point.x));
-  return *find_half_turn_self_contact(equations_->model());
+  return *half_turn_geometry(*problem_, problem_->parameters_at(point.x));
 }
 
 std::vector<WholeRodSection> SelfPassageGuard::whole_rod_at(const ContinuationPoint& point, int intervals) {
   if (newest_ && newest_->intervals == intervals && newest_->parameter == point.parameter && newest_->x == point.x)
     return newest_->rod;
-  const HalfTurnSelfContact& contact = contact_at(point);
-  const double Lh = contact.options().symmetry_s;
+  const HalfTurnGeometry half_turn = geometry_at(point);
+  const double Lh = half_turn.symmetry_s;
   std::vector<double> s(intervals + 1);
   for (int k = 0; k <= intervals; ++k) s[k] = Lh * k / intervals;
-  auto rod = contact.whole_rod(problem_->sample(point.x, s));
+  auto rod = half_turn.whole_rod(problem_->sample(point.x, s));
   newest_ = std::make_shared<Sampled>(Sampled{point.parameter, point.x, intervals, std::move(rod)});
   return newest_->rod;
 }
 
 std::string SelfPassageGuard::operator()(const ContinuationPoint& from, const ContinuationPoint& to) {
   // The thinner rod's radius (a step in the slenderness changes it) and its sampling for both.
-  const double R_from = contact_at(from).options().radius;
-  const HalfTurnSelfContactOptions at_to = contact_at(to).options();
+  const double R_from = geometry_at(from).radius;
+  const HalfTurnGeometry at_to = geometry_at(to);
   const double R = std::min(R_from, at_to.radius), Lh = at_to.symmetry_s;
   // R/2 apart: two sections that meet between samples have sampled neighbours within ~R/2.
   const int intervals = static_cast<int>(std::ceil(Lh / (0.5 * R)));
@@ -76,7 +76,7 @@ std::string SelfPassageGuard::operator()(const ContinuationPoint& from, const Co
 }
 
 bool guard_self_passage(const ShootingProblem& problem, ContinuationOptions* options) {
-  if (!find_half_turn_self_contact(problem.equations(problem.parameters())->model())) return false;
+  if (!half_turn_geometry(problem, problem.parameters())) return false;
   options->step_check = SelfPassageGuard(problem, options->parameter);
   return true;
 }

@@ -38,7 +38,8 @@ struct SelfPassage {
 SelfPassage closest_approach_in_motion(const std::vector<WholeRodSection>& from,
                                        const std::vector<WholeRodSection>& to, double apart, double reach);
 
-// A ContinuationOptions::step_check for a problem whose rod has a HalfTurnSelfContact: refuses a
+// A ContinuationOptions::step_check for a plectoneme problem (a HalfTurnSelfContact in its rod, or
+// hard contact: half_turn_geometry, plectoneme.hpp): refuses a
 // step along which two cross-sections more than pi R apart along the rod come within R of each
 // other (the whole rod sampled R/2 apart, so a pair that meets between samples is still caught).
 // Each point's samples cost one integration without sensitivities (the newest is kept for the
@@ -50,8 +51,8 @@ class SelfPassageGuard {
   std::string operator()(const ContinuationPoint& from, const ContinuationPoint& to);
 
  private:
-  // The self-contact at a point (its parameter set on the guard's problem).
-  const HalfTurnSelfContact& contact_at(const ContinuationPoint& point);
+  // The half-turn geometry at a point (its parameter set on the guard's problem).
+  HalfTurnGeometry geometry_at(const ContinuationPoint& point);
   // The whole rod of a point sampled at `intervals` equal intervals of the half rod.
   std::vector<WholeRodSection> whole_rod_at(const ContinuationPoint& point, int intervals);
 
@@ -64,12 +65,10 @@ class SelfPassageGuard {
   };
   std::shared_ptr<ShootingProblem> problem_;  // shared: std::function copies the guard
   std::string parameter_;
-  std::shared_ptr<const RodEquations> equations_;  // keeps contact_at's answer alive
   std::shared_ptr<Sampled> newest_;
 };
 
-// Sets options->step_check to a SelfPassageGuard when the problem's rod has a half-turn
-// self-contact; returns whether it did.
+// Sets options->step_check to a SelfPassageGuard for a plectoneme problem; returns whether it did.
 bool guard_self_passage(const ShootingProblem& problem, ContinuationOptions* options);
 
 }  // namespace kirchhoff

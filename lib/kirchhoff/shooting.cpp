@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "kirchhoff/jacobian_lu.hpp"
+#include "kirchhoff/rod_on_cylinder.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -59,12 +60,12 @@ ShootingProblem::ShootingProblem(ProblemDefinition definition) : definition_(std
   std::vector<double> rows;
   const Eigen::VectorXd y = eq->state(RodPoint{});
   residual_count_ = static_cast<int>(eq->gauge_residual(y, nullptr).size());
+  gauge_count_ = residual_count_;
   definition_.start.append_residuals(*eq, true, y, definition_.parameters, &rows, nullptr);
   start_condition_count_ = static_cast<int>(rows.size());
   definition_.end.append_residuals(*eq, false, y, definition_.parameters, &rows, nullptr);
   residual_count_ += static_cast<int>(rows.size()) + (segments() - 1) * state_size_;
   if (!definition_.contacts.empty()) {
-    if (segments() != 1) throw std::invalid_argument("solver: point contacts need single shooting (segments = 1)");
     for (const auto& c : definition_.contacts)
       if (c.obstacle < 0 || c.obstacle >= static_cast<int>(definition_.obstacles.size()))
         throw std::invalid_argument("contact on obstacle " + std::to_string(c.obstacle) + ", which does not exist");
@@ -72,10 +73,20 @@ ShootingProblem::ShootingProblem(ProblemDefinition definition) : definition_(std
   }
   // Moving obstacles decide: `obstacles` is kept as their value at the current parameters.
   if (definition_.moving_obstacles) definition_.obstacles = definition_.moving_obstacles(definition_.parameters);
-  for (const auto& c : definition_.contacts)
-    if (c.extended)
-      if (std::string e = extended_contact_unsupported(*eq, definition_.obstacles[c.obstacle]); !e.empty())
-        throw std::invalid_argument(e);
+  for (const auto& c : definition_.contacts) {
+    if (!c.extended) continue;
+    if (std::string e = extended_contact_unsupported(*eq, definition_.obstacles[c.obstacle]); !e.empty())
+      throw std::invalid_argument(e);
+    // Each way of shooting through a wrap is written once: the closed-form planar ones through a
+    // single segment, the spatial rod on a cylinder as a piece of multiple shooting.
+    if (eq->is_planar() && segments() > 1)
+      throw std::invalid_argument("solver: extended contacts of planar rods need single shooting (segments = 1)");
+    if (!eq->is_planar() && segments() == 1)
+      throw std::invalid_argument(
+          "solver: a spatial rod lying on a cylinder is shot piece by piece: set segments to at least the number of "
+          "pieces the contacts cut the rod into");
+  }
+  if (!definition_.contacts.empty() && segments() > 1) set_piece_segments();
   if (residual_count_ != size())
     throw std::invalid_argument("boundary conditions give " + std::to_string(residual_count_) +
                                 " equations for " + std::to_string(size()) + " unknowns");
@@ -108,6 +119,7 @@ double ShootingProblem::flat_contact_margin(const Eigen::VectorXd& x, const Poin
 
 double ShootingProblem::wrap_tension(const Eigen::VectorXd& x, const PointContact& contact) const {
   if (!contact.extended || obstacles(parameters_at(x))[contact.obstacle].is_flat()) return NAN;
+  if (definition_.kind == RodKind::Spatial) return NAN;
   const RodPoint p = sample(x, {0.5 * (contact.s + contact.s_end)}).front();
   return p.n.dot(p.R.col(2));
 }
@@ -245,8 +257,8 @@ bool ShootingProblem::parameter_derivative(const Eigen::VectorXd& x, const std::
 }
 
 void ShootingProblem::place_condition_rows(const Eigen::VectorXd& rows, Eigen::VectorXd* column) const {
-  const int gauge = residual_count_ - static_cast<int>(rows.size()) - (segments() - 1) * state_size_;
-  column->segment(gauge, start_condition_count_) = rows.head(start_condition_count_);
+  // Start rows follow the gauge rows; end rows are the last ones (contact rows lie between).
+  column->segment(gauge_count_, start_condition_count_) = rows.head(start_condition_count_);
   column->tail(rows.size() - start_condition_count_) = rows.tail(rows.size() - start_condition_count_);
 }
 
@@ -320,7 +332,9 @@ bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Ei
     if (failure) *failure = std::string("the rod model is not defined there: ") + e.what();
     return false;
   }
-  if (!definition_.contacts.empty()) return residual_with_contacts(x, p, F, J, failure, y_end);
+  if (!definition_.contacts.empty())
+    return segments() > 1 ? residual_pieces(x, p, F, J, failure, y_end)
+                          : residual_with_contacts(x, p, F, J, failure, y_end);
   const int n = state_size_, M = segments();
   const Eigen::VectorXd y0 = x.head(n);
   int row = start_rows(*eq, y0, p, F, J);
@@ -409,6 +423,110 @@ std::vector<Breakpoint> breakpoints(const std::vector<PointContact>& contacts, c
   return out;
 }
 
+// Whether the breakpoints increase inside (0, L): strictly, except that an extended contact may
+// have zero length (when it forms), and a wrap a negative one (traversed backwards: not a rod, but
+// the residual stays smooth where a wrap shrinks to a point, so that event is located by crossing).
+// Flat contacts are kept >= 0: their legs are degenerate (see run_legs in contact.cpp), and allowed
+// a negative length the first step after flattening goes that way.
+bool contacts_in_order(const std::vector<Breakpoint>& points, const std::vector<Obstacle>& obstacles, double L) {
+  for (size_t k = 0; k < points.size(); ++k) {
+    const double previous = k == 0 ? 0.0 : points[k - 1].s;
+    const bool wrap_end = points[k].kind == Breakpoint::ExtendedEnd && !obstacles[points[k].obstacle].is_flat();
+    const double before_contact = k >= 2 ? points[k - 2].s : 0.0;
+    const bool ok = wrap_end ? points[k].s > before_contact
+                    : points[k].kind == Breakpoint::ExtendedEnd ? points[k].s >= previous
+                                                                : points[k].s > previous;
+    if (!ok || !(points[k].s < L)) return false;
+  }
+  return true;
+}
+
+// A segment of multiple shooting with contacts: segment `local` of the `count` equal ones of its
+// piece [a, b] between breakpoints (a = 0 or a contact arclength, b = a contact arclength or L),
+// so s0 = a + (b - a) local / count and s1 = a + (b - a) (local + 1) / count. The unknowns that a
+// and b are (-1: fixed) and ds0/da, ds0/db, ds1/da, ds1/db.
+struct SegmentSpan {
+  int piece = 0, local = 0, count = 1;
+  double s0 = 0.0, s1 = 0.0;
+  int a_column = -1, b_column = -1;
+  double s0_a = 0.0, s0_b = 0.0, s1_a = 0.0, s1_b = 0.0;
+};
+
+std::vector<SegmentSpan> segment_spans(const std::vector<Breakpoint>& points, const std::vector<int>& piece_segments,
+                                       double L) {
+  std::vector<SegmentSpan> out;
+  for (size_t k = 0; k < piece_segments.size(); ++k) {
+    const double a = k == 0 ? 0.0 : points[k - 1].s, b = k == points.size() ? L : points[k].s;
+    const int count = piece_segments[k];
+    for (int j = 0; j < count; ++j) {
+      SegmentSpan span;
+      span.piece = static_cast<int>(k);
+      span.local = j;
+      span.count = count;
+      const double f0 = static_cast<double>(j) / count, f1 = static_cast<double>(j + 1) / count;
+      span.s0 = a + (b - a) * f0;
+      span.s1 = j + 1 == count ? b : a + (b - a) * f1;  // exactly on the breakpoint
+      span.a_column = k == 0 ? -1 : points[k - 1].s_column;
+      span.b_column = k == points.size() ? -1 : points[k].s_column;
+      span.s0_a = 1.0 - f0;
+      span.s0_b = f0;
+      span.s1_a = 1.0 - f1;
+      span.s1_b = f1;
+      out.push_back(span);
+    }
+  }
+  return out;
+}
+
+// What a point contact (or the entry of an extended one on a plane or disc) imposes, closed-form
+// in the state y at arclength s, with the derivatives the Jacobian needs.
+struct PointContactTerms {
+  Obstacle::ContactConditions here;  // gap, tangency and the reaction's direction
+  Eigen::MatrixXd d_rows;            // 2 x n: gap and tangency in the state
+  Eigen::MatrixXd d_normal;          // 3 x n: the direction in the state
+  Eigen::Vector2d d_s = Eigen::Vector2d::Zero();  // gap and tangency in s (r' depends on s where natural strains do)
+};
+
+PointContactTerms point_contact_terms(const RodEquations& eq, const Obstacle& o, const Eigen::VectorXd& y, double s,
+                                      bool derivatives) {
+  const Eigen::MatrixXd position = eq.slot_map(Slot::Position);
+  auto conditions = [&](const Eigen::VectorXd& state, double at) {
+    return o.contact_conditions(position * state, position * eq.derivative(state, at));
+  };
+  PointContactTerms t;
+  t.here = conditions(y, s);
+  if (!derivatives) return t;
+  // The state derivatives by central differences.
+  const int n = static_cast<int>(y.size());
+  t.d_rows.resize(2, n);
+  t.d_normal = Eigen::MatrixXd::Zero(3, n);
+  for (int i = 0; i < n; ++i) {
+    const double h = 1e-7 * (1.0 + std::abs(y[i]));
+    Eigen::VectorXd yp = y, ym = y;
+    yp[i] += h;
+    ym[i] -= h;
+    const auto plus = conditions(yp, s), minus = conditions(ym, s);
+    t.d_rows(0, i) = (plus.gap - minus.gap) / (2 * h);
+    t.d_rows(1, i) = (plus.tangency - minus.tangency) / (2 * h);
+    t.d_normal.col(i) = (plus.normal - minus.normal) / (2 * h);
+  }
+  // A plane's gap is linear in the position: exact (the cavity's hanging fold runs so close
+  // to branch points that rounding in this row alone can send it onto another branch).
+  if (o.is_flat()) t.d_rows.row(0) = o.gradient(position * y).transpose() * position;
+  const auto after = conditions(y, s + 1e-7), before = conditions(y, s - 1e-7);
+  t.d_s << (after.gap - before.gap) / 2e-7, (after.tangency - before.tangency) / 2e-7;
+  return t;
+}
+
+// The cylinder a spatial rod lies on over an extended contact.
+CylinderSupport support_of(const Obstacle& o) {
+  CylinderSupport c;
+  c.point = o.point();
+  c.axis = o.direction();
+  c.radius = o.radius();
+  return c;
+}
+
 }  // namespace
 
 std::vector<int> ShootingProblem::contact_columns() const {
@@ -424,22 +542,9 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
   const double L = eq->model().length;
   const auto points = breakpoints(contacts_at(x), contact_columns());
   const std::vector<Obstacle> obstacles_here = obstacles(p);
-  for (size_t k = 0; k < points.size(); ++k) {
-    const double previous = k == 0 ? 0.0 : points[k - 1].s;
-    // Strictly increasing, except that an extended contact may have zero length (when it forms),
-    // and a wrap a negative one (traversed backwards: not a rod, but the residual stays smooth
-    // where a wrap shrinks to a point, so that event is located by crossing). Flat contacts are
-    // kept >= 0: their legs are degenerate (see run_legs in contact.cpp), and allowed a negative
-    // length the first step after flattening goes that way.
-    const bool wrap_end = points[k].kind == Breakpoint::ExtendedEnd && !obstacles_here[points[k].obstacle].is_flat();
-    const double before_contact = k >= 2 ? points[k - 2].s : 0.0;
-    const bool ok = wrap_end ? points[k].s > before_contact
-                    : points[k].kind == Breakpoint::ExtendedEnd ? points[k].s >= previous
-                                                                : points[k].s > previous;
-    if (!ok || !(points[k].s < L)) {
-      if (failure) *failure = "contact arclengths must increase inside (0, L)";
-      return false;
-    }
+  if (!contacts_in_order(points, obstacles_here, L)) {
+    if (failure) *failure = "contact arclengths must increase inside (0, L)";
+    return false;
   }
   const Eigen::VectorXd y0 = x.head(n);
   int row = start_rows(*eq, y0, p, F, J);
@@ -481,39 +586,18 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
       const Breakpoint& b = points[k];
       const Obstacle& o = obstacles_here[b.obstacle];
       // What the contact imposes, closed-form in the state here (and in s through r').
-      auto conditions = [&](const Eigen::VectorXd& state, double at) {
-        return o.contact_conditions(position * state, position * eq->derivative(state, at));
-      };
-      const Obstacle::ContactConditions here = conditions(y, s1);
+      const PointContactTerms terms = point_contact_terms(*eq, o, y, s1, J != nullptr);
+      const Obstacle::ContactConditions& here = terms.here;
       const Eigen::VectorXd jump = -force.transpose() * here.normal;  // n jumps by -force * nu
-      // Their state derivatives by central differences.
-      Eigen::MatrixXd d_rows(2, n), d_normal = Eigen::MatrixXd::Zero(3, n);
-      if (J) {
-        for (int i = 0; i < n; ++i) {
-          const double h = 1e-7 * (1.0 + std::abs(y[i]));
-          Eigen::VectorXd yp = y, ym = y;
-          yp[i] += h;
-          ym[i] -= h;
-          const auto plus = conditions(yp, s1), minus = conditions(ym, s1);
-          d_rows(0, i) = (plus.gap - minus.gap) / (2 * h);
-          d_rows(1, i) = (plus.tangency - minus.tangency) / (2 * h);
-          d_normal.col(i) = (plus.normal - minus.normal) / (2 * h);
-        }
-        // A plane's gap is linear in the position: exact (the cavity's hanging fold runs so close
-        // to branch points that rounding in this row alone can send it onto another branch).
-        if (o.is_flat()) d_rows.row(0) = o.gradient(position * y).transpose() * position;
-      }
       if (b.kind != Breakpoint::ExtendedEnd) {
         // On the obstacle and tangent to it.
         (*F)[row] = here.gap;
         (*F)[row + 1] = here.tangency;
         if (J) {
-          J->row(row) = d_rows.row(0) * S;
-          J->row(row + 1) = d_rows.row(1) * S;
-          // r' depends on s itself where the natural strains do.
-          const auto after = conditions(y, s1 + 1e-7), before = conditions(y, s1 - 1e-7);
-          J->row(row)[b.s_column] += (after.gap - before.gap) / 2e-7;
-          J->row(row + 1)[b.s_column] += (after.tangency - before.tangency) / 2e-7;
+          J->row(row) = terms.d_rows.row(0) * S;
+          J->row(row + 1) = terms.d_rows.row(1) * S;
+          J->row(row)[b.s_column] += terms.d_s[0];
+          J->row(row + 1)[b.s_column] += terms.d_s[1];
         }
         row += 2;
       }
@@ -535,7 +619,7 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
       }
       if (J) {
         // On a curved obstacle the jump's direction turns with the contact point.
-        if (!o.is_flat()) S -= b.force * force.transpose() * d_normal * S;
+        if (!o.is_flat()) S -= b.force * force.transpose() * terms.d_normal * S;
         S.col(b.force_column) += jump;
       }
       y += b.force * jump;
@@ -556,18 +640,246 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
   return true;
 }
 
-Eigen::VectorXd ShootingProblem::initial_unknowns(const RodPoint& start_guess) const {
-  const auto eq = equations(definition_.parameters);
-  RodPoint p0 = start_guess;
-  definition_.start.impose_on(*eq, true, definition_.parameters, &p0);
-  const int n = state_size_, M = segments();
-  Eigen::VectorXd x(size());
-  Eigen::VectorXd y = eq->state(p0);
-  const double L = eq->model().length;
-  for (int i = 0; i < M; ++i) {
-    x.segment(i * n, n) = y;
-    if (i + 1 < M) y = eq->flow(y, L * i / M, L * (i + 1) / M, false, definition_.options.integrator).y;
+void ShootingProblem::set_piece_segments() {
+  const auto points = breakpoints(definition_.contacts, contact_columns());
+  const int pieces = static_cast<int>(points.size()) + 1, M = segments();
+  const std::string what = "solver: " + std::to_string(M) + " segments for the " + std::to_string(pieces) +
+                           " pieces the contacts cut the rod into";
+  if (M < pieces) throw std::invalid_argument(what + ": each piece needs at least one");
+  if (!definition_.piece_segments.empty()) {
+    const auto& given = definition_.piece_segments;
+    int total = 0;
+    for (int count : given) total += count;
+    if (static_cast<int>(given.size()) != pieces || total != M ||
+        *std::min_element(given.begin(), given.end()) < 1)
+      throw std::invalid_argument(what + ": piece_segments must give each piece at least one, " +
+                                  std::to_string(M) + " in all");
+    piece_segments_ = given;
+    return;
   }
+  // One each, the rest in proportion to the pieces' lengths (largest remainders first).
+  const double L = length(definition_.parameters);
+  std::vector<double> quota(pieces);
+  double total_length = 0.0;
+  for (int k = 0; k < pieces; ++k) {
+    const double a = k == 0 ? 0.0 : points[k - 1].s, b = k + 1 == pieces ? L : points[k].s;
+    quota[k] = std::max(0.0, b - a);
+    total_length += quota[k];
+  }
+  piece_segments_.assign(pieces, 1);
+  const int spare = M - pieces;
+  int given_out = 0;
+  std::vector<std::pair<double, int>> remainders;
+  for (int k = 0; k < pieces; ++k) {
+    const double share = total_length > 0.0 ? spare * quota[k] / total_length : 0.0;
+    const int whole = static_cast<int>(std::floor(share));
+    piece_segments_[k] += whole;
+    given_out += whole;
+    remainders.push_back({share - whole, k});
+  }
+  std::sort(remainders.begin(), remainders.end(), std::greater<>());
+  for (int i = 0; i < spare - given_out; ++i) ++piece_segments_[remainders[i % pieces].second];
+}
+
+std::vector<std::shared_ptr<const RodEquations>> ShootingProblem::piece_equations(const Eigen::VectorXd& x,
+                                                                                const Parameters& p) const {
+  const auto points = breakpoints(contacts_at(x), contact_columns());
+  const auto obstacles_here = obstacles(p);
+  std::vector<std::shared_ptr<const RodEquations>> out(points.size() + 1);  // null: the rod's own
+  for (size_t k = 0; k < points.size(); ++k)
+    if (points[k].kind == Breakpoint::ExtendedStart)
+      out[k + 1] = make_spatial_equations_on_cylinder(equations(p)->model(), support_of(obstacles_here[points[k].obstacle]));
+  return out;
+}
+
+bool ShootingProblem::residual_pieces(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
+                                      Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const {
+  const auto eq = equations(p);
+  const int n = state_size_, M = segments(), N = size();
+  const double L = eq->model().length;
+  const auto points = breakpoints(contacts_at(x), contact_columns());
+  const std::vector<Obstacle> obstacles_here = obstacles(p);
+  if (!contacts_in_order(points, obstacles_here, L)) {
+    if (failure) *failure = "contact arclengths must increase inside (0, L)";
+    return false;
+  }
+  const auto spans = segment_spans(points, piece_segments_, L);
+  std::vector<std::shared_ptr<const RodEquations>> on_piece;
+  try {
+    on_piece = piece_equations(x, p);
+  } catch (const std::invalid_argument& e) {
+    if (failure) *failure = e.what();
+    return false;
+  }
+  auto equations_of = [&](int i, const RodEquations& own) -> const RodEquations& {
+    const auto& special = on_piece[spans[i].piece];
+    return special ? *special : own;
+  };
+  int row = start_rows(*eq, x.head(n), p, F, J);
+
+  std::vector<SegmentFlow> flows(M);
+  try {
+    for_each_segment(p, [&](int i, const RodEquations& own) {
+      flows[i] = equations_of(i, own).flow(x.segment(i * n, n), spans[i].s0, spans[i].s1, J != nullptr,
+                                           definition_.options.integrator);
+    });
+  } catch (const IntegrationError& e) {
+    if (failure) *failure = e.what();
+    return false;
+  }
+  for (const auto& flow : flows) rhs_evaluations_ += flow.rhs_evaluations;
+
+  // A segment's end state moves with the ends of its piece: d y1 / d s0 = -Phi y'(s0), d y1 / d s1 =
+  // y'(s1), times how s0 and s1 move with the breakpoints.
+  auto add_span_columns = [&](int i, const std::function<void(int, const Eigen::VectorXd&)>& add) {
+    const SegmentSpan& span = spans[i];
+    const RodEquations& e = equations_of(i, *eq);
+    const Eigen::VectorXd d0 = -flows[i].Phi * e.derivative(x.segment(i * n, n), span.s0);
+    const Eigen::VectorXd d1 = e.derivative(flows[i].y, span.s1);
+    if (span.a_column >= 0) add(span.a_column, span.s0_a * d0 + span.s1_a * d1);
+    if (span.b_column >= 0) add(span.b_column, span.s0_b * d0 + span.s1_b * d1);
+  };
+  const Eigen::MatrixXd force = eq->slot_map(Slot::Force);
+  const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(n, n);
+  for (int i = 0; i < M; ++i) {
+    const bool last = i + 1 == M;
+    if (!last && spans[i + 1].piece == spans[i].piece) {
+      F->segment(row, n) = flows[i].y - x.segment((i + 1) * n, n);
+      if (J) {
+        J->block(row, i * n, n, n) = flows[i].Phi;
+        J->block(row, (i + 1) * n, n, n) = -I;
+        add_span_columns(i, [&](int c, const Eigen::VectorXd& v) { J->block(row, c, n, 1) += v; });
+      }
+      row += n;
+      continue;
+    }
+    // The end of a piece: a breakpoint, or s = L. S = dy/dx there (dense: a few per evaluation).
+    Eigen::VectorXd y = flows[i].y;
+    Eigen::MatrixXd S;
+    if (J) {
+      S = Eigen::MatrixXd::Zero(n, N);
+      S.block(0, i * n, n, n) = flows[i].Phi;
+      add_span_columns(i, [&](int c, const Eigen::VectorXd& v) { S.col(c) += v; });
+    }
+    if (last) {
+      if (y_end) *y_end = y;
+      ConditionRows end;
+      definition_.end.append_residuals(*eq, false, y, p, &end.values, J ? &end.jacobian : nullptr);
+      for (size_t k = 0; k < end.values.size(); ++k, ++row) {
+        (*F)[row] = end.values[k];
+        if (J) J->row(row) = end.jacobian[k] * S;
+      }
+      break;
+    }
+    const Breakpoint& b = points[spans[i].piece];
+    const Obstacle& o = obstacles_here[b.obstacle];
+    Eigen::VectorXd jump;
+    if (b.kind == Breakpoint::Point) {
+      const PointContactTerms terms = point_contact_terms(*eq, o, y, b.s, J != nullptr);
+      (*F)[row] = terms.here.gap;
+      (*F)[row + 1] = terms.here.tangency;
+      if (J) {
+        J->row(row) = terms.d_rows.row(0) * S;
+        J->row(row + 1) = terms.d_rows.row(1) * S;
+        J->row(row)[b.s_column] += terms.d_s[0];
+        J->row(row + 1)[b.s_column] += terms.d_s[1];
+        if (!o.is_flat()) S -= b.force * force.transpose() * terms.d_normal * S;
+      }
+      row += 2;
+      jump = -force.transpose() * terms.here.normal;  // n jumps by -force * nu
+    } else {
+      // A spatial rod on a cylinder (the only extended contact of multiple shooting): entering, it
+      // is on the cylinder with g = g' = g'' = 0, and g''' = 0 once the edge force is applied
+      // (rod_on_cylinder.hpp); leaving, only the edge force. Both push along e.
+      const CylinderSupport c = support_of(o);
+      const RodModel& model = eq->model();
+      Eigen::MatrixXd dG, de;
+      if (b.kind == Breakpoint::ExtendedStart) {
+        const Eigen::Vector4d G = cylinder_gap_derivatives(model, c, y, J ? &dG : nullptr);
+        for (int k = 0; k < 3; ++k, ++row) {
+          (*F)[row] = G[k];
+          if (J) J->row(row) = dG.row(k) * S;
+        }
+      }
+      const Vec3 e = cylinder_normal(c, y, J ? &de : nullptr);
+      if (J) S -= b.force * force.transpose() * de * S;
+      jump = -force.transpose() * e;
+      if (b.kind == Breakpoint::ExtendedStart) {
+        const Eigen::VectorXd after = y + b.force * jump;
+        const Eigen::Vector4d G = cylinder_gap_derivatives(model, c, after, J ? &dG : nullptr);
+        (*F)[row] = G[3];
+        if (J) {
+          Eigen::MatrixXd S_after = S;
+          S_after.col(b.force_column) += jump;
+          J->row(row) = dG.row(3) * S_after;
+        }
+        ++row;
+      }
+    }
+    if (J) S.col(b.force_column) += jump;
+    y += b.force * jump;
+    // Into the next piece's first node.
+    F->segment(row, n) = y - x.segment((i + 1) * n, n);
+    if (J) {
+      J->middleRows(row, n) = S;
+      J->block(row, (i + 1) * n, n, n) -= I;
+    }
+    row += n;
+  }
+  return true;
+}
+
+std::vector<double> ShootingProblem::node_arclengths(const Eigen::VectorXd& x) const {
+  const double L = length(parameters_at(x));
+  std::vector<double> out;
+  if (piece_segments_.empty()) {
+    for (int i = 0; i < segments(); ++i) out.push_back(L * i / segments());
+    return out;
+  }
+  for (const auto& span : segment_spans(breakpoints(contacts_at(x), contact_columns()), piece_segments_, L))
+    out.push_back(span.s0);
+  return out;
+}
+
+Eigen::VectorXd ShootingProblem::unknowns_from(const std::vector<RodPoint>& nodes) const {
+  if (static_cast<int>(nodes.size()) != segments())
+    throw std::invalid_argument("unknowns_from: one point per segment needed");
+  const auto eq = equations(definition_.parameters);
+  Eigen::VectorXd x = unknowns_without_states();
+  // The turn angle counts whole turns along the rod; at s = 0 the gauge wants it in (-pi, pi].
+  const int turns = eq->turn_angle_index();
+  const double offset = eq->state(nodes.front())[turns] - nodes.front().turn_angle;
+  for (int i = 0; i < segments(); ++i) {
+    Eigen::VectorXd y = eq->state(nodes[i]);
+    y[turns] = nodes[i].turn_angle + offset;
+    x.segment(i * state_size_, state_size_) = y;
+  }
+  return x;
+}
+
+double ShootingProblem::smallest_wrap_pressure(const Eigen::VectorXd& x, const PointContact& contact,
+                                               int samples) const {
+  if (!contact.extended) return NAN;
+  const Parameters p = parameters_at(x);
+  const Obstacle o = obstacles(p)[contact.obstacle];
+  if (o.is_flat()) return NAN;
+  const auto eq = equations(p);
+  if (eq->is_planar()) return wrap_tension(x, contact) / o.radius();
+  const PointContact& c = contact;  // solved: from contacts_at(x)
+  // Just inside the wrap at both ends: at the breakpoints themselves the samples lie on the free side.
+  std::vector<double> s(samples);
+  const double inset = 1e-12 * (1.0 + c.s_end);
+  for (int i = 0; i < samples; ++i) s[i] = c.s + inset + (c.s_end - c.s - 2.0 * inset) * i / (samples - 1);
+  double smallest = INFINITY;
+  const CylinderSupport support = support_of(o);
+  for (const auto& point : sample(x, s))
+    smallest = std::min(smallest, cylinder_pressure(eq->model(), support, eq->state(point)));
+  return smallest;
+}
+
+Eigen::VectorXd ShootingProblem::unknowns_without_states() const {
+  const int n = state_size_, M = segments();
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(size());
   for (size_t j = 0; j < unknown_index_.size(); ++j)
     x[M * n + j] = definition_.parameters.values()[unknown_index_[j]];
   for (size_t k = 0; k < definition_.contacts.size(); ++k) {
@@ -583,6 +895,42 @@ Eigen::VectorXd ShootingProblem::initial_unknowns(const RodPoint& start_guess) c
   return x;
 }
 
+Eigen::VectorXd ShootingProblem::initial_unknowns(const RodPoint& start_guess) const {
+  const auto eq = equations(definition_.parameters);
+  RodPoint p0 = start_guess;
+  definition_.start.impose_on(*eq, true, definition_.parameters, &p0);
+  const int n = state_size_, M = segments();
+  Eigen::VectorXd x = unknowns_without_states();
+  Eigen::VectorXd y = eq->state(p0);
+  if (piece_segments_.empty()) {
+    const double L = eq->model().length;
+    for (int i = 0; i < M; ++i) {
+      x.segment(i * n, n) = y;
+      if (i + 1 < M) y = eq->flow(y, L * i / M, L * (i + 1) / M, false, definition_.options.integrator).y;
+    }
+    return x;
+  }
+  // Piece by piece, each jump applied with its guessed force.
+  const auto points = breakpoints(definition_.contacts, contact_columns());
+  const auto spans = segment_spans(points, piece_segments_, eq->model().length);
+  const auto on_piece = piece_equations(x, definition_.parameters);
+  const auto obstacles_here = obstacles(definition_.parameters);
+  const Eigen::MatrixXd force = eq->slot_map(Slot::Force);
+  for (int i = 0; i < M; ++i) {
+    x.segment(i * n, n) = y;
+    if (i + 1 == M) break;
+    const RodEquations& e = on_piece[spans[i].piece] ? *on_piece[spans[i].piece] : *eq;
+    y = e.flow(y, spans[i].s0, spans[i].s1, false, definition_.options.integrator).y;
+    if (spans[i + 1].piece == spans[i].piece) continue;
+    const Breakpoint& b = points[spans[i].piece];
+    const Obstacle& o = obstacles_here[b.obstacle];
+    const Vec3 normal = b.kind == Breakpoint::Point ? point_contact_terms(*eq, o, y, b.s, false).here.normal
+                                                    : cylinder_normal(support_of(o), y);
+    y -= b.force * force.transpose() * normal;
+  }
+  return x;
+}
+
 std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const std::vector<double>& s) const {
   const Parameters p = parameters_at(x);
   const auto eq = equations(p);
@@ -591,7 +939,7 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
   std::vector<RodPoint> out;
   out.reserve(s.size());
   size_t k = 0;
-  if (!definition_.contacts.empty()) {
+  if (!definition_.contacts.empty() && piece_segments_.empty()) {
     // Piece by piece between breakpoints, applying the jump of n at each.
     const auto points = breakpoints(contacts_at(x), contact_columns());
     const std::vector<Obstacle> obstacles_here = obstacles(p);
@@ -628,16 +976,30 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
     }
     return out;
   }
-  // Each segment samples the arclengths in it, from its own start state.
+  // Each segment samples the arclengths in it, from its own start state (with contacts, on the
+  // equations of its piece: a node after a breakpoint holds the state after the jump).
+  std::vector<SegmentSpan> spans;
+  std::vector<std::shared_ptr<const RodEquations>> on_piece{nullptr};
+  if (piece_segments_.empty()) {
+    for (int i = 0; i < M; ++i) {
+      SegmentSpan span;
+      span.s0 = L * i / M;
+      span.s1 = L * (i + 1) / M;
+      spans.push_back(span);
+    }
+  } else {
+    spans = segment_spans(breakpoints(contacts_at(x), contact_columns()), piece_segments_, L);
+    on_piece = piece_equations(x, p);
+  }
   std::vector<std::vector<double>> local(M);
   for (int i = 0; i < M; ++i) {
-    const double s0 = L * i / M, s1 = L * (i + 1) / M;
-    local[i] = {s0};
-    while (k < s.size() && (s[k] < s1 || i + 1 == M)) local[i].push_back(std::min(s[k++], s1));
+    local[i] = {spans[i].s0};
+    while (k < s.size() && (s[k] < spans[i].s1 || i + 1 == M)) local[i].push_back(std::min(s[k++], spans[i].s1));
   }
   std::vector<std::vector<RodPoint>> points(M);
-  for_each_segment(p, [&](int i, const RodEquations& equations) {
+  for_each_segment(p, [&](int i, const RodEquations& own) {
     if (local[i].size() == 1) return;
+    const RodEquations& equations = on_piece[spans[i].piece] ? *on_piece[spans[i].piece] : own;
     const auto states = equations.sample(x.segment(i * n, n), local[i], definition_.options.integrator);
     for (size_t j = 1; j < states.size(); ++j) points[i].push_back(equations.point(states[j], local[i][j]));
   }, s.size() >= 64);
@@ -646,8 +1008,12 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
 }
 
 std::string extended_contact_unsupported(const RodEquations& equations, const Obstacle& obstacle) {
-  if (!equations.is_planar())
-    return "extended contact is modelled for planar rods only (a spatial rod lying on an obstacle is not implemented)";
+  if (!equations.is_planar()) {
+    if (obstacle.shape() != Obstacle::Shape::Cylinder)
+      return "a spatial rod lying on " + obstacle.describe() +
+             " is not implemented: of the obstacles, only cylinders are modelled for spatial rods";
+    return rod_on_cylinder_unsupported(equations.model());
+  }
   if (obstacle.is_flat()) return "";
   const std::string what = "wrapping around " + obstacle.describe();
   if (obstacle.shape() != Obstacle::Shape::Cylinder || std::abs(std::abs(obstacle.direction().z()) - 1.0) > 1e-12)

@@ -36,13 +36,15 @@ struct PointContact {
   int obstacle = 0;
   double s = 0.0;
   double force = 0.0;
-  // Extended contact (planar rods): the rod lies on the obstacle over [s, s_end], held by the
+  // Extended contact: the rod lies on the obstacle over [s, s_end], held by the
   // forces `force` at s and `force_end` at s_end. On a plane it is straight and free of moment,
   // and a flat wall carries no distributed force there (n_y' = 0 and m = 0 on the interval). On a
   // disc (a cylinder along e_z) it wraps around it: curvature 1/radius, constant moment, n along
   // the tangent with a constant tension N, pressing on the disc with p = N / radius (admissible
   // while N >= 0). At s: g = 0, tangency, the obstacle's curvature (m = B2 (kappa - u_hat2)) and
-  // no normal force just after s; s_end and force_end are set by the rest.
+  // no normal force just after s; s_end and force_end are set by the rest. A spatial rod on a
+  // cylinder lies on it with the pressure that keeps it there (rod_on_cylinder.hpp): at s it is
+  // on the cylinder with g = g' = g'' = 0 and g''' = 0 after the edge force.
   bool extended = false;
   double s_end = 0.0;
   double force_end = 0.0;
@@ -51,9 +53,11 @@ struct PointContact {
 
 // Why an extended contact on this obstacle is not modelled for this rod, or "" when it is: planes
 // for planar rods; discs for uniform, inextensible planar rods without an external field, where
-// the wrapped part is known in closed form (the section turns rigidly about the disc's centre).
-// Wrapping a spatial rod around a cylinder, or a tapered or extensible rod around a disc, would
-// need the constrained equations on the interval (a differential-algebraic system).
+// the wrapped part is known in closed form (the section turns rigidly about the disc's centre);
+// cylinders for the spatial rods rod_on_cylinder.hpp models (isotropic, uniform, naturally
+// straight Kirchhoff rods), whose wrapped part is integrated with the cylinder's pressure (by
+// multiple shooting; the planar wraps by single shooting). A tapered or extensible rod around a
+// disc would need the constrained equations on the interval, as the spatial rod has them.
 std::string extended_contact_unsupported(const RodEquations& equations, const Obstacle& obstacle);
 
 using ModelFunction = std::function<RodModel(const Parameters&)>;
@@ -86,6 +90,13 @@ struct ProblemDefinition {
   std::function<std::vector<Obstacle>(const Parameters&)> moving_obstacles;
   std::set<std::string> obstacle_parameters;
   std::vector<PointContact> contacts;    // the active set: point contacts solved for
+  // Multiple shooting with contacts (segments > 1): the contacts' arclengths (both ends of an
+  // extended one) split the rod into pieces, and each piece is shot over this many segments of
+  // equal length that move with its ends (so no node is ever crossed by a contact). Empty: the
+  // segments shared out in proportion to the pieces' lengths at the contacts' guesses, at least
+  // one each. A spatial rod lying on a cylinder (an extended contact on a cylinder,
+  // rod_on_cylinder.hpp) is solved this way; planar extended contacts need single shooting.
+  std::vector<int> piece_segments;
 };
 
 class ShootingProblem final : public NonlinearSystem {
@@ -133,10 +144,27 @@ class ShootingProblem final : public NonlinearSystem {
   // its first mode 1 - cos(2 pi (s - s1) / l) leaves the obstacle, so it buckles (a hanging fold
   // forms) where this margin reaches 0. NaN for a point contact or a flat part of zero length.
   double flat_contact_margin(const Eigen::VectorXd& x, const PointContact& contact) const;
-  // Tension n.d3 in the middle of an extended contact on a curved obstacle: the wrapped part
-  // presses on the disc with tension / radius, so it must not be negative. NaN for a point
-  // contact or a flat one (whose tension is the flat_contact_margin's business).
+  // Tension n.d3 in the middle of an extended contact on a disc: the wrapped part presses on the
+  // disc with tension / radius, so it must not be negative. NaN for a point contact, a flat one
+  // (whose tension is the flat_contact_margin's business) or a spatial rod on a cylinder.
   double wrap_tension(const Eigen::VectorXd& x, const PointContact& contact) const;
+  // The smallest pressure (force per length) of the wrapped part of an extended contact on a
+  // curved obstacle, over `samples` equally spaced points of it (ends included): tension / radius
+  // on a disc, the cylinder's pressure for a spatial rod (rod_on_cylinder.hpp). Complementarity
+  // wants it >= 0. NaN for a point contact or a flat one.
+  double smallest_wrap_pressure(const Eigen::VectorXd& x, const PointContact& contact, int samples = 65) const;
+
+  // Multiple shooting with contacts: segments per piece (see ProblemDefinition::piece_segments),
+  // empty without contacts or with single shooting.
+  const std::vector<int>& piece_segments() const { return piece_segments_; }
+  // Where each segment starts (node i of the unknowns), for the contact arclengths in x, or for
+  // the definition's contact guesses.
+  std::vector<double> node_arclengths(const Eigen::VectorXd& x) const;
+  std::vector<double> node_arclengths() const { return node_arclengths(unknowns_without_states()); }
+  // Unknowns with node i's state from nodes[i] (a solution of another formulation sampled at
+  // node_arclengths(), say), the turn angle from its turn_angle, and the definition's parameters
+  // and contacts.
+  Eigen::VectorXd unknowns_from(const std::vector<RodPoint>& nodes) const;
 
   // dF/d(parameter) at x, for a known (not solved-for) parameter: from the closed-form boundary
   // conditions when the parameter does not enter the rod model, else by central differences of
@@ -166,12 +194,23 @@ class ShootingProblem final : public NonlinearSystem {
   // Single shooting through the contact points: the state jumps in n at each of them.
   bool residual_with_contacts(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
                               Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const;
+  // Multiple shooting with contacts: the segments of each piece between contacts move with its
+  // ends; the jumps sit between a piece's last segment and the next piece's first node.
+  bool residual_pieces(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F, Eigen::MatrixXd* J,
+                       std::string* failure, Eigen::VectorXd* y_end) const;
+  // The equations of each piece between the breakpoints of x: the rod's, or on a cylinder.
+  std::vector<std::shared_ptr<const RodEquations>> piece_equations(const Eigen::VectorXd& x, const Parameters& p) const;
+  void set_piece_segments();
+  // The unknown parameters' and contacts' entries of x from the definition, the states zero.
+  Eigen::VectorXd unknowns_without_states() const;
 
   ProblemDefinition definition_;
   int state_size_ = 0;
   int residual_count_ = 0;
   int start_condition_count_ = 0;
-  std::vector<int> unknown_index_;  // index of each unknown parameter in Parameters
+  int gauge_count_ = 0;
+  std::vector<int> unknown_index_;
+  std::vector<int> piece_segments_;  // multiple shooting with contacts: segments per piece  // index of each unknown parameter in Parameters
   // A new equations object for these parameters (uncached; a thread's own copy).
   std::shared_ptr<const RodEquations> build_equations(const Parameters& p) const;
   // Calls work(i, equations) for every segment i of multiple shooting, in parallel (see

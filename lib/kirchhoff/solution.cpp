@@ -81,6 +81,7 @@ const std::map<std::string, std::string> kCatalogue = {
     {"min_contact_length", "smallest s_end - s over extended contacts (NaN without): 0 where one shrinks to a point"},
     {"flat_contact_margin", "smallest 4 pi^2 B2 / l^2 - P_flat over extended contacts: < 0 once a flat part would buckle away"},
     {"min_wrap_tension", "smallest tension n.d3 of the parts wrapped around discs (the disc's pressure is tension / radius; NaN without)"},
+    {"min_wrap_pressure", "smallest pressure (force per length) of the parts wrapped around discs or cylinders (NaN without)"},
     {"kappa_contact", "curvature u2 at the first point contact (signed, planar)"},
     {"contact_s", "arclength of the first point contact"},
     {"min_gap", "smallest distance to the obstacles along the rod"},
@@ -157,6 +158,8 @@ double derived_value(const std::string& name, const ShootingProblem& problem, co
   if (name == "flat_contact_margin")
     return smallest([&](const PointContact& c) { return problem.flat_contact_margin(x, c); });
   if (name == "min_wrap_tension") return smallest([&](const PointContact& c) { return problem.wrap_tension(x, c); });
+  if (name == "min_wrap_pressure")
+    return smallest([&](const PointContact& c) { return problem.smallest_wrap_pressure(x, c); });
   if (name == "contact_bending")
     return smallest([&](const PointContact& c) { return c.extended ? NAN : problem.contact_bending(x, c); });
   if (name == "contact_count") return static_cast<double>(sol.contacts.size());

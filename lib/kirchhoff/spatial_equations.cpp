@@ -156,6 +156,8 @@ class SpatialEquations final : public RodEquations {
     return p;
   }
 
+  int turn_angle_index() const override { return kChi; }
+
   Eigen::VectorXd state(const RodPoint& p) const override {
     Eigen::VectorXd y(kStateSize);
     y.segment<3>(kR) = p.r;
