@@ -222,6 +222,16 @@ int main(int argc, char** argv) {
   plectonemes_cmd->add_option("--hard-spacing", plect.hard_spacing, "Node spacing of the hard-contact rod, in R")
       ->check(CLI::Range(0.01, 1.0))
       ->capture_default_str();
+  plectonemes_cmd
+      ->add_option("--hard-from", plect.hard_from,
+                   "Exact self-contact in the shooting core from this many turns (0: the barrier throughout):\n"
+                   "the barrier branch stops there, its ply is re-solved with the strands touching exactly\n"
+                   "(contact points and the line of the ply, read off the discretised solution) and followed\n"
+                   "in turns up to --turns and down to --turns-min, each leg stopping where complementarity\n"
+                   "would fail; DIR/plectoneme_<L/2R>_ply.csv (T_ext R^2/EI beside eq. 61 with R itself).\n"
+                   "Branches from the untwisted rod only (not --from-ply ones); 5 suits L/2R = 100 and 200")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
 
   try {
     app.parse(argc, argv);

@@ -13,6 +13,7 @@
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/continuation.hpp"
 #include "kirchhoff/hard_self_contact.hpp"
+#include "kirchhoff/plectoneme.hpp"
 #include "kirchhoff/self_passage.hpp"
 #include "run_state.hpp"
 
@@ -35,9 +36,17 @@ HelixFormulas helix_formulas(double theta, double rho, double EI) {
   return {analytic::plectoneme_end_tension(theta, 1.0, 1.0), analytic::helix_twisting_moment(theta, EI, rho)};
 }
 
-std::map<std::string, double> columns(const ContinuationPoint& p, double EI) {
+// The hard-contact ply's columns (--hard-from): the same measures, rho = R exactly, and what
+// complementarity watches (contact forces, the line's pressure, the gaps between contacts).
+const std::vector<std::string> kHardMeasured = {"T_ext",         "helix_angle",       "helix_radius",
+                                                "m3",            "contact_pressure",  "contact_start",
+                                                "contact_end",   "H_A",               "H_B",
+                                                "self_distance", "min_contact_force", "min_wrap_pressure",
+                                                "ply_clearance", "contact_count"};
+
+std::map<std::string, double> columns(const ContinuationPoint& p, double EI, const std::vector<std::string>& measured) {
   std::map<std::string, double> c;
-  for (const auto& name : kMeasured) c[name] = p.derived.count(name) ? p.derived.at(name) : NAN;
+  for (const auto& name : measured) c[name] = p.derived.count(name) ? p.derived.at(name) : NAN;
   const double theta = c["helix_angle"], rho = c["helix_radius"];
   // rho, the strands' distance to the axis, is the helix radius R of eqs. (58)-(61).
   c["T_rho2_over_EI"] = c["T_ext"] * rho * rho / EI;
@@ -119,13 +128,10 @@ ContinuationOptions continuation_options(const ShootingProblem& problem, const C
 
 namespace {
 
-const std::vector<std::string>& csv_names() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> n = kMeasured;
-    for (const char* extra : {"T_rho2_over_EI", "eq61", "m3_eq58b"}) n.push_back(extra);
-    return n;
-  }();
-  return names;
+std::vector<std::string> csv_names(const std::vector<std::string>& measured) {
+  std::vector<std::string> n = measured;
+  for (const char* extra : {"T_rho2_over_EI", "eq61", "m3_eq58b"}) n.push_back(extra);
+  return n;
 }
 
 // The hard-contact re-solutions of a branch's ply points (opt-in): one row per re-solved point,
@@ -188,8 +194,13 @@ class HardContactCsv {
 class BranchCsv {
  public:
   BranchCsv(const std::string& csv_path, double EI, double slenderness, const PlectonemeRunOptions& options,
-            PlectonemeBranchSummary* summary)
-      : state_path_(csv_path + ".state.json"), EI_(EI), slenderness_(slenderness), options_(options), summary_(summary) {
+            PlectonemeBranchSummary* summary, std::vector<std::string> measured = kMeasured)
+      : state_path_(csv_path + ".state.json"),
+        EI_(EI),
+        slenderness_(slenderness),
+        options_(options),
+        summary_(summary),
+        measured_(std::move(measured)) {
     const bool resuming = options.resume && std::filesystem::exists(state_path_);
     if (resuming) {
       state_ = load_state(state_path_);
@@ -201,7 +212,7 @@ class BranchCsv {
     csv_ << std::setprecision(12);
     if (!resuming) {
       csv_ << "index,turns,type";
-      for (const auto& n : csv_names()) csv_ << ',' << n;
+      for (const auto& n : csv_names(measured_)) csv_ << ',' << n;
       csv_ << ",newton_iterations,step\n";
     }
     resumed_ = resuming;
@@ -219,9 +230,9 @@ class BranchCsv {
   }
 
   void operator()(const ContinuationPoint& p) {
-    const auto row = columns(p, EI_);
+    const auto row = columns(p, EI_, measured_);
     csv_ << ++state_.row << ',' << p.parameter << ',' << to_string(p.type);
-    for (const auto& n : csv_names()) csv_ << ',' << row.at(n);
+    for (const auto& n : csv_names(measured_)) csv_ << ',' << row.at(n);
     csv_ << ',' << p.newton_iterations << ',' << p.step << '\n' << std::flush;
     if (hard_) hard_->consider(p, state_.row, row);
     if (resumable(p)) save_resume_point(state_path_, p, &state_);
@@ -241,6 +252,7 @@ class BranchCsv {
   double EI_, slenderness_;
   PlectonemeRunOptions options_;
   PlectonemeBranchSummary* summary_;
+  std::vector<std::string> measured_;
   RunState state_;
   std::ofstream csv_;
   bool resumed_ = false;
@@ -257,34 +269,152 @@ std::string stop_text(const ContinuationResult& r) {
 
 }  // namespace
 
+namespace {
+
+// The hard-contact ply's problem: the barrier case's definition at `turns` with exact self-contact
+// where `start` says (its contacts and segments per piece), tolerances scaled with the forces.
+ShootingProblem hard_ply_problem(const Case& c, double slenderness, const RunState& start) {
+  ProblemDefinition barrier = c.definition;
+  barrier.parameters.set("turns", start.last.parameter);
+  ProblemDefinition d = hard_ply_definition(barrier, start.contacts);
+  d.piece_segments = start.piece_segments;
+  return ShootingProblem(with_scaled_tolerance(d, slenderness));
+}
+
+// Where a hard-contact ply leg stops: the contact set would change there (not followed), or the
+// rod would pass through itself away from the ply's contacts.
+std::vector<ContinuationEvent> complementarity_events() {
+  return {{"min_contact_force", 0.0, true, "a contact lifts off (its force reaches 0)"},
+          {"min_wrap_pressure", 0.0, true, "the line contact's pressure reaches 0 inside it"},
+          {"ply_clearance", 0.0, true, "a new contact forms between the ply's contacts"},
+          {"self_distance", 1.0 - kSelfDistanceSlack, true, "the rod reaches itself away from the ply's contacts"}};
+}
+
+// The hard-contact ply legs of a branch (--hard-from): from the barrier solution `at` (a ply), the
+// contact set read off the discretised hard solution (Ipopt), the shooting problem with exact
+// self-contact solved from the barrier's states, then followed in turns up to turns_max (branch 0)
+// and from the same start down to turns_min (branch 1) into hard_csv. The start is saved beside it
+// (hard_csv + ".start.json"), so a resumed run skips the re-solution and resumes the leg it was in.
+void follow_hard_ply(const Case& c, double slenderness, const ContinuationPoint& at, double turns_min,
+                     double turns_max, const std::string& hard_csv, const PlectonemeRunOptions& options,
+                     PlectonemeBranchSummary* summary) {
+  const auto started = std::chrono::steady_clock::now();
+  const std::string start_path = hard_csv + ".start.json";
+  if (options.resume && branch_complete(hard_csv) && std::filesystem::exists(hard_csv + ".state.json") &&
+      load_state(hard_csv + ".state.json").branch == 1) {
+    summary->hard_ply_stop = "already complete";
+    return;
+  }
+  RunState start;
+  if (options.resume && std::filesystem::exists(start_path)) {
+    start = load_state(start_path);
+  } else {
+    ShootingProblem barrier(with_scaled_tolerance(c.definition, slenderness));
+    barrier.set_parameter("turns", at.parameter);
+    HardSelfContactOptions discrete_options;
+    discrete_options.spacing = options.hard_spacing;
+    const HardSelfContactPlectoneme discrete = solve_hard_self_contact(barrier, at.x, discrete_options);
+    if (!discrete.converged)
+      throw std::runtime_error("hard contact at turns = " + std::to_string(at.parameter) +
+                               ": the discretised hard problem (Ipopt), whose contacts seed the shooting, did not "
+                               "solve: " + discrete.status);
+    const HardPlyStart seed = hard_ply_from_barrier(barrier, at.x, ply_contacts(discrete));
+    const ShootingProblem hard(with_scaled_tolerance(seed.definition, slenderness));
+    const ShootingResult solved = solve(hard, seed.x);
+    if (!solved.summary.converged())
+      throw std::runtime_error("hard contact at turns = " + std::to_string(at.parameter) +
+                               ": the shooting problem with the discretised solution's " +
+                               std::to_string(seed.definition.contacts.size()) +
+                               " contacts did not solve: " + solved.summary.brief_report());
+    start.parameter_name = "turns";
+    start.last.parameter = at.parameter;
+    start.last.x = solved.x;
+    start.contacts = hard.contacts_at(solved.x);
+    start.piece_segments = hard.piece_segments();
+    save_state(start_path, start);
+  }
+  ShootingProblem problem = hard_ply_problem(c, slenderness, start);
+  PlectonemeBranchSummary legs;
+  BranchCsv csv(hard_csv, c.definition.parameters.get("EI"), slenderness, options, &legs, kHardMeasured);
+  csv.state().contacts = start.contacts;
+  csv.state().piece_segments = start.piece_segments;
+  auto sink = [&](const ContinuationPoint& p) { csv(p); };
+  const int first_leg = csv.resumed() ? csv.state().branch : 0;
+  std::vector<std::string> stops;
+  for (int leg = first_leg; leg < 2; ++leg) {
+    ContinuationOptions o = continuation_options(problem, c, slenderness, leg == 0 ? turns_max : turns_min, options);
+    o.derived = kHardMeasured;
+    o.events = complementarity_events();
+    const bool resume_leg = csv.resumed() && leg == first_leg;
+    csv.state().branch = leg;
+    ContinuationResult r;
+    if (resume_leg) {
+      problem.set_parameter("turns", csv.state().last.parameter);
+      r = Continuation(problem, o).resume(csv.state().last, sink);
+    } else {
+      problem.set_parameter("turns", start.last.parameter);
+      r = Continuation(problem, o).run(start.last.x, sink);
+    }
+    stops.push_back((leg == 0 ? "up: " : "down: ") + stop_text(r));
+    legs.refused_steps += r.refused_steps;
+  }
+  for (const auto& stop : stops) summary->hard_ply_stop += (summary->hard_ply_stop.empty() ? "" : "; ") + stop;
+  summary->hard_ply_points += legs.points;
+  summary->hard_ply = legs.ply;
+  summary->refused_steps += legs.refused_steps;
+  summary->hard_ply_seconds += seconds_since(started);
+}
+
+}  // namespace
+
 PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, double slenderness, double turns_max,
                                                  const std::string& csv_path, const PlectonemeRunOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   PlectonemeBranchSummary summary;
+  const Case c = load_case(case_path, {{"slenderness", slenderness}});
+  // With --hard-from the barrier leg ends there and hands its ply to exact contact.
+  const bool hard = options.hard_from > 0.0 && options.hard_from < turns_max;
+  const std::string end_path = csv_path + ".end.json";  // the barrier leg's last point, where hard legs start
+  std::optional<ContinuationPoint> end;
   if (options.resume && branch_complete(csv_path)) {
     summary.stop = "already complete";
-    return summary;
-  }
-  const Case c = load_case(case_path, {{"slenderness", slenderness}});
-  ShootingProblem problem(with_scaled_tolerance(c.definition, slenderness));
-  const ContinuationOptions o = continuation_options(problem, c, slenderness, turns_max, options);
-  BranchCsv csv(csv_path, c.definition.parameters.get("EI"), slenderness, options, &summary);
-  csv.follow_hard_contact(csv_path, problem);
-  auto sink = [&](const ContinuationPoint& p) { csv(p); };
-  Continuation run(problem, o);
-  ContinuationResult branch;
-  if (csv.resumed()) {
-    problem.set_parameter(o.parameter, csv.state().last.parameter);
-    branch = run.resume(csv.state().last, sink);
+    if (hard && std::filesystem::exists(end_path)) end = load_state(end_path).last;
   } else {
-    const ShootingResult untwisted = solve(problem, problem.initial_unknowns(c.start_guess));
-    if (!untwisted.summary.converged())
-      throw std::runtime_error(case_path + ": the untwisted rod does not solve: " + untwisted.summary.brief_report());
-    branch = run.run(untwisted.x, sink);
+    ShootingProblem problem(with_scaled_tolerance(c.definition, slenderness));
+    const ContinuationOptions o =
+        continuation_options(problem, c, slenderness, hard ? options.hard_from : turns_max, options);
+    BranchCsv csv(csv_path, c.definition.parameters.get("EI"), slenderness, options, &summary);
+    csv.follow_hard_contact(csv_path, problem);
+    auto sink = [&](const ContinuationPoint& p) { csv(p); };
+    Continuation run(problem, o);
+    ContinuationResult branch;
+    if (csv.resumed()) {
+      problem.set_parameter(o.parameter, csv.state().last.parameter);
+      branch = run.resume(csv.state().last, sink);
+    } else {
+      const ShootingResult untwisted = solve(problem, problem.initial_unknowns(c.start_guess));
+      if (!untwisted.summary.converged())
+        throw std::runtime_error(case_path + ": the untwisted rod does not solve: " + untwisted.summary.brief_report());
+      branch = run.run(untwisted.x, sink);
+    }
+    summary.stop = stop_text(branch);
+    summary.refused_steps = branch.refused_steps;
+    if (hard && branch.reason == StopReason::ReachedTarget) {
+      end = branch.points.back();
+      RunState at_end;
+      at_end.parameter_name = "turns";
+      at_end.last = *end;
+      save_state(end_path, at_end);
+    }
   }
-  summary.stop = stop_text(branch);
-  summary.refused_steps = branch.refused_steps;
   summary.seconds = seconds_since(started);
+  if (hard) {
+    if (end)
+      follow_hard_ply(c, slenderness, *end, options.hard_turns_min, turns_max,
+                      csv_path.substr(0, csv_path.size() - 4) + "_ply.csv", options, &summary);
+    else
+      summary.hard_ply_stop = "not started: the barrier leg did not reach turns = " + std::to_string(options.hard_from);
+  }
   return summary;
 }
 
@@ -408,6 +538,8 @@ int run_plectonemes(const PlectonemesArguments& args) {
       options.ply_log_softness = args.ply_log_softness;
       options.hard_contact_every = args.hard_contact_every;
       options.hard_spacing = args.hard_spacing;
+      options.hard_from = args.hard_from;
+      options.hard_turns_min = args.turns_min;
       const auto s = via_ply ? follow_from_ply(args.case_path, csv_of(args.slenderness[k - 1]) + ".state.json",
                                                args.slenderness[k - 1], sl, args.turns_min, args.turns[k], csv, options)
                              : follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, options);
@@ -418,6 +550,11 @@ int run_plectonemes(const PlectonemesArguments& args) {
       if (s.hard_points > 0)
         std::cout << ", " << s.hard_points << " points re-solved with hard contact (" << s.hard_failures
                   << " failed) in " << std::setprecision(3) << s.hard_seconds << " s" << std::setprecision(6);
+      if (!s.hard_ply_stop.empty()) {
+        total += s.hard_ply_points;
+        std::cout << "; the ply with exact contact: " << s.hard_ply_points << " points in " << std::setprecision(3)
+                  << s.hard_ply_seconds << " s" << std::setprecision(6) << ", stopped: " << s.hard_ply_stop;
+      }
       // Flushed: a sweep killed later keeps the lines of the branches it finished.
       std::cout << ", stopped: " << s.stop << ", " << csv << std::endl;
     } catch (const std::exception& e) {

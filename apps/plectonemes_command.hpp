@@ -21,6 +21,12 @@ struct PlectonemeBranchSummary {
   int refused_steps = 0;                    // steps that would have carried the rod through itself
   std::map<std::string, double> last;       // the CSV columns at the last point with a ply
   std::vector<std::map<std::string, double>> ply;  // the same at every point with a ply, in order
+  // The ply with exact contact in the shooting core (--hard-from): its points, time, stops and,
+  // at every point with a ply, its CSV columns.
+  int hard_ply_points = 0;
+  double hard_ply_seconds = 0.0;
+  std::string hard_ply_stop;
+  std::vector<std::map<std::string, double>> hard_ply;
   int hard_points = 0;                      // ply points re-solved with hard self-contact
   int hard_failures = 0;                    // of those, the ones Ipopt did not solve (rows say why)
   double hard_seconds = 0.0;                // time spent in them
@@ -49,6 +55,14 @@ struct PlectonemeRunOptions {
   // into csv_path with "_hard.csv" for ".csv".
   double hard_contact_every = 0.0;
   double hard_spacing = 0.25;
+  // > 0 (and below the branch's largest turns): the barrier branch stops at this many turns and
+  // hands its ply to exact contact in the shooting core (hard_ply_definition): the contact set read
+  // off the discretised hard solution (Ipopt, at hard_spacing R), the shooting problem solved and
+  // followed in turns up to the branch's largest turns and down to hard_turns_min, into csv_path
+  // with "_ply.csv" for ".csv". Each leg stops where complementarity would fail (the contact set
+  // changes there; not followed).
+  double hard_from = 0.0;
+  double hard_turns_min = 4.0;
 };
 
 // Follows cases/plectoneme.toml (at `case_path`) with slenderness set, from turns = 0 to
@@ -86,6 +100,7 @@ struct PlectonemesArguments {
   bool resume = false;
   double hard_contact_every = 0.0;
   double hard_spacing = 0.25;
+  double hard_from = 0.0;
 };
 
 int run_plectonemes(const PlectonemesArguments& args);

@@ -38,6 +38,7 @@ void save_state(const std::filesystem::path& path, const RunState& s) {
   for (const auto& c : s.contacts)
     j["contacts"].push_back({{"obstacle", c.obstacle}, {"s", c.s}, {"force", c.force}, {"extended", c.extended},
                              {"s_end", c.s_end}, {"force_end", c.force_end}});
+  j["piece_segments"] = s.piece_segments;
   const fs::path tmp = path.string() + ".tmp";
   {
     std::ofstream out(tmp);
@@ -74,6 +75,7 @@ RunState load_state(const std::filesystem::path& path) {
     for (const auto& c : j.at("contacts"))
       s.contacts.push_back({c.at("obstacle").get<int>(), c.at("s").get<double>(), c.at("force").get<double>(),
                             c.at("extended").get<bool>(), c.at("s_end").get<double>(), c.at("force_end").get<double>()});
+  if (j.contains("piece_segments")) s.piece_segments = j.at("piece_segments").get<std::vector<int>>();
   return s;
 }
 

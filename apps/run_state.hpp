@@ -21,6 +21,7 @@ struct RunState {
   std::string parameter_name;     // the parameter continued in (empty in files older than it)
   ContinuationPoint last;
   std::vector<PointContact> contacts;  // the active set of `last` (contact runs)
+  std::vector<int> piece_segments;     // multiple shooting with contacts: the problem's segments per piece
 };
 
 // Points a run can resume from (a special point is re-found by the resumed march, not restarted from).

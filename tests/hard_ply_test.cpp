@@ -78,6 +78,57 @@ const HardPlyAtFiveTurns& hard_ply() {
   return instance;
 }
 
+// (Each test is a process of its own, and the fixture costs ~30 s: the checks of one solution share
+// a test.)
+// Eqs. (58b) and (61) hold for an infinite uniform helix; the ply is a few pitches of one between
+// the tails and the end loop, so they hold to a per cent or so. Measured: T R^2/EI 0.84 % below
+// (61) with R itself (the barrier solution it started from: 4.7 % below with its own radius).
+void expect_the_helix_formulas_with_R_itself() {
+  const HardPlyAtFiveTurns& h = hard_ply();
+  ASSERT_TRUE(h.solved.summary.converged());
+  const PlectonemeMeasures m = measure_plectoneme(*h.hard, h.solved.x, h.solution.profile);
+  const double theta = m.helix_angle;
+  ASSERT_TRUE(theta > 0.2 && theta < 0.35) << theta;
+  EXPECT_NEAR(m.T_ext * kRadius * kRadius / kEI / analytic::plectoneme_end_tension(theta, 1.0, 1.0), 1.0, 0.02);
+  EXPECT_NEAR(std::abs(m.m3) / analytic::helix_twisting_moment(theta, kEI, kRadius), 1.0, 0.015);
+}
+
+// The discretised energy minimised by Ipopt with rho >= R at every node (hard_self_contact.hpp)
+// solves the same hard problem independently, to second order in its node spacing R/4 (0.3 %
+// over R/2 - R/8, irregular as contact acts at nodes): measured 0.15 % apart in T_ext, the contacts
+// within a node of each other.
+void expect_the_discretised_energys_solution() {
+  const HardPlyAtFiveTurns& h = hard_ply();
+  ASSERT_TRUE(h.solved.summary.converged());
+  const PlectonemeMeasures m = measure_plectoneme(*h.hard, h.solved.x, h.solution.profile);
+  EXPECT_NEAR(m.T_ext / h.discrete.T_ext, 1.0, 0.005);
+  EXPECT_NEAR(m.m3 / h.discrete.m3, 1.0, 0.005);
+  const auto shot = h.hard->contacts_at(h.solved.x), discrete = ply_contacts(h.discrete);
+  ASSERT_EQ(shot.size(), discrete.size());
+  for (size_t k = 0; k < shot.size(); ++k) {
+    EXPECT_NEAR(shot[k].s, discrete[k].s, 2.0 * h.discrete.spacing) << k;
+    if (!shot[k].extended) EXPECT_NEAR(shot[k].force / discrete[k].force, 1.0, 0.02) << k;
+  }
+}
+
+// The Jacobian of multiple shooting through the ply - nodes that move with the contacts, the
+// constrained equations' sensitivities, the contact conditions and jumps - against central
+// differences near the solution. The unknowns reach 1e3 (forces), so the differences' relative
+// step is 1e-7, not jacobian_test.cpp's 1e-6: their truncation error falls as h^2 (measured
+// largest difference 24.6, 0.25, 0.0025 at 1e-5, 1e-6, 1e-7, against entries up to 1.6e5).
+void expect_the_jacobian_of_finite_differences() {
+  const HardPlyAtFiveTurns& h = hard_ply();
+  Eigen::VectorXd x = h.solved.x;
+  for (int i = 0; i < x.size(); ++i) x[i] += 1e-4 * (1.0 + std::abs(x[i])) * std::sin(1.0 + 2.3 * i);
+  Eigen::VectorXd F;
+  Eigen::MatrixXd J, J_fd;
+  std::string failure;
+  ASSERT_TRUE(h.solved.summary.converged());
+  ASSERT_TRUE(h.hard->evaluate(x, &F, &J, &failure)) << failure;
+  ASSERT_TRUE(finite_difference_jacobian(*h.hard, x, 1e-7, &J_fd));
+  EXPECT_LE((J - J_fd).cwiseAbs().maxCoeff(), 1e-6 * std::max(1.0, J.cwiseAbs().maxCoeff()));
+}
+
 TEST(HardPly, SolvesFromTheBarrierPlyAndTouchesExactly) {
   const HardPlyAtFiveTurns& h = hard_ply();
   ASSERT_TRUE(h.solved.summary.converged()) << h.solved.summary.brief_report();
@@ -110,37 +161,9 @@ TEST(HardPly, SolvesFromTheBarrierPlyAndTouchesExactly) {
   // cylinder does not depend on s): H_A = H_B to the integrator's accuracy (measured 1e-15).
   EXPECT_NEAR(m.H_A / m.H_B, 1.0, 1e-8);
   EXPECT_LT(h.solution.invariants.H.relative_spread(), 1e-8);
-}
-
-// Eqs. (58b) and (61) hold for an infinite uniform helix; the ply is a few pitches of one between
-// the tails and the end loop, so they hold to a per cent or so. Measured: T R^2/EI 0.84 % below
-// (61) with R itself (the barrier solution it started from: 4.7 % below with its own radius).
-TEST(HardPly, FollowsTheHelixFormulasWithRItself) {
-  const HardPlyAtFiveTurns& h = hard_ply();
-  ASSERT_TRUE(h.solved.summary.converged());
-  const PlectonemeMeasures m = measure_plectoneme(*h.hard, h.solved.x, h.solution.profile);
-  const double theta = m.helix_angle;
-  ASSERT_TRUE(theta > 0.2 && theta < 0.35) << theta;
-  EXPECT_NEAR(m.T_ext * kRadius * kRadius / kEI / analytic::plectoneme_end_tension(theta, 1.0, 1.0), 1.0, 0.02);
-  EXPECT_NEAR(std::abs(m.m3) / analytic::helix_twisting_moment(theta, kEI, kRadius), 1.0, 0.015);
-}
-
-// The discretised energy minimised by Ipopt with rho >= R at every node (hard_self_contact.hpp)
-// solves the same hard problem independently, to second order in its node spacing R/4 (0.3 %
-// over R/2 - R/8, irregular as contact acts at nodes): measured 0.15 % apart in T_ext, the contacts
-// within a node of each other.
-TEST(HardPly, AgreesWithTheDiscretisedEnergy) {
-  const HardPlyAtFiveTurns& h = hard_ply();
-  ASSERT_TRUE(h.solved.summary.converged());
-  const PlectonemeMeasures m = measure_plectoneme(*h.hard, h.solved.x, h.solution.profile);
-  EXPECT_NEAR(m.T_ext / h.discrete.T_ext, 1.0, 0.005);
-  EXPECT_NEAR(m.m3 / h.discrete.m3, 1.0, 0.005);
-  const auto shot = h.hard->contacts_at(h.solved.x), discrete = ply_contacts(h.discrete);
-  ASSERT_EQ(shot.size(), discrete.size());
-  for (size_t k = 0; k < shot.size(); ++k) {
-    EXPECT_NEAR(shot[k].s, discrete[k].s, 2.0 * h.discrete.spacing) << k;
-    if (!shot[k].extended) EXPECT_NEAR(shot[k].force / discrete[k].force, 1.0, 0.02) << k;
-  }
+  expect_the_helix_formulas_with_R_itself();
+  expect_the_discretised_energys_solution();
+  expect_the_jacobian_of_finite_differences();
 }
 
 // Followed in the end rotation from 5 to 5.5 turns with the same contact set: every point keeps
@@ -169,24 +192,6 @@ TEST(HardPly, FollowedInTheEndRotation) {
   EXPECT_NEAR(first, 1.0, 0.02);
   EXPECT_NEAR(last, 1.0, 0.01);
   EXPECT_GT(last, first);
-}
-
-// The Jacobian of multiple shooting through the ply - nodes that move with the contacts, the
-// constrained equations' sensitivities, the contact conditions and jumps - against central
-// differences near the solution. The unknowns reach 1e3 (forces), so the differences' relative
-// step is 1e-7, not jacobian_test.cpp's 1e-6: their truncation error falls as h^2 (measured
-// largest difference 24.6, 0.25, 0.0025 at 1e-5, 1e-6, 1e-7, against entries up to 1.6e5).
-TEST(HardPly, JacobianEqualsFiniteDifferences) {
-  const HardPlyAtFiveTurns& h = hard_ply();
-  Eigen::VectorXd x = h.solved.x;
-  for (int i = 0; i < x.size(); ++i) x[i] += 1e-4 * (1.0 + std::abs(x[i])) * std::sin(1.0 + 2.3 * i);
-  Eigen::VectorXd F;
-  Eigen::MatrixXd J, J_fd;
-  std::string failure;
-  ASSERT_TRUE(h.solved.summary.converged());
-  ASSERT_TRUE(h.hard->evaluate(x, &F, &J, &failure)) << failure;
-  ASSERT_TRUE(finite_difference_jacobian(*h.hard, x, 1e-7, &J_fd));
-  EXPECT_LE((J - J_fd).cwiseAbs().maxCoeff(), 1e-6 * std::max(1.0, J.cwiseAbs().maxCoeff()));
 }
 
 }  // namespace

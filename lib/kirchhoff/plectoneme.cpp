@@ -172,6 +172,29 @@ void measure_hard_contact(const ShootingProblem& problem, const Eigen::VectorXd&
   if (first < last) measure_helix(problem, x, profile, half_turn, pressure, first, last, m);
 }
 
+// Multiple shooting of the hard ply: segments of at most these lengths (in R) on the line contacts,
+// the gaps between contacts, and the tail and the end loop. On the cylinder the equations grow
+// errors like exp(0.7 s / R) (rod_on_cylinder_test), and the line lengthens as the turns grow (by
+// 2.3 times from 5 to 10 turns at L/2R = 100) with its segments fixed: at L/2R = 100, 5 to 7 turns
+// took 182 points (20 segments, 3 on the line) against 83 (43, 13 on the line), 5 to 10 turns
+// 281 points with 26 on the line.
+constexpr double kLineSegment = 0.5, kGapSegment = 1.0, kFreeSegment = 5.0;
+
+std::vector<int> hard_ply_segments(const std::vector<PointContact>& contacts, double length, double R) {
+  std::vector<int> out;
+  double from = 0.0;
+  auto piece = [&](double to, double target) {
+    out.push_back(std::max(1, static_cast<int>(std::ceil((to - from) / (target * R)))));
+    from = to;
+  };
+  for (size_t k = 0; k < contacts.size(); ++k) {
+    piece(contacts[k].s, k == 0 ? kFreeSegment : kGapSegment);
+    if (contacts[k].extended) piece(contacts[k].s_end, kLineSegment);
+  }
+  piece(length, kFreeSegment);
+  return out;
+}
+
 }  // namespace
 
 std::optional<HalfTurnGeometry> half_turn_geometry(const ShootingProblem& problem, const Parameters& p) {
@@ -212,7 +235,9 @@ ProblemDefinition hard_ply_definition(const ProblemDefinition& barrier, const st
   d.obstacle_parameters = barrier.model_parameters;
   d.obstacles = d.moving_obstacles(d.parameters);
   d.contacts = contacts;
-  d.piece_segments.clear();
+  d.piece_segments = hard_ply_segments(contacts, rod.length, find_half_turn_self_contact(rod)->options().radius);
+  d.options.segments = 0;
+  for (int count : d.piece_segments) d.options.segments += count;
   return d;
 }
 

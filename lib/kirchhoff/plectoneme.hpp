@@ -30,11 +30,12 @@ std::optional<HalfTurnGeometry> half_turn_geometry(const ShootingProblem& proble
 // point beside it at each end (ply_contacts, hard_self_contact.hpp, reads the set off the
 // discretised hard solution). The strands of the whole rod then touch exactly (rho = R, not R +
 // the barrier's gap); complementarity off the contacts is checked, not imposed (min_contact_force,
-// min_wrap_pressure, ply_clearance, self_distance). Multiple shooting as the barrier's, the
-// segments shared among the pieces between contacts in proportion to their lengths. The cylinder
+// min_wrap_pressure, ply_clearance, self_distance). The cylinder
 // moves with the parameters (the slenderness sets R). Throws std::invalid_argument when the barrier
 // problem has no half-turn self-contact or its rod has another field besides, or the contacts are
 // out of order.
+// Its segments are set per piece by length (at most R/2 long on the line contacts, R on the gaps
+// between contacts, 5 R on the tail and the end loop), not the barrier's.
 ProblemDefinition hard_ply_definition(const ProblemDefinition& barrier, const std::vector<PointContact>& contacts);
 
 // The hard-contact problem for a solved barrier plectoneme with the contact set given, and its
@@ -80,6 +81,10 @@ struct PlectonemeMeasures {
 // are outside the contact region (the barrier's force falls like exp(-(g/c)^2)/g^2 away from
 // contact, so the threshold moves the region's ends by a small fraction of the range c).
 constexpr double kContactFraction = 0.01;
+
+// A self_distance below 1 - this is the rod passing through itself: at the hard contacts it is 1
+// to the constraint's accuracy (1e-12 measured), and the bar is 2R (1 - 1e-9).
+constexpr double kSelfDistanceSlack = 1e-9;
 
 // Throws std::invalid_argument when the problem has no half-turn self-contact.
 PlectonemeMeasures measure_plectoneme(const ShootingProblem& problem, const Eigen::VectorXd& x,
