@@ -208,36 +208,47 @@ def fig5(profiles, figures):
 def fig11(profiles, figures):
     """Plectoneme branches: T_ext rho^2/EI against the helical angle, eq. (61) alongside.
 
-    Reads profiles/plectoneme_*.csv (reproduce writes L/2R = 100 and 200; `kirchhoff plectonemes --out
-    OUT/profiles` adds the other slendernesses). rho is the computed helix radius (R plus the
-    self-contact barrier's gap), the R of eqs. (58)-(61)."""
-    paths = sorted(profiles.glob("plectoneme_*.csv"), key=lambda p: int(p.stem.split("_")[-1]))
-    if not paths:
+    Reads profiles/plectoneme_<L/2R>.csv, the barrier branches (reproduce writes L/2R = 100 and 200;
+    `kirchhoff plectonemes --out OUT/profiles` adds the other slendernesses), where rho is the computed
+    helix radius (R plus the barrier's gap), and profiles/plectoneme_<L/2R>_ply.csv where present, the
+    ply with exact contact (`plectonemes --hard-from`), where rho = R itself."""
+    def slenderness(path):
+        return int(path.stem.split("_")[1])
+    barrier = sorted((p for p in profiles.glob("plectoneme_*.csv") if p.stem.split("_")[-1].isdigit()), key=slenderness)
+    exact = sorted(profiles.glob("plectoneme_*_ply.csv"), key=slenderness)
+    if not barrier and not exact:
         return
     fig, (ax, axm) = plt.subplots(1, 2, figsize=(11, 4.2))
     theta = np.radians(np.linspace(5.0, 30.0, 200))
     eq61 = 0.5 * np.sin(theta) ** 4 * (1 + 2 / np.cos(2 * theta))
     ax.plot(np.degrees(theta), eq61, "k-", lw=1.2, label="eq. (61)")
-    for path in paths:
+    colours = {}
+    for path, marker, what in [(p, "o", "barrier") for p in barrier] + [(p, "s", "exact contact") for p in exact]:
         d = read(path)
         ply = np.isfinite(d["eq61"]) & (d["contact_end"] - d["contact_start"] > 0.05)
-        label = f"L/2R = {path.stem.split('_')[-1]}"
-        line, = ax.plot(np.degrees(d["helix_angle"][ply]), d["T_rho2_over_EI"][ply], "o", ms=3, label=label)
-        axm.plot(d["turns"][ply], d["T_rho2_over_EI"][ply] / d["eq61"][ply], "o", ms=3, color=line.get_color(),
-                 label=f"{label}: T (61)")
-        axm.plot(d["turns"][ply], d["m3"][ply] / d["m3_eq58b"][ply], "x", ms=3, color=line.get_color(),
+        label = f"L/2R = {slenderness(path)}, {what}"
+        style = dict(ms=3, color=colours.get(slenderness(path)))
+        if marker == "s":
+            style["mfc"] = "none"
+        line, = ax.plot(np.degrees(d["helix_angle"][ply]), d["T_rho2_over_EI"][ply], marker, ls="none", label=label,
+                        **style)
+        colours.setdefault(slenderness(path), line.get_color())
+        style["color"] = line.get_color()
+        axm.plot(d["turns"][ply], d["T_rho2_over_EI"][ply] / d["eq61"][ply], marker, ls="none",
+                 label=f"{label}: T (61)", **style)
+        axm.plot(d["turns"][ply], np.abs(d["m3"][ply] / d["m3_eq58b"][ply]), "x", ms=3, color=line.get_color(),
                  label=f"{label}: m3 (58b)")
     ax.set_xlabel("helical angle $\\theta$ (degrees, middle of the ply)")
     ax.set_ylabel("T$_{ext}$ $\\rho^2$ / EI")
     ax.set_yscale("log")
     ax.set_xlim(5, 30)
     ax.set_title("Fig. 11: plectonemes, end pull against helical angle")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7)
     axm.axhline(1.0, color="k", lw=0.8)
     axm.set_xlabel("end rotation (turns)")
     axm.set_ylabel("numeric / helix formula")
     axm.set_title("T_ext against (61), m3 against (58b) along the branches")
-    axm.legend(fontsize=7)
+    axm.legend(fontsize=6)
     fig.tight_layout()
     fig.savefig(figures / "fig11_plectonemes.png", dpi=130)
     plt.close(fig)
