@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -267,6 +268,33 @@ std::string stop_text(const ContinuationResult& r) {
   return to_string(r.reason) + (r.message.empty() ? "" : " (" + r.message + ")");
 }
 
+// Branch 0: from `start` up to turns_max; branch 1: from the same start down to turns_min, both
+// into `csv` (a resumed CSV resumes the leg it was in). Returns "up: ...; down: ..." and counts
+// the refused steps into *refused.
+std::string follow_up_and_down(ShootingProblem& problem, BranchCsv& csv, const ContinuationPoint& start,
+                               double turns_min, double turns_max,
+                               const std::function<ContinuationOptions(double target)>& options_to, int* refused) {
+  auto sink = [&](const ContinuationPoint& p) { csv(p); };
+  const int first_leg = csv.resumed() ? csv.state().branch : 0;
+  std::string stops;
+  for (int leg = first_leg; leg < 2; ++leg) {
+    const ContinuationOptions o = options_to(leg == 0 ? turns_max : turns_min);
+    const bool resume_leg = csv.resumed() && leg == first_leg;
+    csv.state().branch = leg;
+    ContinuationResult r;
+    if (resume_leg) {
+      problem.set_parameter("turns", csv.state().last.parameter);
+      r = Continuation(problem, o).resume(csv.state().last, sink);
+    } else {
+      problem.set_parameter("turns", start.parameter);
+      r = Continuation(problem, o).run(start.x, sink);
+    }
+    stops += (stops.empty() ? "" : "; ") + std::string(leg == 0 ? "up: " : "down: ") + stop_text(r);
+    *refused += r.refused_steps;
+  }
+  return stops;
+}
+
 }  // namespace
 
 namespace {
@@ -338,27 +366,15 @@ void follow_hard_ply(const Case& c, double slenderness, const ContinuationPoint&
   BranchCsv csv(hard_csv, c.definition.parameters.get("EI"), slenderness, options, &legs, kHardMeasured);
   csv.state().contacts = start.contacts;
   csv.state().piece_segments = start.piece_segments;
-  auto sink = [&](const ContinuationPoint& p) { csv(p); };
-  const int first_leg = csv.resumed() ? csv.state().branch : 0;
-  std::vector<std::string> stops;
-  for (int leg = first_leg; leg < 2; ++leg) {
-    ContinuationOptions o = continuation_options(problem, c, slenderness, leg == 0 ? turns_max : turns_min, options);
-    o.derived = kHardMeasured;
-    o.events = complementarity_events();
-    const bool resume_leg = csv.resumed() && leg == first_leg;
-    csv.state().branch = leg;
-    ContinuationResult r;
-    if (resume_leg) {
-      problem.set_parameter("turns", csv.state().last.parameter);
-      r = Continuation(problem, o).resume(csv.state().last, sink);
-    } else {
-      problem.set_parameter("turns", start.last.parameter);
-      r = Continuation(problem, o).run(start.last.x, sink);
-    }
-    stops.push_back((leg == 0 ? "up: " : "down: ") + stop_text(r));
-    legs.refused_steps += r.refused_steps;
-  }
-  for (const auto& stop : stops) summary->hard_ply_stop += (summary->hard_ply_stop.empty() ? "" : "; ") + stop;
+  summary->hard_ply_stop = follow_up_and_down(
+      problem, csv, start.last, turns_min, turns_max,
+      [&](double target) {
+        ContinuationOptions o = continuation_options(problem, c, slenderness, target, options);
+        o.derived = kHardMeasured;
+        o.events = complementarity_events();
+        return o;
+      },
+      &legs.refused_steps);
   summary->hard_ply_points += legs.points;
   summary->hard_ply = legs.ply;
   summary->refused_steps += legs.refused_steps;
@@ -478,27 +494,10 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
   problem.set_parameter("turns", start.last.parameter);
   BranchCsv csv(csv_path, c.definition.parameters.get("EI"), slenderness, options, &summary);
   csv.follow_hard_contact(csv_path, problem);
-  auto sink = [&](const ContinuationPoint& p) { csv(p); };
-  // Branch 0: up to turns_max; branch 1: from the same start down to turns_min.
-  const int first_leg = csv.resumed() ? csv.state().branch : 0;
-  std::vector<std::string> stops;
-  for (int leg = first_leg; leg < 2; ++leg) {
-    const ContinuationOptions o =
-        continuation_options(problem, c, slenderness, leg == 0 ? turns_max : turns_min, options);
-    const bool resume_leg = csv.resumed() && leg == first_leg;
-    csv.state().branch = leg;
-    ContinuationResult r;
-    if (resume_leg) {
-      problem.set_parameter("turns", csv.state().last.parameter);
-      r = Continuation(problem, o).resume(csv.state().last, sink);
-    } else {
-      problem.set_parameter("turns", start.last.parameter);
-      r = Continuation(problem, o).run(start.last.x, sink);
-    }
-    stops.push_back((leg == 0 ? "up: " : "down: ") + stop_text(r));
-    summary.refused_steps += r.refused_steps;
-  }
-  for (const auto& stop : stops) summary.stop += (summary.stop.empty() ? "" : "; ") + stop;
+  summary.stop = follow_up_and_down(
+      problem, csv, start.last, turns_min, turns_max,
+      [&](double target) { return continuation_options(problem, c, slenderness, target, options); },
+      &summary.refused_steps);
   summary.seconds = seconds_since(started);
   return summary;
 }

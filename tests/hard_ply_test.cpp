@@ -23,24 +23,6 @@ namespace {
 constexpr double kRadius = 0.005;  // L / (2 * 100)
 constexpr double kEI = 1.0;
 
-ContinuationOptions ply_options(double target, const std::vector<std::string>& derived) {
-  ContinuationOptions o;
-  o.parameter = "turns";
-  o.target = target;
-  o.initial_step = 1.0;
-  o.max_step = 60.0;
-  o.max_points = 2000;
-  o.derived = derived;
-  o.samples = 1001;
-  o.detect_branch_points = false;
-  o.modified_newton = true;
-  o.corrector_max_iterations = 16;
-  o.grow_iterations = 10;
-  o.shrink_iterations = 14;
-  o.reuse_jacobian_iterations = 8;
-  return o;
-}
-
 // The barrier branch from the untwisted rod to 5 turns (a ply from ~3.5 turns), its discretised
 // hard solution, and the shooting problem with that contact set solved from the barrier's states.
 struct HardPlyAtFiveTurns {
@@ -55,7 +37,7 @@ struct HardPlyAtFiveTurns {
   HardPlyAtFiveTurns() {
     const ShootingResult start = solve(barrier, barrier.initial_unknowns(c.start_guess));
     if (!start.summary.converged()) throw std::runtime_error("the untwisted rod does not solve");
-    const ContinuationResult branch = Continuation(barrier, ply_options(5.0, c.derived)).run(start.x);
+    const ContinuationResult branch = Continuation(barrier, testing::plectoneme_turns_options(5.0, c.derived)).run(start.x);
     if (branch.reason != StopReason::ReachedTarget) throw std::runtime_error(branch.message);
     point = branch.points.back();
     barrier.set_parameter("turns", point.parameter);
@@ -172,7 +154,7 @@ TEST(HardPly, SolvesFromTheBarrierPlyAndTouchesExactly) {
 TEST(HardPly, FollowedInTheEndRotation) {
   const HardPlyAtFiveTurns& h = hard_ply();
   ASSERT_TRUE(h.solved.summary.converged());
-  ContinuationOptions o = ply_options(5.5, h.derived());
+  ContinuationOptions o = testing::plectoneme_turns_options(5.5, h.derived());
   o.events = {{"min_contact_force", 0.0, true, "a contact lifts off"},
               {"min_wrap_pressure", 0.0, true, "the line contact's pressure vanishes"}};
   ASSERT_TRUE(guard_self_passage(*h.hard, &o));

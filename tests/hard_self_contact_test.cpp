@@ -25,21 +25,8 @@ struct PlyAtFiveTurns {
   PlyAtFiveTurns() {
     const ShootingResult start = solve(problem, problem.initial_unknowns(c.start_guess));
     if (!start.summary.converged()) throw std::runtime_error("the untwisted rod does not solve");
-    ContinuationOptions o;
-    o.parameter = "turns";
-    o.target = 5.0;
-    o.initial_step = 1.0;
-    o.max_step = 60.0;
-    o.max_points = 2000;
-    o.derived = c.derived;
-    o.samples = 1001;
-    o.detect_branch_points = false;
-    o.modified_newton = true;
-    o.corrector_max_iterations = 16;
-    o.grow_iterations = 10;
-    o.shrink_iterations = 14;
-    o.reuse_jacobian_iterations = 8;
-    const ContinuationResult branch = Continuation(problem, o).run(start.x);
+    const ContinuationResult branch =
+        Continuation(problem, testing::plectoneme_turns_options(5.0, c.derived)).run(start.x);
     if (branch.reason != StopReason::ReachedTarget) throw std::runtime_error(branch.message);
     point = branch.points.back();
     problem.set_parameter("turns", point.parameter);

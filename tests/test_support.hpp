@@ -56,6 +56,27 @@ inline ContactBranch follow_contacts(const Case& c, const ContinuationOptions& o
   return out;
 }
 
+// How the plectoneme tests follow cases/plectoneme.toml in its end rotation, as the plectonemes
+// command does at L/2R = 100: long steps, modified Newton, a point whose chord iterations converged
+// keeping the previous matrix, no branch points.
+inline ContinuationOptions plectoneme_turns_options(double target, const std::vector<std::string>& derived) {
+  ContinuationOptions o;
+  o.parameter = "turns";
+  o.target = target;
+  o.initial_step = 1.0;
+  o.max_step = 60.0;
+  o.max_points = 2000;
+  o.derived = derived;
+  o.samples = 1001;
+  o.detect_branch_points = false;
+  o.modified_newton = true;
+  o.corrector_max_iterations = 16;
+  o.grow_iterations = 10;
+  o.shrink_iterations = 14;
+  o.reuse_jacobian_iterations = 8;
+  return o;
+}
+
 // H just before and just after arclength s (either side of a contact).
 inline std::pair<double, double> hamiltonian_across(const ShootingProblem& problem, const Eigen::VectorXd& x, double s) {
   const RodModel& model = problem.equations(problem.parameters_at(x))->model();

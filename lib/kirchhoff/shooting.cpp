@@ -321,6 +321,16 @@ int ShootingProblem::start_rows(const RodEquations& eq, const Eigen::VectorXd& y
   return row;
 }
 
+void ShootingProblem::end_rows(const RodEquations& eq, const Eigen::VectorXd& y_end, const Parameters& p,
+                               const Eigen::MatrixXd* S, Eigen::VectorXd* F, Eigen::MatrixXd* J, int row) const {
+  ConditionRows end;
+  definition_.end.append_residuals(eq, false, y_end, p, &end.values, J ? &end.jacobian : nullptr);
+  for (size_t k = 0; k < end.values.size(); ++k, ++row) {
+    (*F)[row] = end.values[k];
+    if (J) J->row(row) = end.jacobian[k] * *S;
+  }
+}
+
 bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
                                Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const {
   // A Newton or corrector iterate may take a parameter outside the model's domain (a slenderness
@@ -631,12 +641,7 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
     return false;
   }
   if (y_end) *y_end = y;
-  ConditionRows end;
-  definition_.end.append_residuals(*eq, false, y, p, &end.values, J ? &end.jacobian : nullptr);
-  for (size_t k = 0; k < end.values.size(); ++k, ++row) {
-    (*F)[row] = end.values[k];
-    if (J) J->row(row) = end.jacobian[k] * S;
-  }
+  end_rows(*eq, y, p, J ? &S : nullptr, F, J, row);
   return true;
 }
 
@@ -763,12 +768,7 @@ bool ShootingProblem::residual_pieces(const Eigen::VectorXd& x, const Parameters
     }
     if (last) {
       if (y_end) *y_end = y;
-      ConditionRows end;
-      definition_.end.append_residuals(*eq, false, y, p, &end.values, J ? &end.jacobian : nullptr);
-      for (size_t k = 0; k < end.values.size(); ++k, ++row) {
-        (*F)[row] = end.values[k];
-        if (J) J->row(row) = end.jacobian[k] * S;
-      }
+      end_rows(*eq, y, p, J ? &S : nullptr, F, J, row);
       break;
     }
     const Breakpoint& b = points[spans[i].piece];

@@ -181,6 +181,9 @@ class ShootingProblem final : public NonlinearSystem {
   // Sizes F (and J) and fills the gauge and start-condition rows; returns the next row.
   int start_rows(const RodEquations& eq, const Eigen::VectorXd& y0, const Parameters& p, Eigen::VectorXd* F,
                  Eigen::MatrixXd* J) const;
+  // Fills the end-condition rows from `row` on (the last rows), with S = dy(L)/dx for their Jacobian.
+  void end_rows(const RodEquations& eq, const Eigen::VectorXd& y_end, const Parameters& p, const Eigen::MatrixXd* S,
+                Eigen::VectorXd* F, Eigen::MatrixXd* J, int row) const;
   // The rows of F that come from the boundary conditions, at fixed end states.
   Eigen::VectorXd condition_rows(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end, const Parameters& p) const;
   // Scatters condition rows (start then end) into a full-length residual column.
