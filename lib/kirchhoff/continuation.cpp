@@ -27,8 +27,6 @@ constexpr double kChordContraction = 0.3;
 // factor (it converges linearly at that rate, still cheaper than a new matrix when one costs
 // tens of residuals).
 constexpr double kModifiedNewtonContraction = 0.5;
-// Halvings of a Newton update that cannot be evaluated before the corrector gives up (1/16 of it).
-constexpr int kCorrectorBacktracks = 4;
 // H is flagged as not flat above this fraction of its scale (the standard).
 constexpr double kFlatH = 1e-9;
 
@@ -129,14 +127,9 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
     const JacobianLU lu(M);
     if (lu.reciprocal_condition() > 1e-15) {
       const Eigen::VectorXd z_start = z;
-      Eigen::VectorXd z_good = z;  // the last iterate that could be evaluated
       double previous = INFINITY;
       for (; it <= options_.corrector_max_iterations; ++it) {
-        if (!evaluate(z, &F, nullptr, &failure)) {
-          z = z_good;  // Newton goes on from there
-          break;
-        }
-        z_good = z;
+        if (!evaluate(z, &F, nullptr, &failure)) break;
         G << F, normal.dot(z - z_predicted);
         const double norm = G.lpNorm<Eigen::Infinity>();
         if (!std::isfinite(norm)) break;
@@ -155,29 +148,20 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
   }
   double best = INFINITY, previous = INFINITY;
   std::optional<JacobianLU> lu;  // the matrix of the current (modified) Newton iteration
-  Eigen::VectorXd update;        // the last Newton update, shortened where it cannot be evaluated
-  // An update that leaves the problem's domain (contacts out of order, a rod that cannot be
-  // integrated) is halved back towards the last iterate a few times before the step fails: in a
-  // bordered system the first updates of long steps can overshoot in unknowns that are small
-  // against the others (the contacts' arclengths beside their forces).
-  auto evaluate_backtracking = [&](Eigen::MatrixXd* jacobian) {
-    bool ok = evaluate(z, &F, jacobian, &failure);
-    for (int k = 0; !ok && k < kCorrectorBacktracks && update.size() > 0; ++k) {
-      update *= 0.5;
-      z += update;
-      ok = evaluate(z, &F, jacobian, &failure);
-    }
-    if (!ok) last_corrector_failure_ = failure;
-    return ok;
-  };
   for (; it <= 2 * options_.corrector_max_iterations; ++it) {
     if (lu) {
-      if (!evaluate_backtracking(nullptr)) return false;
+      if (!evaluate(z, &F, nullptr, &failure)) {
+        last_corrector_failure_ = failure;
+        return false;
+      }
       G << F, normal.dot(z - z_predicted);
       if (!(G.lpNorm<Eigen::Infinity>() <= kModifiedNewtonContraction * previous)) lu.reset();
     }
     if (!lu) {
-      if (!evaluate_backtracking(&A)) return false;
+      if (!evaluate(z, &F, &A, &failure)) {
+        last_corrector_failure_ = failure;
+        return false;
+      }
       G << F, normal.dot(z - z_predicted);
     }
     if (!G.allFinite()) {
@@ -201,8 +185,7 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
         return false;
       }
     }
-    update = lu->solve(G);
-    z -= update;
+    z -= lu->solve(G);
     previous = norm;
     if (!options_.modified_newton) lu.reset();
   }
