@@ -451,12 +451,12 @@ bool contacts_in_order(const std::vector<Breakpoint>& points, const std::vector<
   return true;
 }
 
-// A segment of multiple shooting with contacts: segment `local` of the `count` equal ones of its
-// piece [a, b] between breakpoints (a = 0 or a contact arclength, b = a contact arclength or L),
-// so s0 = a + (b - a) local / count and s1 = a + (b - a) (local + 1) / count. The unknowns that a
-// and b are (-1: fixed) and ds0/da, ds0/db, ds1/da, ds1/db.
+// A segment of multiple shooting with contacts: segment j of the `count` equal ones of its piece
+// [a, b] between breakpoints (a = 0 or a contact arclength, b = a contact arclength or L), so
+// s0 = a + (b - a) j / count and s1 = a + (b - a) (j + 1) / count. The unknowns that a and b are
+// (-1: fixed) and ds0/da, ds0/db, ds1/da, ds1/db.
 struct SegmentSpan {
-  int piece = 0, local = 0, count = 1;
+  int piece = 0;
   double s0 = 0.0, s1 = 0.0;
   int a_column = -1, b_column = -1;
   double s0_a = 0.0, s0_b = 0.0, s1_a = 0.0, s1_b = 0.0;
@@ -471,8 +471,6 @@ std::vector<SegmentSpan> segment_spans(const std::vector<Breakpoint>& points, co
     for (int j = 0; j < count; ++j) {
       SegmentSpan span;
       span.piece = static_cast<int>(k);
-      span.local = j;
-      span.count = count;
       const double f0 = static_cast<double>(j) / count, f1 = static_cast<double>(j + 1) / count;
       span.s0 = a + (b - a) * f0;
       span.s1 = j + 1 == count ? b : a + (b - a) * f1;  // exactly on the breakpoint
@@ -865,11 +863,10 @@ double ShootingProblem::smallest_wrap_pressure(const Eigen::VectorXd& x, const P
   if (o.is_flat()) return NAN;
   const auto eq = equations(p);
   if (eq->is_planar()) return wrap_tension(x, contact) / o.radius();
-  const PointContact& c = contact;  // solved: from contacts_at(x)
   // Just inside the wrap at both ends: at the breakpoints themselves the samples lie on the free side.
   std::vector<double> s(samples);
-  const double inset = 1e-12 * (1.0 + c.s_end);
-  for (int i = 0; i < samples; ++i) s[i] = c.s + inset + (c.s_end - c.s - 2.0 * inset) * i / (samples - 1);
+  const double inset = 1e-12 * (1.0 + contact.s_end), span = contact.s_end - contact.s - 2.0 * inset;
+  for (int i = 0; i < samples; ++i) s[i] = contact.s + inset + span * i / (samples - 1);
   double smallest = INFINITY;
   const CylinderSupport support = support_of(o);
   for (const auto& point : sample(x, s))

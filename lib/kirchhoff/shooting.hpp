@@ -151,7 +151,7 @@ class ShootingProblem final : public NonlinearSystem {
   // The smallest pressure (force per length) of the wrapped part of an extended contact on a
   // curved obstacle, over `samples` equally spaced points of it (ends included): tension / radius
   // on a disc, the cylinder's pressure for a spatial rod (rod_on_cylinder.hpp). Complementarity
-  // wants it >= 0. NaN for a point contact or a flat one.
+  // wants it >= 0. NaN for a point contact or a flat one. `contact` as solved (contacts_at(x)).
   double smallest_wrap_pressure(const Eigen::VectorXd& x, const PointContact& contact, int samples = 65) const;
 
   // Multiple shooting with contacts: segments per piece (see ProblemDefinition::piece_segments),
