@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/continuation.hpp"
@@ -174,6 +175,84 @@ TEST(HardPly, FollowedInTheEndRotation) {
   EXPECT_NEAR(first, 1.0, 0.02);
   EXPECT_NEAR(last, 1.0, 0.01);
   EXPECT_GT(last, first);
+}
+
+// Thinned from L/2R = 100 to 150 by continuation in the slenderness with exact contact (the
+// cylinder's radius R = L/(2 L/2R) moves with it; --from-ply with --hard-from), then re-segmented
+// by length at the new R: the re-segmented problem has the same equilibrium (the same
+// boundary-value problem shot from other nodes: its residual at the resampled states and the
+// centreline to the integrator's accuracy), with its line contact at most R per segment again, and that
+// equilibrium is the thinner rod's exact ply - complementarity, H_A = H_B, T R^2/EI on (61) with
+// the new R (measured 0.45 % below; bar 2 %).
+TEST(HardPly, ThinnedInSlendernessAndResegmented) {
+  const HardPlyAtFiveTurns& h = hard_ply();
+  ASSERT_TRUE(h.solved.summary.converged());
+  ShootingProblem moving = *h.hard;
+  ContinuationOptions o = testing::plectoneme_turns_options(150.0, h.derived());
+  o.parameter = "slenderness";
+  o.events = {{"min_contact_force", 0.0, true, "a contact lifts off"},
+              {"min_wrap_pressure", 0.0, true, "the line contact's pressure vanishes"}};
+  ASSERT_TRUE(guard_self_passage(moving, &o));
+  const ContinuationResult thinned = Continuation(moving, o).run(h.solved.x);
+  ASSERT_EQ(thinned.reason, StopReason::ReachedTarget) << thinned.message;
+  moving.set_parameter("slenderness", 150.0);
+  const Eigen::VectorXd& moved = thinned.points.back().x;
+
+  ProblemDefinition barrier = h.c.definition;
+  barrier.parameters.set("turns", h.point.parameter);
+  const HardPlyStart seed = resegmented_hard_ply(barrier, moving, moved);
+  const ShootingProblem thin(seed.definition);
+  // The moved solution's states at the new nodes already solve the new problem: each new segment,
+  // integrated from them, ends on the next node's state (continuity to the integrator's accuracy,
+  // measured max |F| 2e-10 against forces ~1e3 and pressures ~1e5; Newton's tolerance 1e-8).
+  Eigen::VectorXd F;
+  std::string failure;
+  ASSERT_TRUE(thin.evaluate(seed.x, &F, nullptr, &failure)) << failure;
+  const double residual = F.lpNorm<Eigen::Infinity>();
+  EXPECT_LT(residual, 1e-8);
+  const ShootingResult solved = solve(thin, seed.x);
+  ASSERT_TRUE(solved.summary.converged()) << solved.summary.brief_report();
+  EXPECT_LE(solved.summary.iterations, 1);
+
+  const double R = 1.0 / 300.0;
+  const auto before = moving.contacts_at(moved), after = thin.contacts_at(solved.x);
+  ASSERT_EQ(after.size(), 3u);
+  ASSERT_TRUE(after[1].extended);
+  for (size_t k = 0; k < after.size(); ++k) {
+    EXPECT_NEAR(after[k].s, before[k].s, 1e-9) << k;
+    EXPECT_NEAR(after[k].force / before[k].force, 1.0, 1e-8) << k;
+  }
+  // The line contact is piece 2 (tail, gap, line, gap, loop): its segments shrank with R and are
+  // as many again as R apart takes.
+  EXPECT_EQ(thin.piece_segments()[2], static_cast<int>(std::ceil((after[1].s_end - after[1].s) / R)));
+  EXPECT_GT(thin.piece_segments()[2], moving.piece_segments()[2]);
+
+  const Solution solution = make_solution(thin, solved, 3001, h.derived());
+  const Solution unsegmented = make_solution(moving, [&] {
+    ShootingResult r;
+    r.x = moved;
+    r.summary.status = SolverStatus::Converged;
+    r.parameters = moving.parameters_at(moved);
+    return r;
+  }(), 3001, h.derived());
+  // The same rod, shot from other nodes: the centrelines agree to the integrator's accuracy
+  // (measured 5e-13 R).
+  double apart = 0.0;
+  ASSERT_EQ(solution.profile.size(), unsegmented.profile.size());
+  for (size_t i = 0; i < solution.profile.size(); ++i)
+    apart = std::max(apart, (solution.profile[i].r - unsegmented.profile[i].r).norm());
+  EXPECT_LT(apart, 1e-9 * R);
+  EXPECT_GT(solution.derived.at("min_contact_force"), 0.0);
+  EXPECT_GT(solution.derived.at("min_wrap_pressure"), 0.0);
+  EXPECT_GE(solution.derived.at("self_distance"), 1.0 - 1e-9);
+  EXPECT_NEAR(solution.derived.at("H_A") / solution.derived.at("H_B"), 1.0, 1e-8);
+  EXPECT_NEAR(solution.derived.at("helix_radius") / R, 1.0, 1e-9);
+  const double ratio = solution.derived.at("T_ext") * R * R /
+                       analytic::plectoneme_end_tension(solution.derived.at("helix_angle"), 1.0, 1.0);
+  EXPECT_NEAR(ratio, 1.0, 0.02);
+  std::cout << "L/2R = 150: T_ext " << solution.derived.at("T_ext") << ", T R^2/EI / eq. (61) = " << ratio
+            << ", line segments " << moving.piece_segments()[2] << " -> " << thin.piece_segments()[2]
+            << ", residual " << residual << ", centrelines apart " << apart / R << " R\n";
 }
 
 }  // namespace

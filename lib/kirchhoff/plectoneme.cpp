@@ -177,8 +177,10 @@ void measure_hard_contact(const ShootingProblem& problem, const Eigen::VectorXd&
 // errors like exp(0.7 s / R) (rod_on_cylinder_test), and the line lengthens as the turns grow (by
 // 2.3 times from 5 to 10 turns at L/2R = 100) with its segments fixed: at L/2R = 100, 5 to 7 turns
 // took 182 points (20 segments, 3 on the line) against 83 (43, 13 on the line), 5 to 10 turns
-// 281 points with 26 on the line.
-constexpr double kLineSegment = 0.5, kGapSegment = 1.0, kFreeSegment = 5.0;
+// 281 points with 26 on the line. Shorter is not better: the Jacobian is dense, and its size grows
+// with the segments - at L/2R = 500 (5 -> 8 and 5 -> 4.5 turns, from the 200 ply) R apart on the
+// line took 49 s against 70 s at R/2, the same end points to 1e-10.
+constexpr double kLineSegment = 1.0, kGapSegment = 1.0, kFreeSegment = 5.0;
 
 std::vector<int> hard_ply_segments(const std::vector<PointContact>& contacts, double length, double R) {
   std::vector<int> out;
@@ -241,15 +243,31 @@ ProblemDefinition hard_ply_definition(const ProblemDefinition& barrier, const st
   return d;
 }
 
-HardPlyStart hard_ply_from_barrier(const ShootingProblem& barrier, const Eigen::VectorXd& x,
-                                   const std::vector<PointContact>& contacts) {
+namespace {
+
+// The hard ply of `barrier` at source's parameters at x, with these contacts, its unknowns from
+// source's solution at its nodes.
+HardPlyStart hard_ply_sampling(const ProblemDefinition& barrier, const ShootingProblem& source,
+                               const Eigen::VectorXd& x, const std::vector<PointContact>& contacts) {
   HardPlyStart start;
-  ProblemDefinition at_x = barrier.definition();
-  at_x.parameters = barrier.parameters_at(x);
+  ProblemDefinition at_x = barrier;
+  at_x.parameters = source.parameters_at(x);
   start.definition = hard_ply_definition(at_x, contacts);
   const ShootingProblem hard(start.definition);
-  start.x = hard.unknowns_from(barrier.sample(x, hard.node_arclengths()));
+  start.x = hard.unknowns_from(source.sample(x, hard.node_arclengths()));
   return start;
+}
+
+}  // namespace
+
+HardPlyStart hard_ply_from_barrier(const ShootingProblem& barrier, const Eigen::VectorXd& x,
+                                   const std::vector<PointContact>& contacts) {
+  return hard_ply_sampling(barrier.definition(), barrier, x, contacts);
+}
+
+HardPlyStart resegmented_hard_ply(const ProblemDefinition& barrier, const ShootingProblem& hard,
+                                  const Eigen::VectorXd& x) {
+  return hard_ply_sampling(barrier, hard, x, hard.contacts_at(x));
 }
 
 PlectonemeMeasures measure_plectoneme(const ShootingProblem& problem, const Eigen::VectorXd& x,

@@ -34,7 +34,7 @@ std::optional<HalfTurnGeometry> half_turn_geometry(const ShootingProblem& proble
 // moves with the parameters (the slenderness sets R). Throws std::invalid_argument when the barrier
 // problem has no half-turn self-contact or its rod has another field besides, or the contacts are
 // out of order.
-// Its segments are set per piece by length (at most R/2 long on the line contacts, R on the gaps
+// Its segments are set per piece by length (at most R long on the line contacts and on the gaps
 // between contacts, 5 R on the tail and the end loop), not the barrier's.
 ProblemDefinition hard_ply_definition(const ProblemDefinition& barrier, const std::vector<PointContact>& contacts);
 
@@ -47,6 +47,13 @@ struct HardPlyStart {
 };
 HardPlyStart hard_ply_from_barrier(const ShootingProblem& barrier, const Eigen::VectorXd& x,
                                    const std::vector<PointContact>& contacts);
+
+// A solved hard ply (`hard` at x) re-segmented by length at x's parameters: its contacts as
+// solved, its unknowns from its own solution at the new nodes. Continuation in slenderness moves
+// the nodes with R but keeps their count, so a thinner rod's line contact has fewer segments per R
+// than hard_ply_definition gives it; `barrier` is the definition the hard problem was made from.
+HardPlyStart resegmented_hard_ply(const ProblemDefinition& barrier, const ShootingProblem& hard,
+                                  const Eigen::VectorXd& x);
 
 struct PlectonemeMeasures {
   double T_ext = 0.0;             // tension at the clamp, n(0).d3(0) (the pull on the end B)
