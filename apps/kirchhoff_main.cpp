@@ -229,8 +229,15 @@ int main(int argc, char** argv) {
                    "(contact points and the line of the ply, read off the discretised solution) and followed\n"
                    "in turns up to --turns and down to --turns-min, each leg stopping where complementarity\n"
                    "would fail; DIR/plectoneme_<L/2R>_ply.csv (T_ext R^2/EI beside eq. 61 with R itself).\n"
-                   "Branches from the untwisted rod only (not --from-ply ones); 5 suits L/2R = 100 and 200")
+                   "With it, --from-ply slendernesses are reached from the previous one's exact ply instead\n"
+                   "(continued in L/2R with exact contact; no barrier branch): the all-exact Fig. 11 is\n"
+                   "--hard-from 5 --from-ply 200,500,1000 (Ipopt, which seeds the contact set, fails at 500)")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  plectonemes_cmd
+      ->add_option("--ply-max-step", plect.ply_max_step,
+                   "Largest pseudo-arclength step of the exact ply's legs at L/2R = 100 (scaled like --max-step)")
+      ->check(CLI::PositiveNumber)
       ->capture_default_str();
 
   try {

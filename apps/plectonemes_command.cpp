@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <numeric>
 #include <optional>
 
 #include "kirchhoff/analytic.hpp"
@@ -305,7 +306,8 @@ ShootingProblem hard_ply_problem(const Case& c, double slenderness, const RunSta
   ProblemDefinition barrier = c.definition;
   barrier.parameters.set("turns", start.last.parameter);
   ProblemDefinition d = hard_ply_definition(barrier, start.contacts);
-  d.piece_segments = start.piece_segments;
+  d.piece_segments = start.piece_segments;  // x's layout (set by length where x was solved)
+  d.options.segments = std::accumulate(d.piece_segments.begin(), d.piece_segments.end(), 0);
   return ShootingProblem(with_scaled_tolerance(d, slenderness));
 }
 
@@ -318,18 +320,60 @@ std::vector<ContinuationEvent> complementarity_events() {
           {"self_distance", 1.0 - kSelfDistanceSlack, true, "the rod reaches itself away from the ply's contacts"}};
 }
 
+// The hard-contact ply legs from `start` (a solved exact ply at start.last.parameter turns, its
+// contacts and segments per piece): followed in turns up to turns_max (branch 0) and from the same
+// start down to turns_min (branch 1) into hard_csv, each leg stopping where complementarity would
+// fail; a resumed run resumes the leg it was in. (Re-segmenting a leg every turn as its line
+// contact lengthens was tried: the same points, 1.5-3 times slower at L/2R = 200.)
+void follow_hard_legs(const Case& c, double slenderness, const RunState& start, double turns_min, double turns_max,
+                      const std::string& hard_csv, const PlectonemeRunOptions& options,
+                      PlectonemeBranchSummary* summary) {
+  ShootingProblem problem = hard_ply_problem(c, slenderness, start);
+  PlectonemeBranchSummary legs;
+  BranchCsv csv(hard_csv, c.definition.parameters.get("EI"), slenderness, options, &legs, kHardMeasured);
+  csv.state().contacts = start.contacts;
+  csv.state().piece_segments = start.piece_segments;
+  summary->hard_ply_stop = follow_up_and_down(
+      problem, csv, start.last, turns_min, turns_max,
+      [&](double target) {
+        ContinuationOptions o = continuation_options(problem, c, slenderness, target, options);
+        o.max_step = options.ply_max_step * force_scale(slenderness);
+        o.derived = kHardMeasured;
+        o.events = complementarity_events();
+        return o;
+      },
+      &legs.refused_steps);
+  summary->hard_ply_points += legs.points;
+  summary->hard_ply = legs.ply;
+  summary->refused_steps += legs.refused_steps;
+}
+
+// A complete hard ply CSV (both legs done) is left alone by a resumed run.
+bool hard_legs_complete(const std::string& hard_csv, const PlectonemeRunOptions& options) {
+  return options.resume && branch_complete(hard_csv) && std::filesystem::exists(hard_csv + ".state.json") &&
+         load_state(hard_csv + ".state.json").branch == 1;
+}
+
+RunState solved_start(const ShootingProblem& hard, const Eigen::VectorXd& x, double turns) {
+  RunState start;
+  start.parameter_name = "turns";
+  start.last.parameter = turns;
+  start.last.x = x;
+  start.contacts = hard.contacts_at(x);
+  start.piece_segments = hard.piece_segments();
+  return start;
+}
+
 // The hard-contact ply legs of a branch (--hard-from): from the barrier solution `at` (a ply), the
 // contact set read off the discretised hard solution (Ipopt), the shooting problem with exact
-// self-contact solved from the barrier's states, then followed in turns up to turns_max (branch 0)
-// and from the same start down to turns_min (branch 1) into hard_csv. The start is saved beside it
-// (hard_csv + ".start.json"), so a resumed run skips the re-solution and resumes the leg it was in.
+// self-contact solved from the barrier's states, then follow_hard_legs. The start is saved beside
+// hard_csv (+ ".start.json"), so a resumed run skips the re-solution.
 void follow_hard_ply(const Case& c, double slenderness, const ContinuationPoint& at, double turns_min,
                      double turns_max, const std::string& hard_csv, const PlectonemeRunOptions& options,
                      PlectonemeBranchSummary* summary) {
   const auto started = std::chrono::steady_clock::now();
   const std::string start_path = hard_csv + ".start.json";
-  if (options.resume && branch_complete(hard_csv) && std::filesystem::exists(hard_csv + ".state.json") &&
-      load_state(hard_csv + ".state.json").branch == 1) {
+  if (hard_legs_complete(hard_csv, options)) {
     summary->hard_ply_stop = "already complete";
     return;
   }
@@ -345,7 +389,8 @@ void follow_hard_ply(const Case& c, double slenderness, const ContinuationPoint&
     if (!discrete.converged)
       throw std::runtime_error("hard contact at turns = " + std::to_string(at.parameter) +
                                ": the discretised hard problem (Ipopt), whose contacts seed the shooting, did not "
-                               "solve: " + discrete.status);
+                               "solve: " + discrete.status +
+                               " (a thinner rod's exact ply is reached from a thicker one's: --from-ply)");
     const HardPlyStart seed = hard_ply_from_barrier(barrier, at.x, ply_contacts(discrete));
     const ShootingProblem hard(with_scaled_tolerance(seed.definition, slenderness));
     const ShootingResult solved = solve(hard, seed.x);
@@ -354,30 +399,10 @@ void follow_hard_ply(const Case& c, double slenderness, const ContinuationPoint&
                                ": the shooting problem with the discretised solution's " +
                                std::to_string(seed.definition.contacts.size()) +
                                " contacts did not solve: " + solved.summary.brief_report());
-    start.parameter_name = "turns";
-    start.last.parameter = at.parameter;
-    start.last.x = solved.x;
-    start.contacts = hard.contacts_at(solved.x);
-    start.piece_segments = hard.piece_segments();
+    start = solved_start(hard, solved.x, at.parameter);
     save_state(start_path, start);
   }
-  ShootingProblem problem = hard_ply_problem(c, slenderness, start);
-  PlectonemeBranchSummary legs;
-  BranchCsv csv(hard_csv, c.definition.parameters.get("EI"), slenderness, options, &legs, kHardMeasured);
-  csv.state().contacts = start.contacts;
-  csv.state().piece_segments = start.piece_segments;
-  summary->hard_ply_stop = follow_up_and_down(
-      problem, csv, start.last, turns_min, turns_max,
-      [&](double target) {
-        ContinuationOptions o = continuation_options(problem, c, slenderness, target, options);
-        o.derived = kHardMeasured;
-        o.events = complementarity_events();
-        return o;
-      },
-      &legs.refused_steps);
-  summary->hard_ply_points += legs.points;
-  summary->hard_ply = legs.ply;
-  summary->refused_steps += legs.refused_steps;
+  follow_hard_legs(c, slenderness, start, turns_min, turns_max, hard_csv, options, summary);
   summary->hard_ply_seconds += seconds_since(started);
 }
 
@@ -437,11 +462,18 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
 namespace {
 
 // Follows `problem` in `parameter` from x (at its current value) to `target`, with progress on
-// stderr; returns the end point. No measures are taken on the way (only the end matters).
+// stderr; returns the end point. No measures are taken on the way (only the end matters) unless
+// `events` watch them (a hard ply's complementarity): an event stops the move as a failure.
 ContinuationPoint move_ply(ShootingProblem& problem, const std::string& parameter, const Eigen::VectorXd& x,
-                           double target, double slenderness, const PlectonemeRunOptions& options) {
+                           double target, double slenderness, const PlectonemeRunOptions& options,
+                           const std::vector<ContinuationEvent>& events = {}) {
   ContinuationOptions o = ply_continuation(problem, parameter, target, slenderness, options);
   o.samples = 11;
+  if (!events.empty()) {
+    o.events = events;
+    o.derived = kHardMeasured;
+    o.samples = 10 * static_cast<int>(slenderness) + 1;  // as on the legs: R/10 apart at the target
+  }
   int points = 0;
   auto progress = [&](const ContinuationPoint& p) {
     if (options.progress_every > 0 && ++points % options.progress_every == 0)
@@ -502,6 +534,51 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
   return summary;
 }
 
+PlectonemeBranchSummary follow_hard_from_ply(const std::string& case_path, const std::string& base_start_path,
+                                             double base_slenderness, double slenderness, double turns_min,
+                                             double turns_max, const std::string& hard_csv,
+                                             const PlectonemeRunOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  PlectonemeBranchSummary summary;
+  summary.stop = "exact contact only, from the L/2R = " + std::to_string(static_cast<int>(base_slenderness)) +
+                 " exact ply";
+  if (hard_legs_complete(hard_csv, options)) {
+    summary.hard_ply_stop = "already complete";
+    return summary;
+  }
+  const Case c = load_case(case_path, {{"slenderness", slenderness}});
+  const std::string start_path = hard_csv + ".start.json";
+  RunState start;
+  if (options.resume && std::filesystem::exists(start_path)) {
+    start = load_state(start_path);
+  } else {
+    if (!std::filesystem::exists(base_start_path))
+      throw std::runtime_error(base_start_path + ": no exact ply of L/2R = " + std::to_string(base_slenderness) +
+                               " to start from (--hard-from on the slenderness before)");
+    const RunState base = load_state(base_start_path);
+    const Case thicker = load_case(case_path, {{"slenderness", base_slenderness}});
+    // The thicker rod's segments, moving with R: coarser per R on the way, re-segmented at the end.
+    ShootingProblem moving = hard_ply_problem(thicker, slenderness, base);
+    moving.set_parameter("turns", base.last.parameter);
+    std::cerr << "  from the L/2R = " << base_slenderness << " exact ply at turns = " << base.last.parameter << "\n";
+    const ContinuationPoint p =
+        move_ply(moving, "slenderness", base.last.x, slenderness, slenderness, options, complementarity_events());
+    ProblemDefinition barrier = c.definition;
+    barrier.parameters.set("turns", base.last.parameter);
+    const HardPlyStart seed = resegmented_hard_ply(barrier, moving, p.x);
+    const ShootingProblem hard(with_scaled_tolerance(seed.definition, slenderness));
+    const ShootingResult solved = solve(hard, seed.x);
+    if (!solved.summary.converged())
+      throw std::runtime_error("the exact ply re-segmented at L/2R = " + std::to_string(slenderness) +
+                               " did not solve: " + solved.summary.brief_report());
+    start = solved_start(hard, solved.x, base.last.parameter);
+    save_state(start_path, start);
+  }
+  follow_hard_legs(c, slenderness, start, turns_min, turns_max, hard_csv, options, &summary);
+  summary.hard_ply_seconds = seconds_since(started);
+  return summary;
+}
+
 int run_plectonemes(const PlectonemesArguments& args) {
   if (args.slenderness.size() != args.turns.size()) {
     std::cerr << "error: --slenderness and --turns need the same number of values\n";
@@ -522,7 +599,12 @@ int run_plectonemes(const PlectonemesArguments& args) {
       return 2;
     }
     const std::string csv = csv_of(sl);
-    if (via_ply)
+    const bool exact_only = via_ply && args.hard_from > 0.0;
+    const auto ply_csv_of = [&](double s) { return csv_of(s).substr(0, csv_of(s).size() - 4) + "_ply.csv"; };
+    if (exact_only)
+      std::cerr << "L/2R = " << sl << ": from the L/2R = " << args.slenderness[k - 1]
+                << " exact ply, then turns up to " << args.turns[k] << " and down to " << args.turns_min << "\n";
+    else if (via_ply)
       std::cerr << "L/2R = " << sl << ": from the L/2R = " << args.slenderness[k - 1] << " ply, then turns up to "
                 << args.turns[k] << " and down to " << args.turns_min << "\n";
     else
@@ -539,11 +621,19 @@ int run_plectonemes(const PlectonemesArguments& args) {
       options.hard_spacing = args.hard_spacing;
       options.hard_from = args.hard_from;
       options.hard_turns_min = args.turns_min;
-      const auto s = via_ply ? follow_from_ply(args.case_path, csv_of(args.slenderness[k - 1]) + ".state.json",
+      options.ply_max_step = args.ply_max_step;
+      const auto s = exact_only ? follow_hard_from_ply(args.case_path, ply_csv_of(args.slenderness[k - 1]) + ".start.json",
+                                                       args.slenderness[k - 1], sl, args.turns_min, args.turns[k],
+                                                       ply_csv_of(sl), options)
+                     : via_ply ? follow_from_ply(args.case_path, csv_of(args.slenderness[k - 1]) + ".state.json",
                                                args.slenderness[k - 1], sl, args.turns_min, args.turns[k], csv, options)
                              : follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, options);
       total += s.points;
-      std::cout << "L/2R = " << sl << ": " << s.points << " points in " << std::setprecision(3) << s.seconds << " s";
+      std::cout << "L/2R = " << sl << ": ";
+      if (exact_only)
+        std::cout << "no barrier branch";
+      else
+        std::cout << s.points << " points in " << std::setprecision(3) << s.seconds << " s";
       if (s.points > 0) std::cout << " (" << s.points / s.seconds << " points/s)";
       std::cout << std::setprecision(6) << ", " << s.refused_steps << " steps refused (through itself)";
       if (s.hard_points > 0)
@@ -555,7 +645,7 @@ int run_plectonemes(const PlectonemesArguments& args) {
                   << s.hard_ply_seconds << " s" << std::setprecision(6) << ", stopped: " << s.hard_ply_stop;
       }
       // Flushed: a sweep killed later keeps the lines of the branches it finished.
-      std::cout << ", stopped: " << s.stop << ", " << csv << std::endl;
+      std::cout << ", stopped: " << s.stop << ", " << (exact_only ? ply_csv_of(sl) : csv) << std::endl;
     } catch (const std::exception& e) {
       std::cerr << "L/2R = " << sl << ": " << e.what() << "\n";
       return 1;

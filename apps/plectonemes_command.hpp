@@ -13,6 +13,7 @@ namespace kirchhoff::cli {
 // there, so steps of tens are small.
 inline constexpr double kPlectonemeMaxStep = 60.0;
 inline constexpr int kPlectonemeReuseJacobian = 8;
+inline constexpr double kPlyMaxStep = 120.0;
 
 struct PlectonemeBranchSummary {
   int points = 0;
@@ -63,6 +64,11 @@ struct PlectonemeRunOptions {
   // changes there; not followed).
   double hard_from = 0.0;
   double hard_turns_min = 4.0;
+  // Largest pseudo-arclength step of the exact ply's legs at L/2R = 100, scaled with the forces:
+  // its unknowns hold 2-3 times the barrier's segments, so the same change of the ply is a longer
+  // step (L/2R = 200, 5 -> 8 and 5 -> 4.5 turns: 279 points in 41 s at 60, 152 in 21 s at 120,
+  // 94 in 20 s at 240, the end points the same to 11 digits).
+  double ply_max_step = kPlyMaxStep;
 };
 
 // Follows cases/plectoneme.toml (at `case_path`) with slenderness set, from turns = 0 to
@@ -85,6 +91,17 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
                                         double turns_max, const std::string& csv_path,
                                         const PlectonemeRunOptions& options);
 
+// With --hard-from, a slenderness in --from-ply is reached from the thicker rod's exact ply
+// instead (no barrier branch, no Ipopt: at L/2R = 500 Ipopt fails): its start (base_start_path,
+// the thicker rod's _ply.csv.start.json) is continued in slenderness with exact contact, every
+// step checked for complementarity (an event there is a failure), re-segmented by length at the
+// new R and solved, then followed in turns up to turns_max and down to turns_min into hard_csv
+// (the start saved beside it).
+PlectonemeBranchSummary follow_hard_from_ply(const std::string& case_path, const std::string& base_start_path,
+                                             double base_slenderness, double slenderness, double turns_min,
+                                             double turns_max, const std::string& hard_csv,
+                                             const PlectonemeRunOptions& options);
+
 struct PlectonemesArguments {
   std::string case_path;
   std::vector<double> slenderness{100, 200, 500, 1000};
@@ -101,6 +118,7 @@ struct PlectonemesArguments {
   double hard_contact_every = 0.0;
   double hard_spacing = 0.25;
   double hard_from = 0.0;
+  double ply_max_step = kPlyMaxStep;
 };
 
 int run_plectonemes(const PlectonemesArguments& args);

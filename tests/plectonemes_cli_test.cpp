@@ -3,6 +3,7 @@
 // repeat, the branch ends where the uninterrupted one ends, and a finished branch is left alone.
 #include <gtest/gtest.h>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -105,45 +106,63 @@ TEST_F(PlectonemesCli, FromPlyReachesAThinnerRodAndFollowsItBothWays) {
   EXPECT_EQ(lines_of(out / "plectoneme_110.csv"), rows);
 }
 
-TEST_F(PlectonemesCli, HardFromHandsThePlyToExactContactAndFollowsItBothWays) {
-  // L/2R = 100 on the barrier to 5 turns, then the ply with exact contact up to 5.4 and down to
-  // 4.7 turns (~30 s, most of it the barrier branch).
-  const fs::path out = dir_ / "exact";
-  const std::vector<std::string> args = {KIRCHHOFF_CLI, "plectonemes", "--slenderness", "100", "--turns", "5.4",
-                                         "--hard-from", "5", "--turns-min", "4.7", "--out", out.string()};
-  ASSERT_EQ(run_to_end(args, dir_ / "exact.log", true), 0);
-  const auto barrier = lines_of(out / "plectoneme_100.csv");
-  ASSERT_NE(barrier.back().find(",endpoint,"), std::string::npos);
-  EXPECT_NEAR(csv_field(barrier.back(), 1), 5.0, 1e-8);  // the barrier leg ends where the ply is handed over
-  const auto rows = lines_of(out / "plectoneme_100_ply.csv");
-  ASSERT_GT(rows.size(), 5u);
+// Rows of an exact-ply CSV (DIR/plectoneme_<L/2R>_ply.csv) for a rod of radius R: exact contact
+// (rho = R, column 5), complementarity (contact forces and the line's pressure > 0, no two sections
+// closer than 2R), H_A = H_B to the 1e-8, T R^2/EI on eq. (61) within the helix
+// approximation over this short ply (measured 0.5 - 1.3 % below from 4.7 to 5.4 turns at L/2R =
+// 100, 0.24 - 0.76 % at 150; bar 5 %), and the contact set a point, the line, a point. Returns the
+// rows' indices of the two legs' endpoints.
+std::vector<size_t> expect_exact_ply_rows(const std::vector<std::string>& rows, double R) {
   EXPECT_NE(rows[0].find("min_contact_force,min_wrap_pressure,ply_clearance,contact_count"), std::string::npos);
   std::vector<size_t> ends;
-  for (size_t i = 1; i < rows.size(); ++i)
-    if (rows[i].find(",endpoint,") != std::string::npos) ends.push_back(i);
-  ASSERT_EQ(ends.size(), 2u);
-  EXPECT_NEAR(csv_field(rows[ends[0]], 1), 5.4, 1e-8);
-  EXPECT_NEAR(csv_field(rows[ends[1]], 1), 4.7, 1e-8);
   for (size_t i = 1; i < rows.size(); ++i) {
     SCOPED_TRACE(rows[i]);
-    // Exact contact: rho = R (column 5 in units of L: R = 0.005), complementarity (contact forces
-    // and the line's pressure > 0, no two sections closer than 2R), H_A = H_B to the 1e-8,
-    // and T R^2/EI on eq. (61) within the helix approximation over this short ply (measured 0.5 -
-    // 1.3 % below from 4.7 to 5.4 turns; bar 5 %).
-    EXPECT_NEAR(csv_field(rows[i], 5) / 0.005, 1.0, 1e-3);
+    if (rows[i].find(",endpoint,") != std::string::npos) ends.push_back(i);
+    EXPECT_NEAR(csv_field(rows[i], 5) / R, 1.0, 1e-3);
     EXPECT_GT(csv_field(rows[i], 13), 0.0);
     EXPECT_GT(csv_field(rows[i], 14), 0.0);
     EXPECT_GE(csv_field(rows[i], 12), 1.0 - 1e-9);
     EXPECT_NEAR(csv_field(rows[i], 10) / csv_field(rows[i], 11), 1.0, 1e-8);
     EXPECT_NEAR(csv_field(rows[i], 17) / csv_field(rows[i], 18), 1.0, 0.05);
-    EXPECT_EQ(csv_field(rows[i], 16), 3.0);  // a point, the line, a point
+    EXPECT_EQ(csv_field(rows[i], 16), 3.0);
   }
+  return ends;
+}
+
+TEST_F(PlectonemesCli, HardFromHandsThePlyToExactContactAndFollowsItBothWays) {
+  // L/2R = 100 on the barrier to 5 turns, then the ply with exact contact up to 5.4 and down to
+  // 4.7 turns; L/2R = 150 from that exact ply at 5 turns (--from-ply: thinned with exact contact,
+  // no barrier branch), then the same legs (~45 s, most of it the barrier branch).
+  const fs::path out = dir_ / "exact";
+  const std::vector<std::string> args = {KIRCHHOFF_CLI, "plectonemes", "--slenderness", "100,150", "--turns",
+                                         "5.4,5.4", "--hard-from", "5", "--from-ply", "150", "--turns-min", "4.7",
+                                         "--out", out.string()};
+  ASSERT_EQ(run_to_end(args, dir_ / "exact.log", true), 0);
+  const auto barrier = lines_of(out / "plectoneme_100.csv");
+  ASSERT_NE(barrier.back().find(",endpoint,"), std::string::npos);
+  EXPECT_NEAR(csv_field(barrier.back(), 1), 5.0, 1e-8);  // the barrier leg ends where the ply is handed over
+  EXPECT_FALSE(fs::exists(out / "plectoneme_150.csv"));  // the thinner rod has no barrier branch
+  std::map<double, std::vector<std::string>> rows;
+  for (const auto& [slenderness, name] : {std::pair{100.0, "plectoneme_100_ply.csv"}, {150.0, "plectoneme_150_ply.csv"}}) {
+    SCOPED_TRACE(name);
+    rows[slenderness] = lines_of(out / name);
+    ASSERT_GT(rows[slenderness].size(), 5u);
+    const auto ends = expect_exact_ply_rows(rows[slenderness], 0.5 / slenderness);
+    ASSERT_EQ(ends.size(), 2u);
+    EXPECT_NEAR(csv_field(rows[slenderness][ends[0]], 1), 5.4, 1e-8);
+    EXPECT_NEAR(csv_field(rows[slenderness][ends[1]], 1), 4.7, 1e-8);
+  }
+  // Equal turns, a thinner rod: a ply of smaller helix angle (measured 0.220 against 0.273 rad at
+  // 5 turns), on (61) with its own R as the rows above check.
+  EXPECT_LT(csv_field(rows[150.0][1], 4), 0.9 * csv_field(rows[100.0][1], 4));
   std::string log;
   for (const auto& l : lines_of(dir_ / "exact.log")) log += l + "\n";
   EXPECT_NE(log.find("the ply with exact contact"), std::string::npos) << log;
-  // Run again with --resume: both legs are complete and left alone.
+  EXPECT_NE(log.find("from the L/2R = 100 exact ply"), std::string::npos) << log;
+  // Run again with --resume: all four legs are complete and left alone.
   auto again = args;
   again.push_back("--resume");
   ASSERT_EQ(run_to_end(again, dir_ / "again.log", true), 0);
-  EXPECT_EQ(lines_of(out / "plectoneme_100_ply.csv"), rows);
+  EXPECT_EQ(lines_of(out / "plectoneme_100_ply.csv"), rows[100.0]);
+  EXPECT_EQ(lines_of(out / "plectoneme_150_ply.csv"), rows[150.0]);
 }
