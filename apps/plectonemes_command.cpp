@@ -348,10 +348,10 @@ void follow_hard_legs(const Case& c, double slenderness, const RunState& start, 
   summary->refused_steps += legs.refused_steps;
 }
 
-// A complete hard ply CSV (both legs done) is left alone by a resumed run.
-bool hard_legs_complete(const std::string& hard_csv, const PlectonemeRunOptions& options) {
-  return options.resume && branch_complete(hard_csv) && std::filesystem::exists(hard_csv + ".state.json") &&
-         load_state(hard_csv + ".state.json").branch == 1;
+// A CSV whose both legs (up and down in turns) are done is left alone by a resumed run.
+bool both_legs_complete(const std::string& csv, const PlectonemeRunOptions& options) {
+  return options.resume && branch_complete(csv) && std::filesystem::exists(csv + ".state.json") &&
+         load_state(csv + ".state.json").branch == 1;
 }
 
 RunState solved_start(const ShootingProblem& hard, const Eigen::VectorXd& x, double turns) {
@@ -373,7 +373,7 @@ void follow_hard_ply(const Case& c, double slenderness, const ContinuationPoint&
                      PlectonemeBranchSummary* summary) {
   const auto started = std::chrono::steady_clock::now();
   const std::string start_path = hard_csv + ".start.json";
-  if (hard_legs_complete(hard_csv, options)) {
+  if (both_legs_complete(hard_csv, options)) {
     summary->hard_ply_stop = "already complete";
     return;
   }
@@ -496,8 +496,7 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
   const auto started = std::chrono::steady_clock::now();
   PlectonemeBranchSummary summary;
   const std::string start_path = csv_path + ".start.json";
-  if (options.resume && branch_complete(csv_path) && std::filesystem::exists(csv_path + ".state.json") &&
-      load_state(csv_path + ".state.json").branch == 1) {
+  if (both_legs_complete(csv_path, options)) {
     summary.stop = "already complete";
     return summary;
   }
@@ -542,7 +541,7 @@ PlectonemeBranchSummary follow_hard_from_ply(const std::string& case_path, const
   PlectonemeBranchSummary summary;
   summary.stop = "exact contact only, from the L/2R = " + std::to_string(static_cast<int>(base_slenderness)) +
                  " exact ply";
-  if (hard_legs_complete(hard_csv, options)) {
+  if (both_legs_complete(hard_csv, options)) {
     summary.hard_ply_stop = "already complete";
     return summary;
   }
