@@ -210,12 +210,17 @@ def fig11(profiles, figures):
 
     Reads profiles/plectoneme_<L/2R>.csv, the barrier branches (reproduce writes L/2R = 100 and 200;
     `kirchhoff plectonemes --out OUT/profiles` adds the other slendernesses), where rho is the computed
-    helix radius (R plus the barrier's gap), and profiles/plectoneme_<L/2R>_ply.csv where present, the
-    ply with exact contact (`plectonemes --hard-from`), where rho = R itself."""
+    helix radius (R plus the barrier's gap), and profiles/plectoneme_<L/2R>_ply.csv (or
+    profiles/exact/..., as reproduce writes them) where present, the ply with exact contact
+    (`plectonemes --hard-from`), where rho = R itself."""
     def slenderness(path):
         return int(path.stem.split("_")[1])
     barrier = sorted((p for p in profiles.glob("plectoneme_*.csv") if p.stem.split("_")[-1].isdigit()), key=slenderness)
-    exact = sorted(profiles.glob("plectoneme_*_ply.csv"), key=slenderness)
+    # reproduce writes exact plies into profiles/exact; `plectonemes --hard-from` runs written into
+    # profiles itself take precedence for their slendernesses.
+    exact = {slenderness(p): p for p in profiles.glob("exact/plectoneme_*_ply.csv")}
+    exact.update({slenderness(p): p for p in profiles.glob("plectoneme_*_ply.csv")})
+    exact = [exact[k] for k in sorted(exact)]
     if not barrier and not exact:
         return
     fig, (ax, axm) = plt.subplots(1, 2, figsize=(11, 4.2))
