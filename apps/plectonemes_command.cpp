@@ -583,6 +583,30 @@ int run_plectonemes(const PlectonemesArguments& args) {
     std::cerr << "error: --slenderness and --turns need the same number of values\n";
     return 2;
   }
+  const auto via_ply_at = [&](size_t k) {
+    return std::count(args.from_ply.begin(), args.from_ply.end(), args.slenderness[k]) > 0;
+  };
+  // Whether branch k ends with an exact ply (--hard-from below its turns, or reached from one).
+  std::function<bool(size_t)> has_exact_ply = [&](size_t k) {
+    if (!(args.hard_from > 0.0)) return false;
+    return via_ply_at(k) && k > 0 ? has_exact_ply(k - 1) : args.hard_from < args.turns[k];
+  };
+  // Refused before anything runs: a branch from a ply the sweep would not have.
+  for (size_t k = 0; k < args.slenderness.size(); ++k) {
+    if (!via_ply_at(k)) continue;
+    const double sl = args.slenderness[k];
+    if (k == 0 || !(args.slenderness[k - 1] < sl)) {
+      std::cerr << "error: L/2R = " << sl << " is reached from the ply of the slenderness before it in --slenderness, "
+                << "which must be smaller\n";
+      return 2;
+    }
+    if (args.hard_from > 0.0 && !has_exact_ply(k - 1)) {
+      std::cerr << "error: L/2R = " << sl << " is reached from the exact ply of L/2R = " << args.slenderness[k - 1]
+                << ", which has none: --hard-from " << args.hard_from << " must be below its --turns "
+                << args.turns[k - 1] << "\n";
+      return 2;
+    }
+  }
   std::filesystem::create_directories(args.out_dir);
   const auto started = std::chrono::steady_clock::now();
   const auto csv_of = [&](double sl) {
@@ -591,12 +615,7 @@ int run_plectonemes(const PlectonemesArguments& args) {
   int total = 0;
   for (size_t k = 0; k < args.slenderness.size(); ++k) {
     const double sl = args.slenderness[k];
-    const bool via_ply = std::count(args.from_ply.begin(), args.from_ply.end(), sl) > 0;
-    if (via_ply && (k == 0 || !(args.slenderness[k - 1] < sl))) {
-      std::cerr << "error: L/2R = " << sl << " is reached from the ply of the slenderness before it in --slenderness, "
-                << "which must be smaller\n";
-      return 2;
-    }
+    const bool via_ply = via_ply_at(k);
     const std::string csv = csv_of(sl);
     const bool exact_only = via_ply && args.hard_from > 0.0;
     const auto ply_csv_of = [&](double s) { return csv_of(s).substr(0, csv_of(s).size() - 4) + "_ply.csv"; };

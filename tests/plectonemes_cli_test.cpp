@@ -166,3 +166,18 @@ TEST_F(PlectonemesCli, HardFromHandsThePlyToExactContactAndFollowsItBothWays) {
   EXPECT_EQ(lines_of(out / "plectoneme_100_ply.csv"), rows[100.0]);
   EXPECT_EQ(lines_of(out / "plectoneme_150_ply.csv"), rows[150.0]);
 }
+
+TEST_F(PlectonemesCli, RefusesAnExactPlyFromASlendernessThatHasNone) {
+  // L/2R = 150 would start from the exact ply of 100, whose branch ends (4 turns) before --hard-from
+  // (5): refused as input before anything runs, naming both slendernesses and the reason.
+  const fs::path out = dir_ / "refused";
+  const std::vector<std::string> args = {KIRCHHOFF_CLI, "plectonemes", "--slenderness", "100,150", "--turns", "4,5",
+                                         "--hard-from", "5", "--from-ply", "150", "--out", out.string()};
+  ASSERT_EQ(run_to_end(args, dir_ / "refused.log", true), 2);
+  std::string log;
+  for (const auto& l : lines_of(dir_ / "refused.log")) log += l + "\n";
+  EXPECT_NE(log.find("L/2R = 150 is reached from the exact ply of L/2R = 100, which has none"), std::string::npos)
+      << log;
+  EXPECT_NE(log.find("--hard-from 5 must be below its --turns 4"), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(out));  // nothing was computed or written
+}
