@@ -324,7 +324,7 @@ std::vector<ContinuationEvent> complementarity_events() {
 // contacts and segments per piece): followed in turns up to turns_max (branch 0) and from the same
 // start down to turns_min (branch 1) into hard_csv, each leg stopping where complementarity would
 // fail; a resumed run resumes the leg it was in. (Re-segmenting a leg every turn as its line
-// contact lengthens was tried: the same points, 1.5-3 times slower at L/2R = 200.)
+// contact lengthens was tried: the same end points, 1.7-3 times slower at L/2R = 200.)
 void follow_hard_legs(const Case& c, double slenderness, const RunState& start, double turns_min, double turns_max,
                       const std::string& hard_csv, const PlectonemeRunOptions& options,
                       PlectonemeBranchSummary* summary) {
