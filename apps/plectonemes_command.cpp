@@ -354,12 +354,18 @@ bool both_legs_complete(const std::string& csv, const PlectonemeRunOptions& opti
          load_state(csv + ".state.json").branch == 1;
 }
 
-RunState solved_start(const ShootingProblem& hard, const Eigen::VectorXd& x, double turns) {
+// The start of a hard ply's legs at `turns`: `seed` solved, tolerances scaled with the forces.
+// Throws "<what> did not solve: ..." when it does not.
+RunState solved_start(const HardPlyStart& seed, double slenderness, double turns, const std::string& what) {
+  const ShootingProblem hard(with_scaled_tolerance(seed.definition, slenderness));
+  const ShootingResult solved = solve(hard, seed.x);
+  if (!solved.summary.converged())
+    throw std::runtime_error(what + " did not solve: " + solved.summary.brief_report());
   RunState start;
   start.parameter_name = "turns";
   start.last.parameter = turns;
-  start.last.x = x;
-  start.contacts = hard.contacts_at(x);
+  start.last.x = solved.x;
+  start.contacts = hard.contacts_at(solved.x);
   start.piece_segments = hard.piece_segments();
   return start;
 }
@@ -392,14 +398,10 @@ void follow_hard_ply(const Case& c, double slenderness, const ContinuationPoint&
                                "solve: " + discrete.status +
                                " (a thinner rod's exact ply is reached from a thicker one's: --from-ply)");
     const HardPlyStart seed = hard_ply_from_barrier(barrier, at.x, ply_contacts(discrete));
-    const ShootingProblem hard(with_scaled_tolerance(seed.definition, slenderness));
-    const ShootingResult solved = solve(hard, seed.x);
-    if (!solved.summary.converged())
-      throw std::runtime_error("hard contact at turns = " + std::to_string(at.parameter) +
-                               ": the shooting problem with the discretised solution's " +
-                               std::to_string(seed.definition.contacts.size()) +
-                               " contacts did not solve: " + solved.summary.brief_report());
-    start = solved_start(hard, solved.x, at.parameter);
+    start = solved_start(seed, slenderness, at.parameter,
+                         "hard contact at turns = " + std::to_string(at.parameter) +
+                             ": the shooting problem with the discretised solution's " +
+                             std::to_string(seed.definition.contacts.size()) + " contacts");
     save_state(start_path, start);
   }
   follow_hard_legs(c, slenderness, start, turns_min, turns_max, hard_csv, options, summary);
@@ -562,15 +564,9 @@ PlectonemeBranchSummary follow_hard_from_ply(const std::string& case_path, const
     std::cerr << "  from the L/2R = " << base_slenderness << " exact ply at turns = " << base.last.parameter << "\n";
     const ContinuationPoint p =
         move_ply(moving, "slenderness", base.last.x, slenderness, slenderness, options, complementarity_events());
-    ProblemDefinition barrier = c.definition;
-    barrier.parameters.set("turns", base.last.parameter);
-    const HardPlyStart seed = resegmented_hard_ply(barrier, moving, p.x);
-    const ShootingProblem hard(with_scaled_tolerance(seed.definition, slenderness));
-    const ShootingResult solved = solve(hard, seed.x);
-    if (!solved.summary.converged())
-      throw std::runtime_error("the exact ply re-segmented at L/2R = " + std::to_string(slenderness) +
-                               " did not solve: " + solved.summary.brief_report());
-    start = solved_start(hard, solved.x, base.last.parameter);
+    // (The re-segmented problem takes its parameters from `moving` at p.)
+    start = solved_start(resegmented_hard_ply(c.definition, moving, p.x), slenderness, base.last.parameter,
+                         "the exact ply re-segmented at L/2R = " + std::to_string(slenderness));
     save_state(start_path, start);
   }
   follow_hard_legs(c, slenderness, start, turns_min, turns_max, hard_csv, options, &summary);

@@ -526,6 +526,22 @@ PointContactTerms point_contact_terms(const RodEquations& eq, const Obstacle& o,
   return t;
 }
 
+// A point contact's two rows at `row` (on the obstacle and tangent to it), with their Jacobian
+// through S = dy/dx there and the contact arclength's own column (J null: the rows alone).
+// Returns the next row.
+int point_contact_rows(const PointContactTerms& t, const Eigen::MatrixXd& S, int s_column, Eigen::VectorXd* F,
+                       Eigen::MatrixXd* J, int row) {
+  (*F)[row] = t.here.gap;
+  (*F)[row + 1] = t.here.tangency;
+  if (J) {
+    J->row(row) = t.d_rows.row(0) * S;
+    J->row(row + 1) = t.d_rows.row(1) * S;
+    J->row(row)[s_column] += t.d_s[0];
+    J->row(row + 1)[s_column] += t.d_s[1];
+  }
+  return row + 2;
+}
+
 // The cylinder a spatial rod lies on over an extended contact.
 CylinderSupport support_of(const Obstacle& o) {
   CylinderSupport c;
@@ -597,18 +613,7 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
       const PointContactTerms terms = point_contact_terms(*eq, o, y, s1, J != nullptr);
       const Obstacle::ContactConditions& here = terms.here;
       const Eigen::VectorXd jump = -force.transpose() * here.normal;  // n jumps by -force * nu
-      if (b.kind != Breakpoint::ExtendedEnd) {
-        // On the obstacle and tangent to it.
-        (*F)[row] = here.gap;
-        (*F)[row + 1] = here.tangency;
-        if (J) {
-          J->row(row) = terms.d_rows.row(0) * S;
-          J->row(row + 1) = terms.d_rows.row(1) * S;
-          J->row(row)[b.s_column] += terms.d_s[0];
-          J->row(row + 1)[b.s_column] += terms.d_s[1];
-        }
-        row += 2;
-      }
+      if (b.kind != Breakpoint::ExtendedEnd) row = point_contact_rows(terms, S, b.s_column, F, J, row);
       if (b.kind == Breakpoint::ExtendedStart) {
         // On the obstacle from here: its curvature (none on a plane), and no normal force once the
         // jump is applied.
@@ -774,16 +779,8 @@ bool ShootingProblem::residual_pieces(const Eigen::VectorXd& x, const Parameters
     Eigen::VectorXd jump;
     if (b.kind == Breakpoint::Point) {
       const PointContactTerms terms = point_contact_terms(*eq, o, y, b.s, J != nullptr);
-      (*F)[row] = terms.here.gap;
-      (*F)[row + 1] = terms.here.tangency;
-      if (J) {
-        J->row(row) = terms.d_rows.row(0) * S;
-        J->row(row + 1) = terms.d_rows.row(1) * S;
-        J->row(row)[b.s_column] += terms.d_s[0];
-        J->row(row + 1)[b.s_column] += terms.d_s[1];
-        if (!o.is_flat()) S -= b.force * force.transpose() * terms.d_normal * S;
-      }
-      row += 2;
+      row = point_contact_rows(terms, S, b.s_column, F, J, row);
+      if (J && !o.is_flat()) S -= b.force * force.transpose() * terms.d_normal * S;
       jump = -force.transpose() * terms.here.normal;  // n jumps by -force * nu
     } else {
       // A spatial rod on a cylinder (the only extended contact of multiple shooting): entering, it
