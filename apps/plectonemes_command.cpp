@@ -519,7 +519,7 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
     start.parameter_name = "turns";
     start.last = p;
     start.last.parameter = base.last.parameter;
-    start.last.jacobian.resize(0, 0);
+    start.last.jacobian.reset();
     save_state(start_path, start);
   }
   problem.set_parameter("slenderness", slenderness);

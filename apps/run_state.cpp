@@ -50,7 +50,7 @@ void save_state(const std::filesystem::path& path, const RunState& s) {
 
 void save_resume_point(const std::filesystem::path& path, const ContinuationPoint& p, RunState* state) {
   state->last = p;
-  state->last.jacobian.resize(0, 0);  // not needed to resume
+  state->last.jacobian.reset();  // not needed to resume
   state->saved_row = state->row;
   save_state(path, *state);
 }

@@ -384,7 +384,7 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
   auto keep = [&](const ContinuationResult& r, int branch) {
     for (const auto& p : r.points) {
       points.push_back({p, branch});
-      points.back().point.jacobian.resize(0, 0);
+      points.back().point.jacobian.reset();
     }
   };
   {

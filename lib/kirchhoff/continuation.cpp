@@ -106,12 +106,12 @@ bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen:
     return problem_.evaluate(x, F, nullptr, failure);
   }
   ++evaluations_.matrices;
-  Eigen::MatrixXd J;
   Eigen::VectorXd y_end, F_lambda;
-  if (!problem_.evaluate_with_end(x, F, &J, &y_end, failure)) return false;
+  if (!problem_.evaluate_with_end(x, F, A, &y_end, failure)) return false;
   if (!problem_.parameter_derivative(x, options_.parameter, &F_lambda, failure, &y_end)) return false;
-  A->resize(n_, n_ + 1);
-  A->leftCols(n_) = J;
+  // A column appended in place: the matrices of long rods are tens of megabytes, and realloc
+  // extends such blocks without copying them.
+  A->conservativeResize(n_, n_ + 1);
   A->col(n_) = F_lambda;
   return true;
 }
@@ -119,12 +119,11 @@ bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen:
 bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
                            int* iterations, const Eigen::MatrixXd* chord, bool* by_chord) {
   Eigen::VectorXd F, G(n_ + 1);
-  Eigen::MatrixXd A, M(n_ + 1, n_ + 1);
+  Eigen::MatrixXd A;
   std::string failure;
   int it = 0;
   if (chord && chord->rows() == n_) {
-    M << *chord, normal.transpose();
-    const JacobianLU lu(M);
+    const JacobianLU lu(*chord, normal);
     if (lu.reciprocal_condition() > 1e-15) {
       const Eigen::VectorXd z_start = z;
       double previous = INFINITY;
@@ -175,8 +174,7 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
       return true;
     }
     if (!lu) {
-      M << A, normal.transpose();
-      lu.emplace(M);
+      lu.emplace(A, normal);
       if (!(lu->reciprocal_condition() > 1e-15)) {
         std::ostringstream os;
         os << "singular bordered matrix (reciprocal condition " << lu->reciprocal_condition() << ", residual " << norm
@@ -197,19 +195,17 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
 
 std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous,
                                                         PointType type, int index, double arclength, int iterations,
-                                                        const Eigen::MatrixXd* reused) {
+                                                        std::shared_ptr<const Eigen::MatrixXd> reused) {
   Eigen::VectorXd F;
   Eigen::MatrixXd A;
   std::string failure;
   if (!reused && !evaluate(z, &F, &A, &failure)) return std::nullopt;
-  Eigen::MatrixXd M(n_ + 1, n_ + 1);
-  M << (reused ? *reused : A), previous.transpose();
+  const Eigen::MatrixXd& FxFl = reused ? *reused : A;
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n_ + 1);
   rhs[n_] = 1.0;
-  Eigen::VectorXd t = JacobianLU(M).solve(rhs);
+  Eigen::VectorXd t = JacobianLU(FxFl, previous).solve(rhs);
   if (!t.allFinite() || t.norm() == 0.0) return std::nullopt;
   t.normalize();
-  M.row(n_) = t.transpose();
 
   ContinuationPoint p;
   p.index = index;
@@ -220,16 +216,18 @@ std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z
   p.arclength = arclength;
   p.newton_iterations = iterations;
   p.jacobian_reused = reused != nullptr;
-  p.jacobian = reused ? *reused : std::move(A);
   // The determinant and singular values only serve branch-point detection, and the SVD costs
   // O(n^3) with a large constant: on multiple-shooting problems of several hundred unknowns it
   // was 95 % of a run.
   if (options_.detect_branch_points) {
+    Eigen::MatrixXd M(n_ + 1, n_ + 1);
+    M << FxFl, t.transpose();
     p.determinant = JacobianLU(M).determinant();
     const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(M).singularValues();
     p.smallest_singular = sv[n_] / sv[0];
     for (int i = 0; i <= n_; ++i) p.small_count += sv[i] / sv[0] < options_.branch_point_tolerance ? 1 : 0;
   }
+  p.jacobian = reused ? std::move(reused) : std::make_shared<const Eigen::MatrixXd>(std::move(A));
   describe(&p);
   return p;
 }
@@ -258,14 +256,15 @@ std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint
   Eigen::VectorXd z = z_pred;
   int iterations = 0;
   bool by_chord = false;
-  if (!correct(z, z_pred, from.tangent, &iterations, &from.jacobian, &by_chord)) return std::nullopt;
+  if (!correct(z, z_pred, from.tangent, &iterations, from.jacobian.get(), &by_chord)) return std::nullopt;
   // A corrector that converged quickly on the previous matrix shows that matrix still serves:
   // the new point keeps it for its tangent and the next chord instead of paying for its own.
   // (Not a modified-Newton matrix from an iterate of this corrector: tried at L/2R = 200, its
   // tangents cost three times the run time in harder correctors.)
-  const bool reuse = by_chord && iterations <= options_.reuse_jacobian_iterations && from.jacobian.rows() == n_;
+  const bool reuse =
+      by_chord && iterations <= options_.reuse_jacobian_iterations && from.jacobian && from.jacobian->rows() == n_;
   return point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations,
-                  reuse ? &from.jacobian : nullptr);
+                  reuse ? from.jacobian : nullptr);
 }
 std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& from, double h_max,
                                                       const std::function<double(const ContinuationPoint&)>& monitor,
@@ -419,7 +418,7 @@ ContinuationResult Continuation::switch_branch(const ContinuationPoint& bp, cons
 ContinuationResult Continuation::march(ContinuationPoint current, const PointSink& sink) {
   ContinuationResult result;
   result.points.push_back(current);
-  if (current.type != PointType::BranchPoint) result.points.back().jacobian.resize(0, 0);
+  if (current.type != PointType::BranchPoint) result.points.back().jacobian.reset();
   if (sink) sink(current);
   double ds = current.step > 0 ? current.step : options_.initial_step;
   std::optional<ContinuationPoint> before_current;  // the point before `current`, for minima
@@ -430,13 +429,13 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
 
   // Only branch points keep their matrix in the branch (for switching); the newest point's moves
   // on to `current`, for the next corrector's chord. A long branch keeping every one would hold
-  // n^2 doubles per point, and copying them cost ~10 % of a point at L/2R = 500.
-  Eigen::MatrixXd newest_matrix;
+  // n^2 doubles per point.
+  std::shared_ptr<const Eigen::MatrixXd> newest_matrix;
   auto accept = [&](ContinuationPoint p) {
     p.index = result.points.back().index + 1;
     p.step = ds;
     newest_matrix = std::move(p.jacobian);
-    p.jacobian = p.type == PointType::BranchPoint ? newest_matrix : Eigen::MatrixXd();
+    p.jacobian = p.type == PointType::BranchPoint ? newest_matrix : nullptr;
     result.points.push_back(std::move(p));
     if (sink) sink(result.points.back());
   };

@@ -19,6 +19,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -113,8 +114,11 @@ struct ContinuationPoint {
   double determinant = 0.0;
   double smallest_singular = 0.0;
   int small_count = 0;
-  // [F_x F_lambda] at this point: the next corrector starts with chord iterations on it.
-  Eigen::MatrixXd jacobian;
+  // [F_x F_lambda] at this point: the next corrector starts with chord iterations on it. Shared:
+  // a point that keeps the previous point's matrix (reuse_jacobian_iterations) shares it rather
+  // than copying tens of megabytes on long rods. Empty once a point is recorded in a branch
+  // (branch points keep theirs, for switching).
+  std::shared_ptr<const Eigen::MatrixXd> jacobian;
 };
 
 // Inadmissible: a contact continuation reached a point that penetrates an obstacle or has a
@@ -179,7 +183,7 @@ class Continuation {
   // With `reused`, that matrix stands for [F_x F_lambda] at z (no evaluation).
   std::optional<ContinuationPoint> point_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous, PointType type,
                                             int index, double arclength, int iterations,
-                                            const Eigen::MatrixXd* reused = nullptr);
+                                            std::shared_ptr<const Eigen::MatrixXd> reused = nullptr);
   ContinuationResult march(ContinuationPoint start, const PointSink& sink);
   // Locates where `monitor` (of the point reached from `from` by a step h) vanishes or is
   // minimal, by the secant method or Brent on h in (0, h_max].

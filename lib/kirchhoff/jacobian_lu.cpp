@@ -2,38 +2,98 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace kirchhoff {
 
-JacobianLU::JacobianLU(const Eigen::MatrixXd& unscaled) {
+namespace {
+
+// [top; bottom^T] (bottom empty: top alone) scaled by rows, as a compressed sparse matrix, built in
+// one pass over top in its storage order; the row maxima (the scaling) are applied to the values
+// afterwards. nullopt when more than kSparseDensity of the entries are non-zero. The Jacobians of
+// long rods are tens of megabytes dense: neither the bordered nor the scaled matrix is formed.
+std::optional<Eigen::SparseMatrix<double>> sparse_bordered(const Eigen::MatrixXd& top, const Eigen::VectorXd& bottom,
+                                                           double density, Eigen::VectorXd* row_scale) {
+  const Eigen::Index rows = top.rows() + (bottom.size() > 0 ? 1 : 0), cols = top.cols();
+  const auto allowed = static_cast<Eigen::Index>(density * static_cast<double>(rows * cols));
+  Eigen::VectorXd row_max = Eigen::VectorXd::Zero(rows);
+  Eigen::SparseMatrix<double> S(rows, cols);
+  S.reserve(std::min<Eigen::Index>(allowed, 32 * rows));
+  Eigen::Index nonzeros = 0;
+  for (Eigen::Index j = 0; j < cols; ++j) {
+    S.startVec(j);
+    const double* column = top.col(j).data();
+    for (Eigen::Index i = 0; i < top.rows(); ++i)
+      if (const double v = column[i]; v != 0.0) {
+        S.insertBack(i, j) = v;
+        row_max[i] = std::max(row_max[i], std::abs(v));
+        ++nonzeros;
+      }
+    if (bottom.size() > 0 && bottom[j] != 0.0) {
+      S.insertBack(rows - 1, j) = bottom[j];
+      row_max[rows - 1] = std::max(row_max[rows - 1], std::abs(bottom[j]));
+      ++nonzeros;
+    }
+    if (nonzeros > allowed) return std::nullopt;
+  }
+  S.finalize();
+  *row_scale = row_max.unaryExpr([](double v) { return v > 0 ? 1.0 / v : 1.0; });
+  for (Eigen::Index j = 0; j < cols; ++j)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(S, j); it; ++it) it.valueRef() *= (*row_scale)[it.row()];
+  return S;
+}
+
+Eigen::MatrixXd stacked(const Eigen::MatrixXd& top, const Eigen::VectorXd& bottom) {
+  if (bottom.size() == 0) return top;
+  Eigen::MatrixXd M(top.rows() + 1, top.cols());
+  M << top, bottom.transpose();
+  return M;
+}
+
+}  // namespace
+
+JacobianLU::JacobianLU(const Eigen::MatrixXd& M) : JacobianLU(M, Eigen::VectorXd()) {}
+
+JacobianLU::JacobianLU(const Eigen::MatrixXd& top, const Eigen::VectorXd& bottom) {
   // Rows of large matrices are equilibrated first: residuals of forces (~1e4 on a tight
   // plectoneme) sit beside residuals of positions and quaternions (~1), and unscaled, that spread
   // alone made the condition estimate of a well-posed corrector matrix fall below the singularity
   // threshold. Small matrices are factorised as they come: they are well scaled, and the planar
   // contact continuations (the hanging fold) follow branches so close to branch points that
   // rounding of another pivot sequence sent them onto the asymmetric branch.
-  const Eigen::Index n = unscaled.rows();
+  const Eigen::Index n = top.rows() + (bottom.size() > 0 ? 1 : 0);
   row_scale_ = Eigen::VectorXd::Ones(n);
-  if (n >= kSparseFrom)
-    row_scale_ = unscaled.cwiseAbs().rowwise().maxCoeff().unaryExpr([](double v) { return v > 0 ? 1.0 / v : 1.0; });
-  const Eigen::MatrixXd M = row_scale_.asDiagonal() * unscaled;
-  const Eigen::Index nonzeros = n >= kSparseFrom ? (M.array() != 0.0).count() : n * n;
-  if (nonzeros <= kSparseDensity * static_cast<double>(n * n)) {
-    sparse_ = std::make_unique<Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>>>();
-    const Eigen::SparseMatrix<double> S = M.sparseView(1.0, 0.0);
-    sparse_->compute(S);
-    ok_ = sparse_->info() == Eigen::Success;
-    rcond_ = ok_ ? estimate_reciprocal_condition(M) : 0.0;
-    if (rcond_ > 0.0) return;
-    // Sparse LU pivots within a column of the fill-reducing order; where that meets an exact zero
-    // the dense LU, free to pivot over the whole column, decides whether M is singular.
-    sparse_.reset();
+  if (n >= kSparseFrom) {
+    if (auto S = sparse_bordered(top, bottom, kSparseDensity, &row_scale_)) {
+      sparse_ = std::make_unique<Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>>>();
+      sparse_->compute(*S);
+      ok_ = sparse_->info() == Eigen::Success;
+      rcond_ = ok_ ? estimate_reciprocal_condition(one_norm(*S)) : 0.0;
+      if (rcond_ > 0.0) return;
+      // Sparse LU pivots within a column of the fill-reducing order; where that meets an exact
+      // zero the dense LU, free to pivot over the whole column, decides whether M is singular.
+      sparse_.reset();
+    }
+    const Eigen::MatrixXd M = stacked(top, bottom);
+    row_scale_ = M.cwiseAbs().rowwise().maxCoeff().unaryExpr([](double v) { return v > 0 ? 1.0 / v : 1.0; });
+    dense_.compute(row_scale_.asDiagonal() * M);
+  } else {
+    dense_.compute(stacked(top, bottom));
   }
-  dense_.compute(M);
   ok_ = true;
   const Eigen::VectorXd pivots = dense_.matrixLU().diagonal().cwiseAbs();
   const double largest = n > 0 ? pivots.maxCoeff() : 0.0;
   rcond_ = largest > 0 ? std::min(dense_.rcond(), pivots.minCoeff() / largest) : 0.0;
+}
+
+double JacobianLU::one_norm(const Eigen::SparseMatrix<double>& S) {
+  double largest = 0.0;
+  for (Eigen::Index j = 0; j < S.outerSize(); ++j) {
+    double column = 0.0;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(S, j); it; ++it) column += std::abs(it.value());
+    largest = std::max(largest, column);
+  }
+  return largest;
 }
 
 Eigen::VectorXd JacobianLU::solve(const Eigen::VectorXd& b) const { return solve_scaled(row_scale_.cwiseProduct(b)); }
@@ -68,9 +128,8 @@ double JacobianLU::determinant() const {
 
 // Hager's estimate of |M^-1|_1 (as LAPACK's dgecon and Eigen's dense rcond use), with solves by
 // the sparse factors: a handful of solves instead of forming the inverse.
-double JacobianLU::estimate_reciprocal_condition(const Eigen::MatrixXd& M) const {
-  const Eigen::Index n = M.rows();
-  const double norm_M = M.cwiseAbs().colwise().sum().maxCoeff();
+double JacobianLU::estimate_reciprocal_condition(double norm_M) const {
+  const Eigen::Index n = row_scale_.size();
   if (!(norm_M > 0)) return 0.0;
   Eigen::VectorXd x = Eigen::VectorXd::Constant(n, 1.0 / static_cast<double>(n));
   double estimate = 0.0;

@@ -16,6 +16,8 @@ namespace kirchhoff {
 class JacobianLU {
  public:
   explicit JacobianLU(const Eigen::MatrixXd& M);
+  // The bordered matrix [top; bottom^T] (the continuation's [F_x F_lambda; t^T]) without forming it.
+  JacobianLU(const Eigen::MatrixXd& top, const Eigen::VectorXd& bottom);
 
   // False when the factorisation broke down (an exactly singular sparse matrix).
   bool ok() const { return ok_; }
@@ -36,7 +38,9 @@ class JacobianLU {
  private:
   Eigen::VectorXd solve_scaled(const Eigen::VectorXd& b) const;  // by the factors of the row-scaled matrix
   Eigen::VectorXd solve_transposed(const Eigen::VectorXd& b) const;
-  double estimate_reciprocal_condition(const Eigen::MatrixXd& M) const;
+  // Of the factorised (row-scaled) matrix, whose 1-norm is norm_M.
+  double estimate_reciprocal_condition(double norm_M) const;
+  static double one_norm(const Eigen::SparseMatrix<double>& S);
 
   Eigen::VectorXd row_scale_;  // 1 / largest |entry| of each row
   bool ok_ = false;
