@@ -76,5 +76,29 @@ TEST(FiniteDifferenceFallback, ConvergesToTheSameSolution) {
   EXPECT_NEAR(a.parameters["P"], b.parameters["P"], 1e-9 * a.parameters["P"]);
 }
 
+// sensitivity_tol integrates the variational equations at a looser tolerance than the state.
+// The residual must be the very number an evaluation without sensitivities gives (the
+// corrector's chords compare the two), and Phi must still be the Jacobian to about the looser
+// tolerance: RK78's error per step is held to 1e-8 of each component, and a segment of ~10 R
+// takes tens of steps, so ~1e-7 of the largest entry is the expected error, 1e-5 the bound.
+TEST(LooseSensitivities, KeepTheResidualAndTheJacobianToTheirTolerance) {
+  Case c = load_case(testing::case_path("plectoneme.toml"), {{"turns", 1.5}});
+  const ShootingProblem tight(c.definition);
+  c.definition.options.integrator.sensitivity_tol = 1e-8;
+  const ShootingProblem loose(c.definition);
+  const Eigen::VectorXd x = perturbed_guess(tight, c, 0.01);
+  Eigen::VectorXd F_tight, F_loose, F_alone;
+  Eigen::MatrixXd J_tight, J_loose;
+  std::string failure;
+  ASSERT_TRUE(tight.evaluate(x, &F_tight, &J_tight, &failure)) << failure;
+  ASSERT_TRUE(loose.evaluate(x, &F_loose, &J_loose, &failure)) << failure;
+  ASSERT_TRUE(loose.evaluate(x, &F_alone, nullptr, &failure)) << failure;
+  EXPECT_EQ((F_loose - F_alone).cwiseAbs().maxCoeff(), 0.0);
+  const double scale = J_tight.cwiseAbs().maxCoeff();
+  const double difference = (J_loose - J_tight).cwiseAbs().maxCoeff() / scale;
+  EXPECT_LE(difference, 1e-5);
+  EXPECT_GT(difference, 0.0);  // the looser integration did run
+}
+
 }  // namespace
 }  // namespace kirchhoff

@@ -661,8 +661,8 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
 
   // [solver]
   if (const Value* s = Reader::find(root, "solver")) {
-    reader.allow_keys(*s, "solver", {"unknowns", "segments", "stepper", "abs_tol", "rel_tol", "tolerance",
-                                     "max_iterations", "jacobian", "fallback_search", "phase_condition",
+    reader.allow_keys(*s, "solver", {"unknowns", "segments", "stepper", "abs_tol", "rel_tol", "sensitivity_tol",
+                                     "tolerance", "max_iterations", "jacobian", "fallback_search", "phase_condition",
                                      "threads"});
     ShootingOptions& o = d.options;
     if (const Value* v = Reader::find(*s, "unknowns")) {
@@ -698,6 +698,7 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
     };
     positive("abs_tol", &o.integrator.abs_tol);
     positive("rel_tol", &o.integrator.rel_tol);
+    positive("sensitivity_tol", &o.integrator.sensitivity_tol);
     positive("tolerance", &o.newton.residual_tolerance);
     if (const Value* v = Reader::find(*s, "max_iterations")) {
       o.newton.max_iterations = static_cast<int>(reader.integer(*v, "solver.max_iterations"));

@@ -20,6 +20,14 @@ struct IntegratorOptions {
   double rel_tol = 1e-12;   // relative error per step
   double initial_step = 1e-2;  // first trial step as a fraction of the segment length
   long max_steps = 200000;     // per segment; beyond this the integration is reported as failed
+  // Tolerance (absolute and relative) of the variational equations alone; 0: those of the state.
+  // When set, a flow with sensitivities is two integrations: the state at abs_tol/rel_tol (the
+  // very computation a residual without sensitivities makes, so F is the same number either way)
+  // and state plus Phi at this looser tolerance. Newton, chords and tangents need Phi to a few
+  // digits only, and RK78 takes (tol ratio)^(1/8) fewer steps: at 1e-8 against 1e-13 about four
+  // times fewer on the duals that are most of a long rod's cost. Branch-point location, whose
+  // smallest singular values reach ~1e-12, needs Phi as accurate as the state: leave it 0 there.
+  double sensitivity_tol = 0.0;
 
   // Returns an empty string when valid, else the reason.
   std::string validate() const;

@@ -66,7 +66,28 @@ SegmentFlow flow_state(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, dou
 // arithmetic. Returns Phi restricted to those columns (N x K) in out.Phi.
 template <int N, int K, class Rhs>
 SegmentFlow flow_with_partial_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                            const IntegratorOptions& opt, const std::array<int, K>& seeds);
+
+// Phi at opt.sensitivity_tol, the state at the state's own tolerance (IntegratorOptions).
+template <int N, int K, class Rhs>
+SegmentFlow flow_with_loose_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                          const IntegratorOptions& opt, const std::array<int, K>& seeds) {
+  IntegratorOptions loose = opt;
+  loose.abs_tol = loose.rel_tol = opt.sensitivity_tol;
+  loose.sensitivity_tol = 0.0;
+  SegmentFlow out = flow_with_partial_sensitivities<N, K>(rhs, y0, s0, s1, loose, seeds);
+  const SegmentFlow state = flow_state<N>(rhs, y0, s0, s1, opt);
+  out.y = state.y;
+  out.steps += state.steps;
+  out.rhs_evaluations += state.rhs_evaluations;
+  return out;
+}
+
+template <int N, int K, class Rhs>
+SegmentFlow flow_with_partial_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
                                             const IntegratorOptions& opt, const std::array<int, K>& seeds) {
+  if (opt.sensitivity_tol > 0 && opt.sensitivity_tol > opt.abs_tol)
+    return flow_with_loose_sensitivities<N, K>(rhs, y0, s0, s1, opt, seeds);
   using State = std::array<double, N + N * K>;  // y, then the N x K block row-major
   State x{};
   for (int i = 0; i < N; ++i) x[i] = y0[i];

@@ -34,6 +34,7 @@ std::string ShootingOptions::validate() const {
 
 std::string IntegratorOptions::validate() const {
   if (!(abs_tol > 0) || !(rel_tol >= 0)) return "integrator tolerances must be > 0";
+  if (!(sensitivity_tol >= 0)) return "sensitivity_tol must be >= 0 (0: the state's tolerances)";
   if (!(initial_step > 0) || initial_step > 1) return "initial_step must be in (0, 1]";
   if (max_steps < 1) return "max_steps must be >= 1";
   return {};
