@@ -3,9 +3,11 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <set>
 #include <vector>
 
 #include "kirchhoff/self_passage.hpp"
+#include "kirchhoff/spatial_bins.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {
@@ -64,6 +66,37 @@ TEST(SelfPassage, RefusesDifferentSamplings) {
   shorter.pop_back();
   EXPECT_THROW(closest_approach_in_motion(hairpin(Vec3(0, 0, 2.2 * kR)), shorter, M_PI * kR, kR),
                std::invalid_argument);
+}
+
+// The binned search visits every pair closer than the cell among the strided points, each once
+// with i < j: checked against all pairs on a cloud (points on both sides of the origin, so cubes
+// of negative index too) and on the hairpin's two strands.
+TEST(NearPairs, AreEveryPairCloserThanTheCellVisitedOnce) {
+  std::vector<Vec3> cloud;
+  for (int k = 0; k < 600; ++k)
+    cloud.push_back(Vec3(std::sin(1.3 * k), std::cos(0.7 * k + 0.2), std::sin(0.37 * k) * std::cos(2.1 * k)));
+  std::vector<Vec3> strands;
+  for (const auto& section : hairpin(Vec3(0.0, 0.0, 2.2 * kR))) strands.push_back(section.r);
+  for (const auto& [points, cell] : {std::pair{cloud, 0.15}, std::pair{strands, 4.0 * kR}})
+    for (const std::size_t stride : {1, 3}) {
+      std::set<std::pair<std::size_t, std::size_t>> visited;
+      int repeats = 0;
+      for_each_near_pair(points, cell, stride, [&](std::size_t i, std::size_t j) {
+        EXPECT_LT(i, j);
+        EXPECT_EQ(i % stride, 0u);
+        EXPECT_EQ(j % stride, 0u);
+        repeats += visited.insert({i, j}).second ? 0 : 1;
+      });
+      EXPECT_EQ(repeats, 0);
+      int close = 0;
+      for (std::size_t i = 0; i < points.size(); i += stride)
+        for (std::size_t j = i + stride; j < points.size(); j += stride)
+          if ((points[i] - points[j]).norm() < cell) {
+            ++close;
+            EXPECT_TRUE(visited.count({i, j})) << i << " " << j;
+          }
+      EXPECT_GT(close, 20);  // the case has pairs to find
+    }
 }
 
 }  // namespace

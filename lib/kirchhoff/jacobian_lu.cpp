@@ -18,7 +18,9 @@ std::optional<Eigen::SparseMatrix<double>> sparse_bordered(const Eigen::MatrixXd
   const auto allowed = static_cast<Eigen::Index>(density * static_cast<double>(rows * cols));
   Eigen::VectorXd row_max = Eigen::VectorXd::Zero(rows);
   Eigen::SparseMatrix<double> S(rows, cols);
-  S.reserve(std::min<Eigen::Index>(allowed, 32 * rows));
+  // All the room the sparse path may use, at once: insertBack grows the storage one entry at a
+  // time past its capacity (quadratic), and untouched capacity costs no more than its address space.
+  S.reserve(allowed + 1);
   Eigen::Index nonzeros = 0;
   for (Eigen::Index j = 0; j < cols; ++j) {
     S.startVec(j);

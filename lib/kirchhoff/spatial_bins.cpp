@@ -1,35 +1,43 @@
 #include "kirchhoff/spatial_bins.hpp"
 
+#include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <unordered_map>
+#include <tuple>
 
 namespace kirchhoff {
+namespace {
 
-void for_each_near_pair(const std::vector<Vec3>& points, double cell, std::size_t stride,
-                        const std::function<void(std::size_t, std::size_t)>& visit) {
-  auto cube = [&](const Vec3& r) {
-    return Eigen::Vector3i(static_cast<int>(std::floor(r.x() / cell)), static_cast<int>(std::floor(r.y() / cell)),
-                           static_cast<int>(std::floor(r.z() / cell)));
-  };
-  // Cubes that share a hash share a bin: more pairs get visited, none is missed.
-  auto key = [](const Eigen::Vector3i& c) {
-    return (static_cast<int64_t>(c.x()) * 73856093) ^ (static_cast<int64_t>(c.y()) * 19349663) ^
-           (static_cast<int64_t>(c.z()) * 83492791);
-  };
-  std::unordered_map<int64_t, std::vector<std::size_t>> bins;
-  for (std::size_t i = 0; i < points.size(); i += stride) bins[key(cube(points[i]))].push_back(i);
+bool before(const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
+  return std::tie(a.x(), a.y(), a.z()) < std::tie(b.x(), b.y(), b.z());
+}
+
+}  // namespace
+
+CubeBins::CubeBins(const std::vector<Vec3>& points, double cell, std::size_t stride) {
+  std::vector<std::pair<Eigen::Vector3i, std::size_t>> binned;
+  binned.reserve(points.size() / stride + 1);
   for (std::size_t i = 0; i < points.size(); i += stride) {
-    const Eigen::Vector3i c = cube(points[i]);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const auto bin = bins.find(key(c + Eigen::Vector3i(dx, dy, dz)));
-          if (bin == bins.end()) continue;
-          for (const std::size_t j : bin->second)
-            if (j > i) visit(i, j);
-        }
+    const Vec3& r = points[i];
+    binned.emplace_back(Eigen::Vector3i(static_cast<int>(std::floor(r.x() / cell)),
+                                        static_cast<int>(std::floor(r.y() / cell)),
+                                        static_cast<int>(std::floor(r.z() / cell))),
+                        i);
   }
+  std::sort(binned.begin(), binned.end(), [](const auto& a, const auto& b) {
+    return before(a.first, b.first) || (a.first == b.first && a.second < b.second);
+  });
+  indices_.reserve(binned.size());
+  for (std::size_t k = 0; k < binned.size(); ++k) {
+    if (k == 0 || binned[k].first != binned[k - 1].first) cubes_.push_back(Cube{binned[k].first, k, k});
+    indices_.push_back(binned[k].second);
+    cubes_.back().end = k + 1;
+  }
+}
+
+const CubeBins::Cube* CubeBins::find(const Eigen::Vector3i& at) const {
+  const auto it = std::lower_bound(cubes_.begin(), cubes_.end(), at,
+                                   [](const Cube& c, const Eigen::Vector3i& v) { return before(c.at, v); });
+  return it != cubes_.end() && it->at == at ? &*it : nullptr;
 }
 
 }  // namespace kirchhoff
