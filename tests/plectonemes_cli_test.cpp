@@ -3,6 +3,8 @@
 // repeat, the branch ends where the uninterrupted one ends, and a finished branch is left alone.
 #include <gtest/gtest.h>
 
+#include <iomanip>
+#include <iostream>
 #include <map>
 #include <string>
 #include <vector>
@@ -60,6 +62,25 @@ TEST_F(PlectonemesCli, KilledSweepResumesOnTheSameBranch) {
   std::string all;
   for (const auto& l : log) all += l + "\n";
   EXPECT_NE(all.find("already complete"), std::string::npos) << all;
+}
+
+// The barrier branches' Jacobian at --sensitivity-tol (default 1e-8) against the case's 1e-13:
+// the residual is the same function either way, so both runs solve the same equations and differ
+// only by their corrector paths (other Jacobians, so other steps): the branch must end at the same
+// T_ext to the 1e-5 that tells those paths (1.5e-6, see above) from another branch (O(1) apart).
+// Measured: 153.472687192 against 153.472687089 (7e-10), in 124 and 90 rows.
+TEST_F(PlectonemesCli, LooseSensitivitiesFollowTheSameBranch) {
+  const fs::path loose = dir_ / "loose", tight = dir_ / "tight";
+  ASSERT_EQ(run_to_end(sweep_args(loose), dir_ / "loose.log", true), 0);
+  auto tight_args = sweep_args(tight);
+  tight_args.insert(tight_args.end(), {"--sensitivity-tol", "0"});
+  ASSERT_EQ(run_to_end(tight_args, dir_ / "tight.log", true), 0);
+  const auto a = lines_of(loose / "plectoneme_100.csv"), b = lines_of(tight / "plectoneme_100.csv");
+  ASSERT_NE(a.back().find(",endpoint,"), std::string::npos);
+  ASSERT_NE(b.back().find(",endpoint,"), std::string::npos);
+  EXPECT_NEAR(csv_field(a.back(), 3) / csv_field(b.back(), 3), 1.0, 1e-5);
+  std::cerr << std::setprecision(12) << "T_ext at 3 turns: " << csv_field(a.back(), 3) << " (1e-8) and " << csv_field(b.back(), 3)
+            << " (the case's), " << a.size() << " and " << b.size() << " rows\n";
 }
 
 }  // namespace
