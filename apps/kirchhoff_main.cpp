@@ -242,10 +242,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   plectonemes_cmd
       ->add_option("--sensitivity-tol", plect.sensitivity_tol,
-                   "Tolerance of the barrier branches' variational equations (the Jacobian), integrated apart from the "
-                   "state, which keeps the case's 1e-13: Newton and the tangents need the Jacobian to a few digits, "
-                   "and at 1e-8 the sweep is 2.25 times faster with the branch ends the same to 10-12 digits "
-                   "(0: the case's; the exact ply always keeps the case's)")
+                   "Tolerance of the variational equations (the Jacobian) of the barrier branches and of the exact "
+                   "ply's legs, integrated apart from the state, which keeps the case's 1e-13: Newton and the "
+                   "tangents need the Jacobian to a few digits, and at 1e-8 the sweep is 2.25 times faster with the "
+                   "branch ends the same to 10-12 digits (0: the case's; the exact ply's first solve from its seed "
+                   "always keeps the case's)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
 

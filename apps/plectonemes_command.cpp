@@ -82,8 +82,9 @@ ProblemDefinition with_scaled_tolerance(ProblemDefinition d, double slenderness)
 
 // A barrier branch's problem: the tolerance scaled with the forces and the variational equations
 // at options.sensitivity_tol (IntegratorOptions; the sweep 2.25 times faster, its branch ends the
-// same to 10-12 digits). Not for the exact ply: at 1e-8 its first Newton solve from the Ipopt seed
-// diverged (an integration underflow by the third iteration), so it keeps the case's tolerance.
+// same to 10-12 digits). Not for the exact ply's first solve from its seed: at 1e-8 Newton
+// diverged there (an integration underflow by the third iteration); its legs use it
+// (follow_hard_legs).
 ProblemDefinition barrier_definition(ProblemDefinition d, double slenderness, const PlectonemeRunOptions& options) {
   if (options.sensitivity_tol > 0) d.options.integrator.sensitivity_tol = options.sensitivity_tol;
   return with_scaled_tolerance(std::move(d), slenderness);
@@ -310,9 +311,12 @@ std::string follow_up_and_down(ShootingProblem& problem, BranchCsv& csv, const C
 namespace {
 
 // The hard-contact ply's problem: the barrier case's definition at `turns` with exact self-contact
-// where `start` says (its contacts and segments per piece), tolerances scaled with the forces.
-ShootingProblem hard_ply_problem(const Case& c, double slenderness, const RunState& start) {
+// where `start` says (its contacts and segments per piece), tolerances scaled with the forces, the
+// variational equations at sensitivity_tol (0: the case's).
+ShootingProblem hard_ply_problem(const Case& c, double slenderness, const RunState& start,
+                                 double sensitivity_tol = 0.0) {
   ProblemDefinition barrier = c.definition;
+  if (sensitivity_tol > 0) barrier.options.integrator.sensitivity_tol = sensitivity_tol;
   barrier.parameters.set("turns", start.last.parameter);
   ProblemDefinition d = hard_ply_definition(barrier, start.contacts);
   d.piece_segments = start.piece_segments;  // x's layout (set by length where x was solved)
@@ -337,7 +341,10 @@ std::vector<ContinuationEvent> complementarity_events() {
 void follow_hard_legs(const Case& c, double slenderness, const RunState& start, double turns_min, double turns_max,
                       const std::string& hard_csv, const PlectonemeRunOptions& options,
                       PlectonemeBranchSummary* summary) {
-  ShootingProblem problem = hard_ply_problem(c, slenderness, start);
+  // The legs continue from a solved start, so their Jacobian can be looser (L/2R = 100, 5 -> 10
+  // and 5 -> 4 turns at 1e-8: 32.9 s -> 17.7 s, T_ext at the ends equal to 11 digits, the contact
+  // forces to 2e-9); the start's own solve from its seed keeps the case's.
+  ShootingProblem problem = hard_ply_problem(c, slenderness, start, options.sensitivity_tol);
   PlectonemeBranchSummary legs;
   BranchCsv csv(hard_csv, c.definition.parameters.get("EI"), slenderness, options, &legs, kHardMeasured);
   csv.state().contacts = start.contacts;

@@ -14,8 +14,9 @@ namespace kirchhoff::cli {
 inline constexpr double kPlectonemeMaxStep = 60.0;
 inline constexpr int kPlectonemeReuseJacobian = 8;
 inline constexpr double kPlyMaxStep = 120.0;
-// The barrier branches' variational equations at this tolerance (the state stays at the case's
-// 1e-13): the whole sweep 703 s -> 312 s, the branch ends the same to 10-12 digits.
+// The variational equations of the barrier branches and of the exact ply's legs at this tolerance
+// (the state stays at the case's 1e-13): the whole sweep 703 s -> 312 s, the branch ends the same
+// to 10-12 digits.
 inline constexpr double kPlectonemeSensitivityTol = 1e-8;
 
 struct PlectonemeBranchSummary {
@@ -72,8 +73,8 @@ struct PlectonemeRunOptions {
   // step (L/2R = 200, 5 -> 8 and 5 -> 4.5 turns: 279 points in 41 s at 60, 152 in 21 s at 120,
   // 94 in 20 s at 240, the end points the same to 11 digits).
   double ply_max_step = kPlyMaxStep;
-  // The barrier branches' IntegratorOptions::sensitivity_tol (0: the case's); the exact ply keeps
-  // the case's.
+  // IntegratorOptions::sensitivity_tol of the barrier branches and of the exact ply's legs (0: the
+  // case's); the exact ply's first solve from its seed keeps the case's.
   double sensitivity_tol = kPlectonemeSensitivityTol;
 };
 
@@ -125,8 +126,8 @@ struct PlectonemesArguments {
   double hard_spacing = 0.25;
   double hard_from = 0.0;
   double ply_max_step = kPlyMaxStep;
-  // The barrier branches' IntegratorOptions::sensitivity_tol (0: the case's); the exact ply keeps
-  // the case's.
+  // IntegratorOptions::sensitivity_tol of the barrier branches and of the exact ply's legs (0: the
+  // case's); the exact ply's first solve from its seed keeps the case's.
   double sensitivity_tol = kPlectonemeSensitivityTol;
 };
 
