@@ -20,7 +20,8 @@ struct IntegratorOptions {
   double rel_tol = 1e-12;   // relative error per step
   double initial_step = 1e-2;  // first trial step as a fraction of the segment length
   long max_steps = 200000;     // per segment; beyond this the integration is reported as failed
-  // Tolerance (absolute and relative) of the variational equations alone; 0: those of the state.
+  // Tolerance (absolute and relative) of the variational equations alone; 0 (or anything not
+  // looser than abs_tol): those of the state, in one pass.
   // When set, a flow with sensitivities is two integrations: the state at abs_tol/rel_tol (the
   // very computation a residual without sensitivities makes, so F is the same number either way)
   // and state plus Phi at this looser tolerance. Newton, chords and tangents need Phi to a few

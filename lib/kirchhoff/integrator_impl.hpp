@@ -86,7 +86,7 @@ SegmentFlow flow_with_loose_sensitivities(const Rhs& rhs, const Eigen::VectorXd&
 template <int N, int K, class Rhs>
 SegmentFlow flow_with_partial_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
                                             const IntegratorOptions& opt, const std::array<int, K>& seeds) {
-  if (opt.sensitivity_tol > 0 && opt.sensitivity_tol > opt.abs_tol)
+  if (opt.sensitivity_tol > opt.abs_tol)  // (abs_tol > 0, so 0 keeps the one pass)
     return flow_with_loose_sensitivities<N, K>(rhs, y0, s0, s1, opt, seeds);
   using State = std::array<double, N + N * K>;  // y, then the N x K block row-major
   State x{};
