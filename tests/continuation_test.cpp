@@ -205,6 +205,41 @@ TEST(EulerColumn, StepCheckShortensRefusedStepsOrStopsTheRun) {
   EXPECT_EQ(refused.result.points.size(), 1u);
 }
 
+// A run resumed from one of its points (as `--resume` does from the saved state) hands its points
+// to the sink as it finds them, like a fresh run, so that killed again it keeps what it had
+// computed: when the first new point reaches the sink, the march has taken one step, not the rest
+// of the branch (measured: 1 residual then, 17 for the 11 points to P = 30; before the fix every
+// point reached the sink after the last). It then walks the same branch: the same points as the
+// uninterrupted run to kLocated.
+TEST(EulerColumn, ResumedRunReportsEachPointAsItIsFound) {
+  ContinuationOptions o = euler_options();
+  o.target = 30.0;
+  o.detect_branch_points = false;
+  const BranchRun whole = continue_case("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, o);
+  ASSERT_EQ(whole.result.reason, StopReason::ReachedTarget) << whole.result.message;
+  ASSERT_GT(whole.result.points.size(), 8u);
+  const ContinuationPoint& saved = whole.result.points[2];
+
+  ShootingProblem problem = *whole.problem;
+  problem.set_parameter("P", saved.parameter);
+  Continuation resumed(problem, o);
+  int residuals_at_first_point = -1;
+  std::vector<ContinuationPoint> reported;
+  const ContinuationResult r = resumed.resume(saved, [&](const ContinuationPoint& p) {
+    if (reported.empty()) residuals_at_first_point = resumed.evaluations().residuals;
+    reported.push_back(p);
+  });
+  ASSERT_EQ(r.reason, StopReason::ReachedTarget) << r.message;
+  ASSERT_EQ(reported.size(), r.points.size());
+  EXPECT_EQ(reported.front().index, saved.index + 1);  // the saved point itself is not reported again
+  EXPECT_GT(resumed.evaluations().residuals, 4 * residuals_at_first_point);
+  std::cout << reported.size() << " points resumed; residuals " << residuals_at_first_point << " at the first, "
+            << resumed.evaluations().residuals << " in all\n";
+  EXPECT_NEAR(reported.back().parameter, 30.0, 1e-9);
+  for (size_t k = 0; k < reported.size() && 3 + k < whole.result.points.size(); ++k)
+    EXPECT_NEAR(reported[k].parameter, whole.result.points[3 + k].parameter, kLocated) << k;
+}
+
 ContinuationOptions twist_options() {
   ContinuationOptions o;
   o.parameter = "phi";

@@ -351,11 +351,15 @@ ContinuationResult Continuation::resume(const ContinuationPoint& last, const Poi
     return result;
   }
   start->step = last.step > 0 ? last.step : options_.initial_step;
-  ContinuationResult r = march(*start, {});
-  // march reports its start point first; a resumed run already has it.
+  // march reports its start point first; a resumed run already has it. The rest go to the sink
+  // as they are found, so that a resumed run killed again keeps what it had computed.
+  bool start_skipped = false;
+  const PointSink after_start = [&](const ContinuationPoint& p) {
+    if (start_skipped && sink) sink(p);
+    start_skipped = true;
+  };
+  ContinuationResult r = march(*start, after_start);
   if (!r.points.empty()) r.points.erase(r.points.begin());
-  if (sink)
-    for (const auto& p : r.points) sink(p);
   return r;
 }
 
