@@ -10,6 +10,7 @@
 #include <iostream>
 #include <numeric>
 #include <optional>
+#include <sstream>
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/case_file.hpp"
@@ -257,6 +258,7 @@ class BranchCsv {
     if (options_.progress_every > 0 && summary_->points % options_.progress_every == 0)
       std::cerr << "  L/2R = " << slenderness_ << "  point " << state_.row << "  turns = " << std::setprecision(6)
                 << p.parameter << "\n";
+    if (options_.after_point) options_.after_point();
   }
 
  private:
@@ -590,47 +592,55 @@ PlectonemeBranchSummary follow_hard_from_ply(const std::string& case_path, const
   return summary;
 }
 
-int run_plectonemes(const PlectonemesArguments& args) {
-  if (args.slenderness.size() != args.turns.size()) {
-    std::cerr << "error: --slenderness and --turns need the same number of values\n";
-    return 2;
-  }
-  const auto via_ply_at = [&](size_t k) {
-    return std::count(args.from_ply.begin(), args.from_ply.end(), args.slenderness[k]) > 0;
-  };
-  // Whether branch k ends with an exact ply (--hard-from below its turns, or reached from one).
-  std::function<bool(size_t)> has_exact_ply = [&](size_t k) {
-    if (!(args.hard_from > 0.0)) return false;
-    return via_ply_at(k) && k > 0 ? has_exact_ply(k - 1) : args.hard_from < args.turns[k];
-  };
-  // Refused before anything runs: a branch from a ply the sweep would not have.
+namespace {
+
+// Whether slenderness k of the sweep is reached from the ply of the one before it (--from-ply).
+bool reached_from_ply(const PlectonemesArguments& args, size_t k) {
+  return std::count(args.from_ply.begin(), args.from_ply.end(), args.slenderness[k]) > 0;
+}
+
+// Whether branch k ends with an exact ply (--hard-from below its turns, or reached from one).
+bool has_exact_ply(const PlectonemesArguments& args, size_t k) {
+  if (!(args.hard_from > 0.0)) return false;
+  return reached_from_ply(args, k) && k > 0 ? has_exact_ply(args, k - 1) : args.hard_from < args.turns[k];
+}
+
+}  // namespace
+
+std::string plectonemes_input_error(const PlectonemesArguments& args) {
+  if (args.slenderness.size() != args.turns.size()) return "--slenderness and --turns need the same number of values";
   for (size_t k = 0; k < args.slenderness.size(); ++k) {
-    if (!via_ply_at(k)) continue;
+    if (!reached_from_ply(args, k)) continue;
     const double sl = args.slenderness[k];
+    std::ostringstream e;
     if (k == 0 || !(args.slenderness[k - 1] < sl)) {
-      std::cerr << "error: L/2R = " << sl << " is reached from the ply of the slenderness before it in --slenderness, "
-                << "which must be smaller\n";
-      return 2;
+      e << "L/2R = " << sl << " is reached from the ply of the slenderness before it in --slenderness, "
+        << "which must be smaller";
+      return e.str();
     }
-    if (args.hard_from > 0.0 && !has_exact_ply(k - 1)) {
-      std::cerr << "error: L/2R = " << sl << " is reached from the exact ply of L/2R = " << args.slenderness[k - 1]
-                << ", which has none: --hard-from " << args.hard_from << " must be below its --turns "
-                << args.turns[k - 1] << "\n";
-      return 2;
+    if (args.hard_from > 0.0 && !has_exact_ply(args, k - 1)) {
+      e << "L/2R = " << sl << " is reached from the exact ply of L/2R = " << args.slenderness[k - 1]
+        << ", which has none: --hard-from " << args.hard_from << " must be below its --turns " << args.turns[k - 1];
+      return e.str();
     }
   }
+  return "";
+}
+
+PlectonemeSweep sweep_plectonemes(const PlectonemesArguments& args, std::ostream& report) {
+  if (const std::string e = plectonemes_input_error(args); !e.empty()) throw std::invalid_argument(e);
   std::filesystem::create_directories(args.out_dir);
   const auto started = std::chrono::steady_clock::now();
   const auto csv_of = [&](double sl) {
     return args.out_dir + "/plectoneme_" + std::to_string(static_cast<int>(sl)) + ".csv";
   };
-  int total = 0;
+  const auto ply_csv_of = [&](double sl) { return csv_of(sl).substr(0, csv_of(sl).size() - 4) + "_ply.csv"; };
+  PlectonemeSweep sweep;
   for (size_t k = 0; k < args.slenderness.size(); ++k) {
     const double sl = args.slenderness[k];
-    const bool via_ply = via_ply_at(k);
+    const bool via_ply = reached_from_ply(args, k);
     const std::string csv = csv_of(sl);
     const bool exact_only = via_ply && args.hard_from > 0.0;
-    const auto ply_csv_of = [&](double s) { return csv_of(s).substr(0, csv_of(s).size() - 4) + "_ply.csv"; };
     if (exact_only)
       std::cerr << "L/2R = " << sl << ": from the L/2R = " << args.slenderness[k - 1]
                 << " exact ply, then turns up to " << args.turns[k] << " and down to " << args.turns_min << "\n";
@@ -639,52 +649,73 @@ int run_plectonemes(const PlectonemesArguments& args) {
                 << args.turns[k] << " and down to " << args.turns_min << "\n";
     else
       std::cerr << "L/2R = " << sl << ": turns 0 -> " << args.turns[k] << "\n";
+    PlectonemeRunOptions options;
+    options.progress_every = 50;
+    options.max_step = args.max_step;
+    options.reuse_jacobian = args.reuse_jacobian;
+    options.modified_newton = args.modified_newton;
+    options.resume = args.resume;
+    options.ply_log_softness = args.ply_log_softness;
+    options.hard_contact_every = args.hard_contact_every;
+    options.hard_spacing = args.hard_spacing;
+    options.hard_from = args.hard_from;
+    options.hard_turns_min = args.turns_min;
+    options.ply_max_step = args.ply_max_step;
+    options.sensitivity_tol = args.sensitivity_tol;
+    options.after_point = args.after_point;
+    PlectonemeSweepBranch branch;
+    branch.slenderness = sl;
     try {
-      PlectonemeRunOptions options;
-      options.progress_every = 50;
-      options.max_step = args.max_step;
-      options.reuse_jacobian = args.reuse_jacobian;
-      options.modified_newton = args.modified_newton;
-      options.resume = args.resume;
-      options.ply_log_softness = args.ply_log_softness;
-      options.hard_contact_every = args.hard_contact_every;
-      options.hard_spacing = args.hard_spacing;
-      options.hard_from = args.hard_from;
-      options.hard_turns_min = args.turns_min;
-      options.ply_max_step = args.ply_max_step;
-      options.sensitivity_tol = args.sensitivity_tol;
-      const auto s = exact_only ? follow_hard_from_ply(args.case_path, ply_csv_of(args.slenderness[k - 1]) + ".start.json",
-                                                       args.slenderness[k - 1], sl, args.turns_min, args.turns[k],
-                                                       ply_csv_of(sl), options)
-                     : via_ply ? follow_from_ply(args.case_path, csv_of(args.slenderness[k - 1]) + ".state.json",
-                                               args.slenderness[k - 1], sl, args.turns_min, args.turns[k], csv, options)
-                             : follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, options);
-      total += s.points;
-      std::cout << "L/2R = " << sl << ": ";
-      if (exact_only)
-        std::cout << "no barrier branch";
-      else
-        std::cout << s.points << " points in " << std::setprecision(3) << s.seconds << " s";
-      if (s.points > 0) std::cout << " (" << s.points / s.seconds << " points/s)";
-      std::cout << std::setprecision(6) << ", " << s.refused_steps << " steps refused (through itself)";
-      if (s.hard_points > 0)
-        std::cout << ", " << s.hard_points << " points re-solved with hard contact (" << s.hard_failures
-                  << " failed) in " << std::setprecision(3) << s.hard_seconds << " s" << std::setprecision(6);
-      if (!s.hard_ply_stop.empty()) {
-        total += s.hard_ply_points;
-        std::cout << "; the ply with exact contact: " << s.hard_ply_points << " points in " << std::setprecision(3)
-                  << s.hard_ply_seconds << " s" << std::setprecision(6) << ", stopped: " << s.hard_ply_stop;
-      }
-      // Flushed: a sweep killed later keeps the lines of the branches it finished.
-      std::cout << ", stopped: " << s.stop << ", " << (exact_only ? ply_csv_of(sl) : csv) << std::endl;
+      branch.summary =
+          exact_only ? follow_hard_from_ply(args.case_path, ply_csv_of(args.slenderness[k - 1]) + ".start.json",
+                                            args.slenderness[k - 1], sl, args.turns_min, args.turns[k], ply_csv_of(sl),
+                                            options)
+          : via_ply  ? follow_from_ply(args.case_path, csv_of(args.slenderness[k - 1]) + ".state.json",
+                                       args.slenderness[k - 1], sl, args.turns_min, args.turns[k], csv, options)
+                     : follow_plectoneme_branch(args.case_path, sl, args.turns[k], csv, options);
     } catch (const std::exception& e) {
-      std::cerr << "L/2R = " << sl << ": " << e.what() << "\n";
-      return 1;
+      std::ostringstream what;
+      what << "L/2R = " << sl << ": " << e.what();
+      throw std::runtime_error(what.str());
     }
+    const PlectonemeBranchSummary& s = branch.summary;
+    if (!exact_only) branch.barrier_csv = csv;
+    if (!s.hard_ply_stop.empty()) branch.ply_csv = ply_csv_of(sl);
+    sweep.points += s.points + s.hard_ply_points;
+    report << "L/2R = " << sl << ": ";
+    if (exact_only)
+      report << "no barrier branch";
+    else
+      report << s.points << " points in " << std::setprecision(3) << s.seconds << " s";
+    if (s.points > 0) report << " (" << s.points / s.seconds << " points/s)";
+    report << std::setprecision(6) << ", " << s.refused_steps << " steps refused (through itself)";
+    if (s.hard_points > 0)
+      report << ", " << s.hard_points << " points re-solved with hard contact (" << s.hard_failures << " failed) in "
+             << std::setprecision(3) << s.hard_seconds << " s" << std::setprecision(6);
+    if (!s.hard_ply_stop.empty())
+      report << "; the ply with exact contact: " << s.hard_ply_points << " points in " << std::setprecision(3)
+             << s.hard_ply_seconds << " s" << std::setprecision(6) << ", stopped: " << s.hard_ply_stop;
+    // Flushed: a sweep killed later keeps the lines of the branches it finished.
+    report << ", stopped: " << s.stop << ", " << (exact_only ? ply_csv_of(sl) : csv) << std::endl;
+    sweep.branches.push_back(std::move(branch));
   }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  std::cout << "sweep: " << total << " points in " << std::setprecision(4) << seconds << " s ("
-            << total / seconds << " points/s)\n";
+  sweep.seconds = seconds_since(started);
+  return sweep;
+}
+
+int run_plectonemes(const PlectonemesArguments& args) {
+  if (const std::string e = plectonemes_input_error(args); !e.empty()) {
+    std::cerr << "error: " << e << "\n";
+    return 2;
+  }
+  try {
+    const PlectonemeSweep sweep = sweep_plectonemes(args, std::cout);
+    std::cout << "sweep: " << sweep.points << " points in " << std::setprecision(4) << sweep.seconds << " s ("
+              << sweep.points / sweep.seconds << " points/s)\n";
+  } catch (const std::exception& e) {
+    std::cerr << e.what() << "\n";
+    return 1;
+  }
   return 0;
 }
 

@@ -3,7 +3,9 @@
 // CSV rows of T_ext rho^2/EI against the helical angle beside eq. (61).
 #pragma once
 
+#include <functional>
 #include <map>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -76,6 +78,9 @@ struct PlectonemeRunOptions {
   // IntegratorOptions::sensitivity_tol of the barrier branches and of the exact ply's legs (0: the
   // case's); the exact ply's first solve from its seed keeps the case's.
   double sensitivity_tol = kPlectonemeSensitivityTol;
+  // Called after every point is written (the Python module checks for Ctrl-C there); may throw
+  // to stop the run, which a resume then continues.
+  std::function<void()> after_point;
 };
 
 // Follows cases/plectoneme.toml (at `case_path`) with slenderness set, from turns = 0 to
@@ -129,8 +134,34 @@ struct PlectonemesArguments {
   // IntegratorOptions::sensitivity_tol of the barrier branches and of the exact ply's legs (0: the
   // case's); the exact ply's first solve from its seed keeps the case's.
   double sensitivity_tol = kPlectonemeSensitivityTol;
+  std::function<void()> after_point;  // PlectonemeRunOptions::after_point
 };
 
+// What a sweep computed for one slenderness: the CSV of its barrier branch (empty for one reached
+// from a thicker rod's exact ply) and of its exact ply (empty without hard_from), and its summary.
+struct PlectonemeSweepBranch {
+  double slenderness = 0.0;
+  std::string barrier_csv, ply_csv;
+  PlectonemeBranchSummary summary;
+};
+
+struct PlectonemeSweep {
+  std::vector<PlectonemeSweepBranch> branches;
+  int points = 0;  // computed by this run (a resumed run counts only its own)
+  double seconds = 0.0;
+};
+
+// Why `args` cannot make a sweep (checked before anything runs), or "".
+std::string plectonemes_input_error(const PlectonemesArguments& args);
+
+// The sweep: each slenderness in turn (follow_plectoneme_branch, follow_from_ply or
+// follow_hard_from_ply), progress on stderr and a line per finished slenderness on `report`.
+// Throws std::invalid_argument for plectonemes_input_error's reasons and std::runtime_error
+// ("L/2R = <slenderness>: ...") when a branch fails; the branches before it stay written.
+PlectonemeSweep sweep_plectonemes(const PlectonemesArguments& args, std::ostream& report);
+
+// The CLI command: sweep_plectonemes with its report and totals on stdout; exit status 2 for bad
+// arguments, 1 when a branch fails.
 int run_plectonemes(const PlectonemesArguments& args);
 
 }  // namespace kirchhoff::cli
