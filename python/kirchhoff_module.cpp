@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <limits>
 #include <map>
 #include <memory>
@@ -32,6 +33,7 @@
 #include "kirchhoff/shooting.hpp"
 #include "kirchhoff/solution.hpp"
 #include "kirchhoff/vibration.hpp"
+#include "plectonemes_command.hpp"  // apps/: the sweep behind `kirchhoff plectonemes`
 
 namespace py = pybind11;
 
@@ -438,6 +440,69 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
   return out;
 }
 
+// A CSV the sweep wrote, as a dict of its columns: numpy arrays of numbers, lists of str for the
+// text columns (numpy's own reader, so that the columns are what the CLI's users load).
+py::dict csv_columns(const std::string& path) {
+  const py::module_ np = py::module_::import("numpy");
+  const py::object table = np.attr("genfromtxt")(path, py::arg("delimiter") = ",", py::arg("names") = true,
+                                                 py::arg("dtype") = py::none(), py::arg("encoding") = "utf-8",
+                                                 py::arg("ndmin") = 1);
+  py::dict d;
+  for (const py::handle name : table.attr("dtype").attr("names")) {
+    const py::object values = table[name];
+    d[name] = values.attr("dtype").attr("kind").cast<std::string>() == "U" ? values.attr("tolist")() : values;
+  }
+  return d;
+}
+
+// The Fig. 11 sweep (the CLI's `plectonemes`): each slenderness's branches, as the CSVs it wrote.
+py::dict py_plectonemes(const std::string& out, const std::vector<double>& slenderness,
+                        const std::vector<double>& turns, const py::object& case_path,
+                        const std::vector<double>& from_ply, double turns_min, double hard_from, bool resume,
+                        double sensitivity_tol) {
+  cli::PlectonemesArguments args;
+  args.case_path = case_path.is_none() ? std::string(KIRCHHOFF_CASES_DIR) + "/plectoneme.toml"
+                                       : case_path.cast<std::string>();
+  args.out_dir = out;
+  args.slenderness = slenderness;
+  args.turns = turns;
+  args.from_ply = from_ply;
+  args.turns_min = turns_min;
+  args.hard_from = hard_from;
+  args.resume = resume;
+  args.sensitivity_tol = sensitivity_tol;
+  if (hard_from < 0) throw CaseError("hard_from must be >= 0 (got " + std::to_string(hard_from) + ")");
+  if (sensitivity_tol < 0) throw CaseError("sensitivity_tol must be >= 0");
+  if (const std::string e = cli::plectonemes_input_error(args); !e.empty()) throw CaseError(e);
+  // Ctrl-C stops the sweep after its next point; resume=True then continues it.
+  args.after_point = [] {
+    py::gil_scoped_acquire acquire;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  };
+  cli::PlectonemeSweep sweep;
+  {
+    py::gil_scoped_release release;
+    (void)load_case(args.case_path, {});  // a case file that cannot be used is a CaseError
+    sweep = cli::sweep_plectonemes(args, std::cout);
+  }
+  py::dict branches;
+  for (const auto& b : sweep.branches) {
+    py::dict d;
+    d["barrier"] = b.barrier_csv.empty() ? py::object(py::none()) : py::object(csv_columns(b.barrier_csv));
+    d["exact"] = b.ply_csv.empty() ? py::object(py::none()) : py::object(csv_columns(b.ply_csv));
+    d["barrier_csv"] = b.barrier_csv;
+    d["exact_csv"] = b.ply_csv;
+    d["stop"] = b.summary.stop;
+    d["exact_stop"] = b.summary.hard_ply_stop;
+    branches[py::float_(b.slenderness)] = d;
+  }
+  py::dict result;
+  result["branches"] = branches;
+  result["points"] = sweep.points;
+  result["seconds"] = sweep.seconds;
+  return result;
+}
+
 std::string repr_solution(const PySolution& s) {
   std::ostringstream o;
   o.precision(10);
@@ -634,6 +699,45 @@ Returns:
 
 Raises:
     CaseError (ValueError): the file cannot be used; the message names the key and the reason.)doc");
+
+  m.def("plectonemes", &py_plectonemes, py::arg("out"), py::arg("slenderness") = std::vector<double>{100},
+        py::arg("turns") = std::vector<double>{10}, py::kw_only(), py::arg("case") = py::none(),
+        py::arg("from_ply") = std::vector<double>{}, py::arg("turns_min") = 4.0, py::arg("hard_from") = 0.0,
+        py::arg("resume") = false, py::arg("sensitivity_tol") = cli::kPlectonemeSensitivityTol,
+        R"doc(The Fig. 11 sweep of cases/plectoneme.toml (the CLI's `kirchhoff plectonemes`, the same
+files into `out`; progress on stderr, a line per slenderness on stdout).
+
+Each slenderness L/2R is followed in the end rotation from the untwisted rod (a self-contact
+barrier) through the loop's closing into the ply, up to its `turns`; with `hard_from` > 0 the
+barrier branch stops at that many turns and its ply is re-solved with exact contact in the
+shooting core (the strands touching: rho = R, complementarity checked) and followed up to
+`turns` and down to `turns_min`. Slendernesses in `from_ply` are reached from the ply of the one
+before them in `slenderness` (with `hard_from`: from its exact ply, no barrier branch).
+
+Args:
+    out (str): output folder (created).
+    slenderness, turns (lists of float): L/2R and the largest turns, one each.
+    case (str, optional): the case file (default: the source tree's cases/plectoneme.toml).
+    from_ply (list of float): slendernesses reached from the previous one's ply.
+    turns_min (float): where the legs from a ply end on the way down.
+    hard_from (float): exact contact from this many turns (0: the barrier throughout).
+    resume (bool): continue a sweep that was stopped (killed, or Ctrl-C): finished branches are
+        kept, an unfinished one continues from its last saved point.
+    sensitivity_tol (float): tolerance of the variational equations (0: the case's).
+
+Returns:
+    dict: "branches": {slenderness: {"barrier": columns or None, "exact": columns or None,
+    "barrier_csv", "exact_csv" (paths, "" when absent), "stop", "exact_stop" (why each ended)}},
+    "points" (computed by this call), "seconds". Columns are the CSV's: numpy arrays (index, turns,
+    T_ext, helix_angle, helix_radius, T_rho2_over_EI beside eq61, m3 beside m3_eq58b, H_A, H_B,
+    self_distance, and on the exact ply min_contact_force, min_wrap_pressure, ply_clearance,
+    contact_count, ...) and "type" as a list of str.
+
+Raises:
+    CaseError (ValueError): arguments the sweep refuses (lists of different lengths, a
+        slenderness from a ply the sweep would not have) or a case file that cannot be used.
+    RuntimeError: a branch failed (its message says which and why; the CSVs so far are kept).
+    KeyboardInterrupt: Ctrl-C (the sweep stops after its current point).)doc");
 
   m.def("derived_catalogue", &derived_catalogue,
         "The derived quantities a case or an event may name, with a one-line meaning each (dict).");

@@ -307,5 +307,54 @@ class AnalyticHelixTest(unittest.TestCase):
             kirchhoff.analytic_plectoneme_end_tension(1.0, 1.0, 1.0)  # theta beyond pi/4: no ply
 
 
+class PlectonemesTest(unittest.TestCase):
+    """kirchhoff.plectonemes: the CLI's sweep, its CSVs returned as columns."""
+
+    def test_exact_ply_from_the_barrier_branch(self):
+        # L/2R = 100 on the barrier to 5 turns, then the ply with exact contact up to 5.2 and down
+        # to 4.9 turns (~15 s). The exact rows: rho = R (R = L/(2 L/2R) = 0.005), contact forces and
+        # the line's pressure > 0, strands no closer than 2R (1 - 1e-9), H_A = H_B to the issue's
+        # 1e-8, and T R^2/EI within the helix approximation of eq. (61) on this short ply
+        # (measured 0.85 % below; bar 5 %), the contact set a point, the line and a point.
+        with tempfile.TemporaryDirectory() as tmp:
+            r = kirchhoff.plectonemes(tmp, [100], [5.2], hard_from=5, turns_min=4.9)
+            branch = r["branches"][100.0]
+            barrier, exact = branch["barrier"], branch["exact"]
+            self.assertEqual(branch["stop"], "reached_target")
+            self.assertEqual(branch["exact_stop"], "up: reached_target; down: reached_target")
+            self.assertAlmostEqual(barrier["turns"][-1], 5.0, delta=1e-8)
+            self.assertEqual(r["points"], len(barrier["turns"]) + len(exact["turns"]))  # a row per point
+            ends = [i for i, t in enumerate(exact["type"]) if t == "endpoint"]
+            self.assertEqual(len(ends), 2)
+            self.assertAlmostEqual(exact["turns"][ends[0]], 5.2, delta=1e-8)
+            self.assertAlmostEqual(exact["turns"][ends[1]], 4.9, delta=1e-8)
+            np.testing.assert_allclose(exact["helix_radius"], 0.005, rtol=1e-3)
+            self.assertTrue(np.all(exact["min_contact_force"] > 0))
+            self.assertTrue(np.all(exact["min_wrap_pressure"] > 0))
+            self.assertTrue(np.all(exact["self_distance"] >= 1 - 1e-9))
+            np.testing.assert_allclose(exact["H_A"] / exact["H_B"], 1.0, rtol=1e-8)
+            np.testing.assert_allclose(exact["T_rho2_over_EI"] / exact["eq61"], 1.0, rtol=0.05)
+            self.assertTrue(np.all(exact["contact_count"] == 3))
+            # The same rows as the CSV the CLI's users read.
+            with open(branch["exact_csv"]) as f:
+                self.assertEqual(len(f.read().splitlines()) - 1, len(exact["turns"]))
+            # Resumed, a finished sweep is left alone: nothing computed, the same columns.
+            again = kirchhoff.plectonemes(tmp, [100], [5.2], hard_from=5, turns_min=4.9, resume=True)
+            self.assertEqual(again["points"], 0)
+            np.testing.assert_array_equal(again["branches"][100.0]["exact"]["T_ext"], exact["T_ext"])
+
+    def test_arguments_the_sweep_refuses_raise_case_error(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            with self.assertRaises(kirchhoff.CaseError) as cm:
+                kirchhoff.plectonemes(tmp, [100, 200], [10])
+            self.assertIn("--slenderness and --turns need the same number of values", str(cm.exception))
+            with self.assertRaises(kirchhoff.CaseError) as cm:
+                kirchhoff.plectonemes(tmp, [100, 150], [4, 5], hard_from=5, from_ply=[150])
+            self.assertIn("L/2R = 150 is reached from the exact ply of L/2R = 100, which has none", str(cm.exception))
+            with self.assertRaises(kirchhoff.CaseError):
+                kirchhoff.plectonemes(tmp, [100], [3], case=str(pathlib.Path(tmp) / "no_such_case.toml"))
+            self.assertEqual(os.listdir(tmp), [])  # refused before anything ran
+
+
 if __name__ == "__main__":
     unittest.main()
