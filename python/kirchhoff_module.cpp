@@ -1,5 +1,6 @@
 // Python bindings: `import kirchhoff` (pybind11). A thin layer over the library that mirrors the
-// CLI's `solve`, `continue` and `vibrate` commands, returning plain dicts and numpy arrays.
+// CLI's `solve`, `continue`, `vibrate` and `plectonemes` commands, returning plain dicts and numpy
+// arrays.
 //
 // Conventions, as in the CLI:
 //   - bad input (a case file that cannot be used, an unknown parameter or derived quantity, bad
