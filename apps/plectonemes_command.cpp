@@ -650,7 +650,7 @@ PlectonemeSweep sweep_plectonemes(const PlectonemesArguments& args, std::ostream
     else
       std::cerr << "L/2R = " << sl << ": turns 0 -> " << args.turns[k] << "\n";
     PlectonemeRunOptions options;
-    options.progress_every = 50;
+    options.progress_every = args.progress_every;
     options.max_step = args.max_step;
     options.reuse_jacobian = args.reuse_jacobian;
     options.modified_newton = args.modified_newton;

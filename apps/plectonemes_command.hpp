@@ -135,6 +135,7 @@ struct PlectonemesArguments {
   // case's); the exact ply's first solve from its seed keeps the case's.
   double sensitivity_tol = kPlectonemeSensitivityTol;
   std::function<void()> after_point;  // PlectonemeRunOptions::after_point
+  int progress_every = 50;            // PlectonemeRunOptions::progress_every
 };
 
 // What a sweep computed for one slenderness: the CSV of its barrier branch (empty for one reached

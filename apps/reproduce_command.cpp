@@ -668,34 +668,37 @@ void plectonemes(const fs::path& cases, const fs::path& out, bool full, std::vec
   }
 }
 
-// Fig. 11 with exact contact (`plectonemes --hard-from 5 --from-ply 200`): the L/2R = 100 barrier
-// branch handed to exact self-contact at 5 turns, 200 thinned from that ply, each followed 5 -> 6
-// and 5 -> 4.5 turns into out/plectoneme_<L/2R>_ply.csv. At each ply's 6 turns: (61) and (58b)
-// with R itself, H_A = H_B; over all its points the self-distance; and the legs reaching their
-// ends (a contact force or the line's pressure reaching 0 would have stopped them).
-void exact_plies(const std::string& case_path, const fs::path& out, std::vector<ReportRow>* rows) {
-  fs::create_directories(out);
-  PlectonemeRunOptions options;
-  options.hard_from = 5.0;
-  options.hard_turns_min = 4.5;
-  const double turns = 6.0;
-  const auto csv = [&](double slenderness, const std::string& suffix) {
-    return (out / ("plectoneme_" + std::to_string(static_cast<int>(slenderness)) + suffix)).string();
-  };
-  const std::vector<std::pair<double, PlectonemeBranchSummary>> plies = {
-      {100.0, follow_plectoneme_branch(case_path, 100.0, turns, csv(100.0, ".csv"), options)},
-      {200.0, follow_hard_from_ply(case_path, csv(100.0, "_ply.csv.start.json"), 100.0, 200.0, options.hard_turns_min,
-                                   turns, csv(200.0, "_ply.csv"), options)}};
-  for (const auto& [slenderness, branch] : plies) {
-    const std::string name = std::to_string(static_cast<int>(slenderness));
+// Fig. 11 with exact contact (`plectonemes --hard-from 5 --from-ply 200`, with `full` also 500):
+// the L/2R = 100 barrier branch handed to exact self-contact at 5 turns, each thinner rod
+// reached from the thicker one's exact ply, each followed up from 5 turns (to 6, with `full` to the
+// sweep's 10, 20, 20) and down (to 4.5, with `full` to 4) into out/plectoneme_<L/2R>_ply.csv. At
+// each ply's largest turns: (61) and (58b) with R itself, H_A = H_B; over all its points the
+// self-distance; and the legs reaching their ends (a contact force or the line's pressure
+// reaching 0 would have stopped them). L/2R = 1000 with exact contact is a CLI run (README).
+void exact_plies(const std::string& case_path, const fs::path& out, bool full, std::vector<ReportRow>* rows) {
+  PlectonemesArguments args;
+  args.case_path = case_path;
+  args.out_dir = out.string();
+  args.hard_from = 5.0;
+  args.slenderness = full ? std::vector<double>{100, 200, 500} : std::vector<double>{100, 200};
+  args.turns = full ? std::vector<double>{10, 20, 20} : std::vector<double>{6, 6};
+  args.from_ply = {200, 500};
+  args.turns_min = full ? 4.0 : 4.5;
+  args.progress_every = full ? 250 : 0;
+  std::ostringstream report;
+  const PlectonemeSweep sweep = sweep_plectonemes(args, report);
+  for (size_t k = 0; k < sweep.branches.size(); ++k) {
+    const PlectonemeBranchSummary& branch = sweep.branches[k].summary;
+    const double turns = args.turns[k];
+    const std::string name = std::to_string(static_cast<int>(args.slenderness[k]));
     if (branch.hard_ply.empty()) throw std::runtime_error("plectoneme: no exact ply at L/2R = " + name);
     const auto top = std::max_element(branch.hard_ply.begin(), branch.hard_ply.end(),
                                       [](const auto& a, const auto& b) { return a.at("turns") < b.at("turns"); });
     const auto& ply = *top;
     const std::string where = "L/2R = " + name + ", exact contact (rho = R), turns = " + format_short(ply.at("turns")) +
                               ", theta = " + format_short(ply.at("helix_angle") * 180.0 / M_PI) + " deg";
-    // Measured 0.2-0.4 % below (61) at 6 turns: the helix formulas idealise the middle of a long
-    // ply, these have a few pitches.
+    // Measured 0.2-0.4 % below (61) at 6 turns, <= 0.01 % from 9 turns: the helix formulas
+    // idealise the middle of a long ply, these have a few pitches at 6 turns.
     rows->push_back({"Fig. 11, eq. (61), exact contact", "T_ext R^2 / EI in the ply", {}, ply.at("eq61"),
                      ply.at("T_rho2_over_EI"), ply.at("eq61"), 0.01, where});
     rows->push_back({"Fig. 11, eq. (58b), exact contact", "m3 in the ply", {}, ply.at("m3_eq58b"),
@@ -709,7 +712,9 @@ void exact_plies(const std::string& case_path, const fs::path& out, std::vector<
                      "L/2R = " + name + ", over all " + std::to_string(branch.hard_ply.size()) +
                          " points of both legs; the contacts are at 1"});
     rows->push_back({"Fig. 11, exact contact", "turns reached with complementarity (forces and pressure > 0)", {},
-                     turns, ply.at("turns"), turns, 1e-9, where + "; legs: " + branch.hard_ply_stop});
+                     turns, ply.at("turns"), turns, 1e-9,
+                     where + "; legs: " + branch.hard_ply_stop + "; " + std::to_string(branch.hard_ply_points) +
+                         " points in " + format_short(branch.hard_ply_seconds) + " s"});
   }
 }
 
@@ -780,8 +785,9 @@ int run_reproduce(const std::string& out_dir, const std::string& cases_dir, bool
                   : "Section 7.6 / Fig. 11: plectonemes at L/2R = 100 and 200, from the untwisted rod into the ply "
                     "(about 2 minutes; --full adds 500 and 1000)");
     plectonemes(cases, out / "profiles", full, &rows);
-    progress("Section 7.6 / Fig. 11: the ply with exact self-contact at L/2R = 100 and 200 (about a minute)");
-    exact_plies((cases / "plectoneme.toml").string(), out / "profiles" / "exact", &rows);
+    progress(full ? "Section 7.6 / Fig. 11: the ply with exact self-contact at L/2R = 100, 200 and 500 (about 7 minutes)"
+                  : "Section 7.6 / Fig. 11: the ply with exact self-contact at L/2R = 100 and 200 (about a minute)");
+    exact_plies((cases / "plectoneme.toml").string(), out / "profiles" / "exact", full, &rows);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitNotConverged;
