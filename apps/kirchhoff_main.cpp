@@ -163,7 +163,8 @@ int main(int argc, char** argv) {
   bool reproduce_full = false;
   reproduce_cmd->add_flag("--full", reproduce_full,
                           "Fig. 11 with all four slendernesses (L/2R = 100, 200, 500 to 10, 20, 20 turns; 1000 from\n"
-                          "the 500 ply to 50 and down to 4): about half an hour instead of 2 minutes");
+                          "the 500 ply to 50 and down to 4) and the ply with exact contact at 100, 200 and 500 to\n"
+                          "10, 20 and 20 turns: about 20 minutes instead of 2");
   reproduce_cmd->add_option("--cases", cases_dir, "Folder of the case files")->capture_default_str()->check(CLI::ExistingDirectory);
 
   PlectonemesArguments plect;

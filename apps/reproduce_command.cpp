@@ -595,7 +595,7 @@ double tension_at(const std::vector<std::pair<double, double>>& ply, double thet
 
 // Section 7.6 / Fig. 11: plectoneme branches for L/2R = 100 (to 6 turns) and 200 (to 13), from
 // the untwisted rod into the ply (with `full`: the whole sweep of `kirchhoff plectonemes`, 100,
-// 200, 500 to 10, 20, 20 turns and 1000 from the 500 ply to 50 and down to 4, ~20 minutes); at each
+// 200, 500 to 10, 20, 20 turns and 1000 from the 500 ply to 50 and down to 4, ~9 minutes); at each
 // branch's last ply point the helix formulas (58b) and (61) against the computed ply, with its
 // helix radius rho (R plus the self-contact barrier's gap) and angle, and H_A = H_B (eqs. 59-60);
 // across slendernesses, the 1/R^2 scaling of T_ext at a common helix angle.
@@ -781,7 +781,7 @@ int run_reproduce(const std::string& out_dir, const std::string& cases_dir, bool
     vibrations(cases, out / "profiles", &rows);
     progress("Section 7.2 / Fig. 5: the Elastica in a cavity, hanging fold");
     cavity(cases, out / "profiles", &rows);
-    progress(full ? "Section 7.6 / Fig. 11: plectonemes at L/2R = 100, 200, 500 and 1000 (about 20 minutes)"
+    progress(full ? "Section 7.6 / Fig. 11: plectonemes at L/2R = 100, 200, 500 and 1000 (about 9 minutes)"
                   : "Section 7.6 / Fig. 11: plectonemes at L/2R = 100 and 200, from the untwisted rod into the ply "
                     "(about 2 minutes; --full adds 500 and 1000)");
     plectonemes(cases, out / "profiles", full, &rows);
