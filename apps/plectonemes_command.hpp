@@ -78,10 +78,14 @@ struct PlectonemeRunOptions {
   // IntegratorOptions::sensitivity_tol of the barrier branches and of the exact ply's legs (0: the
   // case's); the exact ply's first solve from its seed keeps the case's.
   double sensitivity_tol = kPlectonemeSensitivityTol;
-  // Called after every point is written (the Python module checks for Ctrl-C there); may throw
-  // to stop the run, which a resume then continues.
+  // Called after every point is written (the Python module checks for Ctrl-C there); it may
+  // throw SweepStopped to stop the run, which a resume then continues.
   std::function<void()> after_point;
 };
+
+// What after_point throws to stop a sweep. Not a std::exception, so that the sweep's reports of a
+// failed branch ("L/2R = ...: ...") let it through to the caller.
+struct SweepStopped {};
 
 // Follows cases/plectoneme.toml (at `case_path`) with slenderness set, from turns = 0 to
 // turns_max, writing one CSV row per point to csv_path (flushed as it goes) and the state to

@@ -475,16 +475,19 @@ py::dict py_plectonemes(const std::string& out, const std::vector<double>& slend
   if (hard_from < 0) throw CaseError("hard_from must be >= 0 (got " + std::to_string(hard_from) + ")");
   if (sensitivity_tol < 0) throw CaseError("sensitivity_tol must be >= 0");
   if (const std::string e = cli::plectonemes_input_error(args); !e.empty()) throw CaseError(e);
-  // Ctrl-C stops the sweep after its next point; resume=True then continues it.
+  // Ctrl-C stops the sweep after its next point (the KeyboardInterrupt stays pending until the
+  // GIL is back); resume=True then continues it.
   args.after_point = [] {
     py::gil_scoped_acquire acquire;
-    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (PyErr_CheckSignals() != 0) throw cli::SweepStopped{};
   };
   cli::PlectonemeSweep sweep;
-  {
+  try {
     py::gil_scoped_release release;
     (void)load_case(args.case_path, {});  // a case file that cannot be used is a CaseError
     sweep = cli::sweep_plectonemes(args, std::cout);
+  } catch (const cli::SweepStopped&) {
+    throw py::error_already_set();
   }
   py::dict branches;
   for (const auto& b : sweep.branches) {

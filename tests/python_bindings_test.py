@@ -10,6 +10,8 @@ import os
 import pathlib
 import re
 import tempfile
+import threading
+import _thread
 import unittest
 
 import numpy as np
@@ -342,6 +344,27 @@ class PlectonemesTest(unittest.TestCase):
             again = kirchhoff.plectonemes(tmp, [100], [5.2], hard_from=5, turns_min=4.9, resume=True)
             self.assertEqual(again["points"], 0)
             np.testing.assert_array_equal(again["branches"][100.0]["exact"]["T_ext"], exact["T_ext"])
+
+    def test_interrupted_sweep_resumes_without_losing_rows(self):
+        # Ctrl-C (interrupt_main, 2 s into L/2R = 100 to 3 turns, a ~6 s run) raises
+        # KeyboardInterrupt after the point being written; the CSV keeps its rows, and resume=True
+        # finishes the branch from the last saved point, the rows before it untouched.
+        with tempfile.TemporaryDirectory() as tmp:
+            timer = threading.Timer(2.0, _thread.interrupt_main)
+            timer.start()
+            with self.assertRaises(KeyboardInterrupt):
+                kirchhoff.plectonemes(tmp, [100], [3])
+            timer.join()
+            csv = pathlib.Path(tmp) / "plectoneme_100.csv"
+            before = csv.read_text().splitlines()
+            self.assertGreater(len(before), 5)
+            self.assertNotIn(",endpoint,", before[-1])
+            done = kirchhoff.plectonemes(tmp, [100], [3], resume=True)
+            after = csv.read_text().splitlines()
+            self.assertEqual(done["branches"][100.0]["stop"], "reached_target")
+            self.assertIn(",endpoint,", after[-1])
+            self.assertEqual(after[:len(before) - 3], before[:-3])
+            self.assertEqual([int(r.split(",")[0]) for r in after[1:]], list(range(len(after) - 1)))
 
     def test_arguments_the_sweep_refuses_raise_case_error(self):
         with tempfile.TemporaryDirectory() as tmp:
