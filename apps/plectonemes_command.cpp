@@ -605,8 +605,7 @@ bool has_exact_ply(const PlectonemesArguments& args, size_t k) {
   return reached_from_ply(args, k) && k > 0 ? has_exact_ply(args, k - 1) : args.hard_from < args.turns[k];
 }
 
-}  // namespace
-
+// Why `args` cannot make a sweep (checked before anything runs), or "".
 std::string plectonemes_input_error(const PlectonemesArguments& args) {
   if (args.slenderness.size() != args.turns.size()) return "--slenderness and --turns need the same number of values";
   for (size_t k = 0; k < args.slenderness.size(); ++k) {
@@ -627,8 +626,10 @@ std::string plectonemes_input_error(const PlectonemesArguments& args) {
   return "";
 }
 
+}  // namespace
+
 PlectonemeSweep sweep_plectonemes(const PlectonemesArguments& args, std::ostream& report) {
-  if (const std::string e = plectonemes_input_error(args); !e.empty()) throw std::invalid_argument(e);
+  if (const std::string e = plectonemes_input_error(args); !e.empty()) throw CaseError(e);
   std::filesystem::create_directories(args.out_dir);
   const auto started = std::chrono::steady_clock::now();
   const auto csv_of = [&](double sl) {
@@ -704,14 +705,13 @@ PlectonemeSweep sweep_plectonemes(const PlectonemesArguments& args, std::ostream
 }
 
 int run_plectonemes(const PlectonemesArguments& args) {
-  if (const std::string e = plectonemes_input_error(args); !e.empty()) {
-    std::cerr << "error: " << e << "\n";
-    return 2;
-  }
   try {
     const PlectonemeSweep sweep = sweep_plectonemes(args, std::cout);
     std::cout << "sweep: " << sweep.points << " points in " << std::setprecision(4) << sweep.seconds << " s ("
               << sweep.points / sweep.seconds << " points/s)\n";
+  } catch (const CaseError& e) {  // refused before anything ran
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << e.what() << "\n";
     return 1;

@@ -156,12 +156,10 @@ struct PlectonemeSweep {
   double seconds = 0.0;
 };
 
-// Why `args` cannot make a sweep (checked before anything runs), or "".
-std::string plectonemes_input_error(const PlectonemesArguments& args);
-
 // The sweep: each slenderness in turn (follow_plectoneme_branch, follow_from_ply or
 // follow_hard_from_ply), progress on stderr and a line per finished slenderness on `report`.
-// Throws std::invalid_argument for plectonemes_input_error's reasons and std::runtime_error
+// Throws CaseError, before anything runs, for arguments that cannot make a sweep (lists of
+// different lengths, a slenderness from a ply the sweep would not have), and std::runtime_error
 // ("L/2R = <slenderness>: ...") when a branch fails; the branches before it stay written.
 PlectonemeSweep sweep_plectonemes(const PlectonemesArguments& args, std::ostream& report);
 

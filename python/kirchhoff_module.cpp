@@ -474,7 +474,6 @@ py::dict py_plectonemes(const std::string& out, const std::vector<double>& slend
   args.sensitivity_tol = sensitivity_tol;
   if (hard_from < 0) throw CaseError("hard_from must be >= 0 (got " + std::to_string(hard_from) + ")");
   if (sensitivity_tol < 0) throw CaseError("sensitivity_tol must be >= 0");
-  if (const std::string e = cli::plectonemes_input_error(args); !e.empty()) throw CaseError(e);
   // Ctrl-C stops the sweep after its next point (the KeyboardInterrupt stays pending until the
   // GIL is back); resume=True then continues it.
   args.after_point = [] {
@@ -485,7 +484,7 @@ py::dict py_plectonemes(const std::string& out, const std::vector<double>& slend
   try {
     py::gil_scoped_release release;
     (void)load_case(args.case_path, {});  // a case file that cannot be used is a CaseError
-    sweep = cli::sweep_plectonemes(args, std::cout);
+    sweep = cli::sweep_plectonemes(args, std::cout);  // so are arguments it refuses
   } catch (const cli::SweepStopped&) {
     throw py::error_already_set();
   }
