@@ -3,7 +3,12 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -18,10 +23,90 @@
 namespace kirchhoff {
 namespace {
 
-// Material properties are checked for positivity at this many points along the rod.
+// Material properties are checked (positive, finite) at this many points along the rod.
 constexpr int kPositivitySamples = 101;
 
 using Value = toml::value;
+using namespace case_limits;
+
+// "1e+100" rather than std::to_string's "10000000000...".
+std::string shown(double v) {
+  std::ostringstream os;
+  os.precision(15);  // whole numbers up to 1e15 exactly (4294967297, not 4.29497e+09)
+  os << v;
+  return os.str();
+}
+
+// The first line on which arrays and inline tables nest deeper than `limit` in TOML text, 0 when
+// none does. Each level counts, and so does each component of a dotted key leading to one (a.b.c
+// = [..] nests the array 3 deep; [a.b.c] headers count the same way): toml11 recurses once per
+// level while parsing and again while destroying the tree, and a few thousand levels overflow
+// the stack. Only strings and comments have to be told apart, so that brackets inside them are
+// not counted; for malformed text the scan may count too much, never too little before the
+// point where toml11 would stop with a syntax error (a basic string ends at its line's end, as
+// toml11 reads it).
+int line_beyond_nesting(const std::string& text, int limit) {
+  std::vector<int> open;   // for each open [ or {: the dotted-key components before it
+  int components = 0;      // the sum of `open`
+  int dots = 0;            // dots since the last '=', ',', bracket or line end: a dotted key's
+  int line = 1;
+  const std::size_t n = text.size();
+  std::size_t i = 0;
+  auto run_of = [&](char c) {  // how many c start at i
+    std::size_t k = 0;
+    while (i + k < n && text[i + k] == c) ++k;
+    return k;
+  };
+  auto too_deep = [&] { return static_cast<int>(open.size()) + components + dots > limit; };
+  while (i < n) {
+    const char c = text[i];
+    if (c == '\n') {
+      ++line;
+      dots = 0;
+      ++i;
+    } else if (c == '#') {
+      while (i < n && text[i] != '\n') ++i;
+    } else if (c == '"' || c == '\'') {
+      // """ and ''' open multi-line strings; "" is an empty string.
+      const bool multi = run_of(c) >= 3;
+      i += multi ? 3 : 1;
+      while (i < n) {
+        if (c == '"' && text[i] == '\\') {  // an escape; in a multi-line string \ may end a line
+          if (i + 1 < n && text[i + 1] == '\n') ++line;
+          i += 2;
+        } else if (text[i] == '\n') {
+          if (!multi) break;  // a one-line string ends here (a syntax error toml11 reports)
+          ++line;
+          ++i;
+        } else if (text[i] == c && (!multi || run_of(c) >= 3)) {
+          // A multi-line string ends at the last three of a run of up to five quotes.
+          i += multi ? std::min<std::size_t>(run_of(c), 5) : 1;
+          break;
+        } else {
+          ++i;
+        }
+      }
+    } else if (c == '[' || c == '{') {
+      open.push_back(dots);
+      components += dots;
+      dots = 0;
+      if (too_deep()) return line;
+      ++i;
+    } else if (c == ']' || c == '}') {
+      if (!open.empty()) {
+        components -= open.back();
+        open.pop_back();
+      }
+      dots = 0;
+      ++i;
+    } else {
+      if (c == '=' || c == ',') dots = 0;
+      if (c == '.' && (++dots, too_deep())) return line;
+      ++i;
+    }
+  }
+  return 0;
+}
 
 std::string join(const std::set<std::string>& names) {
   std::string out;
@@ -33,8 +118,9 @@ std::string join(const std::set<std::string>& names) {
 // the file, the line, the key and the reason.
 class Reader {
  public:
-  Reader(std::string path, std::vector<std::string> parameter_names)
-      : path_(std::move(path)), parameter_names_(std::move(parameter_names)) {}
+  // Expressions may use the parameters, and are checked at their values.
+  Reader(std::string path, Parameters parameters)
+      : path_(std::move(path)), parameter_names_(parameters.names()), parameters_(std::move(parameters)) {}
 
   [[noreturn]] void fail(const Value& v, const std::string& key, const std::string& reason) const {
     std::ostringstream os;
@@ -66,14 +152,53 @@ class Reader {
     return it == t.end() ? nullptr : &it->second;
   }
 
+  // TOML allows inf and nan; no quantity of a rod may be either, or beyond kMaxMagnitude.
   double number(const Value& v, const std::string& key) const {
-    if (v.is_floating()) return v.as_floating();
-    if (v.is_integer()) return static_cast<double>(v.as_integer());
-    fail(v, key, "must be a number, got " + type_name(v));
+    double x = 0.0;
+    if (v.is_floating()) x = v.as_floating();
+    else if (v.is_integer()) x = static_cast<double>(v.as_integer());
+    else fail(v, key, "must be a number, got " + type_name(v));
+    check_magnitude(v, key, x);
+    return x;
   }
-  long integer(const Value& v, const std::string& key) const {
-    if (v.is_integer()) return static_cast<long>(v.as_integer());
-    fail(v, key, "must be an integer, got " + type_name(v));
+  void check_magnitude(const Value& v, const std::string& key, double x, const std::string& where = "") const {
+    if (!std::isfinite(x)) fail(v, key, "must be a finite number, got " + shown(x) + where);
+    if (std::abs(x) > kMaxMagnitude)
+      fail(v, key, "must have a magnitude <= " + shown(kMaxMagnitude) + " (so that the equations' products do not "
+                   "overflow), got " + shown(x) + where);
+  }
+  // An integer in [low, high], checked before it is narrowed to int: a TOML integer has 64 bits,
+  // and 9223372036854775807 must be refused, not wrapped. `why` says where the bound comes from.
+  int integer(const Value& v, const std::string& key, long low, long high, const std::string& why = "") const {
+    if (!v.is_integer()) fail(v, key, "must be an integer, got " + type_name(v));
+    return in_range(v, key, static_cast<double>(v.as_integer()), low, high, why);
+  }
+  int in_range(const Value& v, const std::string& key, double x, long low, long high, const std::string& why) const {
+    if (!(x >= static_cast<double>(low) && x <= static_cast<double>(high)))
+      fail(v, key, "must be " + (high == std::numeric_limits<int>::max() ? ">= " + std::to_string(low)
+                                                                          : "in [" + std::to_string(low) + ", " +
+                                                                                std::to_string(high) + "]") +
+                       why + ", got " + shown(x));
+    return static_cast<int>(x);
+  }
+  // A value in (0, kMaxTolerance].
+  double tolerance(const Value& v, const std::string& key) const {
+    double x = 0.0;
+    if (v.is_floating()) x = v.as_floating();
+    else if (v.is_integer()) x = static_cast<double>(v.as_integer());
+    else fail(v, key, "must be a number, got " + type_name(v));
+    if (!(x > 0 && x <= kMaxTolerance))  // also refuses nan and inf
+      fail(v, key, "must be in (0, " + shown(kMaxTolerance) + "] (a looser tolerance gives answers wrong in the "
+                   "second digit), got " + shown(x));
+    return x;
+  }
+  // An array of at most `most` entries.
+  const toml::array& array(const Value& v, const std::string& key, int most, const std::string& what) const {
+    if (!v.is_array()) fail(v, key, "must be an array of " + what + ", got " + type_name(v));
+    if (v.as_array().size() > static_cast<std::size_t>(most))
+      fail(v, key, "has " + std::to_string(v.as_array().size()) + " entries, at most " + std::to_string(most) +
+                       " are allowed");
+    return v.as_array();
   }
   bool boolean(const Value& v, const std::string& key) const {
     if (v.is_boolean()) return v.as_boolean();
@@ -84,20 +209,38 @@ class Reader {
     fail(v, key, "must be a string, got " + type_name(v));
   }
   std::vector<std::string> strings(const Value& v, const std::string& key) const {
-    if (!v.is_array()) fail(v, key, "must be an array of strings, got " + type_name(v));
     std::vector<std::string> out;
-    for (const auto& e : v.as_array()) out.push_back(string(e, key));
+    for (const auto& e : array(v, key, kMaxNames, "strings")) out.push_back(string(e, key));
     return out;
   }
 
+  // An expression of the parameters (and of s when uses_s). One that does not use s is also
+  // evaluated here, at the case's parameter values, and refused unless finite and within
+  // kMaxMagnitude ("1/0", "exp(1000)", "1e60 * 1e60"); material profiles are checked along the
+  // rod once its length is known.
   Expression expression(const Value& v, const std::string& key, bool uses_s = false) const {
     if (v.is_floating() || v.is_integer()) return Expression::constant(number(v, key));
     if (!v.is_string()) fail(v, key, "must be a number or an expression string, got " + type_name(v));
+    std::optional<Expression> e;
     try {
-      return Expression(v.as_string().str, parameter_names_, uses_s);
-    } catch (const std::invalid_argument& e) {
-      fail(v, key, e.what());
+      e.emplace(v.as_string().str, parameter_names_, uses_s);
+    } catch (const std::invalid_argument& error) {
+      fail(v, key, error.what());
     }
+    if (!e->depends_on_s()) (void)value(*e, v, key);
+    return *e;
+  }
+
+  // e at the case's parameter values and arclength s: finite and within kMaxMagnitude.
+  double value(const Expression& e, const Value& v, const std::string& key, double s = 0.0) const {
+    double x = 0.0;
+    try {
+      x = e(parameters_, s);
+    } catch (const std::invalid_argument& error) {
+      fail(v, key, error.what());
+    }
+    check_magnitude(v, key, x, e.depends_on_s() ? " at s = " + shown(s) : "");
+    return x;
   }
 
   // An expression of the parameters and the position x, y, z (a level set).
@@ -118,7 +261,7 @@ class Reader {
 
   std::array<Expression, 3> vector(const Value& v, const std::string& key, bool uses_s = false) const {
     if (!v.is_array() || (v.as_array().size() != 3 && v.as_array().size() != 2))
-      fail(v, key, "must be an array of 2 or 3 numbers/expressions");
+      fail(v, key, "must be an array of 2 or 3 numbers/expressions");  // (also bounds the array)
     const auto& a = v.as_array();
     return {expression(a[0], key, uses_s), expression(a[1], key, uses_s),
             a.size() == 3 ? expression(a[2], key, uses_s) : Expression::constant(0.0)};
@@ -142,6 +285,7 @@ class Reader {
   }
   std::string path_;
   std::vector<std::string> parameter_names_;
+  Parameters parameters_;
 };
 
 VectorTarget vector_target(const std::array<Expression, 3>& e) {
@@ -254,9 +398,8 @@ ObstacleSpec read_obstacle(const Reader& reader, const Value& o, RodKind kind, c
 
 // All [[obstacles]]: fixed, or moving with the parameters their expressions use.
 void read_obstacles(const Reader& reader, const Value& list, RodKind kind, ProblemDefinition* d) {
-  if (!list.is_array()) reader.fail(list, "obstacles", "must be an array of tables [[obstacles]]");
   std::vector<std::function<Obstacle(const Parameters&)>> specs;
-  for (const auto& o : list.as_array()) {
+  for (const auto& o : reader.array(list, "obstacles", kMaxObstacles, "tables [[obstacles]]")) {
     ObstacleSpec spec = read_obstacle(reader, o, kind, d->parameters);
     try {
       d->obstacles.push_back(spec.at(d->parameters));
@@ -278,8 +421,7 @@ void read_obstacles(const Reader& reader, const Value& list, RodKind kind, Probl
 // whose contact-free solution is admissible but not the one wanted (a rod to be found wrapped
 // over an obstacle rather than beside it).
 void read_contact_guesses(const Reader& reader, const Value& list, ProblemDefinition* d) {
-  if (!list.is_array()) reader.fail(list, "guess.contacts", "must be an array of tables [[guess.contacts]]");
-  for (const auto& t : list.as_array()) {
+  for (const auto& t : reader.array(list, "guess.contacts", kMaxContacts, "tables [[guess.contacts]]")) {
     reader.allow_keys(t, "guess.contacts", {"obstacle", "s", "force", "s_end", "force_end"});
     const Value* name = Reader::find(t, "obstacle");
     const Value* s = Reader::find(t, "s");
@@ -289,18 +431,19 @@ void read_contact_guesses(const Reader& reader, const Value& list, ProblemDefini
     if (it == d->obstacles.end()) reader.fail(*name, "guess.contacts.obstacle", "no obstacle named '" + wanted + "'");
     PointContact c;
     c.obstacle = static_cast<int>(it - d->obstacles.begin());
-    c.s = reader.expression(*s, "guess.contacts.s")(d->parameters);
+    c.s = reader.value(reader.expression(*s, "guess.contacts.s"), *s, "guess.contacts.s");
     const double L = d->model(d->parameters).length;
     if (!(c.s > 0 && c.s < L)) reader.fail(*s, "guess.contacts.s", "must lie inside (0, L)");
-    if (const Value* f = Reader::find(t, "force")) c.force = reader.expression(*f, "guess.contacts.force")(d->parameters);
+    if (const Value* f = Reader::find(t, "force"))
+      c.force = reader.value(reader.expression(*f, "guess.contacts.force"), *f, "guess.contacts.force");
     // With s_end, an extended contact over [s, s_end]: flat on a plane, wrapped around a disc.
     if (const Value* e = Reader::find(t, "s_end")) {
       c.extended = true;
-      c.s_end = reader.expression(*e, "guess.contacts.s_end")(d->parameters);
+      c.s_end = reader.value(reader.expression(*e, "guess.contacts.s_end"), *e, "guess.contacts.s_end");
       if (!(c.s_end > c.s && c.s_end < L)) reader.fail(*e, "guess.contacts.s_end", "must lie inside (s, L)");
       c.force_end = c.force;
       if (const Value* f = Reader::find(t, "force_end"))
-        c.force_end = reader.expression(*f, "guess.contacts.force_end")(d->parameters);
+        c.force_end = reader.value(reader.expression(*f, "guess.contacts.force_end"), *f, "guess.contacts.force_end");
       const RodModel model = d->model(d->parameters);
       const auto equations = d->kind == RodKind::Planar ? make_planar_equations(model) : make_spatial_equations(model);
       if (const std::string why = extended_contact_unsupported(*equations, d->obstacles[c.obstacle]); !why.empty())
@@ -425,20 +568,35 @@ struct ProfileSpec {
 
 }  // namespace
 
+namespace {
+
+// A parameter name muParser can bind: a letter or '_', then letters, digits and '_'.
+bool is_identifier(const std::string& name) {
+  if (name.empty() || std::isdigit(static_cast<unsigned char>(name[0]))) return false;
+  return std::all_of(name.begin(), name.end(),
+                     [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+}
+
+}  // namespace
+
 std::pair<std::string, double> parse_override(const std::string& text) {
   const auto eq = text.find('=');
   if (eq == std::string::npos || eq == 0)
     throw std::invalid_argument("'" + text + "' is not NAME=VALUE");
   const std::string name = text.substr(0, eq), value = text.substr(eq + 1);
-  size_t used = 0;
-  double v = 0.0;
-  try {
-    v = std::stod(value, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != value.size()) throw std::invalid_argument("'" + value + "' in '" + text + "' is not a number");
+  if (!is_identifier(name))
+    throw std::invalid_argument("'" + name + "' in '" + text + "' is not a parameter name (letters, digits, _)");
+  // strtod rather than stod: stod throws on underflow ("1e-400" is 0 to a double, a number all
+  // the same); overflow gives inf, refused below with the other non-finite values.
+  char* end = nullptr;
+  const char* begin = value.c_str();
+  const double v = std::strtod(begin, &end);
+  if (value.empty() || end != begin + value.size() || std::isspace(static_cast<unsigned char>(value[0])))
+    throw std::invalid_argument("'" + value + "' in '" + text + "' is not a number");
   if (!std::isfinite(v)) throw std::invalid_argument("'" + value + "' in '" + text + "' is not finite");
+  if (std::abs(v) > case_limits::kMaxMagnitude)
+    throw std::invalid_argument("'" + value + "' in '" + text + "' is out of range (|value| <= " +
+                                shown(case_limits::kMaxMagnitude) + ")");
   return {name, v};
 }
 
@@ -456,13 +614,34 @@ void apply_phase_condition(const Reader& reader, const Value* where, const std::
 }  // namespace
 
 Case load_case(const std::string& path, const ParameterOverrides& overrides, const std::string& phase_condition) {
+  // Read with a cap, not by size: a FIFO or /dev/zero has none.
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw CaseError(path + ": cannot open the file (" + std::strerror(errno) + ")");
+  std::string text(kMaxFileBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad()) throw CaseError(path + ": cannot read the file (" + std::strerror(errno) + ")");
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxFileBytes)
+    throw CaseError(path + ": larger than " + std::to_string(kMaxFileBytes >> 20) + " MiB: not a case file");
+  return load_case_text(text, path, overrides, phase_condition);
+}
+
+Case load_case_text(const std::string& text, const std::string& path, const ParameterOverrides& overrides,
+                    const std::string& phase_condition) {
+  if (text.size() > kMaxFileBytes)
+    throw CaseError(path + ": larger than " + std::to_string(kMaxFileBytes >> 20) + " MiB: not a case file");
+  if (const int line = line_beyond_nesting(text, kMaxNesting))
+    throw CaseError(path + ":" + std::to_string(line) + ": arrays, inline tables and dotted keys nest deeper than " +
+                    std::to_string(kMaxNesting) + " levels (a case file needs 3)");
   Value root;
   try {
-    root = toml::parse(path);
+    std::istringstream stream(text);
+    root = toml::parse(stream, path);
   } catch (const toml::syntax_error& e) {
     throw CaseError(path + ": TOML syntax error: " + e.what());
-  } catch (const std::runtime_error& e) {
-    throw CaseError(path + ": " + e.what());
+  } catch (const std::exception& e) {
+    // toml11 reports some malformed values (out-of-range numbers, dates) with other exceptions.
+    throw CaseError(path + ": TOML syntax error: " + e.what());
   }
 
   Case c;
@@ -474,11 +653,14 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
                               "solver", "output", "obstacles"});
   if (const Value* table = Reader::find(root, "parameters")) {
     if (!table->is_table()) plain.fail(*table, "parameters", "must be a table of named numbers");
+    if (table->as_table().size() > static_cast<std::size_t>(kMaxParameters))
+      plain.fail(*table, "parameters", "has " + std::to_string(table->as_table().size()) + " entries, at most " +
+                                           std::to_string(kMaxParameters) + " are allowed");
     for (const auto& [name, value] : table->as_table()) {
       if (name == "s") plain.fail(value, "parameters.s", "'s' is reserved for the arclength");
-      const double v = plain.number(value, "parameters." + name);
-      if (!std::isfinite(v)) plain.fail(value, "parameters." + name, "must be a finite number");
-      parameters.set(name, v);
+      if (!is_identifier(name))
+        plain.fail(value, "parameters." + name, "is not a name expressions can use (letters, digits and _)");
+      parameters.set(name, plain.number(value, "parameters." + name));  // finite, within kMaxMagnitude
     }
   }
   for (const auto& [name, value] : overrides) {
@@ -487,9 +669,13 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
       throw CaseError(path + ": --set " + name + ": no parameter '" + name + "' in [parameters] (have: " +
                       join(names) + ")");
     }
+    // The CLI's parse_override checks this too; load_case is also called with overrides directly.
+    if (!std::isfinite(value) || std::abs(value) > kMaxMagnitude)
+      throw CaseError(path + ": --set " + name + ": " + shown(value) + " is not a finite number with magnitude <= " +
+                      shown(kMaxMagnitude));
     parameters.set(name, value);
   }
-  const Reader reader(path, parameters.names());
+  const Reader reader(path, parameters);
   if (const Value* v = Reader::find(root, "title")) c.title = reader.string(*v, "title");
   if (const Value* v = Reader::find(root, "description")) c.description = reader.string(*v, "description");
   ProblemDefinition& d = c.definition;
@@ -612,16 +798,19 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
     };
   }
 
-  // Physical checks at the case's parameter values, naming the key.
+  // Physical checks at the case's parameter values, naming the key. Expressions without s were
+  // checked finite when read; those with s are sampled along the rod here.
   const double L = length(parameters);
   if (!(L > 0)) reader.fail(*length_value, "rod.length", "must be > 0, got " + std::to_string(L));
-  for (const auto* group : {&B, &A}) {
+  for (const auto* group : {&B, &A, &u_hat, &v_hat}) {
     if (group == &A && !extensible) continue;
+    const bool stiffness = group == &B || group == &A;
     for (const auto& spec : *group) {
       for (int k = 0; k < kPositivitySamples; ++k) {
         const double s = L * k / (kPositivitySamples - 1);
-        const double value = spec.expression(parameters, s);
-        if (!(value > 0)) {
+        // Defaults have no source; they are constants in range.
+        const double value = spec.source ? reader.value(spec.expression, *spec.source, spec.key, s) : spec.expression(parameters, s);
+        if (stiffness && !(value > 0)) {
           const std::string reason = "stiffness must be > 0, got " + std::to_string(value) + " at s = " + std::to_string(s);
           if (spec.source) reader.fail(*spec.source, spec.key, reason);
           reader.fail(spec.key, reason);
@@ -673,16 +862,20 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
     }
     if (const Value* v = Reader::find(*s, "segments")) {
       // An integer, or an expression of the parameters rounded (e.g. "slenderness / 5": long
-      // slender rods need more segments) evaluated at load time.
-      o.segments = v->is_string() ? static_cast<int>(std::lround(reader.expression(*v, "solver.segments")(parameters)))
-                                  : static_cast<int>(reader.integer(*v, "solver.segments"));
-      if (o.segments < 1) reader.fail(*v, "solver.segments", "must be >= 1");
+      // slender rods need more segments) evaluated at load time. Either is range-checked
+      // before it becomes an int ("1e10" once wrapped to -129542143).
+      const std::string why = " (Newton's Jacobian is dense: 13 x segments unknowns squared)";
+      if (v->is_string()) {
+        const double x = reader.value(reader.expression(*v, "solver.segments"), *v, "solver.segments");
+        o.segments = reader.in_range(*v, "solver.segments", std::round(x), 1, kMaxSegments, why);
+      } else {
+        o.segments = reader.integer(*v, "solver.segments", 1, kMaxSegments, why);
+      }
       if (o.segments > 1 && !d.obstacles.empty())
         reader.fail(*v, "solver.segments", "contact with obstacles needs single shooting (segments = 1)");
     }
     if (const Value* v = Reader::find(*s, "threads")) {
-      o.threads = static_cast<int>(reader.integer(*v, "solver.threads"));
-      if (o.threads < 0) reader.fail(*v, "solver.threads", "must be >= 0 (0: the machine's hardware concurrency)");
+      o.threads = reader.integer(*v, "solver.threads", 0, kMaxThreads, " (0: the machine's hardware concurrency)");
     }
     if (const Value* v = Reader::find(*s, "stepper")) {
       const std::string name = reader.string(*v, "solver.stepper");
@@ -691,18 +884,15 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
       else reader.fail(*v, "solver.stepper", "'" + name + "' is not 'rk78' or 'dopri5'");
     }
     auto positive = [&](const char* key, double* target) {
-      if (const Value* v = Reader::find(*s, key)) {
-        *target = reader.number(*v, std::string("solver.") + key);
-        if (!(*target > 0)) reader.fail(*v, std::string("solver.") + key, "must be > 0");
-      }
+      if (const Value* v = Reader::find(*s, key)) *target = reader.tolerance(*v, std::string("solver.") + key);
     };
     positive("abs_tol", &o.integrator.abs_tol);
     positive("rel_tol", &o.integrator.rel_tol);
     positive("sensitivity_tol", &o.integrator.sensitivity_tol);
     positive("tolerance", &o.newton.residual_tolerance);
     if (const Value* v = Reader::find(*s, "max_iterations")) {
-      o.newton.max_iterations = static_cast<int>(reader.integer(*v, "solver.max_iterations"));
-      if (o.newton.max_iterations < 1) reader.fail(*v, "solver.max_iterations", "must be >= 1");
+      o.newton.max_iterations = reader.integer(*v, "solver.max_iterations", 1, kMaxIterations,
+                                               " (each iteration forms a Jacobian; Newton converges in tens)");
     }
     if (const Value* v = Reader::find(*s, "jacobian")) {
       const std::string name = reader.string(*v, "solver.jacobian");
@@ -721,7 +911,8 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
   if (const Value* g = Reader::find(root, "guess")) {
     reader.allow_keys(*g, "guess", {"position", "orientation", "force", "moment", "contacts"});
     auto vec = [&](const char* key, Vec3* target) {
-      if (const Value* v = Reader::find(*g, key)) *target = vector_target(reader.vector(*v, std::string("guess.") + key))(parameters);
+      if (const Value* v = Reader::find(*g, key))
+        *target = vector_target(reader.vector(*v, std::string("guess.") + key))(parameters);  // checked finite
     };
     vec("position", &c.start_guess.r);
     vec("force", &c.start_guess.n);
@@ -732,6 +923,32 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
       c.start_guess.turn_angle = t.angle;
     }
     if (const Value* v = Reader::find(*g, "contacts")) read_contact_guesses(reader, *v, &d);
+  }
+
+  // A level set's gap must be finite where the rod is held and where its guess starts: "1/0"
+  // compiles, and a gap that is inf everywhere is no obstacle at all, which would be solved and
+  // reported as if it were one.
+  if (const Value* list = Reader::find(root, "obstacles")) {
+    std::vector<std::pair<Vec3, std::string>> points{{c.start_guess.r, "the guess's start"}};
+    for (const char* end : {"start", "end"})
+      if (const Value* p = Reader::find(*Reader::find(root, end), "position"))
+        points.emplace_back(vector_target(reader.vector(*p, std::string(end) + ".position"))(parameters),
+                            std::string(end) + ".position");
+    for (std::size_t k = 0; k < d.obstacles.size(); ++k) {
+      if (d.obstacles[k].shape() != Obstacle::Shape::LevelSet) continue;
+      const Value& gap = *Reader::find(list->as_array()[k], "gap");
+      for (const auto& [r, where] : points) {
+        std::ostringstream at;
+        at << " at " << where << " (" << r.x() << ", " << r.y() << ", " << r.z() << ")";
+        double g = NAN;
+        try {
+          g = d.obstacles[k].gap(r);
+        } catch (const std::invalid_argument& e) {
+          reader.fail(gap, "obstacles.gap", e.what() + at.str());
+        }
+        reader.check_magnitude(gap, "obstacles.gap", g, at.str());
+      }
+    }
   }
 
   // [output]
@@ -751,8 +968,8 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
           reader.fail(*v, "output.derived", "'" + name + "' is a plectoneme quantity: it needs [rod.self_contact]");
     }
     if (const Value* v = Reader::find(*o, "samples")) {
-      c.samples = static_cast<int>(reader.integer(*v, "output.samples"));
-      if (c.samples < 2) reader.fail(*v, "output.samples", "must be >= 2");
+      c.samples = reader.integer(*v, "output.samples", 2, kMaxSamples,
+                                 " (1e5 samples resolve 1e-5 of the rod in a 21 MB profile)");
     }
   }
 

@@ -3,6 +3,7 @@
 // (muParser syntax), and material properties may also use the arclength s.
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -30,14 +31,55 @@ struct Case {
 
 using ParameterOverrides = std::vector<std::pair<std::string, double>>;
 
+// What a case file may ask for. Input beyond these bounds is refused (file, line, key, reason)
+// rather than left to exhaust the stack, the memory or the range of doubles; each bound is far
+// above what the shipped cases use (in brackets) and is justified beside it.
+namespace case_limits {
+// Case files are a few kB; a larger file is not a case file.
+constexpr std::size_t kMaxFileBytes = std::size_t{1} << 20;
+// Arrays and inline tables inside each other, plus the components of dotted keys leading to
+// them (the shipped cases: 3). toml11 parses nesting by recursion, so thousands of levels
+// overflow the stack; the text is scanned for this before toml11 sees it.
+constexpr int kMaxNesting = 64;
+// Named parameters (12). Every expression binds all of them, and each evaluation looks them up
+// by name.
+constexpr int kMaxParameters = 256;
+// Multiple-shooting segments (200, the plectoneme at L/2R = 1000). Newton's Jacobian is a dense
+// n x n matrix, n = 13 x segments for a spatial rod: 1000 segments take 1.6 GB, 2000 about 6 GB.
+constexpr int kMaxSegments = 2000;
+// Profile samples (2001). 1e5 samples are a 21 MB profile CSV (2 s); 1e6 took 20 s and 0.6 GB.
+constexpr int kMaxSamples = 100000;
+// Newton iterations (50): a converging Newton needs tens, each one costs a Jacobian.
+constexpr int kMaxIterations = 10000;
+// Threads for multiple shooting (0 = all): more than the segments/4 it can use is pointless.
+constexpr int kMaxThreads = 1024;
+// [[obstacles]] (2), [[guess.contacts]] (1), and the names in unknowns and output.derived (7):
+// each obstacle is checked against every sample of every Newton iterate.
+constexpr int kMaxObstacles = 64;
+constexpr int kMaxContacts = 64;
+constexpr int kMaxNames = 64;
+// Every number the case computes (lengths, stiffnesses, loads, positions, angles, parameters):
+// |value| <= 1e100, so that the products of up to three of them the equations form (B u^2 L,
+// n x r, energies) stay below the largest double (1.8e308) instead of overflowing to inf.
+constexpr double kMaxMagnitude = 1e100;
+// Integrator and Newton tolerances lie in (0, 1e-2]: a looser tolerance gives answers wrong in
+// the second digit that would still be reported as converged (the cases use 1e-8 to 1e-13).
+// Tolerances too small to be met fail honestly (integration_failed / max_iterations, exit 1).
+constexpr double kMaxTolerance = 1e-2;
+}  // namespace case_limits
+
 // Reads, validates and builds the case (including a ShootingProblem construction, so that
 // inconsistent boundary conditions are reported here). Overrides replace [parameters] values
 // and must name existing parameters.
 // phase_condition, when non-empty, replaces [solver] phase_condition ("none" or "axial").
 Case load_case(const std::string& path, const ParameterOverrides& overrides = {},
                const std::string& phase_condition = "");
+// The same from the text of a case file; `path` names it in messages (and in Case::path).
+Case load_case_text(const std::string& text, const std::string& path, const ParameterOverrides& overrides = {},
+                    const std::string& phase_condition = "");
 
-// Parses "NAME=VALUE"; throws std::invalid_argument with the reason.
+// Parses "NAME=VALUE" (--set); throws std::invalid_argument with the reason: no '=', an empty
+// name or one that is not an identifier, a value that is not a finite number with |value| <= 1e100.
 std::pair<std::string, double> parse_override(const std::string& text);
 
 }  // namespace kirchhoff
