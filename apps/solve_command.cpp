@@ -98,16 +98,17 @@ int load_and_solve(const std::string& case_path, const std::vector<std::string>&
   }
   if (!json)
     for (const auto& line : contact_log) std::cerr << "contact: " << line << "\n";
-  if (!result.summary.converged()) {
-    std::cerr << "error: " << c.path << ": not converged: " << result.summary.brief_report() << "\n";
-    if (json)
-      std::cout << failure_json(c, to_string(result.summary.status), result.summary.iterations,
-                                result.summary.residual_norm, result.summary.message)
-                       .dump(2)
-                << "\n";
-    return kExitNotConverged;
-  }
+  if (!result.summary.converged()) return report_not_converged(c, result.summary, json);
   return kExitOk;
+}
+
+int report_not_converged(const Case& c, const NewtonSummary& summary, bool json) {
+  std::cerr << "error: " << c.path << ": not converged: " << summary.brief_report() << "\n";
+  if (json)
+    std::cout << failure_json(c, to_string(summary.status), summary.iterations, summary.residual_norm, summary.message)
+                     .dump(2)
+              << "\n";
+  return kExitNotConverged;
 }
 
 int run_solve(const SolveArguments& args) {
@@ -119,6 +120,8 @@ int run_solve(const SolveArguments& args) {
   const std::unique_ptr<ShootingProblem>& problem = solved.problem;
   ShootingResult result = std::move(solved.result);
   const Solution sol = make_solution(*problem, std::move(result), c.samples, c.derived);
+  // The profile is checked as it is made (verification.hpp): a failure is a status, not a result.
+  if (!sol.result.summary.converged()) return report_not_converged(c, sol.result.summary, args.json);
   if (!args.profile_path.empty()) {
     try {
       write_profile_csv(args.profile_path, problem->equations(sol.result.parameters)->model(), sol.profile);

@@ -46,6 +46,9 @@ struct SolvedCase {
 // and returns the exit status, else kExitOk.
 int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
                    const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed = {});
+// Prints why a solve is not a trustworthy equilibrium (and, with json, the failure object) and
+// returns kExitNotConverged.
+int report_not_converged(const Case& c, const NewtonSummary& summary, bool json);
 int run_check(const std::string& case_path, const std::vector<std::string>& overrides);
 
 }  // namespace kirchhoff::cli

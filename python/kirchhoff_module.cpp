@@ -222,6 +222,10 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
         sol = std::make_unique<Solution>(make_solution(*problem, std::move(result), samples, c.derived));
       else
         failed = std::move(result);
+      if (sol && !sol->result.summary.converged()) {  // its profile failed the checks (verification.hpp)
+        failed = std::move(sol->result);
+        sol.reset();
+      }
     }
   }
   if (!seed_refused.empty()) throw py::value_error(seed_refused);

@@ -11,7 +11,7 @@ namespace kirchhoff {
 
 struct IntegratorOptions {
   enum class Stepper {
-    Dopri5,        // Dormand-Prince 5(4): cheap steps, dense output for profiles
+    Dopri5,        // Dormand-Prince 5(4): cheap steps, for loose tolerances
     RungeKutta78,  // Runge-Kutta-Fehlberg 7(8): fewer steps at the tight tolerances we default to
   };
   // Default: RK78 at 1e-12, tight enough that H is flat to ~1e-10 of its scale on the test cases.

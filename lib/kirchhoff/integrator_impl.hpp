@@ -123,8 +123,10 @@ SegmentFlow flow_with_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, d
   return flow_with_partial_sensitivities<N, N>(rhs, y0, s0, s1, opt, all);
 }
 
-// States at the requested arclengths (sorted). Dopri5 uses its dense output (interpolation
-// between steps); RK78 steps onto each sample point so profiles keep its accuracy.
+// States at the requested arclengths (sorted; repeated values allowed). Both steppers step onto
+// each sample point, so profiles keep the integration's accuracy. (Dopri5's dense output is not
+// used: odeint's integrate_times interpolates a sample equal to the start before the first step,
+// from the stepper's uninitialised previous state, and gave NaN there.)
 template <int N, class Rhs>
 std::vector<Eigen::VectorXd> sample_states(const Rhs& rhs, const Eigen::VectorXd& y0,
                                            const std::vector<double>& s_values,
@@ -141,7 +143,7 @@ std::vector<Eigen::VectorXd> sample_states(const Rhs& rhs, const Eigen::VectorXd
   const double span = s_values.back() - s_values.front();
   const double ds = opt.initial_step * (span > 0 ? span : 1.0);
   if (opt.stepper == IntegratorOptions::Stepper::Dopri5) {
-    auto stepper = odeint::make_dense_output(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_dopri5<State>());
+    auto stepper = odeint::make_controlled(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_dopri5<State>());
     odeint::integrate_times(stepper, system, x, s_values.begin(), s_values.end(), ds, observer);
   } else {
     auto stepper = odeint::make_controlled(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_fehlberg78<State>());

@@ -1,5 +1,6 @@
 #include "kirchhoff/newton.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <nlopt.hpp>
 #include <sstream>
@@ -16,6 +17,9 @@ const char* to_string(SolverStatus status) {
     case SolverStatus::IntegrationFailed: return "integration_failed";
     case SolverStatus::LineSearchFailed: return "line_search_failed";
     case SolverStatus::UnfoldingNotZero: return "unfolding_not_zero";
+    case SolverStatus::NotFinite: return "not_finite";
+    case SolverStatus::CheckFailed: return "check_failed";
+    case SolverStatus::TimeLimit: return "time_limit";
   }
   return "unknown";
 }
@@ -25,6 +29,7 @@ std::string NewtonOptions::validate() const {
   if (!(residual_tolerance > 0)) return "residual_tolerance must be > 0";
   if (!(finite_difference_step > 0)) return "finite_difference_step must be > 0";
   if (max_backtracks < 0) return "max_backtracks must be >= 0";
+  if (!(max_seconds >= 0) || !std::isfinite(max_seconds)) return "max_seconds must be finite and >= 0";
   return {};
 }
 
@@ -35,6 +40,33 @@ std::string NewtonSummary::brief_report() const {
   if (!message.empty()) os << ": " << message;
   return os.str();
 }
+
+double max_abs_or_nan(const Eigen::VectorXd& v) {
+  if (!v.allFinite()) return NAN;
+  return v.size() == 0 ? 0.0 : v.lpNorm<Eigen::Infinity>();
+}
+
+namespace {
+
+// Wall-clock deadline of a solve; none when the limit is 0.
+class Deadline {
+ public:
+  explicit Deadline(double seconds)
+      : limited_(seconds > 0),
+        end_(std::chrono::steady_clock::now() +
+             std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds))) {}
+  bool passed() const { return limited_ && std::chrono::steady_clock::now() >= end_; }
+  double remaining_seconds() const {
+    if (!limited_) return 0.0;
+    return std::max(1e-3, std::chrono::duration<double>(end_ - std::chrono::steady_clock::now()).count());
+  }
+
+ private:
+  bool limited_;
+  std::chrono::steady_clock::time_point end_;
+};
+
+}  // namespace
 
 bool finite_difference_jacobian(const NonlinearSystem& system, const Eigen::VectorXd& x, double step,
                                 Eigen::MatrixXd* J) {
@@ -54,39 +86,55 @@ bool finite_difference_jacobian(const NonlinearSystem& system, const Eigen::Vect
   return true;
 }
 
-NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options) {
+namespace {
+
+NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options,
+                           const Deadline& deadline) {
   NewtonSummary summary;
   Eigen::VectorXd F, F_trial;
   Eigen::MatrixXd J;
   std::string failure;
+  bool not_finite = false;  // the last failed evaluation returned NaN or inf (not an integrator failure)
   auto evaluate = [&](const Eigen::VectorXd& at, Eigen::VectorXd* f, Eigen::MatrixXd* jac) {
     ++summary.evaluations;
-    if (jac && options.finite_difference_jacobian) {
-      if (!system.evaluate(at, f, nullptr, &failure)) return false;
-      return finite_difference_jacobian(system, at, options.finite_difference_step, jac);
+    not_finite = false;
+    bool ok = false;
+    if (jac && options.finite_difference_jacobian)
+      ok = system.evaluate(at, f, nullptr, &failure) &&
+           finite_difference_jacobian(system, at, options.finite_difference_step, jac);
+    else
+      ok = system.evaluate(at, f, jac, &failure);
+    if (!ok) return false;
+    // A NaN or inf is never a residual: it is reported, never compared with the tolerance.
+    if (!f->allFinite() || (jac && !jac->allFinite())) {
+      not_finite = true;
+      failure = std::string("the ") + (f->allFinite() ? "Jacobian" : "residual") + " holds NaN or inf";
+      return false;
     }
-    return system.evaluate(at, f, jac, &failure);
+    return true;
+  };
+  auto fail = [&](double norm) {
+    summary.status = not_finite ? SolverStatus::NotFinite : SolverStatus::IntegrationFailed;
+    summary.residual_norm = norm;
+    summary.message = failure;
+    return summary;
   };
 
   // F alone first: a converged guess (or iterate) never pays for a Jacobian.
-  if (!evaluate(x, &F, nullptr)) {
-    summary.status = SolverStatus::IntegrationFailed;
-    summary.residual_norm = INFINITY;
-    summary.message = failure;
-    return summary;
-  }
-  double norm = F.lpNorm<Eigen::Infinity>();
+  if (!evaluate(x, &F, nullptr)) return fail(INFINITY);
+  double norm = max_abs_or_nan(F);
   summary.residual_norm = norm;
   for (int it = 0; it < options.max_iterations; ++it) {
     if (norm <= options.residual_tolerance) {
       summary.status = SolverStatus::Converged;
       return summary;
     }
-    if (!evaluate(x, &F, &J)) {
-      summary.status = SolverStatus::IntegrationFailed;
-      summary.message = failure;
+    if (deadline.passed()) {
+      summary.status = SolverStatus::TimeLimit;
+      summary.message = "wall-clock limit of " + std::to_string(options.max_seconds) + " s reached";
       return summary;
     }
+    if (!evaluate(x, &F, &J)) return fail(norm);
     const JacobianLU lu(J);
     const double rcond = lu.reciprocal_condition();
     if (!(rcond > options.singular_rcond)) {
@@ -96,12 +144,13 @@ NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, co
     }
     const Eigen::VectorXd dx = -lu.solve(F);
     // Backtracking on |F|_2: accept the first step length that decreases it (sufficient
-    // decrease with the usual 1e-4 slope fraction).
+    // decrease with the usual 1e-4 slope fraction). A trial whose residual is NaN or inf fails
+    // evaluate and is backed away from.
     const double merit = F.squaredNorm();
     double alpha = 1.0;
     bool accepted = false;
     Eigen::VectorXd x_trial;
-    for (int k = 0; k <= options.max_backtracks; ++k, alpha *= 0.5) {
+    for (int k = 0; k <= options.max_backtracks && !deadline.passed(); ++k, alpha *= 0.5) {
       x_trial = x + alpha * dx;
       if (evaluate(x_trial, &F_trial, nullptr) && F_trial.squaredNorm() <= (1.0 - 1e-4 * alpha) * merit) {
         accepted = true;
@@ -110,13 +159,15 @@ NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, co
     }
     ++summary.iterations;
     if (!accepted) {
-      summary.status = SolverStatus::LineSearchFailed;
-      summary.message = "no step length decreased the residual";
+      summary.status = deadline.passed() ? SolverStatus::TimeLimit : SolverStatus::LineSearchFailed;
+      summary.message = deadline.passed() ? "wall-clock limit of " + std::to_string(options.max_seconds) +
+                                                " s reached in the line search"
+                                          : "no step length decreased the residual";
       return summary;
     }
     x = x_trial;
     F = F_trial;
-    norm = F.lpNorm<Eigen::Infinity>();
+    norm = max_abs_or_nan(F);
     summary.residual_norm = norm;
     summary.history.push_back(norm);
     const bool stalled = alpha * dx.lpNorm<Eigen::Infinity>() <=
@@ -129,6 +180,12 @@ NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, co
   }
   summary.status = norm <= options.residual_tolerance ? SolverStatus::Converged : SolverStatus::MaxIterations;
   return summary;
+}
+
+}  // namespace
+
+NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options) {
+  return newton_until(system, x, options, Deadline(options.max_seconds));
 }
 
 namespace {
@@ -147,7 +204,8 @@ double least_squares_objective(unsigned n, const double* x, double* grad, void* 
   Eigen::VectorXd F;
   Eigen::MatrixXd J;
   std::string failure;
-  if (!ctx->system->evaluate(xv, &F, grad ? &J : nullptr, &failure)) {
+  if (!ctx->system->evaluate(xv, &F, grad ? &J : nullptr, &failure) || !F.allFinite() ||
+      (grad && !J.allFinite())) {
     if (grad) std::fill(grad, grad + n, 0.0);
     return 1e300;
   }
@@ -159,14 +217,16 @@ double least_squares_objective(unsigned n, const double* x, double* grad, void* 
 
 NewtonSummary solve_with_fallback(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options) {
   const Eigen::VectorXd guess = x;
-  NewtonSummary summary = newton_solve(system, x, options);
-  if (summary.converged() || !options.fallback_search) return summary;
+  const Deadline deadline(options.max_seconds);
+  NewtonSummary summary = newton_until(system, x, options, deadline);
+  if (summary.converged() || !options.fallback_search || deadline.passed()) return summary;
 
   SearchContext ctx{&system};
   nlopt::opt search(nlopt::LD_LBFGS, static_cast<unsigned>(system.size()));
   search.set_min_objective(least_squares_objective, &ctx);
   search.set_maxeval(options.fallback_evaluations);
   search.set_ftol_abs(0.5 * options.residual_tolerance * options.residual_tolerance);
+  if (options.max_seconds > 0) search.set_maxtime(deadline.remaining_seconds());
   std::vector<double> start(guess.data(), guess.data() + guess.size());
   double value = 0.0;
   try {
@@ -175,7 +235,7 @@ NewtonSummary solve_with_fallback(const NonlinearSystem& system, Eigen::VectorXd
     // NLopt stops with roundoff_limited or similar: the point reached is still a candidate.
   }
   Eigen::VectorXd candidate = Eigen::Map<Eigen::VectorXd>(start.data(), start.size());
-  NewtonSummary second = newton_solve(system, candidate, options);
+  NewtonSummary second = newton_until(system, candidate, options, deadline);
   second.used_fallback_search = true;
   second.evaluations += summary.evaluations + ctx.evaluations;
   if (second.converged() || second.residual_norm < summary.residual_norm) {

@@ -27,6 +27,10 @@ enum class SolverStatus {
   LineSearchFailed,   // no step length in [2^-max_backtracks, 1] decreased |F|
   UnfoldingNotZero,   // converged, but the symmetry-unfolding parameter is not 0 (|mu| >
                       // kUnfoldingTolerance): a solution of the unfolded system, not an equilibrium
+  NotFinite,          // the residual or its Jacobian holds a NaN or an infinity
+  CheckFailed,        // Newton converged, but the solution failed its own checks afterwards
+                      // (verification.hpp: residual recomputed, finite values, admissibility)
+  TimeLimit,          // the wall-clock limit (NewtonOptions::max_seconds) was reached
 };
 const char* to_string(SolverStatus status);
 
@@ -42,6 +46,9 @@ struct NewtonOptions {
   double finite_difference_step = 1e-6;     // central differences: error ~ h^2 ~ 1e-12
   bool fallback_search = true;  // run an NLopt least-squares search when Newton fails
   int fallback_evaluations = 2000;
+  // Wall-clock limit of one solve in seconds (0: none). Checked between evaluations, so a solve
+  // ends within this plus one evaluation (an integration is itself bounded by max_steps).
+  double max_seconds = 0.0;
 
   std::string validate() const;  // empty when valid
 };
@@ -66,8 +73,9 @@ NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, co
 // |F|^2 / 2 from the original guess followed by Newton again.
 NewtonSummary solve_with_fallback(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options);
 
-// Reciprocal condition estimate of an LU factorisation that also sees exactly zero pivots
-// (Eigen's estimate alone does not when a whole column vanishes): min(rcond, min|U_ii|/max|U_ii|).
+// max_i |v_i|, or NaN when any entry is NaN or infinite. (Eigen's lpNorm<Infinity> takes a
+// maximum whose comparisons ignore a NaN, so a NaN residual could pass a `<= tolerance` test.)
+double max_abs_or_nan(const Eigen::VectorXd& v);
 
 // Central-difference Jacobian; returns false when an evaluation fails.
 bool finite_difference_jacobian(const NonlinearSystem& system, const Eigen::VectorXd& x, double step,

@@ -9,6 +9,7 @@
 
 #include "kirchhoff/closest_approach.hpp"
 #include "kirchhoff/plectoneme.hpp"
+#include "kirchhoff/verification.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -233,7 +234,9 @@ Solution make_solution(const ShootingProblem& problem, ShootingResult result, in
   s.back() = L;  // exactly: L * (n - 1) / (n - 1) may differ from L by an ulp
   sol.profile = problem.sample(sol.result.x, s);
   sol.contacts = problem.contacts_at(sol.result.x);
-  sol.invariants = compute_invariants(problem.equations(sol.result.parameters)->model(), sol.profile);
+  const RodModel& model = problem.equations(sol.result.parameters)->model();
+  mark_check_failure(&sol.result, profile_failure(model, sol.profile));
+  sol.invariants = compute_invariants(model, sol.profile);
   std::optional<PlectonemeMeasures> plectoneme;  // measured once, when a quantity asks for it
   for (const auto& name : derived_names) {
     if (kCatalogue.count(name)) {

@@ -1,0 +1,178 @@
+// No result is called converged unless it is one: NaN and inf never pass Newton's test, a
+// converged solve is checked again (verification.hpp), solves end within their wall-clock limit,
+// and both steppers give the same equilibrium on every shipped case.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <thread>
+
+#include "kirchhoff/newton.hpp"
+#include "kirchhoff/verification.hpp"
+#include "test_support.hpp"
+
+namespace kirchhoff {
+namespace {
+
+// F(x) = x - 1 in every component, with component `poisoned` replaced by `value`.
+class PoisonedSystem final : public NonlinearSystem {
+ public:
+  PoisonedSystem(int poisoned, double value) : poisoned_(poisoned), value_(value) {}
+  int size() const override { return 3; }
+  bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, std::string*) const override {
+    *F = x.array() - 1.0;
+    (*F)[poisoned_] = value_;
+    if (J) *J = Eigen::MatrixXd::Identity(3, 3);
+    return true;
+  }
+
+ private:
+  int poisoned_;
+  double value_;
+};
+
+TEST(MaxAbsOrNan, SeesEveryNonFiniteEntry) {
+  EXPECT_EQ(max_abs_or_nan(Eigen::Vector3d(1.0, -3.0, 2.0)), 3.0);
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Vector3d v(1e-20, 1e-20, 1e-20);
+    v[i] = NAN;
+    EXPECT_TRUE(std::isnan(max_abs_or_nan(v))) << "NaN at " << i;
+    v[i] = -INFINITY;
+    EXPECT_TRUE(std::isnan(max_abs_or_nan(v))) << "inf at " << i;
+  }
+  EXPECT_EQ(max_abs_or_nan(Eigen::VectorXd()), 0.0);
+}
+
+// Eigen's lpNorm<Infinity> skipped a NaN in some positions, so a residual of NaN beside tiny
+// entries passed `norm <= tolerance`: wherever the NaN sits, the solve is not converged.
+TEST(NewtonOnNonFiniteResiduals, NeverConverges) {
+  for (int i = 0; i < 3; ++i)
+    for (double poison : {double(NAN), double(INFINITY)}) {
+      const PoisonedSystem system(i, poison);
+      Eigen::VectorXd x = Eigen::VectorXd::Ones(3);
+      NewtonOptions options;
+      options.fallback_search = true;  // the NLopt search must not turn it into a success either
+      const NewtonSummary s = solve_with_fallback(system, x, options);
+      EXPECT_FALSE(s.converged()) << i << " " << poison;
+      EXPECT_EQ(s.status, SolverStatus::NotFinite) << i << " " << poison << ": " << s.brief_report();
+    }
+}
+
+// Each evaluation takes 50 ms and F = 1 + 1 / (1 + x^2) has no root, so Newton and the NLopt
+// search after it would go on for minutes: the 0.2 s limit stops both.
+class SlowSystem final : public NonlinearSystem {
+ public:
+  int size() const override { return 1; }
+  bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, std::string*) const override {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    *F = Eigen::VectorXd::Constant(1, 1.0 + 1.0 / (1.0 + x[0] * x[0]));
+    if (J) *J = Eigen::MatrixXd::Constant(1, 1, -2.0 * x[0] / std::pow(1.0 + x[0] * x[0], 2));
+    return true;
+  }
+};
+
+TEST(NewtonWallClockLimit, StopsWithTimeLimit) {
+  const SlowSystem system;
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(1, 0.3);
+  NewtonOptions options;
+  options.max_iterations = 10000;
+  options.max_backtracks = 0;
+  options.max_seconds = 0.2;
+  const auto start = std::chrono::steady_clock::now();
+  const NewtonSummary s = solve_with_fallback(system, x, options);
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_FALSE(s.converged());
+  // Not a timing assert on speed: the limit plus a few 50 ms evaluations, with a wide margin
+  // for a loaded machine. Without the limit this solve would run for minutes.
+  EXPECT_LT(elapsed, 5.0) << s.brief_report();
+  EXPECT_TRUE(s.status == SolverStatus::TimeLimit || s.status == SolverStatus::LineSearchFailed) << s.brief_report();
+}
+
+TEST(NewtonOptionsValidation, RefusesNonFiniteTimeLimit) {
+  NewtonOptions o;
+  o.max_seconds = INFINITY;
+  EXPECT_FALSE(o.validate().empty());
+  o.max_seconds = -1;
+  EXPECT_FALSE(o.validate().empty());
+  o.max_seconds = 10;
+  EXPECT_TRUE(o.validate().empty());
+}
+
+TEST(ProfileFailure, NamesNaNAndTheSoftWall) {
+  RodModel model;
+  std::vector<RodPoint> profile(3);
+  for (int i = 0; i < 3; ++i) profile[i].s = 0.5 * i;
+  EXPECT_EQ(profile_failure(model, profile), "");
+  profile[1].n.x() = NAN;
+  EXPECT_NE(profile_failure(model, profile).find("NaN"), std::string::npos);
+  profile[1].n.x() = 0.0;
+  model.field = std::make_shared<BarrierWall>(1e-3, 0.1, Vec3::UnitY());
+  EXPECT_EQ(profile_failure(model, profile), "");
+  profile[2].r.y() = 0.1 + 1e-6;  // beyond the wall at y = 0.1
+  EXPECT_NE(profile_failure(model, profile).find("soft wall"), std::string::npos) << profile_failure(model, profile);
+}
+
+// A solve of the soft wall at a range b = 1e-20 once "converged" with the rod beyond the wall:
+// now it is never reported converged with a negative gap.
+TEST(SoftWall, NoConvergedSolutionBeyondTheWall) {
+  for (double log_b : {-20.0, -25.0}) {
+    const Case c = load_case(testing::case_path("soft_wall.toml"), {{"log_b", log_b}});
+    DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
+    const Solution sol = make_solution(*solved.problem, solved.result, 401, {"gap"});
+    if (sol.result.summary.converged()) {
+      EXPECT_GT(sol.derived.at("gap"), 0.0) << log_b;
+      for (const RodPoint& p : sol.profile) EXPECT_LT(p.r.y(), 0.1) << "log_b " << log_b << " s " << p.s;
+    }
+  }
+}
+
+// Both steppers give the same equilibrium on every shipped case. Dopri5 returned NaN profiles
+// (odeint's dense output sampled s = 0 before its first step) that the solve called converged.
+class BothSteppers : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(BothSteppers, GiveTheSameEquilibrium) {
+  const std::string name = GetParam();
+  Solution by[2];
+  for (int k = 0; k < 2; ++k) {
+    Case c = load_case(testing::case_path(name));
+    c.definition.options.integrator.stepper =
+        k == 0 ? IntegratorOptions::Stepper::RungeKutta78 : IntegratorOptions::Stepper::Dopri5;
+    c.definition.options.integrator.sensitivity_tol = 0.0;
+    DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
+    by[k] = make_solution(*solved.problem, solved.result, 101, c.derived);
+    ASSERT_TRUE(by[k].result.summary.converged()) << name << (k ? " dopri5: " : " rk78: ")
+                                                  << by[k].result.summary.brief_report();
+    for (const RodPoint& p : by[k].profile) ASSERT_TRUE(p.r.allFinite() && p.n.allFinite() && p.m.allFinite());
+  }
+  // Both solve to the case's residual tolerance (<= 1e-8) with local errors <= the case's 1e-12
+  // per step; the global error of either is ~1e-10 of the scale, and the derived quantities
+  // amplify it by their conditioning (<= ~1e2 on these cases): 1e-6 of the scale bounds it.
+  for (const auto& [quantity, value] : by[0].derived) {
+    const double other = by[1].derived.at(quantity);
+    if (std::isnan(value)) {
+      EXPECT_TRUE(std::isnan(other)) << name << " " << quantity;
+      continue;
+    }
+    EXPECT_NEAR(other, value, 1e-6 * std::max(1.0, std::abs(value))) << name << " " << quantity;
+  }
+  EXPECT_NEAR(by[1].invariants.H.mean, by[0].invariants.H.mean, 1e-6 * std::max(1.0, std::abs(by[0].invariants.H.mean)))
+      << name;
+}
+
+std::vector<std::string> shipped_cases() {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(KIRCHHOFF_CASES_DIR))
+    if (entry.path().extension() == ".toml") names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::string test_name(const ::testing::TestParamInfo<std::string>& info) {
+  return info.param.substr(0, info.param.size() - 5);  // without ".toml"
+}
+
+INSTANTIATE_TEST_SUITE_P(ShippedCases, BothSteppers, ::testing::ValuesIn(shipped_cases()), test_name);
+
+}  // namespace
+}  // namespace kirchhoff
