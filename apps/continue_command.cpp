@@ -1,9 +1,11 @@
 #include "continue_command.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -25,27 +27,50 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Branch points already written on branch 0 (for resuming a run with --switch-at-bp).
-int count_branch_points(const fs::path& path) {
+// Data rows of a branch CSV (0 when there is none).
+int data_rows(const fs::path& path) {
   std::ifstream in(path);
   std::string line;
-  std::getline(in, line);
+  std::getline(in, line);  // the header
   int count = 0;
   while (std::getline(in, line))
-    if (line.find(",0,") == line.find(',') && line.find(",branch_point,") != std::string::npos) ++count;
+    if (!line.empty()) ++count;
   return count;
 }
 
-// Rows already written on a branch (max_points counts a branch's points across resumes).
-int count_rows_on_branch(const fs::path& path, int branch) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  const std::string tag = "," + std::to_string(branch) + ",";
-  int count = 0;
-  while (std::getline(in, line))
-    if (line.find(tag) == line.find(',')) ++count;
-  return count;
+// The arguments that decide a run's points, in one line: a state file records them, and a
+// resume with other ones is refused (it would not continue the same run). The output paths and
+// --resume itself are not among them.
+std::string run_arguments(const ContinueArguments& a) {
+  std::ostringstream o;
+  o << std::setprecision(17) << "case=" << a.case_path << " param=" << a.parameter;
+  for (const auto& s : a.overrides) o << " set=" << s;
+  o << " phase=" << a.phase_condition << " to=";
+  if (a.has_to)
+    o << a.to;
+  else
+    o << "none";
+  o << " step=" << a.step
+    << " min_step=" << a.min_step << " max_step=" << a.max_step << " max_points=" << a.max_points
+    << " switch_at_bp=" << a.switch_at_bp << " side=" << a.switch_side << " branch_points=" << !a.no_branch_points;
+  for (const auto& e : a.stop_events) o << " event=" << e;
+  for (const auto& e : a.record_events) o << " record=" << e;
+  o << " samples=" << a.samples << " seed=" << (a.seed.ipopt ? "ipopt" : "guess");
+  if (a.seed.ipopt) o << " seed_segments=" << a.seed.segments << " seed_amplitude=" << a.seed.amplitude;
+  return o.str();
+}
+
+// For tests and tests/resume_soak.sh: KIRCHHOFF_TEST_KILL_AFTER_ROW=K makes the run kill itself
+// with SIGKILL right after row K is written and flushed, before the state is saved for it (the
+// narrowest window a real kill can hit: the row is on disk, the state is the previous point's);
+// -1 kills it once the CSV header is written, before any point. Nothing is cleaned up, as with a
+// real kill. Unset (or not a number), runs are not affected.
+int kill_after_row() {
+  const char* value = std::getenv("KIRCHHOFF_TEST_KILL_AFTER_ROW");
+  if (!value || !*value) return -2;
+  char* end = nullptr;
+  const long k = std::strtol(value, &end, 10);
+  return *end == '\0' && k >= -1 ? static_cast<int>(k) : -2;
 }
 
 class BranchWriter {
@@ -121,6 +146,23 @@ int run_continue(const ContinueArguments& args) {
   Case c;
   ContinuationOptions options;
   Eigen::VectorXd start_point;  // --start-from: the unknowns to start from
+  const fs::path csv(args.out_path), state_path(args.out_path + ".state.json");
+  // A run killed before it saved its first point (its start) has no state file, and at most the
+  // start's row, which it had not finished: resuming it is starting it again, which rewrites the
+  // CSV with the same rows. More rows and no state means the state was removed or the rows are
+  // another run's: nothing records where that march stood, so it is refused.
+  bool resuming = args.resume;
+  if (args.resume && !fs::exists(state_path)) {
+    if (const int rows = data_rows(csv); rows > 1) {
+      std::cerr << "error: cannot resume: " << csv.string() << " has " << rows << " rows but there is no state file "
+                << state_path.string() << " (a run saves it after its first point, so it was removed or the rows "
+                << "come from another run); run again without --resume to compute the branch from its start\n";
+      return kExitBadInput;
+    }
+    std::cerr << "resume: no state file " << state_path.string()
+              << ": the run was stopped before its first point was saved, so it starts from the beginning\n";
+    resuming = false;
+  }
   try {
     ParameterOverrides overrides;
     for (const auto& t : args.overrides) overrides.push_back(parse_override(t));
@@ -156,7 +198,7 @@ int run_continue(const ContinueArguments& args) {
       std::cerr << "start: the point at " << name << " = " << std::setprecision(15) << from.last.parameter << " of "
                 << args.start_from << "\n" << std::setprecision(6);
     }
-    if (args.seed.ipopt && !args.resume) {
+    if (args.seed.ipopt && !resuming) {
       // The first point from Ipopt's shape and contact set instead of the case's guess.
       const DiscreteSeed seed = seed_from_discrete_energy(c.definition, args.seed.segments, args.seed.amplitude);
       std::cerr << "seed: " << seed.summary << "\n";
@@ -181,26 +223,39 @@ int run_continue(const ContinueArguments& args) {
     std::cerr << "error: " << args.case_path << ": --switch-at-bp is not implemented for cases with obstacles yet\n";
     return kExitBadInput;
   }
-  const fs::path csv(args.out_path), state_path(args.out_path + ".state.json");
   if (!args.profiles_dir.empty()) fs::create_directories(args.profiles_dir);
   Progress progress(args.parameter);
   RunState state;
   state.phase_condition = args.phase_condition.empty() ? "none" : args.phase_condition;
+  state.arguments = run_arguments(args);
   std::unique_ptr<BranchWriter> writer;
+  const int kill_after = kill_after_row();
 
   try {
-    if (args.resume) {
-      state = load_state(state_path);
+    if (resuming) {
+      RunState saved = load_state(state_path);
+      // Without the march's whole state (files written before 2026-12-02) or with other
+      // arguments, the resumed run would not be the interrupted one continued: refused, not
+      // approximated.
+      if (!saved.has_march)
+        throw CaseError("cannot resume from " + state_path.string() +
+                        ": it was written by an older kirchhoff that did not save the march's whole state, so a "
+                        "resumed run would not repeat the uninterrupted one; run again without --resume");
+      if (saved.arguments != state.arguments)
+        throw CaseError("cannot resume from " + state_path.string() + ": it belongs to a run with other arguments\n  saved: " +
+                        saved.arguments + "\n  now:   " + state.arguments);
+      state = std::move(saved);
       truncate_csv(csv, state.row);
     }
     state.parameter_name = args.parameter;
     std::vector<std::string> columns = c.definition.unknown_parameters;  // solved-for parameters first
     columns.insert(columns.end(), options.derived.begin(), options.derived.end());
-    writer = std::make_unique<BranchWriter>(csv, args.parameter, columns, args.resume);
+    writer = std::make_unique<BranchWriter>(csv, args.parameter, columns, resuming);
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;
   }
+  if (kill_after == -1) kill(getpid(), SIGKILL);
 
   // The problem of the current branch (the switched branch of a symmetric rod has the phase
   // condition added).
@@ -225,16 +280,22 @@ int run_continue(const ContinueArguments& args) {
                       s.profile);
   };
 
+  // The state is saved after every point a run can resume from (options.on_resumable, called
+  // right after the point's row is written): a run killed after a special point (fold, branch
+  // point, event) redoes the step that found it from the point before, and its row is rewritten.
+  auto save_march = [&](const MarchState& m) {
+    set_march_state(&state, m);
+    state.saved_row = state.row;
+    save_state(state_path, state);
+  };
   auto sink_for = [&](const ShootingProblem& problem, int branch, const std::string& phase) {
     return [&, branch, phase](const ContinuationPoint& p) {
       ++state.row;
       writer->write(state.row, p, branch);
-      // Only points the march goes on from are resumable: a run killed after a special point
-      // (fold, branch point, event) redoes the step that found it, and its row is rewritten.
+      if (state.row == kill_after) kill(getpid(), SIGKILL);
       if (resumable(p)) {
         state.branch = branch;
         state.phase_condition = phase;
-        save_resume_point(state_path, p, &state);
       }
       progress.point(state.row, p, branch);
       write_profile(problem, p);
@@ -263,20 +324,21 @@ int run_continue(const ContinueArguments& args) {
   if (!c.definition.obstacles.empty()) {
     // Contact: the active set changes along the branch (each change is an event row).
     try {
-      std::vector<PointContact> active;
       std::unique_ptr<ShootingProblem> leg_problem;  // for --profiles
       auto sink = [&](const ContinuationPoint& p) {
         ++state.row;
         writer->write(state.row, p, 0);
-        if (resumable(p)) {
-          state.contacts = active;
-          save_resume_point(state_path, p, &state);
-        }
+        if (state.row == kill_after) kill(getpid(), SIGKILL);
         progress.point(state.row, p, 0);
         if (leg_problem) write_profile(*leg_problem, p);
       };
+      // The leg's state (its active set among it) after every point the run can resume from.
+      auto save_leg = [&](const ContactMarchState& m) {
+        set_contact_march_state(&state, m);
+        state.saved_row = state.row;
+        save_state(state_path, state);
+      };
       auto on_active_set = [&](const std::vector<PointContact>& contacts) {
-        active = contacts;
         if (args.profiles_dir.empty()) return;
         // The points that follow belong to this leg's problem (its active set).
         ProblemDefinition d = c.definition;
@@ -284,17 +346,9 @@ int run_continue(const ContinueArguments& args) {
         leg_problem = std::make_unique<ShootingProblem>(d);
       };
       ContactContinuationResult r;
-      if (args.resume) {
-        ProblemDefinition d = c.definition;
-        d.contacts = state.contacts;
-        ContinuationOptions rest = options;
-        // The resumed march counts its start point, which is already written.
-        rest.max_points = std::max(1, options.max_points - count_rows_on_branch(csv, 0) + 1);
-        active = state.contacts;
-        r = resume_with_contacts(d, state.last, rest, sink, {}, on_active_set);
-      } else {
-        r = continue_with_contacts(c.definition, c.start_guess, options, sink, {}, on_active_set);
-      }
+      r = resuming
+              ? resume_with_contacts(c.definition, contact_march_state(state), options, sink, {}, on_active_set, save_leg)
+              : continue_with_contacts(c.definition, c.start_guess, options, sink, {}, on_active_set, save_leg);
       progress.done();
       for (const auto& line : r.changes) std::cerr << "contact: " << line << "\n";
       std::cerr << "stopped: " << to_string(r.result.reason)
@@ -309,6 +363,7 @@ int run_continue(const ContinueArguments& args) {
       return kExitNotConverged;
     }
   }
+  options.on_resumable = save_march;
   try {
     auto problem = problem_for(state.phase_condition);
     if (start_point.size() > 0 && start_point.size() != problem->size()) {
@@ -317,21 +372,22 @@ int run_continue(const ContinueArguments& args) {
                 << problem->size() << " (set the parameters that fix the segments as in that run)\n";
       return kExitBadInput;
     }
+    // Each branch's march is run with the options the uninterrupted run gives it, a resumed one
+    // too: branch 0 with the target, the self-passage guard and the stop at the K-th branch
+    // point (the count of those passed is in the saved state), branch 1 with
+    // bifurcating_branch_options (no target: `--to` applied there stopped resumed runs at it).
     ContinuationOptions first = options;
     // A rod with self-contact: steps that would carry it through itself are refused.
-    if (guard_self_passage(*problem, &first)) std::cerr << "self-contact: steps through the rod itself are refused\n";
-    if (branch == 0 && args.switch_at_bp > 0)
-      first.stop_at_branch_point = args.switch_at_bp - (args.resume ? count_branch_points(csv) : 0);
-    if (args.resume) {
-      problem->set_parameter(args.parameter, state.last.parameter);
-      // The resumed march counts its start point, which is already written.
-      first.max_points = std::max(1, options.max_points - count_rows_on_branch(csv, branch) + 1);
-    }
+    if (branch == 0 && guard_self_passage(*problem, &first))
+      std::cerr << "self-contact: steps through the rod itself are refused\n";
+    if (branch == 0 && args.switch_at_bp > 0) first.stop_at_branch_point = args.switch_at_bp;
+    if (branch == 1) first = bifurcating_branch_options(options);
+    if (resuming) problem->set_parameter(args.parameter, state.last.parameter);
     Continuation run(*problem, first);
     // (A resume never starts on a branch point: only points the march goes on from are saved.)
-    result = args.resume ? run.resume(state.last, sink_for(*problem, branch, state.phase_condition))
-                         : run.run(start_point.size() > 0 ? start_point : problem->initial_unknowns(c.start_guess),
-                                   sink_for(*problem, 0, state.phase_condition));
+    result = resuming ? run.resume(march_state(state), sink_for(*problem, branch, state.phase_condition))
+                      : run.run(start_point.size() > 0 ? start_point : problem->initial_unknowns(c.start_guess),
+                                sink_for(*problem, 0, state.phase_condition));
     if (branch == 0 && args.switch_at_bp > 0) {
       if (result.reason != StopReason::BranchPointStop) {
         progress.done();

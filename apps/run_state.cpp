@@ -1,5 +1,6 @@
 #include "run_state.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,29 @@ nlohmann::json to_json(const Eigen::VectorXd& v) { return std::vector<double>(v.
 Eigen::VectorXd vector_from(const nlohmann::json& j) {
   const auto v = j.get<std::vector<double>>();
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+
+// The fields of a point a march resumes from (the rest is recomputed from x and the parameter).
+// Doubles are written in their shortest round-trip form and read back to the same bits.
+nlohmann::json point_json(const ContinuationPoint& p) {
+  return {{"index", p.index},         {"parameter", p.parameter}, {"arclength", p.arclength},
+          {"step", p.step},           {"x", to_json(p.x)},        {"tangent", to_json(p.tangent)},
+          {"type", to_string(p.type)}, {"newton_iterations", p.newton_iterations}};
+}
+
+PointType point_type_from(const std::string& name);
+
+ContinuationPoint point_from(const nlohmann::json& j) {
+  ContinuationPoint p;
+  p.index = j.at("index");
+  p.parameter = j.at("parameter");
+  p.arclength = j.at("arclength");
+  p.step = j.at("step");
+  p.x = vector_from(j.at("x"));
+  p.tangent = vector_from(j.at("tangent"));
+  p.type = point_type_from(j.at("type"));
+  p.newton_iterations = j.value("newton_iterations", 0);
+  return p;
 }
 
 PointType point_type_from(const std::string& name) {
@@ -39,6 +63,21 @@ void save_state(const std::filesystem::path& path, const RunState& s) {
     j["contacts"].push_back({{"obstacle", c.obstacle}, {"s", c.s}, {"force", c.force}, {"extended", c.extended},
                              {"s_end", c.s_end}, {"force_end", c.force_end}});
   j["piece_segments"] = s.piece_segments;
+  j["newton_iterations"] = s.last.newton_iterations;
+  if (s.has_march) {
+    nlohmann::json m = {{"previous_step", s.previous_step},
+                        {"just_reported_branch_point", s.just_reported_branch_point},
+                        {"branch_points_found", s.branch_points_found},
+                        {"points", s.march_points},
+                        {"refused_steps", s.refused_steps},
+                        {"contact_bending_event", s.contact_bending_event},
+                        {"leg_max_points", s.leg_max_points},
+                        {"reported", s.reported},
+                        {"first_leg", s.first_leg}};
+    if (s.before) m["before"] = point_json(*s.before);
+    j["march"] = m;
+  }
+  if (!s.arguments.empty()) j["arguments"] = s.arguments;
   const fs::path tmp = path.string() + ".tmp";
   {
     std::ofstream out(tmp);
@@ -76,7 +115,63 @@ RunState load_state(const std::filesystem::path& path) {
       s.contacts.push_back({c.at("obstacle").get<int>(), c.at("s").get<double>(), c.at("force").get<double>(),
                             c.at("extended").get<bool>(), c.at("s_end").get<double>(), c.at("force_end").get<double>()});
   if (j.contains("piece_segments")) s.piece_segments = j.at("piece_segments").get<std::vector<int>>();
+  s.last.newton_iterations = j.value("newton_iterations", 0);
+  if (j.contains("march")) {
+    const nlohmann::json& m = j.at("march");
+    s.has_march = true;
+    if (m.contains("before")) s.before = point_from(m.at("before"));
+    s.previous_step = m.at("previous_step");
+    s.just_reported_branch_point = m.at("just_reported_branch_point");
+    s.branch_points_found = m.at("branch_points_found");
+    s.march_points = m.at("points");
+    s.refused_steps = m.at("refused_steps");
+    // (JSON has no NaN: a non-finite value is written as null.)
+    const auto& bending = m.at("contact_bending_event");
+    s.contact_bending_event = bending.is_null() ? NAN : bending.get<double>();
+    s.leg_max_points = m.at("leg_max_points");
+    s.reported = m.at("reported");
+    s.first_leg = m.at("first_leg");
+  }
+  s.arguments = j.value("arguments", "");
   return s;
+}
+
+MarchState march_state(const RunState& s) {
+  MarchState m;
+  m.current = s.last;
+  m.before = s.before;
+  m.previous_step = s.previous_step;
+  m.just_reported_branch_point = s.just_reported_branch_point;
+  m.branch_points_found = s.branch_points_found;
+  m.points = s.march_points;
+  m.refused_steps = s.refused_steps;
+  return m;
+}
+
+void set_march_state(RunState* s, const MarchState& m) {
+  s->last = m.current;
+  s->last.jacobian.reset();
+  s->before = m.before;
+  if (s->before) s->before->jacobian.reset();
+  s->previous_step = m.previous_step;
+  s->just_reported_branch_point = m.just_reported_branch_point;
+  s->branch_points_found = m.branch_points_found;
+  s->march_points = m.points;
+  s->refused_steps = m.refused_steps;
+  s->has_march = true;
+}
+
+ContactMarchState contact_march_state(const RunState& s) {
+  return {march_state(s), s.contacts, s.contact_bending_event, s.leg_max_points, s.reported, s.first_leg};
+}
+
+void set_contact_march_state(RunState* s, const ContactMarchState& m) {
+  set_march_state(s, m.march);
+  s->contacts = m.contacts;
+  s->contact_bending_event = m.contact_bending_event;
+  s->leg_max_points = m.leg_max_points;
+  s->reported = m.reported;
+  s->first_leg = m.first_leg;
 }
 
 // Keeps the header and the rows up to and including `last_index` (a row written after the

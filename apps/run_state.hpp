@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,7 +23,32 @@ struct RunState {
   ContinuationPoint last;
   std::vector<PointContact> contacts;  // the active set of `last` (contact runs)
   std::vector<int> piece_segments;     // multiple shooting with contacts: the problem's segments per piece
+
+  // The rest of the march's state at `last` (MarchState; `continue` saves it so that a resumed
+  // run repeats the uninterrupted one; plectonemes' files and those written before 2026-12-02
+  // have none: has_march false).
+  bool has_march = false;
+  std::optional<ContinuationPoint> before;
+  double previous_step = 0.0;
+  bool just_reported_branch_point = false;
+  int branch_points_found = 0;
+  int march_points = 1;
+  int refused_steps = 0;
+  // Contact runs: the leg's state beyond its active set (ContactMarchState).
+  double contact_bending_event = 0.0;
+  int leg_max_points = 0;
+  int reported = 0;
+  bool first_leg = true;
+  // The run's arguments, as `continue` words them (a resume with others would not continue the
+  // same run); empty in files that did not record them.
+  std::string arguments;
 };
+
+// The march's state of a RunState and back (`last` is its current point).
+MarchState march_state(const RunState& s);
+void set_march_state(RunState* s, const MarchState& m);
+ContactMarchState contact_march_state(const RunState& s);
+void set_contact_march_state(RunState* s, const ContactMarchState& m);
 
 // Points a run can resume from (a special point is re-found by the resumed march, not restarted from).
 bool resumable(const ContinuationPoint& p);

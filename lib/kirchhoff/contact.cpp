@@ -237,20 +237,27 @@ std::string complementarity_violation(const ContinuationPoint& p, const ContactO
   return what.str();
 }
 
-// The legs of a contact continuation, from unknowns x (a new run) or from a point (a resume).
-ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const ContinuationPoint* resume_from,
+// The legs of a contact continuation, from unknowns x (a new run) or from a saved state (a resume).
+ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const ContactMarchState* resume_from,
                                    ContinuationOptions options, const PointSink& sink, const ContactOptions& contact,
-                                   const ActiveSetSink& active_set_sink, ContactContinuationResult out) {
+                                   const ActiveSetSink& active_set_sink, const ContactStateSink& state_sink,
+                                   ContactContinuationResult out) {
   const int max_points = options.max_points;
-  bool first_leg = true;
+  bool first_leg = true;  // the first leg of this call (its start is not a point reported before)
+  // The run's points reported so far and whether the leg is the run's first: with a resume they
+  // continue those of the interrupted run, so that the legs' shares of max_points are the same.
+  int reported = resume_from ? resume_from->reported : 0;
+  bool run_first_leg = resume_from ? resume_from->first_leg : true;
   // Set when a flat contact has just buckled: the next leg leaves the flat branch along the fold.
   std::optional<ContinuationPoint> fold_onset;
   size_t fold_contact = 0;  // the first of the fold's two contacts
   std::optional<double> unwound_bending;  // g'' of a contact that has just shrunk to a point
   std::optional<size_t> unwound_contact;  // which one, set at the event
   while (true) {
+    const bool resuming = first_leg && resume_from;
     ContinuationOptions leg = options;
-    leg.max_points = max_points - static_cast<int>(out.result.points.size()) + (first_leg ? 0 : 1);
+    // (A later leg's start is the last point of the previous one, counted there.)
+    leg.max_points = resuming ? resume_from->leg_max_points : max_points - reported + (run_first_leg ? 0 : 1);
     // The gap event sits at -penetration_tolerance: an active contact touches with a gap of 0 up to
     // round-off, whose sign must not count as a crossing.
     leg.events.push_back({"min_gap", -contact.penetration_tolerance, true, "obstacle_reached"});
@@ -274,8 +281,9 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     }
     // After a contact shrank to a point its g'' starts at ~0 (to the event's location, not
     // exactly): the event is armed at that start value, so the start is not a crossing.
+    const double bending_event = resuming ? resume_from->contact_bending_event : unwound_bending.value_or(0.0);
     if (has_point && d.kind == RodKind::Planar)
-      leg.events.push_back({"contact_bending", unwound_bending.value_or(0.0), true, "contact_flattens"});
+      leg.events.push_back({"contact_bending", bending_event, true, "contact_flattens"});
     unwound_bending.reset();
     // A wrapped part presses on its disc with tension / radius: where the tension would turn to
     // compression the rod leaves the disc inside the wrap.
@@ -293,9 +301,20 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
         return;
       }
       if (violation.empty()) violation = complementarity_violation(p, contact);
-      if (violation.empty() && sink) sink(p);
+      if (violation.empty()) {
+        ++reported;
+        if (sink) sink(p);
+      }
     };
-    ContinuationResult r = first_leg && resume_from ? Continuation(problem, leg).resume(*resume_from, leg_sink)
+    // The state to resume from at each resumable point of the leg, the leg's start included: a
+    // later leg's start (not reported: it is the previous leg's event point) is where a run
+    // killed before the leg's first new point resumes, without redoing the change of active set.
+    leg.on_resumable = nullptr;
+    if (state_sink)
+      leg.on_resumable = [&, leg_max_points = leg.max_points, bending_event](const MarchState& m) {
+        if (violation.empty()) state_sink({m, d.contacts, bending_event, leg_max_points, reported, run_first_leg});
+      };
+    ContinuationResult r = resuming ? Continuation(problem, leg).resume(resume_from->march, leg_sink)
                            : fold_onset ? leave_flat_branch(problem, leg, *fold_onset, fold_contact, leg_sink)
                                         : Continuation(problem, leg).run(x, leg_sink);
     fold_onset.reset();
@@ -313,6 +332,7 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     out.result.message = r.message;
     out.definition = d;
     first_leg = false;
+    run_first_leg = false;
     if (r.reason != StopReason::EventStop || r.points.empty()) return out;
 
     // The active set changes at the event point.
@@ -435,7 +455,8 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
 
 ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodPoint& guess, ContinuationOptions options,
                                                  const PointSink& sink, const ContactOptions& contact,
-                                                 const ActiveSetSink& active_set_sink) {
+                                                 const ActiveSetSink& active_set_sink,
+                                                 const ContactStateSink& state_sink) {
   ContactContinuationResult out;
   ContactSolveResult start = solve_with_contacts(d, guess, contact);
   if (!start.result.summary.converged() || !start.complementarity) {
@@ -445,14 +466,17 @@ ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodP
   }
   for (const auto& line : start.log) out.changes.push_back("start: " + line);
   return run_legs(start.definition, start.result.x, nullptr, std::move(options), sink, contact, active_set_sink,
-                  std::move(out));
+                  state_sink, std::move(out));
 }
 
-ContactContinuationResult resume_with_contacts(ProblemDefinition d, const ContinuationPoint& last,
+ContactContinuationResult resume_with_contacts(ProblemDefinition d, const ContactMarchState& state,
                                                ContinuationOptions options, const PointSink& sink,
-                                               const ContactOptions& contact, const ActiveSetSink& active_set_sink) {
-  d.parameters.set(options.parameter, last.parameter);
-  return run_legs(std::move(d), last.x, &last, std::move(options), sink, contact, active_set_sink, {});
+                                               const ContactOptions& contact, const ActiveSetSink& active_set_sink,
+                                               const ContactStateSink& state_sink) {
+  d.contacts = state.contacts;
+  d.parameters.set(options.parameter, state.march.current.parameter);
+  return run_legs(std::move(d), state.march.current.x, &state, std::move(options), sink, contact, active_set_sink,
+                  state_sink, {});
 }
 
 }  // namespace kirchhoff

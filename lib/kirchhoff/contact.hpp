@@ -90,14 +90,33 @@ struct ContactContinuationResult {
 // caller save it beside the points to resume later.
 using ActiveSetSink = std::function<void(const std::vector<PointContact>&)>;
 
+// Where a contact continuation stands at a point it can resume from: the leg's march (MarchState)
+// and what the leg itself was started with, which a resume cannot re-derive from the point.
+struct ContactMarchState {
+  MarchState march;
+  std::vector<PointContact> contacts;  // the leg's active set
+  // The value contact_flattens is armed at: 0, or after contact_shrinks_to_a_point the contact's
+  // g'' where the leg started (re-armed at 0, the resumed leg would see a crossing that is none).
+  double contact_bending_event = 0.0;
+  int leg_max_points = 0;  // the leg's share of max_points (the legs share the run's budget)
+  int reported = 0;        // points the run has handed to its sink so far, over all legs
+  bool first_leg = true;   // the run's first leg (a later leg starts on the previous leg's event point)
+};
+// Called right after the point sink with every point such a run can resume from.
+using ContactStateSink = std::function<void(const ContactMarchState&)>;
+
 ContactContinuationResult continue_with_contacts(ProblemDefinition definition, const RodPoint& guess,
                                                  ContinuationOptions options, const PointSink& sink = {},
                                                  const ContactOptions& contact = {},
-                                                 const ActiveSetSink& active_set_sink = {});
-// Resumes such a run from its last point, whose active set is the definition's contacts.
-ContactContinuationResult resume_with_contacts(ProblemDefinition definition, const ContinuationPoint& last,
+                                                 const ActiveSetSink& active_set_sink = {},
+                                                 const ContactStateSink& state_sink = {});
+// Resumes such a run from a state its state_sink was given (the definition's contacts are
+// replaced by the state's), taking the same steps and active-set changes as the uninterrupted
+// run with the same options. The state's point is not reported again.
+ContactContinuationResult resume_with_contacts(ProblemDefinition definition, const ContactMarchState& state,
                                                ContinuationOptions options, const PointSink& sink = {},
                                                const ContactOptions& contact = {},
-                                               const ActiveSetSink& active_set_sink = {});
+                                               const ActiveSetSink& active_set_sink = {},
+                                               const ContactStateSink& state_sink = {});
 
 }  // namespace kirchhoff

@@ -32,6 +32,10 @@ constexpr double kFlatH = 1e-9;
 
 double sign_of(double v) { return v < 0 ? -1.0 : 1.0; }
 
+// Points a march can be resumed from: a special point (fold, branch point, event, end) is found
+// by locating inside a step, and a resumed run finds it again by redoing that step.
+bool resumable_type(PointType t) { return t == PointType::Start || t == PointType::Regular; }
+
 }  // namespace
 
 const char* to_string(PointType type) {
@@ -196,17 +200,26 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
 std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous,
                                                         PointType type, int index, double arclength, int iterations,
                                                         std::shared_ptr<const Eigen::MatrixXd> reused) {
-  Eigen::VectorXd F;
-  Eigen::MatrixXd A;
-  std::string failure;
-  if (!reused && !evaluate(z, &F, &A, &failure)) return std::nullopt;
-  const Eigen::MatrixXd& FxFl = reused ? *reused : A;
+  const bool is_reused = reused != nullptr;
+  std::shared_ptr<const Eigen::MatrixXd> A = std::move(reused);
+  if (!A) {
+    Eigen::VectorXd F;
+    Eigen::MatrixXd own;
+    std::string failure;
+    if (!evaluate(z, &F, &own, &failure)) return std::nullopt;
+    A = std::make_shared<const Eigen::MatrixXd>(std::move(own));
+  }
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n_ + 1);
   rhs[n_] = 1.0;
-  Eigen::VectorXd t = JacobianLU(FxFl, previous).solve(rhs);
+  Eigen::VectorXd t = JacobianLU(*A, previous).solve(rhs);
   if (!t.allFinite() || t.norm() == 0.0) return std::nullopt;
   t.normalize();
+  return make_point(z, t, std::move(A), is_reused, type, index, arclength, iterations);
+}
 
+ContinuationPoint Continuation::make_point(const Eigen::VectorXd& z, const Eigen::VectorXd& t,
+                                           std::shared_ptr<const Eigen::MatrixXd> A, bool reused, PointType type,
+                                           int index, double arclength, int iterations) {
   ContinuationPoint p;
   p.index = index;
   p.x = z.head(n_);
@@ -215,20 +228,35 @@ std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z
   p.type = type;
   p.arclength = arclength;
   p.newton_iterations = iterations;
-  p.jacobian_reused = reused != nullptr;
+  p.jacobian_reused = reused;
   // The determinant and singular values only serve branch-point detection, and the SVD costs
   // O(n^3) with a large constant: on multiple-shooting problems of several hundred unknowns it
   // was 95 % of a run.
   if (options_.detect_branch_points) {
     Eigen::MatrixXd M(n_ + 1, n_ + 1);
-    M << FxFl, t.transpose();
+    M << *A, t.transpose();
     p.determinant = JacobianLU(M).determinant();
     const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(M).singularValues();
     p.smallest_singular = sv[n_] / sv[0];
     for (int i = 0; i <= n_; ++i) p.small_count += sv[i] / sv[0] < options_.branch_point_tolerance ? 1 : 0;
   }
-  p.jacobian = reused ? std::move(reused) : std::make_shared<const Eigen::MatrixXd>(std::move(A));
+  p.jacobian = std::move(A);
   describe(&p);
+  return p;
+}
+
+std::optional<ContinuationPoint> Continuation::restore(const ContinuationPoint& saved) {
+  if (saved.x.size() != n_ || saved.tangent.size() != n_ + 1) return std::nullopt;
+  const Eigen::VectorXd z = join(saved.x, saved.parameter);
+  Eigen::VectorXd F;
+  Eigen::MatrixXd A;
+  std::string failure;
+  if (!evaluate(z, &F, &A, &failure)) return std::nullopt;
+  // The saved tangent, not one solved for again: bordered by another row (the point's own
+  // tangent instead of its predecessor's) the solve gives the same direction to round-off only.
+  ContinuationPoint p = make_point(z, saved.tangent, std::make_shared<const Eigen::MatrixXd>(std::move(A)), false,
+                                   saved.type, saved.index, saved.arclength, saved.newton_iterations);
+  p.step = saved.step;
   return p;
 }
 
@@ -338,29 +366,44 @@ ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink&
     return result;
   }
   start->step = options_.initial_step;
-  return march(*start, sink);
+  MarchState state;
+  state.current = std::move(*start);
+  return march(std::move(state), sink);
+}
+
+ContinuationResult Continuation::resume(const MarchState& saved, const PointSink& sink) {
+  ContinuationResult failed;
+  failed.reason = StopReason::StartFailed;
+  MarchState state = saved;
+  auto current = restore(saved.current);
+  if (!current) {
+    failed.message = "cannot resume: the saved point cannot be evaluated (or does not fit this problem)";
+    return failed;
+  }
+  state.current = std::move(*current);
+  // The point before is only looked at for minima of the smallest singular value.
+  if (saved.before && options_.detect_branch_points) {
+    auto before = restore(*saved.before);
+    if (!before) {
+      failed.message = "cannot resume: the point before the saved one cannot be evaluated";
+      return failed;
+    }
+    state.before = std::move(*before);
+  } else {
+    state.before.reset();
+  }
+  // The saved point is already reported; the rest go to the sink as they are found, so that a
+  // resumed run killed again keeps what it had computed.
+  ContinuationResult r = march(std::move(state), sink, false);
+  if (!r.points.empty()) r.points.erase(r.points.begin());
+  return r;
 }
 
 ContinuationResult Continuation::resume(const ContinuationPoint& last, const PointSink& sink) {
-  auto start = point_at(join(last.x, last.parameter), last.tangent, last.type, last.index, last.arclength,
-                        last.newton_iterations);
-  if (!start) {
-    ContinuationResult result;
-    result.reason = StopReason::StartFailed;
-    result.message = "cannot resume: no tangent at the last point";
-    return result;
-  }
-  start->step = last.step > 0 ? last.step : options_.initial_step;
-  // march reports its start point first; a resumed run already has it. The rest go to the sink
-  // as they are found, so that a resumed run killed again keeps what it had computed.
-  bool start_skipped = false;
-  const PointSink after_start = [&](const ContinuationPoint& p) {
-    if (start_skipped && sink) sink(p);
-    start_skipped = true;
-  };
-  ContinuationResult r = march(*start, after_start);
-  if (!r.points.empty()) r.points.erase(r.points.begin());
-  return r;
+  MarchState state;
+  state.current = last;
+  if (!(state.current.step > 0)) state.current.step = options_.initial_step;
+  return resume(state, sink);
 }
 
 Eigen::MatrixXd Continuation::bifurcation_directions(const ContinuationPoint& point, int count) {
@@ -402,7 +445,9 @@ ContinuationResult Continuation::run_along(const Eigen::VectorXd& x, double lamb
   }
   if (sink) sink(origin);
   first->step = options_.initial_step;
-  result = march(*first, sink);
+  MarchState state;
+  state.current = std::move(*first);
+  result = march(std::move(state), sink);
   result.points.insert(result.points.begin(), origin);
   return result;
 }
@@ -419,17 +464,41 @@ ContinuationResult Continuation::switch_branch(const ContinuationPoint& bp, cons
   return run_along(bp.x, bp.parameter, d, PointType::BranchPoint, sink);
 }
 
-ContinuationResult Continuation::march(ContinuationPoint current, const PointSink& sink) {
+ContinuationResult Continuation::march(MarchState state, const PointSink& sink, bool report_start) {
   ContinuationResult result;
+  ContinuationPoint current = std::move(state.current);
+  std::optional<ContinuationPoint> before_current = std::move(state.before);  // the point before `current`, for minima
+  double previous_h = state.previous_step;
+  int branch_points_found = state.branch_points_found;
+  bool just_reported_branch_point = state.just_reported_branch_point;
+  result.refused_steps = state.refused_steps;
+  // Points of this march made before `current` (by the run that a resumed one continues): they
+  // count against max_points as if it had not been interrupted.
+  const int points_before = state.points - 1;
+  const bool has_target = !std::isnan(options_.target);
+  double ds = current.step > 0 ? current.step : options_.initial_step;
+
+  // The march's state right after `current` was accepted, for a run to resume from.
+  auto report_state = [&]() {
+    if (!options_.on_resumable || !resumable_type(current.type)) return;
+    MarchState now;
+    now.current = result.points.back();
+    now.before = before_current;
+    if (now.before) now.before->jacobian.reset();
+    now.previous_step = previous_h;
+    now.just_reported_branch_point = just_reported_branch_point;
+    now.branch_points_found = branch_points_found;
+    now.points = points_before + static_cast<int>(result.points.size());
+    now.refused_steps = result.refused_steps;
+    options_.on_resumable(now);
+  };
+
   result.points.push_back(current);
   if (current.type != PointType::BranchPoint) result.points.back().jacobian.reset();
-  if (sink) sink(current);
-  double ds = current.step > 0 ? current.step : options_.initial_step;
-  std::optional<ContinuationPoint> before_current;  // the point before `current`, for minima
-  double previous_h = 0.0;
-  const bool has_target = !std::isnan(options_.target);
-  int branch_points_found = 0;
-  bool just_reported_branch_point = false;
+  if (report_start) {
+    if (sink) sink(current);
+    report_state();
+  }
 
   // Only branch points keep their matrix in the branch (for switching); the newest point's moves
   // on to `current`, for the next corrector's chord. A long branch keeping every one would hold
@@ -457,7 +526,7 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
     return true;
   };
 
-  while (static_cast<int>(result.points.size()) < options_.max_points) {
+  while (points_before + static_cast<int>(result.points.size()) < options_.max_points) {
     auto candidate = step_from(current, ds, PointType::Regular);
     if (!candidate) {
       if (refresh_current()) continue;
@@ -600,6 +669,7 @@ ContinuationResult Continuation::march(ContinuationPoint current, const PointSin
     accept(std::move(*candidate));
     current = result.points.back();
     current.jacobian = std::move(newest_matrix);
+    report_state();
   }
   result.reason = StopReason::MaxPoints;
   return result;
@@ -635,11 +705,16 @@ SymmetricBranchStart axial_symmetry_branch(Continuation& straight, const Continu
   return start;
 }
 
+ContinuationOptions bifurcating_branch_options(ContinuationOptions options) {
+  options.target = NAN;
+  options.direction = 1.0;
+  return options;
+}
+
 ContinuationResult follow_bifurcating_branch(Continuation& run, const ContinuationPoint& bp,
                                              ContinuationOptions options, double side,
                                              const BranchSinkFactory& sink_for) {
-  options.target = NAN;
-  options.direction = 1.0;
+  options = bifurcating_branch_options(std::move(options));
   if (bp.multiplicity == 2 && run.problem().definition().kind == RodKind::Spatial) {
     const SymmetricBranchStart start = axial_symmetry_branch(run, bp, side);
     const ShootingProblem switched(start.definition);

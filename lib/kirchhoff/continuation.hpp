@@ -38,6 +38,7 @@ struct ContinuationEvent {
 };
 
 struct ContinuationPoint;
+struct MarchState;
 
 struct ContinuationOptions {
   std::string parameter;                                      // the continued parameter
@@ -86,6 +87,11 @@ struct ContinuationOptions {
   // through itself: SelfPassageGuard): a non-empty answer refuses the step, which is retried
   // shorter; refused at the minimum step, the run stops as Inadmissible with that answer.
   std::function<std::string(const ContinuationPoint& from, const ContinuationPoint& to)> step_check;
+  // Called right after the point sink with every point a run can resume from (start and regular
+  // points), with the march's whole state there: saved, it lets Continuation::resume take the
+  // same steps as the uninterrupted run (see MarchState). Contact continuations report through
+  // their own ContactStateSink instead (it adds the leg's state) and replace this one.
+  std::function<void(const MarchState&)> on_resumable;
 
   std::string validate() const;
 };
@@ -121,6 +127,29 @@ struct ContinuationPoint {
   std::shared_ptr<const Eigen::MatrixXd> jacobian;
 };
 
+// Everything the march's next step depends on besides the problem and the options, as it stands
+// right after the march has reported `current`. Re-deriving any of it on resume changed results:
+// the tangent recomputed from a bordering row other than the previous tangent differs in its
+// last bits (and with it every later step on ill-conditioned legs), a run without the point
+// before `current` cannot see a minimum of the smallest singular value that spans the resume,
+// and the counts (points against max_points, branch points against stop_at_branch_point) were
+// re-derived from the CSV with off-by-one differences. Restored instead, a resumed march repeats
+// the uninterrupted one bit for bit: the matrices, test functions and derived quantities of both
+// points are recomputed from their x and parameter, which are deterministic functions of them.
+struct MarchState {
+  // x, parameter, tangent (its own, as computed when the point was accepted), arclength, index,
+  // type, newton_iterations and step (the size of the next step).
+  ContinuationPoint current;
+  // The point before `current` (same fields) and the step between them: a branch point of even
+  // multiplicity is a minimum over these two steps. Empty at the start of a march.
+  std::optional<ContinuationPoint> before;
+  double previous_step = 0.0;
+  bool just_reported_branch_point = false;  // the step that found `current` found a branch point too
+  int branch_points_found = 0;              // for stop_at_branch_point
+  int points = 1;                           // the march's points so far, `current` included (max_points)
+  int refused_steps = 0;
+};
+
 // Inadmissible: a contact continuation reached a point that penetrates an obstacle or has a
 // pulling contact with no event located before it (reported, not followed).
 enum class StopReason { ReachedTarget, MaxPoints, ParameterBounds, StepTooSmall, EventStop, BranchPointStop, StartFailed,
@@ -144,7 +173,14 @@ class Continuation {
 
   // Starts from unknowns x0 (corrected at fixed lambda first).
   ContinuationResult run(const Eigen::VectorXd& x0, const PointSink& sink = {});
-  // Resumes from a point of an earlier run (its x, parameter, tangent, step, index, arclength).
+  // Resumes a march from its state at one of its points (reported by options.on_resumable),
+  // taking the same steps as the uninterrupted run. The state's `current` is not reported again.
+  // (With reuse_jacobian_iterations the uninterrupted run's matrix at `current` may be an older
+  // point's; the resumed one evaluates its own, so the steps after it agree to the corrector's
+  // tolerance, not bit for bit.)
+  ContinuationResult resume(const MarchState& state, const PointSink& sink = {});
+  // Resumes from a point alone (its x, parameter, tangent, step, index, arclength), as a march
+  // that starts there: what the point does not record (see MarchState) starts afresh.
   ContinuationResult resume(const ContinuationPoint& last, const PointSink& sink = {});
   // Starts on the branch crossing the one of `branch_point` (a located simple branch point):
   // direction from the null space of [F_x F_lambda] orthogonal to the old tangent, oriented so
@@ -184,7 +220,15 @@ class Continuation {
   std::optional<ContinuationPoint> point_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous, PointType type,
                                             int index, double arclength, int iterations,
                                             std::shared_ptr<const Eigen::MatrixXd> reused = nullptr);
-  ContinuationResult march(ContinuationPoint start, const PointSink& sink);
+  // The matrix, test functions and derived quantities of a saved point, its tangent kept.
+  std::optional<ContinuationPoint> restore(const ContinuationPoint& saved);
+  // The point at z with tangent t and matrix A = [F_x F_lambda] there: the test functions and
+  // derived quantities.
+  ContinuationPoint make_point(const Eigen::VectorXd& z, const Eigen::VectorXd& t,
+                               std::shared_ptr<const Eigen::MatrixXd> A, bool reused, PointType type, int index,
+                               double arclength, int iterations);
+  // Marches on from `state` (its `current` reported to the sink first when report_start).
+  ContinuationResult march(MarchState state, const PointSink& sink, bool report_start = true);
   // Locates where `monitor` (of the point reached from `from` by a step h) vanishes or is
   // minimal, by the secant method or Brent on h in (0, h_max].
   std::optional<ContinuationPoint> locate(const ContinuationPoint& from, double h_max,
@@ -221,6 +265,9 @@ SymmetricBranchStart axial_symmetry_branch(Continuation& straight, const Continu
 // problem with the axial phase condition (axial_symmetry_branch). The run has no target (it stops
 // on the options' events, bounds or point count). `sink_for` gives the sink for the new branch's
 // points from the problem they belong to and whether the phase condition was added.
+// The options the bifurcating branch is followed with (no target; it stops on the events,
+// bounds or point count): also those a run resumed on that branch must use.
+ContinuationOptions bifurcating_branch_options(ContinuationOptions options);
 using BranchSinkFactory = std::function<PointSink(const ShootingProblem&, bool with_phase_condition)>;
 ContinuationResult follow_bifurcating_branch(Continuation& run, const ContinuationPoint& branch_point,
                                              ContinuationOptions options, double side,
