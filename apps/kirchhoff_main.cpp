@@ -64,6 +64,11 @@ int main(int argc, char** argv) {
   std::string solve_seed = "guess";
   add_seed_options(solve_cmd, &solve_seed, &solve.seed);
   solve_cmd
+      ->add_option("--max-seconds", solve.max_seconds,
+                   "Wall-clock limit of the solve in seconds (0: none); past it the solve stops with status "
+                   "time_limit, exit 1")
+      ->capture_default_str();
+  solve_cmd
       ->add_option("--phase-condition", solve.phase_condition,
                    "Override [solver] phase_condition: 'axial' selects one buckled solution of an isotropic\n"
                    "twisted rod out of its circle of rotated copies (singular on the straight rod)")

@@ -63,12 +63,17 @@ DefinitionSolve solve_seeded(const Case& c, const StartSeed& options) {
 }  // namespace
 
 int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
-                   const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed) {
+                   const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed,
+                   double max_seconds) {
   Case& c = out->c;
   try {
     c = load_case(case_path, parse_overrides(overrides), phase_condition);
+    limit_wall_clock(c.definition.options, max_seconds);
   } catch (const CaseError& e) {
     std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "error: --max-seconds: " << e.what() << "\n";
     return kExitBadInput;
   }
   std::unique_ptr<ShootingProblem>& problem = out->problem;
@@ -113,7 +118,8 @@ int report_not_converged(const Case& c, const NewtonSummary& summary, bool json)
 
 int run_solve(const SolveArguments& args) {
   SolvedCase solved;
-  if (const int status = load_and_solve(args.case_path, args.overrides, args.phase_condition, args.json, &solved, args.seed);
+  if (const int status = load_and_solve(args.case_path, args.overrides, args.phase_condition, args.json, &solved, args.seed,
+                                        args.max_seconds);
       status != kExitOk)
     return status;
   const Case& c = solved.c;

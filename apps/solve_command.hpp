@@ -29,6 +29,7 @@ struct SolveArguments {
   bool json = false;
   std::string profile_path;
   std::string phase_condition;  // empty: as in the case file
+  double max_seconds = kDefaultSolveSeconds;  // wall-clock limit of the whole solve (0: none)
 };
 
 int run_solve(const SolveArguments& args);
@@ -45,7 +46,8 @@ struct SolvedCase {
 // Loads and solves; on failure prints the reason (and, with json, a failure object on stdout)
 // and returns the exit status, else kExitOk.
 int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
-                   const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed = {});
+                   const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed = {},
+                   double max_seconds = kDefaultSolveSeconds);
 // Prints why a solve is not a trustworthy equilibrium (and, with json, the failure object) and
 // returns kExitNotConverged.
 int report_not_converged(const Case& c, const NewtonSummary& summary, bool json);

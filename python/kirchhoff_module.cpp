@@ -172,8 +172,11 @@ PyCase py_load_case(const std::string& path, const py::object& set, const std::s
   return out;
 }
 
-PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::string& seed, int seed_segments) {
-  const Case& c = pc.c;
+PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::string& seed, int seed_segments,
+                    double max_seconds) {
+  Case c = pc.c;
+  if (!(max_seconds >= 0 && max_seconds <= 1e9)) throw py::value_error("max_seconds must be in [0, 1e9] (0: no limit)");
+  limit_wall_clock(c.definition.options, max_seconds);
   const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
   if (samples < 2) throw py::value_error("samples must be >= 2 (got " + std::to_string(samples) + ")");
   if (seed != "guess" && seed != "ipopt") throw py::value_error("seed must be 'guess' or 'ipopt' (got '" + seed + "')");
@@ -629,7 +632,8 @@ Attributes:
       .def_property_readonly("samples", [](const PyCase& p) { return p.c.samples; })
       .def_readonly("phase_condition", &PyCase::phase_condition)
       .def("solve", &py_solve, py::arg("samples") = py::none(), py::kw_only(), py::arg("seed") = "guess",
-           py::arg("seed_segments") = 200, R"doc(Solves the case by shooting.
+           py::arg("seed_segments") = 200, py::arg("max_seconds") = kDefaultSolveSeconds,
+           R"doc(Solves the case by shooting.
 
 Args:
     samples (int, optional): profile points (>= 2); default the case's [output] samples.
@@ -637,6 +641,8 @@ Args:
         discretised energy, its shape and contact set (planar clamped-clamped rods; ValueError
         for other cases).
     seed_segments (int): segments of that discretised rod.
+    max_seconds (float): wall-clock limit of the solve (0: none); past it the result's status
+        is 'time_limit'.
 
 Returns:
     Solution. Non-convergence is reported in Solution.status, not raised.)doc")

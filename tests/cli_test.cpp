@@ -2,9 +2,12 @@
 // JSON report, the profile CSV, and the messages on stderr. Runs the built binary.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
+#include <chrono>
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -46,8 +49,9 @@ struct CliRun {
   std::string out, err;
 };
 
-const std::set<std::string> kFailureWords = {"max_iterations", "singular_jacobian", "integration_failed",
-                                             "line_search_failed", "unfolding_not_zero"};
+const std::set<std::string> kFailureWords = {"max_iterations",     "singular_jacobian",  "integration_failed",
+                                             "line_search_failed", "unfolding_not_zero", "not_finite",
+                                             "check_failed",       "time_limit"};
 
 class CliTest : public ::testing::Test {
  protected:
@@ -314,6 +318,42 @@ TEST_F(CliTest, NotConvergedExitsOneWithStatus) {
                                       "unknowns = [\"P\"]\nmax_iterations = 50\nfallback_search = false",
                                       "relaxed.toml");
   EXPECT_EQ(run("solve " + quoted(relaxed) + " --set theta0=2.5").status, 0);
+}
+
+// The documented stepper gives the same Elastica as the default one (it gave P = nan, y_max =
+// 0.0042, exit 0): Love's P = 11.2224184758 for theta0 = 1 (eq. 54), to the 1e-9 the residual and
+// the integrator tolerance 1e-12 leave.
+TEST_F(CliTest, Dopri5StepperGivesTheElastica) {
+  const std::string path = variant("simply_supported.toml", "[solver]", "[solver]\nstepper = \"dopri5\"");
+  const CliRun r = run("solve " + quoted(path) + " --json");
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const json j = parse(r);
+  EXPECT_EQ(j["status"], "converged");
+  EXPECT_NEAR(j["derived"]["P"].get<double>(), 11.2224184758, 1e-8);
+  EXPECT_NEAR(j["derived"]["y_max"].get<double>(), 0.286225241775, 1e-8);
+}
+
+// A solve that cannot converge (theta0 = 1e6 spends ~35 s in Newton and the NLopt search) ends at
+// its wall-clock limit with status time_limit, exit 1, the best residual reported.
+TEST_F(CliTest, MaxSecondsEndsASolveWithTimeLimit) {
+  const auto start = std::chrono::steady_clock::now();
+  const CliRun r = run("solve " + quoted(case_path("simply_supported.toml")) + " --set theta0=1e6 --max-seconds 1 --json");
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  const json j = parse(r);
+  EXPECT_EQ(j["status"], "time_limit") << r.out;
+  EXPECT_TRUE(j["residual"].is_number());
+  EXPECT_LT(elapsed, 20.0);  // the limit plus one evaluation, with a wide margin for a loaded machine
+  EXPECT_EQ(run("solve " + quoted(case_path("simply_supported.toml")) + " --max-seconds -1").status, 2);
+}
+
+// The soft wall at a range 1e-20 once converged with the rod beyond the wall (gap < 0, exit 0).
+TEST_F(CliTest, RodBeyondItsSoftWallIsNotConverged) {
+  const CliRun r = run("solve " + quoted(case_path("soft_wall.toml")) + " --set log_b=-20 --json");
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  const json j = parse(r);
+  EXPECT_EQ(j["status"], "check_failed") << r.out;
+  EXPECT_THAT(j["message"].get<std::string>(), HasSubstr("soft wall"));
 }
 
 TEST_F(CliTest, IpoptSeedSolvesWhatTheGuessCannot) {

@@ -29,7 +29,7 @@ std::string NewtonOptions::validate() const {
   if (!(residual_tolerance > 0)) return "residual_tolerance must be > 0";
   if (!(finite_difference_step > 0)) return "finite_difference_step must be > 0";
   if (max_backtracks < 0) return "max_backtracks must be >= 0";
-  if (!(max_seconds >= 0) || !std::isfinite(max_seconds)) return "max_seconds must be finite and >= 0";
+  if (!(max_seconds >= 0 && max_seconds <= 1e9)) return "max_seconds must be in [0, 1e9] (0: no limit)";
   return {};
 }
 
@@ -48,21 +48,23 @@ double max_abs_or_nan(const Eigen::VectorXd& v) {
 
 namespace {
 
-// Wall-clock deadline of a solve; none when the limit is 0.
+// Wall-clock deadline of a solve: the earlier of its own limit (none when 0) and the options'
+// deadline.
 class Deadline {
  public:
-  explicit Deadline(double seconds)
-      : limited_(seconds > 0),
-        end_(std::chrono::steady_clock::now() +
-             std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds))) {}
-  bool passed() const { return limited_ && std::chrono::steady_clock::now() >= end_; }
+  explicit Deadline(const NewtonOptions& options) : end_(options.deadline) {
+    using Clock = std::chrono::steady_clock;
+    if (options.max_seconds > 0)
+      end_ = std::min(end_, Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                               std::chrono::duration<double>(options.max_seconds)));
+  }
+  bool limited() const { return end_ != std::chrono::steady_clock::time_point::max(); }
+  bool passed() const { return limited() && std::chrono::steady_clock::now() >= end_; }
   double remaining_seconds() const {
-    if (!limited_) return 0.0;
     return std::max(1e-3, std::chrono::duration<double>(end_ - std::chrono::steady_clock::now()).count());
   }
 
  private:
-  bool limited_;
   std::chrono::steady_clock::time_point end_;
 };
 
@@ -131,7 +133,7 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
     }
     if (deadline.passed()) {
       summary.status = SolverStatus::TimeLimit;
-      summary.message = "wall-clock limit of " + std::to_string(options.max_seconds) + " s reached";
+      summary.message = "the wall-clock limit was reached";
       return summary;
     }
     if (!evaluate(x, &F, &J)) return fail(norm);
@@ -160,9 +162,8 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
     ++summary.iterations;
     if (!accepted) {
       summary.status = deadline.passed() ? SolverStatus::TimeLimit : SolverStatus::LineSearchFailed;
-      summary.message = deadline.passed() ? "wall-clock limit of " + std::to_string(options.max_seconds) +
-                                                " s reached in the line search"
-                                          : "no step length decreased the residual";
+      summary.message =
+          deadline.passed() ? "the wall-clock limit was reached in the line search" : "no step length decreased the residual";
       return summary;
     }
     x = x_trial;
@@ -185,7 +186,7 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
 }  // namespace
 
 NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options) {
-  return newton_until(system, x, options, Deadline(options.max_seconds));
+  return newton_until(system, x, options, Deadline(options));
 }
 
 namespace {
@@ -217,7 +218,7 @@ double least_squares_objective(unsigned n, const double* x, double* grad, void* 
 
 NewtonSummary solve_with_fallback(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options) {
   const Eigen::VectorXd guess = x;
-  const Deadline deadline(options.max_seconds);
+  const Deadline deadline(options);
   NewtonSummary summary = newton_until(system, x, options, deadline);
   if (summary.converged() || !options.fallback_search || deadline.passed()) return summary;
 
@@ -226,7 +227,7 @@ NewtonSummary solve_with_fallback(const NonlinearSystem& system, Eigen::VectorXd
   search.set_min_objective(least_squares_objective, &ctx);
   search.set_maxeval(options.fallback_evaluations);
   search.set_ftol_abs(0.5 * options.residual_tolerance * options.residual_tolerance);
-  if (options.max_seconds > 0) search.set_maxtime(deadline.remaining_seconds());
+  if (deadline.limited()) search.set_maxtime(deadline.remaining_seconds());
   std::vector<double> start(guess.data(), guess.data() + guess.size());
   double value = 0.0;
   try {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -46,9 +47,12 @@ struct NewtonOptions {
   double finite_difference_step = 1e-6;     // central differences: error ~ h^2 ~ 1e-12
   bool fallback_search = true;  // run an NLopt least-squares search when Newton fails
   int fallback_evaluations = 2000;
-  // Wall-clock limit of one solve in seconds (0: none). Checked between evaluations, so a solve
-  // ends within this plus one evaluation (an integration is itself bounded by max_steps).
+  // Wall-clock limit of one solve in seconds (0: none), and an instant no solve runs past (a
+  // command's limit for all the solves it makes: the rounds of an active-set loop, a fallback
+  // search). Checked between evaluations, so a solve ends within the limit plus one evaluation
+  // (an integration is itself bounded by IntegratorOptions::max_steps). Status time_limit.
   double max_seconds = 0.0;
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
 
   std::string validate() const;  // empty when valid
 };

@@ -73,6 +73,12 @@ struct ShootingOptions {
   std::string validate() const;
 };
 
+// A command's wall-clock limit: every solve made with these options stops with time_limit
+// `seconds` from now (0: no limit). What `solve` uses unless told otherwise: long enough for the
+// slowest shipped case from its guess (seconds), short enough that a user never waits on a hang.
+void limit_wall_clock(ShootingOptions& options, double seconds);
+constexpr double kDefaultSolveSeconds = 120.0;
+
 // Everything needed to state a problem; ShootingProblem checks it on construction.
 struct ProblemDefinition {
   RodKind kind = RodKind::Spatial;
