@@ -171,14 +171,15 @@ class Reader {
   // and 9223372036854775807 must be refused, not wrapped. `why` says where the bound comes from.
   int integer(const Value& v, const std::string& key, long low, long high, const std::string& why = "") const {
     if (!v.is_integer()) fail(v, key, "must be an integer, got " + type_name(v));
-    return in_range(v, key, static_cast<double>(v.as_integer()), low, high, why);
+    return in_range(v, key, static_cast<double>(v.as_integer()), low, high, why, std::to_string(v.as_integer()));
   }
-  int in_range(const Value& v, const std::string& key, double x, long low, long high, const std::string& why) const {
+  int in_range(const Value& v, const std::string& key, double x, long low, long high, const std::string& why,
+               const std::string& as_given = "") const {
     if (!(x >= static_cast<double>(low) && x <= static_cast<double>(high)))
       fail(v, key, "must be " + (high == std::numeric_limits<int>::max() ? ">= " + std::to_string(low)
                                                                           : "in [" + std::to_string(low) + ", " +
                                                                                 std::to_string(high) + "]") +
-                       why + ", got " + shown(x));
+                       why + ", got " + (as_given.empty() ? shown(x) : as_given));
     return static_cast<int>(x);
   }
   // A value in (0, kMaxTolerance].
