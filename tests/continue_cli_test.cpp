@@ -50,11 +50,11 @@ TEST_F(ContinueCli, KilledRunResumesWithoutLosingOrDuplicatingPoints) {
   for (size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(resumed[i], expected[i]) << "line " << i;
 }
 
-// A contact run (the active set changes along it) killed and resumed: rows before the kill are
-// kept as they were, indices stay consecutive, and it ends where the uninterrupted run ends. Step
-// by step equality is not expected here: the flat contact's leg is ill-conditioned, so rounding
-// differences of 1e-13 from recomputing the resumed point change the later step sizes.
-TEST_F(ContinueCli, KilledContactRunResumesOnTheSameBranch) {
+// A contact run (the active set changes along it) killed with SIGKILL half-way and resumed writes
+// the uninterrupted run's CSV, byte for byte, through its flat contact's ill-conditioned leg (until
+// 2026-12-02 the resumed point's tangent was solved for again, and rounding differences of 1e-13
+// changed the later step sizes; see tests/resume_test.cpp for kills at chosen rows).
+TEST_F(ContinueCli, KilledContactRunResumesToTheSameRows) {
   auto args_for = [&](const fs::path& csv) {
     return std::vector<std::string>{KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/wall.toml",
                                     "--param", "Delta", "--to", "0.034", "--set", "Delta=0.005", "--set",
@@ -71,12 +71,10 @@ TEST_F(ContinueCli, KilledContactRunResumesOnTheSameBranch) {
   args.push_back("--resume");
   ASSERT_EQ(run_to_end(args, dir_ / "wall_resume.log"), 0);
   const auto after = lines_of(killed);
-  // Rows up to the last resumable point are untouched (at most the rows after it are redone).
-  for (size_t i = 0; i + 3 < before.size(); ++i) EXPECT_EQ(after[i], before[i]) << "line " << i;
-  for (size_t i = 1; i < after.size(); ++i)
-    EXPECT_EQ(std::stoi(after[i].substr(0, after[i].find(','))), static_cast<int>(i - 1)) << "line " << i;
+  ASSERT_LT(before.size(), expected.size());
+  ASSERT_EQ(after.size(), expected.size()) << "killed after " << before.size() << " lines";
+  for (size_t i = 0; i < expected.size(); ++i) ASSERT_EQ(after[i], expected[i]) << "line " << i;
   EXPECT_NE(after.back().find(",endpoint,"), std::string::npos);
-  EXPECT_NEAR(csv_field(after.back(), 4) / csv_field(expected.back(), 4), 1.0, 1e-8);  // P at Delta = 0.034
 }
 
 TEST_F(ContinueCli, BranchCsvHasTheDocumentedColumnsAndPointTypes) {

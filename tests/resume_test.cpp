@@ -1,0 +1,170 @@
+// `kirchhoff continue --resume` repeats the uninterrupted run: a run killed after any row and
+// resumed with the same command plus --resume writes the same CSV, byte for byte.
+//
+// The kills are deterministic: KIRCHHOFF_TEST_KILL_AFTER_ROW=K makes the run SIGKILL itself right
+// after row K is written and flushed, before the state is saved for it (the narrowest window a
+// real kill can hit; K = -1: before the first point). tests/resume_soak.sh kills the same
+// commands at random times instead.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "cli_run_support.hpp"
+
+namespace {
+
+using kirchhoff::testing::lines_of;
+using kirchhoff::testing::run_to_end;
+namespace fs = std::filesystem;
+
+// The README's Euler column: along the straight column from P = 1 to its first branch point
+// (P = pi^2, row 19), switched onto the buckled branch (origin row 20; --to 12 does not apply
+// there), followed through a branch point of that branch (row 63) to theta0 = 3 at P = 65.25
+// (row 146).
+std::vector<std::string> euler_args(const fs::path& csv) {
+  return {KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/euler_column.toml", "--param", "P",
+          "--to", "12", "--set", "P=1", "--set", "theta_guess=0", "--switch-at-bp", "1", "--event", "theta0=3",
+          "--max-step", "1", "--out", csv.string()};
+}
+
+// The README's wall: contact at Delta = 0.02507 (row 15), the contact flattens at 0.03075
+// (row 97), the flat contact buckles into a hanging fold at 0.04805 (row 2265), a fold at
+// 0.046613 (row 2312), Delta = 0.07 at P = 197.23 (row 2393). About 10 s.
+std::vector<std::string> wall_args(const fs::path& csv, const std::string& max_points = "6000") {
+  return {KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/wall.toml", "--param", "Delta",
+          "--to", "0.07", "--set", "Delta=0.005", "--set", "m_guess=0.9", "--max-step", "2",
+          "--max-points", max_points, "--out", csv.string()};
+}
+
+std::vector<std::string> with_resume(std::vector<std::string> args) {
+  args.push_back("--resume");
+  return args;
+}
+
+class ResumeTest : public kirchhoff::testing::ScratchFolderTest {
+ protected:
+  // Runs `args` (whose --out is `csv`) killed right after row `row`; checks that it wrote rows 0
+  // to `row` and no more.
+  void run_killed_after(const std::vector<std::string>& args, const fs::path& csv, int row) {
+    fs::remove(csv);
+    fs::remove(csv.string() + ".state.json");
+    setenv("KIRCHHOFF_TEST_KILL_AFTER_ROW", std::to_string(row).c_str(), 1);
+    run_to_end(args, dir_ / "killed.log");
+    unsetenv("KIRCHHOFF_TEST_KILL_AFTER_ROW");
+    ASSERT_EQ(lines_of(csv).size(), static_cast<size_t>(row + 2)) << "the header and rows 0.." << row;
+  }
+  // Kills the run after `row`, resumes it and compares its CSV with `expected`, line by line.
+  void expect_resume_repeats(const std::vector<std::string>& args, const fs::path& csv,
+                             const std::vector<std::string>& expected, int row) {
+    SCOPED_TRACE("killed after row " + std::to_string(row));
+    run_killed_after(args, csv, row);
+    ASSERT_EQ(run_to_end(with_resume(args), dir_ / "resume.log"), 0);
+    const auto resumed = lines_of(csv);
+    ASSERT_EQ(resumed.size(), expected.size());
+    for (size_t i = 0; i < expected.size(); ++i) ASSERT_EQ(resumed[i], expected[i]) << "line " << i;
+  }
+};
+
+// (a) Killed on the straight column at its branch point, on the switched branch's origin, below
+// P = 12 on the buckled branch (where --to 12 used to stop a resumed run: 31 rows, "endpoint"),
+// at the buckled branch's own branch point and further on: each resumed run ends at theta0 = 3
+// with the uninterrupted run's 147 rows.
+TEST_F(ResumeTest, EulerColumnResumedOnTheBuckledBranchRepeatsTheRun) {
+  const fs::path full = dir_ / "full.csv", csv = dir_ / "killed.csv";
+  ASSERT_EQ(run_to_end(euler_args(full), dir_ / "full.log"), 0);
+  const auto expected = lines_of(full);
+  ASSERT_EQ(expected.size(), 148u);
+  ASSERT_NE(expected[20].find("19,0,"), std::string::npos);
+  ASSERT_NE(expected[20].find(",branch_point,"), std::string::npos);
+  ASSERT_NE(expected.back().find(",event,0,theta0=3"), std::string::npos);
+  for (int row : {18, 19, 20, 21, 25, 63, 100}) expect_resume_repeats(euler_args(csv), csv, expected, row);
+  EXPECT_NE(lines_of(dir_ / "resume.log").back().find("stopped: event"), std::string::npos);
+}
+
+// max_points counts a branch's points across a resume as in one run (it used to be re-derived
+// from the CSV's rows, one off on the switched branch).
+TEST_F(ResumeTest, PointBudgetIsTheSameAcrossAResume) {
+  auto args_for = [](const fs::path& csv) {
+    auto a = euler_args(csv);
+    a.insert(a.end() - 2, {"--max-points", "30"});
+    return a;
+  };
+  const fs::path full = dir_ / "full.csv", csv = dir_ / "killed.csv";
+  ASSERT_EQ(run_to_end(args_for(full), dir_ / "full.log"), 0);
+  const auto expected = lines_of(full);
+  ASSERT_NE(lines_of(dir_ / "full.log").back().find("stopped: max_points"), std::string::npos);
+  ASSERT_EQ(expected.size(), 52u);  // 20 rows on the straight column, 31 on the buckled branch
+  for (int row : {10, 35, 48})
+    expect_resume_repeats(args_for(csv), csv, expected, row);
+}
+
+// (b) The wall, killed on the point-contact leg, right after the contact flattens (the state is
+// then the new leg's start, which is not a row of its own), on the flat contact's long leg and
+// on the hanging fold's leg past its fold: the same rows, the same active-set changes, the same
+// end (P = 197.23 at Delta = 0.07; resumed runs used to end at 349.65 or 287.37 after a fold at
+// 0.047725).
+TEST_F(ResumeTest, WallResumedOnItsContactLegsRepeatsTheRun) {
+  const fs::path full = dir_ / "wall.csv", csv = dir_ / "killed.csv";
+  ASSERT_EQ(run_to_end(wall_args(full), dir_ / "wall.log"), 0);
+  const auto expected = lines_of(full);
+  ASSERT_EQ(expected.size(), 2395u);
+  ASSERT_NE(expected[98].find("contact_flattens"), std::string::npos);
+  for (int row : {40, 98, 1200, 2330}) expect_resume_repeats(wall_args(csv), csv, expected, row);
+}
+
+// The legs of a contact run share --max-points: a resumed leg gets the share it had.
+TEST_F(ResumeTest, WallPointBudgetIsTheSameAcrossAResume) {
+  const fs::path full = dir_ / "wall.csv", csv = dir_ / "killed.csv";
+  ASSERT_EQ(run_to_end(wall_args(full, "150"), dir_ / "wall.log"), 0);
+  const auto expected = lines_of(full);
+  ASSERT_EQ(expected.size(), 151u);
+  for (int row : {98, 140}) expect_resume_repeats(wall_args(csv, "150"), csv, expected, row);
+}
+
+// (c) Killed before its first point was saved (before it, or after the start's row but before
+// its state): --resume starts the run over and writes the same CSV.
+TEST_F(ResumeTest, RunKilledBeforeItsFirstSaveStartsOver) {
+  const fs::path full = dir_ / "full.csv", csv = dir_ / "killed.csv";
+  ASSERT_EQ(run_to_end(euler_args(full), dir_ / "full.log"), 0);
+  const auto expected = lines_of(full);
+  for (int row : {-1, 0}) {
+    expect_resume_repeats(euler_args(csv), csv, expected, row);
+    EXPECT_NE(lines_of(dir_ / "resume.log").front().find("starts from the beginning"), std::string::npos);
+  }
+  // The same with a contact run.
+  const fs::path wall = dir_ / "wall.csv";
+  run_killed_after(wall_args(wall, "20"), wall, -1);
+  EXPECT_FALSE(fs::exists(wall.string() + ".state.json"));
+  ASSERT_EQ(run_to_end(with_resume(wall_args(wall, "20")), dir_ / "wall_resume.log"), 0);
+  ASSERT_EQ(run_to_end(wall_args(dir_ / "wall_full.csv", "20"), dir_ / "wall_full.log"), 0);
+  EXPECT_EQ(lines_of(wall), lines_of(dir_ / "wall_full.csv"));
+}
+
+// What cannot be resumed is refused with the reason, and the CSV is left as it was: rows with
+// no state file (it was removed: nothing says where the march stood), and a state saved by a run
+// with other arguments (resuming it would not continue that run).
+TEST_F(ResumeTest, UnresumableRunsAreRefusedWithTheReason) {
+  const fs::path csv = dir_ / "run.csv";
+  ASSERT_NO_FATAL_FAILURE(run_killed_after(euler_args(csv), csv, 30));
+  const auto before = lines_of(csv);
+
+  auto other = euler_args(csv);
+  other[other.size() - 3] = "0.5";  // --max-step
+  ASSERT_EQ(other[other.size() - 4], "--max-step");
+  EXPECT_EQ(run_to_end(with_resume(other), dir_ / "other.log"), 2);
+  const auto other_log = lines_of(dir_ / "other.log");
+  ASSERT_FALSE(other_log.empty());
+  EXPECT_NE(other_log.front().find("other arguments"), std::string::npos) << other_log.front();
+  EXPECT_EQ(lines_of(csv), before);
+
+  fs::remove(csv.string() + ".state.json");
+  EXPECT_EQ(run_to_end(with_resume(euler_args(csv)), dir_ / "nostate.log"), 2);
+  const auto log = lines_of(dir_ / "nostate.log");
+  ASSERT_FALSE(log.empty());
+  EXPECT_NE(log.front().find("has 31 rows but there is no state file"), std::string::npos) << log.front();
+  EXPECT_EQ(lines_of(csv), before);
+}
+
+}  // namespace
