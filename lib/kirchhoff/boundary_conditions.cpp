@@ -113,6 +113,8 @@ EndCondition EndCondition::half_turn_symmetry(Vec3 axis, int director,
     c.add({Slot::Orientation, Directions::LateralToAxis, a, {},
            constant_orientation({base.axis(), base.angle()}), false, false});
     c.add({Slot::Moment, Directions::AlongAxis, a, constant(Vec3::Zero()), {}, false, false});
+    c.half_turn_axis_ = a;
+    c.half_turn_director_ = director;
     return c;
   }
   OrientationFunction turned = [a, base, rotation](const Parameters& p) {

@@ -85,6 +85,11 @@ class EndCondition {
   EndCondition& impose_hamiltonian(std::function<double(const Parameters&)> value);
 
   const std::vector<SlotCondition>& conditions() const { return conditions_; }
+  // The half-turn symmetry this end imposes without a turn of its own (half_turn_symmetry without
+  // `rotation`): its axis and director; director 0 for any other end. The link check
+  // (link.hpp) builds the whole rod from it.
+  const Vec3& half_turn_axis() const { return half_turn_axis_; }
+  int half_turn_director() const { return half_turn_director_; }
   int extra_count() const;
 
   // Checks that each work-conjugate pair is imposed exactly once along every admissible
@@ -102,6 +107,8 @@ class EndCondition {
  private:
   std::vector<SlotCondition> conditions_;
   std::function<double(const Parameters&)> hamiltonian_;  // extra H condition, if any
+  Vec3 half_turn_axis_ = Vec3::Zero();
+  int half_turn_director_ = 0;
 };
 
 VectorTarget constant(const Vec3& v);

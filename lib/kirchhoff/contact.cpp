@@ -6,6 +6,8 @@
 #include <sstream>
 
 #include "kirchhoff/closest_approach.hpp"
+#include "kirchhoff/link.hpp"
+#include "kirchhoff/verification.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -104,6 +106,9 @@ DefinitionSolve solve_definition(const ProblemDefinition& definition, const RodP
   if (definition.obstacles.empty()) {
     out.problem = std::make_unique<ShootingProblem>(definition);
     out.result = solve(*out.problem, out.problem->initial_unknowns(guess));
+    // A solve from a guess can land a whole turn away from an imposed end rotation (link.hpp);
+    // a continuation cannot, so only here is the link checked.
+    if (out.result.summary.converged()) mark_check_failure(&out.result, link_failure(*out.problem, out.result.x));
     return out;
   }
   return as_definition_solve(solve_with_contacts(definition, guess));
