@@ -137,6 +137,41 @@ class SolveTest(unittest.TestCase):
         self.assertEqual(sol.parameters["theta0"], 2.5)
 
 
+class CheckedResultTest(unittest.TestCase):
+    """What the CLI refuses to call converged, Python does not either (docs/reliability.md)."""
+
+    def test_dopri5_gives_the_elastica(self):
+        text = pathlib.Path(case_path("simply_supported.toml")).read_text()
+        text = text.replace("[solver]\n", "[solver]\nstepper = \"dopri5\"\n")
+        with tempfile.TemporaryDirectory() as tmp:
+            path = pathlib.Path(tmp) / "dopri5.toml"
+            path.write_text(text)
+            sol = kirchhoff.load_case(str(path)).solve()
+        self.assertTrue(sol.converged, sol.message)
+        # Love's P for theta0 = 1 (eq. 54); the residual and the 1e-12 integrator leave ~1e-10
+        self.assertAlmostEqual(sol.derived["P"], 11.2224184758, delta=1e-8)
+        self.assertTrue(all(np.isfinite(sol.profile["nx"])))
+
+    def test_rod_beyond_its_soft_wall_is_check_failed(self):
+        sol = kirchhoff.load_case(case_path("soft_wall.toml"), set={"log_b": -20}).solve()
+        self.assertFalse(sol.converged)
+        self.assertEqual(sol.status, "check_failed")
+        self.assertIn("soft wall", sol.message)
+        self.assertEqual(sol.derived, {})
+
+    def test_whole_turns_away_is_check_failed(self):
+        sol = kirchhoff.load_case(case_path("plectoneme.toml"), set={"turns": 2}).solve()
+        self.assertEqual(sol.status, "check_failed")
+        self.assertIn("whole turns", sol.message)
+
+    def test_max_seconds_ends_the_solve(self):
+        case = kirchhoff.load_case(case_path("simply_supported.toml"), set={"theta0": 1e6})
+        sol = case.solve(max_seconds=0.5)  # ~35 s without a limit
+        self.assertEqual(sol.status, "time_limit")
+        with self.assertRaises(ValueError):
+            case.solve(max_seconds=-1)
+
+
 class ContactTest(unittest.TestCase):
     def test_wall_contact_like_the_cli(self):
         sol = kirchhoff.load_case(case_path("wall.toml")).solve()
