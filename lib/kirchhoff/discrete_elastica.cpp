@@ -3,7 +3,9 @@
 #include <IpIpoptApplication.hpp>
 #include <IpSolveStatistics.hpp>
 #include <IpTNLP.hpp>
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace kirchhoff {
@@ -14,8 +16,9 @@ using Ipopt::Number;
 
 class ClampedElasticaNLP : public Ipopt::TNLP {
  public:
-  ClampedElasticaNLP(DiscreteClampedElastica rod, int N, double amplitude, DiscreteElasticaResult* out)
-      : rod_(std::move(rod)), N_(N), h_(rod_.L / N), amplitude_(amplitude), out_(out) {
+  ClampedElasticaNLP(DiscreteClampedElastica rod, int N, const DiscreteSolveOptions& options, DiscreteElasticaResult* out)
+      : rod_(std::move(rod)), N_(N), h_(rod_.L / N), amplitude_(options.amplitude),
+        initial_theta_(options.initial_theta), out_(out) {
     for (const auto& o : rod_.obstacles) curved_ = curved_ || !o.is_flat();
     // EI at the nodes 0..N: the interior nodes weight the angle differences, the ends the clamps.
     for (int k = 0; k <= N_; ++k) EI_.push_back(rod_.EI(k * h_));
@@ -51,6 +54,10 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
   }
 
   bool get_starting_point(Index n, bool, Number* x, bool, Number*, Number*, Index, bool, Number*) override {
+    if (!initial_theta_.empty()) {
+      std::copy(initial_theta_.begin(), initial_theta_.end(), x);
+      return true;
+    }
     // The chord's angle, the clamps' angles blended in linearly, and the slope of the first
     // clamped-clamped mode y = (A/2)(1 - cos 2 pi s / L) across the chord.
     const Vec3 chord = rod_.end - rod_.start;
@@ -186,8 +193,11 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
   void finalize_solution(Ipopt::SolverReturn status, Index n, const Number* t, const Number*, const Number*,
                          Index m, const Number* g, const Number* lambda, Number f, const Ipopt::IpoptData*,
                          Ipopt::IpoptCalculatedQuantities*) override {
+    // Provisional: solve_discrete_elastica adds the KKT check's verdict.
     out_->converged = status == Ipopt::SUCCESS;
-    out_->status = status == Ipopt::SUCCESS ? "converged" : "ipopt status " + std::to_string(static_cast<int>(status));
+    out_->ipopt_status = status == Ipopt::SUCCESS ? "success" : "ipopt status " + std::to_string(static_cast<int>(status));
+    out_->status = out_->ipopt_status;
+    out_->multipliers.assign(lambda, lambda + m);
     out_->energy = f;
     out_->theta.assign(t, t + n);
     out_->x.assign(1, rod_.start.x());
@@ -227,6 +237,7 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
   std::vector<double> EI_;
   int N_;
   double h_, amplitude_;
+  std::vector<double> initial_theta_;
   bool curved_ = false;
   DiscreteElasticaResult* out_;
 };
@@ -247,14 +258,29 @@ DiscreteElasticaResult solve_discrete_clamped_elastica(double L, double EI, doub
 }
 
 DiscreteElasticaResult solve_discrete_elastica(const DiscreteClampedElastica& rod, int segments, double amplitude) {
+  DiscreteSolveOptions options;
+  options.amplitude = amplitude;
+  return solve_discrete_elastica(rod, segments, options);
+}
+
+DiscreteElasticaResult solve_discrete_elastica(const DiscreteClampedElastica& rod, int segments,
+                                               const DiscreteSolveOptions& options) {
   if (!(rod.L > 0)) throw std::invalid_argument("discrete Elastica: L must be > 0");
-  for (int k = 0; k <= 20; ++k)
-    if (!(rod.EI(rod.L * k / 20) > 0)) throw std::invalid_argument("discrete Elastica: EI must be > 0 along the rod");
+  double EI_max = 0.0;
+  for (int k = 0; k <= 20; ++k) {
+    const double EI = rod.EI(rod.L * k / 20);
+    if (!(EI > 0)) throw std::invalid_argument("discrete Elastica: EI must be > 0 along the rod");
+    EI_max = std::max(EI_max, EI);
+  }
   if (!((rod.end - rod.start).norm() < rod.L))
     throw std::invalid_argument("discrete Elastica: the clamps are further apart than the rod is long");
   if (segments < 4) throw std::invalid_argument("discrete Elastica: at least 4 segments");
+  if (!options.initial_theta.empty() && static_cast<int>(options.initial_theta.size()) != segments)
+    throw std::invalid_argument("discrete Elastica: initial_theta must hold one angle per segment");
+  if (!(options.initial_multiplier >= 0))
+    throw std::invalid_argument("discrete Elastica: initial_multiplier must be >= 0");
   DiscreteElasticaResult out;
-  Ipopt::SmartPtr<Ipopt::TNLP> nlp = new ClampedElasticaNLP(rod, segments, amplitude, &out);
+  Ipopt::SmartPtr<Ipopt::TNLP> nlp = new ClampedElasticaNLP(rod, segments, options, &out);
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
   app->Options()->SetIntegerValue("print_level", 0);
   app->Options()->SetStringValue("sb", "yes");
@@ -264,10 +290,173 @@ DiscreteElasticaResult solve_discrete_elastica(const DiscreteClampedElastica& ro
   // Exact complementarity: by default Ipopt relaxes bounds by 1e-8, which would let the rod sit
   // 1e-8 inside the wall.
   app->Options()->SetNumericValue("bound_relax_factor", 0.0);
+  // The gap multipliers start as a total force EI / L^2 spread over the nodes, not Ipopt's 1 per
+  // node (N EI / L^2 in all, which pushed the rod off the wall at large N; see the header).
+  const double initial_multiplier =
+      options.initial_multiplier > 0 ? options.initial_multiplier : EI_max / (rod.L * rod.L * segments);
+  app->Options()->SetNumericValue("bound_mult_init_val", initial_multiplier);
   if (app->Initialize() != Ipopt::Solve_Succeeded) throw std::runtime_error("Ipopt failed to initialise");
   const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(nlp);
   if (Ipopt::IsValid(app->Statistics())) out.iterations = app->Statistics()->IterationCount();
-  if (status != Ipopt::Solve_Succeeded && status != Ipopt::Solved_To_Acceptable_Level) out.converged = false;
+  if (out.theta.size() != static_cast<size_t>(segments)) {  // finalize_solution was not called
+    out.converged = false;
+    out.ipopt_status = out.status = "ipopt status " + std::to_string(static_cast<int>(status)) + " (no solution)";
+    return out;
+  }
+  // Ipopt's word is not taken: the KKT conditions are recomputed from its angles and multipliers.
+  out.kkt = check_discrete_elastica(rod, out);
+  if (status != Ipopt::Solve_Succeeded) {
+    out.converged = false;
+  } else if (!out.kkt.passed) {
+    out.converged = false;
+    out.status = "KKT check failed: " + out.kkt.failure;
+  } else {
+    out.converged = true;
+    out.status = "converged";
+  }
+  return out;
+}
+
+DiscreteKktCheck check_discrete_elastica(const DiscreteClampedElastica& rod, const DiscreteElasticaResult& r) {
+  const int N = static_cast<int>(r.theta.size());
+  const size_t obstacles = rod.obstacles.size();
+  if (N < 4 || r.multipliers.size() != 2 + obstacles * (N - 1))
+    throw std::invalid_argument("discrete Elastica check: " + std::to_string(N) + " angles and " +
+                                std::to_string(r.multipliers.size()) + " multipliers do not match the rod");
+  const double h = rod.L / N;
+  const std::vector<double>& t = r.theta;
+  const std::vector<double>& lambda = r.multipliers;
+  std::vector<double> EI(N + 1);
+  double EI_max = 0.0;
+  for (int k = 0; k <= N; ++k) EI_max = std::max(EI_max, EI[k] = rod.EI(k * h));
+  std::vector<Vec3> nodes(N + 1, rod.start);
+  for (int k = 1; k <= N; ++k) nodes[k] = nodes[k - 1] + h * Vec3(std::cos(t[k - 1]), std::sin(t[k - 1]), 0.0);
+
+  DiscreteKktCheck c;
+  // Forces: the end reaction and each node's contact force -lambda |grad g| (Ipopt's multiplier
+  // of an active lower bound is <= 0).
+  Vec3 n_start(-lambda[0], -lambda[1], 0.0);
+  double total_force = 0.0, most_negative = 0.0, worst_product = 0.0, min_gap = INFINITY;
+  // dL/dtheta_i: the energy's gradient, plus the multipliers times the constraints' gradients
+  // (every constraint of node k >= i + 1 depends on theta_i through r_k, d r_k / d theta_i = a_i).
+  std::vector<double> dL(N, 0.0);
+  dL[0] += 2 * EI[0] / h * (t[0] - rod.start_angle);
+  dL[N - 1] += 2 * EI[N] / h * (t[N - 1] - rod.end_angle);
+  for (int k = 1; k < N; ++k) {
+    const double d = EI[k] / h * (t[k] - t[k - 1]);
+    dL[k] += d;
+    dL[k - 1] -= d;
+  }
+  Vec3 pull = Vec3(lambda[0], lambda[1], 0.0);  // sum over the constraints of nodes > i of lambda grad
+  std::vector<Vec3> gradient_tail(N);
+  std::vector<std::vector<Vec3>> gradients(obstacles, std::vector<Vec3>(N + 1, Vec3::Zero()));
+  for (size_t o = 0; o < obstacles; ++o)
+    for (int k = 1; k < N; ++k) gradients[o][k] = rod.obstacles[o].gradient(nodes[k]);
+  for (int i = N - 1; i >= 0; --i) {
+    if (i + 1 <= N - 1)
+      for (size_t o = 0; o < obstacles; ++o) pull += lambda[2 + o * (N - 1) + i] * gradients[o][i + 1];
+    gradient_tail[i] = pull;
+  }
+  for (int i = 0; i < N; ++i) dL[i] += gradient_tail[i].dot(Vec3(-h * std::sin(t[i]), h * std::cos(t[i]), 0.0));
+  std::vector<double> force(obstacles * (N - 1)), gap(obstacles * (N - 1));
+  for (size_t o = 0; o < obstacles; ++o)
+    for (int k = 1; k < N; ++k) {
+      const size_t row = o * (N - 1) + (k - 1);
+      force[row] = -lambda[2 + row] * gradients[o][k].norm();
+      gap[row] = rod.obstacles[o].gap(nodes[k]);
+      n_start += -lambda[2 + row] * gradients[o][k];
+      total_force += std::abs(force[row]);
+      min_gap = std::min(min_gap, gap[row]);
+    }
+  c.force_scale = n_start.norm() + total_force + EI_max / (rod.L * rod.L);
+  const double F = c.force_scale;
+  double stationarity = 0.0;
+  for (int i = 0; i < N; ++i) stationarity = std::max(stationarity, std::abs(dL[i]));
+  c.stationarity = stationarity / (h * F);
+  c.end_error = (nodes[N] - rod.end).norm() / rod.L;
+  c.penetration = obstacles ? std::max(0.0, -min_gap) / rod.L : 0.0;
+  for (size_t row = 0; row < force.size(); ++row) {
+    most_negative = std::min(most_negative, force[row]);
+    worst_product = std::max(worst_product, std::abs(force[row] * gap[row]));
+  }
+  c.negative_force = -most_negative / F;
+  c.complementarity = worst_product / (F * rod.L);
+  auto fail = [&](const char* what, double value) {
+    if (c.failure.empty() && !(value <= kDiscreteKktTolerance)) {
+      char text[160];
+      std::snprintf(text, sizeof text, "%s %.2e > %.0e", what, value, kDiscreteKktTolerance);
+      c.failure = text;
+    }
+  };
+  fail("stationarity (moment balance, relative)", c.stationarity);
+  fail("end position error (relative)", c.end_error);
+  fail("penetration (relative)", c.penetration);
+  fail("pulling contact force (relative)", c.negative_force);
+  fail("complementarity force x gap (relative)", c.complementarity);
+  c.passed = c.failure.empty();
+  return c;
+}
+
+DiscreteRefinementCheck check_refinement(int segments, double P, double P_half, double P_quarter) {
+  DiscreteRefinementCheck c;
+  c.segments = segments;
+  c.P = P;
+  c.P_half = P_half;
+  c.P_quarter = P_quarter;
+  const double fine = P_half - P, coarse = P_quarter - P_half;
+  c.error_estimate = std::abs(fine) / 3.0;
+  c.P_extrapolated = (4.0 * P - P_half) / 3.0;
+  c.ratio = coarse / fine;
+  // Differences at round-off: P is converged in N to the digits Ipopt gives (the Lagrangian's
+  // stationarity to 1e-12 moves P by ~1e-12 of itself; 1e-10 leaves a factor 100).
+  const double roundoff = 1e-10 * std::max({std::abs(P), std::abs(P_half), std::abs(P_quarter)});
+  if (!std::isfinite(P) || !std::isfinite(P_half) || !std::isfinite(P_quarter)) {
+    c.failure = "P is not finite";
+  } else if (std::abs(fine) <= roundoff && std::abs(coarse) <= roundoff) {
+    c.error_estimate = std::max(c.error_estimate, roundoff);
+  } else if (!(c.ratio >= kRefinementRatioMin && c.ratio <= kRefinementRatioMax)) {
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "P at N/4, N/2, N = %.10g, %.10g, %.10g: the differences' ratio %.3g is outside [%g, %g] "
+                  "(4 at second order): not one equilibrium refined, or not yet asymptotic",
+                  P_quarter, P_half, P, c.ratio, kRefinementRatioMin, kRefinementRatioMax);
+    c.failure = text;
+  }
+  c.passed = c.failure.empty();
+  return c;
+}
+
+DiscreteElasticaResult solve_discrete_elastica_refined(const DiscreteClampedElastica& rod, int segments,
+                                                       const DiscreteSolveOptions& options) {
+  if (segments % 4 != 0 || segments / 4 < 4)
+    throw std::invalid_argument("discrete Elastica, refined: N must be a multiple of 4 and N/4 >= 4");
+  DiscreteSolveOptions level = options;
+  if (!level.initial_theta.empty() && static_cast<int>(level.initial_theta.size()) != segments / 4)
+    throw std::invalid_argument("discrete Elastica, refined: initial_theta must hold N/4 angles");
+  std::vector<DiscreteElasticaResult> solved;
+  for (int n : {segments / 4, segments / 2, segments}) {
+    if (!solved.empty()) {
+      // Each coarse segment split in two at the same angle: the same nodes (the end constraints
+      // hold exactly), on the branch the coarse solve found.
+      level.initial_theta.clear();
+      for (double angle : solved.back().theta) level.initial_theta.insert(level.initial_theta.end(), 2, angle);
+    }
+    solved.push_back(solve_discrete_elastica(rod, n, level));
+    if (!solved.back().converged) {
+      DiscreteElasticaResult out = std::move(solved.back());
+      if (n != segments) {
+        out.converged = false;
+        out.status = "the solve at N = " + std::to_string(n) + " for the refinement check failed: " + out.status;
+      }
+      return out;
+    }
+  }
+  DiscreteElasticaResult out = std::move(solved[2]);
+  out.refinement = check_refinement(segments, out.P, solved[1].P, solved[0].P);
+  if (!out.refinement.passed) {
+    out.converged = false;
+    out.status = "refinement check failed: " + out.refinement.failure;
+  }
   return out;
 }
 

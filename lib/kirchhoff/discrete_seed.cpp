@@ -95,6 +95,10 @@ DiscreteSeed seed_from_discrete_energy(const ProblemDefinition& d, int segments,
   const DiscreteClampedElastica rod = discrete_rod(d, problem);
   DiscreteSeed seed;
   seed.discrete = solve_discrete_elastica(rod, segments, amplitude);
+  // converged: Ipopt succeeded and its solution passed the library's own KKT check (stationarity,
+  // end constraints, no penetration, no pulling force, complementarity); anything else is refused
+  // rather than read off. (The seed needs no refinement check: the shooting solve that starts from
+  // it is checked by its own residual and complementarity.)
   if (!seed.discrete.converged)
     throw std::runtime_error("the Ipopt seed did not converge (" + seed.discrete.status + ")");
   const double h = rod.L / segments;
@@ -110,7 +114,8 @@ DiscreteSeed seed_from_discrete_energy(const ProblemDefinition& d, int segments,
   seed.start.m = Vec3(0.0, 0.0, seed.discrete.m_start);
   std::ostringstream summary;
   summary << "Ipopt on " << segments << " segments (" << seed.discrete.iterations << " iterations, energy "
-          << seed.discrete.energy << "): " << seed.contacts.size() << " contact(s)";
+          << seed.discrete.energy << ", KKT checked: stationarity " << seed.discrete.kkt.stationarity
+          << ", complementarity " << seed.discrete.kkt.complementarity << "): " << seed.contacts.size() << " contact(s)";
   for (const auto& c : seed.contacts) {
     summary << (&c == &seed.contacts.front() ? ": " : ", ");
     if (c.extended)

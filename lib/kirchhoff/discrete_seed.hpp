@@ -40,7 +40,7 @@ struct DiscreteSeed {
 
 // `amplitude` picks the side the discrete rod buckles to first (see solve_discrete_elastica).
 // Throws std::invalid_argument for a definition outside the scope above and std::runtime_error
-// when Ipopt does not converge.
+// when Ipopt does not converge or its solution fails the KKT check (DiscreteElasticaResult::kkt).
 DiscreteSeed seed_from_discrete_energy(const ProblemDefinition& definition, int segments = 200,
                                        double amplitude = 0.05);
 

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -481,6 +482,20 @@ HardSelfContactPlectoneme solve_hard_self_contact(const ShootingProblem& problem
   if (out.converged && out.box_active > 0) {
     out.converged = false;
     out.status = "no minimum inside the trust region after " + std::to_string(out.rounds) + " rounds";
+  }
+  // Ipopt's word is not taken alone: the contact set is checked from the solution itself (the
+  // nodes' distances and the multipliers' forces, measure_contact): no strand inside the other,
+  // no pulling force, force only where the strands touch. Measured at L/2R = 100 and 200: gaps
+  // >= -1e-12 R, force x gap <= 4e-12 of the largest force x R; the bound is 100 times Ipopt's
+  // tolerance (1e-10 by default), so only a solution that is not a complementarity point fails.
+  const double bound = std::max(1e-8, 100.0 * options.tolerance);
+  if (out.converged && !(out.min_gap >= -bound && out.min_force >= -bound && out.complementarity <= bound)) {
+    out.converged = false;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "complementarity check failed: smallest gap %.2e R, smallest force %.2e, force x gap %.2e (bound %.0e)",
+                  out.min_gap, out.min_force, out.complementarity, bound);
+    out.status = text;
   }
   return out;
 }

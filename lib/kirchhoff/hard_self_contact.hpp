@@ -42,8 +42,11 @@ struct HardSelfContactOptions {
 };
 
 struct HardSelfContactPlectoneme {
+  // Ipopt succeeded, the minimum lies inside the trust region, and the complementarity check on
+  // the solution (min_gap, min_force, complementarity below, each within max(1e-8, 100 x
+  // tolerance)) passed.
   bool converged = false;
-  std::string status;        // "converged" or Ipopt's return status
+  std::string status;        // "converged", Ipopt's return status, or the check that failed
   int iterations = 0;        // Ipopt's, over all rounds
   int rounds = 0;            // trust-region rounds
   int box_active = 0;        // variables on a bound of the last round's box (0 at an accepted minimum)
