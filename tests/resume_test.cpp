@@ -123,6 +123,23 @@ TEST_F(ResumeTest, WallPointBudgetIsTheSameAcrossAResume) {
   for (int row : {98, 140}) expect_resume_repeats(wall_args(csv, "150"), csv, expected, row);
 }
 
+// A wrap lowered off its disc: the wrap shrinks to a point contact (row 50), after which the
+// next leg arms contact_flattens at that contact's starting g'' (-1.3e-13, not 0), and the
+// contact lifts off (row 87). Resumed on that leg, the event is armed where it was.
+TEST_F(ResumeTest, UnwoundWrapResumedOnItsPointContactLegRepeatsTheRun) {
+  auto args_for = [](const fs::path& csv) {
+    return std::vector<std::string>{KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/wrapped_indenter.toml",
+                                    "--set", "radius=0.5", "--set", "half_span=0.5", "--set", "rise=0.18", "--param",
+                                    "rise", "--to", "-0.01", "--step", "0.01", "--max-step", "1", "--out", csv.string()};
+  };
+  const fs::path full = dir_ / "full.csv", csv = dir_ / "killed.csv";
+  ASSERT_EQ(run_to_end(args_for(full), dir_ / "full.log"), 0);
+  const auto expected = lines_of(full);
+  ASSERT_EQ(expected.size(), 91u);
+  ASSERT_NE(expected[51].find("contact_shrinks_to_a_point"), std::string::npos) << expected[51];
+  for (int row : {50, 51, 60, 87}) expect_resume_repeats(args_for(csv), csv, expected, row);
+}
+
 // (c) Killed before its first point was saved (before it, or after the start's row but before
 // its state): --resume starts the run over and writes the same CSV.
 TEST_F(ResumeTest, RunKilledBeforeItsFirstSaveStartsOver) {
