@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -41,9 +42,17 @@ int data_rows(const fs::path& path) {
 // The arguments that decide a run's points, in one line: a state file records them, and a
 // resume with other ones is refused (it would not continue the same run). The output paths and
 // --resume itself are not among them.
+// The case is named by its canonical path and its content's FNV-1a hash (an edited case file is
+// another run too).
 std::string run_arguments(const ContinueArguments& a) {
+  std::ifstream in(a.case_path, std::ios::binary);
+  std::uint64_t hash = 14695981039346656037ull;
+  for (char ch; in.get(ch);) hash = (hash ^ static_cast<unsigned char>(ch)) * 1099511628211ull;
+  std::error_code ec;
+  const fs::path canonical = fs::weakly_canonical(a.case_path, ec);
   std::ostringstream o;
-  o << std::setprecision(17) << "case=" << a.case_path << " param=" << a.parameter;
+  o << std::setprecision(17) << "case=" << (ec ? fs::path(a.case_path) : canonical).string() << " case_hash=" << std::hex
+    << hash << std::dec << " param=" << a.parameter;
   for (const auto& s : a.overrides) o << " set=" << s;
   o << " phase=" << a.phase_condition << " to=";
   if (a.has_to)

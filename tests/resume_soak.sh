@@ -55,7 +55,8 @@ for name in "$@"; do
     kill -KILL "$pid" 2>/dev/null
     wait "$pid" 2>/dev/null
     [ $? -eq 137 ] || finished=$((finished + 1))  # 128 + SIGKILL: it was killed, else it had ended
-    killed_rows=$(($(wc -l < "$WORK/run.csv" 2>/dev/null || echo 1) - 1))
+    killed_rows=none  # killed before it created its CSV
+    [ -f "$WORK/run.csv" ] && killed_rows=$(($(wc -l < "$WORK/run.csv") - 1))
     # shellcheck disable=SC2086
     "$BIN" continue $args --out "$WORK/run.csv" --resume 2>"$WORK/resume.log"
     rc=$?
