@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Fuzzes the case-file loader and --set parsing (fuzz/case_file_fuzzer.cpp) for SECONDS seconds:
+# configures a clang build in build-fuzz/ with libFuzzer, AddressSanitizer and UBSan, replays
+# fuzz/corpus/regressions/ (inputs that once crashed, hung or were wrongly accepted), then fuzzes
+# from the seed corpus (cases/ and the regressions). Exit status non-zero on any crash, hang
+# (> 10 s for one input), memory blow-up (> 2 GB) or sanitizer report; the input is then saved
+# as build-fuzz/crash-*, timeout-* or oom-* (add it to fuzz/corpus/regressions/ once fixed).
+#   fuzz/run.sh 60                 # CI
+#   JOBS=2 fuzz/run.sh 3600        # longer, two fuzzing processes (libFuzzer -fork)
+# BUILD_JOBS (default: all cores) sets the build's parallelism.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${1:?usage: fuzz/run.sh SECONDS}"
+jobs="${JOBS:-1}"
+build=build-fuzz
+
+runtime=$(clang++ -print-file-name=libclang_rt.fuzzer-x86_64.a 2>/dev/null || true)
+if ! command -v clang++ >/dev/null || [ ! -f "$runtime" ]; then
+  echo "fuzz/run.sh: needs clang++ and libFuzzer (Debian: clang libclang-rt-14-dev)" >&2
+  exit 2
+fi
+
+# The library is instrumented for coverage (fuzzer-no-link) and the sanitizers; only the target
+# links libFuzzer's main (fuzz/CMakeLists.txt). halt_on_error: UBSan otherwise only prints.
+sanitize="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
+sanitize+=" -Wno-unknown-warning-option"  # lib/ passes a GCC-only -Wno-maybe-uninitialized
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+  -DCMAKE_CXX_FLAGS="$sanitize" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
+  -DKIRCHHOFF_FUZZ=ON -DKIRCHHOFF_BUILD_TESTS=OFF -DKIRCHHOFF_BUILD_BENCH=OFF -DKIRCHHOFF_BUILD_PYTHON=OFF >/dev/null
+cmake --build "$build" -j"${BUILD_JOBS:-$(nproc)}" --target case_file_fuzzer
+
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+# Leaks are checked too: the loader allocates per input and a leak would grow over a run.
+export ASAN_OPTIONS="detect_leaks=1"
+fuzzer="$build/fuzz/case_file_fuzzer"
+# -max_len: the largest shipped case is 2.9 kB; toml11 takes ~1 us per byte (more under ASan),
+# so longer inputs would mostly slow the search down.
+limits=(-timeout=10 -rss_limit_mb=2048 -max_len=4096)
+
+echo "== replaying fuzz/corpus/regressions"
+"$fuzzer" "${limits[@]}" fuzz/corpus/regressions/*
+
+# The seed corpus: every shipped case, the regressions, and what earlier runs found (kept in
+# build-fuzz/corpus, outside git; a fresh clone starts from the seeds).
+mkdir -p "$build/corpus"
+echo "== fuzzing for $seconds s"
+cd "$build"
+fork=()
+[ "$jobs" -gt 1 ] && fork=(-fork="$jobs" -ignore_crashes=0)
+../"$fuzzer" "${limits[@]}" "${fork[@]}" -max_total_time="$seconds" -print_final_stats=1 \
+  -dict=../fuzz/case_file.dict corpus ../cases ../fuzz/corpus/regressions
