@@ -142,11 +142,13 @@ DiscreteKktCheck check_discrete_elastica(const DiscreteClampedElastica& rod, con
 // The refinement check above from the three values of P.
 DiscreteRefinementCheck check_refinement(int segments, double P, double P_half, double P_quarter);
 
-// Solves at N/4 from the starting point of `options`, then at N/2 and at N each from the coarser
-// solution interpolated (so the three stay on one branch), and checks the three by Richardson.
-// Returns the solution at N with `refinement` filled; converged only when all three solves pass
-// their KKT check and the refinement check passes. N must be divisible by 4, N/4 >= 4.
-// Costs ~1.3 times the solve at N alone.
+// Solves at N/4 from the starting point of `options` (initial_theta, if given, holds N/4 angles),
+// then at N/2 and at N each from the coarser solution with every segment split in two (the same
+// nodes, so the three stay on one branch), and checks the three by Richardson. Returns the
+// solution at N with `refinement` filled; converged only when all three solves pass their KKT
+// check and the refinement check passes. When a coarser solve fails, its result is returned
+// (not converged, the status naming N). N must be divisible by 4, N/4 >= 4. Costs ~1.3 times the
+// solve at N alone (the gap Jacobian is dense, so a solve costs ~N^2 to N^3).
 DiscreteElasticaResult solve_discrete_elastica_refined(const DiscreteClampedElastica& rod, int segments,
                                                        const DiscreteSolveOptions& options = {});
 
