@@ -19,6 +19,7 @@
 #include "kirchhoff/plectoneme.hpp"
 #include "kirchhoff/self_contact.hpp"
 #include "kirchhoff/solution.hpp"
+#include "kirchhoff/toml_nesting.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -37,76 +38,6 @@ std::string shown(double v) {
   return os.str();
 }
 
-// The first line on which arrays and inline tables nest deeper than `limit` in TOML text, 0 when
-// none does. Each level counts, and so does each component of a dotted key leading to one (a.b.c
-// = [..] nests the array 3 deep; [a.b.c] headers count the same way): toml11 recurses once per
-// level while parsing and again while destroying the tree, and a few thousand levels overflow
-// the stack. Only strings and comments have to be told apart, so that brackets inside them are
-// not counted; for malformed text the scan may count too much, never too little before the
-// point where toml11 would stop with a syntax error (a basic string ends at its line's end, as
-// toml11 reads it).
-int line_beyond_nesting(const std::string& text, int limit) {
-  std::vector<int> open;   // for each open [ or {: the dotted-key components before it
-  int components = 0;      // the sum of `open`
-  int dots = 0;            // dots since the last '=', ',', bracket or line end: a dotted key's
-  int line = 1;
-  const std::size_t n = text.size();
-  std::size_t i = 0;
-  auto run_of = [&](char c) {  // how many c start at i
-    std::size_t k = 0;
-    while (i + k < n && text[i + k] == c) ++k;
-    return k;
-  };
-  auto too_deep = [&] { return static_cast<int>(open.size()) + components + dots > limit; };
-  while (i < n) {
-    const char c = text[i];
-    if (c == '\n') {
-      ++line;
-      dots = 0;
-      ++i;
-    } else if (c == '#') {
-      while (i < n && text[i] != '\n') ++i;
-    } else if (c == '"' || c == '\'') {
-      // """ and ''' open multi-line strings; "" is an empty string.
-      const bool multi = run_of(c) >= 3;
-      i += multi ? 3 : 1;
-      while (i < n) {
-        if (c == '"' && text[i] == '\\') {  // an escape; in a multi-line string \ may end a line
-          if (i + 1 < n && text[i + 1] == '\n') ++line;
-          i += 2;
-        } else if (text[i] == '\n') {
-          if (!multi) break;  // a one-line string ends here (a syntax error toml11 reports)
-          ++line;
-          ++i;
-        } else if (text[i] == c && (!multi || run_of(c) >= 3)) {
-          // A multi-line string ends at the last three of a run of up to five quotes.
-          i += multi ? std::min<std::size_t>(run_of(c), 5) : 1;
-          break;
-        } else {
-          ++i;
-        }
-      }
-    } else if (c == '[' || c == '{') {
-      open.push_back(dots);
-      components += dots;
-      dots = 0;
-      if (too_deep()) return line;
-      ++i;
-    } else if (c == ']' || c == '}') {
-      if (!open.empty()) {
-        components -= open.back();
-        open.pop_back();
-      }
-      dots = 0;
-      ++i;
-    } else {
-      if (c == '=' || c == ',') dots = 0;
-      if (c == '.' && (++dots, too_deep())) return line;
-      ++i;
-    }
-  }
-  return 0;
-}
 
 std::string join(const std::set<std::string>& names) {
   std::string out;
@@ -631,7 +562,7 @@ Case load_case_text(const std::string& text, const std::string& path, const Para
                     const std::string& phase_condition) {
   if (text.size() > kMaxFileBytes)
     throw CaseError(path + ": larger than " + std::to_string(kMaxFileBytes >> 20) + " MiB: not a case file");
-  if (const int line = line_beyond_nesting(text, kMaxNesting))
+  if (const int line = toml_line_beyond_nesting(text, kMaxNesting))
     throw CaseError(path + ":" + std::to_string(line) + ": arrays, inline tables and dotted keys nest deeper than " +
                     std::to_string(kMaxNesting) + " levels (a case file needs 3)");
   Value root;
