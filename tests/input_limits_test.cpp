@@ -20,6 +20,7 @@
 
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/spatial_bins.hpp"
+#include "kirchhoff/toml_nesting.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -113,6 +114,24 @@ TEST(Nesting, SixtyFourLevelsAreAllowedSixtyFiveAreNot) {
   auto nested = [&](int depth) { return "x = " + std::string(depth, '[') + std::string(depth, ']') + "\n" + base; };
   expect_refused(nested(64), "x", {"unknown key"}, 1);
   expect_refused(nested(65), "", {"nest deeper than 64"}, 1);
+}
+
+TEST(Nesting, TheScanCountsLinesInsideStringsAndDottedKeysAcrossBrackets) {
+  // Lines inside multi-line strings (and after an escaped line end) are counted; the nesting is
+  // on line 6.
+  const std::string text = "a = \"\"\"\n[[[\\\n\"\"\"\nb = '''\n]]]'''\nc = [[[[1]]]]\n";
+  EXPECT_EQ(toml_line_beyond_nesting(text, 3), 6);
+  EXPECT_EQ(toml_line_beyond_nesting(text, 4), 0);
+  // The dots of keys inside inline tables add to the levels around them: x.y = { z.w = [1] } counts
+  // a dot, the table, a dot, the array (32 levels of {a.a.a... = } used to count only 64 dots).
+  EXPECT_EQ(toml_line_beyond_nesting("x.y = { z.w = [1] }\n", 3), 1);
+  EXPECT_EQ(toml_line_beyond_nesting("x.y = { z.w = [1] }\n", 4), 0);
+  std::string dotted_tables = "x = ";
+  for (int i = 0; i < 32; ++i) dotted_tables += "{" + std::string(30, 'a').replace(1, 28, std::string(28, '.')) + " = ";
+  dotted_tables += "1" + std::string(32, '}') + "\n";
+  EXPECT_EQ(toml_line_beyond_nesting(dotted_tables, 64), 1);
+  // A one-line string ends at its line's end, as toml11 reads it (then refuses it).
+  EXPECT_EQ(toml_line_beyond_nesting("a = \"[[[\n[[[\n", 2), 2);
 }
 
 // ---- integer keys: range-checked before they become ints -----------------------------------

@@ -8,7 +8,10 @@ namespace kirchhoff {
 int toml_line_beyond_nesting(const std::string& text, int limit) {
   std::vector<int> open;   // for each open [ or {: the dotted-key components before it
   int components = 0;      // the sum of `open`
-  int dots = 0;            // dots since the last '=', ',', bracket or line end (dotted-key parts)
+  // Dots since the last ',', bracket or line end: the parts of a dotted key, carried over its '='
+  // to the bracket that may open its value (a.b = { c.d = [1] } nests 1 + 1 + 1 + 1 deep). A
+  // number's decimal point counts too; that only overestimates.
+  int dots = 0;
   int line = 1;
   const std::size_t n = text.size();
   std::size_t i = 0;
@@ -60,7 +63,7 @@ int toml_line_beyond_nesting(const std::string& text, int limit) {
       dots = 0;
       ++i;
     } else {
-      if (c == '=' || c == ',') dots = 0;
+      if (c == ',') dots = 0;
       if (c == '.' && (++dots, too_deep())) return line;
       ++i;
     }
