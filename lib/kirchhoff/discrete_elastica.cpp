@@ -14,73 +14,95 @@ namespace {
 using Ipopt::Index;
 using Ipopt::Number;
 
+// The same minimisation with the nodes as unknowns beside the angles: variables theta_0..N-1,
+// then (x_k, y_k) of the interior nodes k = 1..N-1; equality constraints per segment i,
+// r_i+1 - r_i - h (cos, sin) theta_i = 0 (r_0 and r_N the clamps); a gap row per interior node and
+// obstacle, g(x_k, y_k) >= 0. Every row involves at most one angle and two nodes, so the KKT
+// matrix is banded and a solve costs O(N) per iteration (with the angles alone every gap row
+// depends on all the angles before its node: a dense Jacobian, O(N^3) per factorisation, 5.6 s
+// at N = 1000). The multipliers are translated back to the angle formulation's (the end
+// reaction, the gap multipliers), which the KKT check verifies in that formulation: the check is
+// not made in the solver's own variables.
 class ClampedElasticaNLP : public Ipopt::TNLP {
  public:
   ClampedElasticaNLP(DiscreteClampedElastica rod, int N, const DiscreteSolveOptions& options, DiscreteElasticaResult* out)
       : rod_(std::move(rod)), N_(N), h_(rod_.L / N), amplitude_(options.amplitude),
         initial_theta_(options.initial_theta), out_(out) {
     for (const auto& o : rod_.obstacles) curved_ = curved_ || !o.is_flat();
-    // EI at the nodes 0..N: the interior nodes weight the angle differences, the ends the clamps.
     for (int k = 0; k <= N_; ++k) EI_.push_back(rod_.EI(k * h_));
   }
 
-  // Constraints: 0, 1: the end's x and y, then for each obstacle o and interior node
-  // k = 1..N-1: gap_o(x_k, y_k) >= 0.
-  int gap_rows() const { return static_cast<int>(rod_.obstacles.size()) * (N_ - 1); }
+  int obstacles() const { return static_cast<int>(rod_.obstacles.size()); }
+  // Variable indices: angle i, node k's x and y (k = 1..N-1).
+  Index X(int k) const { return N_ + 2 * (k - 1); }
+  Index Y(int k) const { return N_ + 2 * (k - 1) + 1; }
+  Index gap_row(int o, int k) const { return 2 * N_ + o * (N_ - 1) + (k - 1); }
+  Vec3 node(const Number* v, int k) const {
+    if (k == 0) return rod_.start;
+    if (k == N_) return rod_.end;
+    return Vec3(v[X(k)], v[Y(k)], 0.0);
+  }
 
   bool get_nlp_info(Index& n, Index& m, Index& nnz_jac, Index& nnz_hess, IndexStyleEnum& style) override {
-    n = N_;
-    m = 2 + gap_rows();
-    // Node k depends on the angles of segments 0..k-1.
-    nnz_jac = 2 * N_ + static_cast<int>(rod_.obstacles.size()) * (N_ - 1) * N_ / 2;
-    // Lower triangle: tridiagonal with planes; curved obstacles couple every pair of angles.
-    nnz_hess = curved_ ? N_ * (N_ + 1) / 2 : 2 * N_ - 1;
+    n = N_ + 2 * (N_ - 1);
+    m = 2 * N_ + obstacles() * (N_ - 1);
+    // Segment rows: the angle and the interior nodes among its two ends (N - 2 segments have
+    // two, the first and last one), per coordinate.
+    nnz_jac = 2 * (N_ + 2 * (N_ - 1)) + 2 * obstacles() * (N_ - 1);
+    // Lower triangle: the angles' tridiagonal; with curved obstacles each node's 2 x 2 block.
+    nnz_hess = 2 * N_ - 1 + (curved_ ? 3 * (N_ - 1) : 0);
     style = C_STYLE;
     return true;
   }
 
   bool get_bounds_info(Index n, Number* x_l, Number* x_u, Index m, Number* g_l, Number* g_u) override {
     for (Index i = 0; i < n; ++i) {
-      x_l[i] = -2e19;  // Ipopt's infinity: the angles are free
+      x_l[i] = -2e19;  // Ipopt's infinity: free
       x_u[i] = 2e19;
     }
-    g_l[0] = g_u[0] = rod_.end.x();
-    g_l[1] = g_u[1] = rod_.end.y();
-    for (Index r = 2; r < m; ++r) {
+    for (Index r = 0; r < 2 * N_; ++r) g_l[r] = g_u[r] = 0.0;
+    for (Index r = 2 * N_; r < m; ++r) {
       g_l[r] = 0.0;
-      g_u[r] = 2e19;  // Ipopt's +infinity
+      g_u[r] = 2e19;
     }
     return true;
   }
 
-  bool get_starting_point(Index n, bool, Number* x, bool, Number*, Number*, Index, bool, Number*) override {
+  bool get_starting_point(Index, bool, Number* v, bool, Number*, Number*, Index, bool, Number*) override {
     if (!initial_theta_.empty()) {
-      std::copy(initial_theta_.begin(), initial_theta_.end(), x);
-      return true;
+      std::copy(initial_theta_.begin(), initial_theta_.end(), v);
+    } else {
+      // The chord's angle, the clamps' angles blended in linearly, and the slope of the first
+      // clamped-clamped mode y = (A/2)(1 - cos 2 pi s / L) across the chord.
+      const Vec3 chord = rod_.end - rod_.start;
+      const double along = std::atan2(chord.y(), chord.x());
+      for (int i = 0; i < N_; ++i) {
+        const double s = (i + 0.5) * h_, t = s / rod_.L;
+        v[i] = along + (1 - t) * (rod_.start_angle - along) + t * (rod_.end_angle - along) +
+               amplitude_ * M_PI / rod_.L * std::sin(2 * M_PI * t);
+      }
     }
-    // The chord's angle, the clamps' angles blended in linearly, and the slope of the first
-    // clamped-clamped mode y = (A/2)(1 - cos 2 pi s / L) across the chord.
-    const Vec3 chord = rod_.end - rod_.start;
-    const double along = std::atan2(chord.y(), chord.x());
-    for (Index i = 0; i < n; ++i) {
-      const double s = (i + 0.5) * h_, t = s / rod_.L;
-      x[i] = along + (1 - t) * (rod_.start_angle - along) + t * (rod_.end_angle - along) +
-             amplitude_ * M_PI / rod_.L * std::sin(2 * M_PI * t);
+    // The nodes from the angles (the segment rows hold but for the last one's, the end).
+    Vec3 r = rod_.start;
+    for (int k = 1; k < N_; ++k) {
+      r += h_ * Vec3(std::cos(v[k - 1]), std::sin(v[k - 1]), 0.0);
+      v[X(k)] = r.x();
+      v[Y(k)] = r.y();
     }
     return true;
   }
 
-  bool eval_f(Index n, const Number* t, bool, Number& f) override {
-    f = EI_[0] / h_ * std::pow(t[0] - rod_.start_angle, 2) + EI_[N_] / h_ * std::pow(t[n - 1] - rod_.end_angle, 2);
-    for (Index k = 1; k < n; ++k) f += 0.5 * EI_[k] / h_ * (t[k] - t[k - 1]) * (t[k] - t[k - 1]);
+  bool eval_f(Index, const Number* t, bool, Number& f) override {
+    f = EI_[0] / h_ * std::pow(t[0] - rod_.start_angle, 2) + EI_[N_] / h_ * std::pow(t[N_ - 1] - rod_.end_angle, 2);
+    for (int k = 1; k < N_; ++k) f += 0.5 * EI_[k] / h_ * (t[k] - t[k - 1]) * (t[k] - t[k - 1]);
     return true;
   }
 
   bool eval_grad_f(Index n, const Number* t, bool, Number* g) override {
     for (Index i = 0; i < n; ++i) g[i] = 0.0;
     g[0] += 2 * EI_[0] / h_ * (t[0] - rod_.start_angle);
-    g[n - 1] += 2 * EI_[N_] / h_ * (t[n - 1] - rod_.end_angle);
-    for (Index k = 1; k < n; ++k) {
+    g[N_ - 1] += 2 * EI_[N_] / h_ * (t[N_ - 1] - rod_.end_angle);
+    for (int k = 1; k < N_; ++k) {
       const double d = EI_[k] / h_ * (t[k] - t[k - 1]);
       g[k] += d;
       g[k - 1] -= d;
@@ -88,148 +110,136 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
     return true;
   }
 
-  bool eval_g(Index n, const Number* t, bool, Index, Number* g) override {
-    double x = rod_.start.x(), y = rod_.start.y();
-    Index row = 2;
-    for (Index k = 1; k <= n; ++k) {
-      x += h_ * std::cos(t[k - 1]);
-      y += h_ * std::sin(t[k - 1]);
-      if (k < n)
-        for (size_t o = 0; o < rod_.obstacles.size(); ++o) g[row + o * (n - 1) + (k - 1)] = rod_.obstacles[o].gap(Vec3(x, y, 0));
+  bool eval_g(Index, const Number* v, bool, Index, Number* g) override {
+    for (int i = 0; i < N_; ++i) {
+      const Vec3 d = node(v, i + 1) - node(v, i);
+      g[2 * i] = d.x() - h_ * std::cos(v[i]);
+      g[2 * i + 1] = d.y() - h_ * std::sin(v[i]);
     }
-    g[0] = x;
-    g[1] = y;
-    (void)row;
+    for (int o = 0; o < obstacles(); ++o)
+      for (int k = 1; k < N_; ++k) g[gap_row(o, k)] = rod_.obstacles[o].gap(node(v, k));
     return true;
   }
 
-  bool eval_jac_g(Index n, const Number* t, bool, Index, Index, Index* rows, Index* cols, Number* values) override {
+  bool eval_jac_g(Index, const Number* v, bool, Index, Index, Index* rows, Index* cols, Number* values) override {
     Index e = 0;
-    for (Index i = 0; i < n; ++i) {
-      if (values) {
-        values[e] = -h_ * std::sin(t[i]);
-        values[e + 1] = h_ * std::cos(t[i]);
-      } else {
-        rows[e] = 0;
-        cols[e] = i;
-        rows[e + 1] = 1;
-        cols[e + 1] = i;
-      }
-      e += 2;
-    }
-    const auto nodes = values ? node_positions(t) : std::vector<Vec3>();
-    for (size_t o = 0; o < rod_.obstacles.size(); ++o) {
-      for (Index k = 1; k < n; ++k) {
-        const Vec3 normal = values ? rod_.obstacles[o].gradient(nodes[k]) : Vec3::Zero();
-        for (Index i = 0; i < k; ++i, ++e) {
-          if (values)
-            values[e] = normal.x() * (-h_ * std::sin(t[i])) + normal.y() * (h_ * std::cos(t[i]));
-          else {
-            rows[e] = 2 + static_cast<Index>(o) * (n - 1) + (k - 1);
-            cols[e] = i;
-          }
-        }
-      }
-    }
-    return true;
-  }
-
-  bool eval_h(Index n, const Number* t, bool, Number obj_factor, Index, const Number* lambda, bool, Index,
-              Index* rows, Index* cols, Number* values) override {
-    if (!values) {
-      Index e = 0;
-      for (Index i = 0; i < n; ++i)
-        for (Index j = curved_ ? 0 : std::max<Index>(0, i - 1); j <= i; ++j, ++e) {
-          rows[e] = i;
-          cols[e] = j;
-        }
-      return true;
-    }
-    // A gap row of node k involves the angles of segments 0..k-1 through r_k = sum h (cos, sin):
-    // d2 g_k / dtheta_i dtheta_j = a_i^T Hess g a_j + delta_ij grad g . b_i, with
-    // a_i = h (-sin, cos) theta_i and b_i = -h (cos, sin) theta_i. Summed with the multipliers over
-    // the nodes k > max(i, j), as suffix sums of lambda_k grad g_k and lambda_k Hess g_k.
-    const auto nodes = node_positions(t);
-    std::vector<Vec3> gradient_tail(n, Vec3::Zero());
-    std::vector<Mat3> hessian_tail(n, Mat3::Zero());
-    for (size_t o = 0; o < rod_.obstacles.size(); ++o) {
-      Vec3 g_sum = Vec3::Zero();
-      Mat3 h_sum = Mat3::Zero();
-      for (Index i = n - 1; i >= 0; --i) {
-        if (i + 1 <= n - 1) {
-          const double multiplier = lambda[2 + o * (n - 1) + i];  // node k = i + 1
-          g_sum += multiplier * rod_.obstacles[o].gradient(nodes[i + 1]);
-          if (!rod_.obstacles[o].is_flat()) h_sum += multiplier * rod_.obstacles[o].hessian(nodes[i + 1]);
-        }
-        gradient_tail[i] += g_sum;
-        hessian_tail[i] += h_sum;
-      }
-    }
-    auto a = [&](Index i) { return Vec3(-h_ * std::sin(t[i]), h_ * std::cos(t[i]), 0.0); };
-    Index e = 0;
-    for (Index i = 0; i < n; ++i) {
-      for (Index j = curved_ ? 0 : std::max<Index>(0, i - 1); j <= i; ++j, ++e) {
-        double value = curved_ ? a(i).dot(hessian_tail[i] * a(j)) : 0.0;
-        if (j + 1 == i) value += -obj_factor * EI_[i] / h_;
-        if (j == i) {
-          // Energy: tridiagonal; end constraints and gaps: b_i = -h (cos, sin) theta_i.
-          const Vec3 b(-h_ * std::cos(t[i]), -h_ * std::sin(t[i]), 0.0);
-          value += obj_factor / h_ * (i > 0 ? EI_[i] : 2.0 * EI_[0]) + obj_factor / h_ * (i + 1 < n ? EI_[i + 1] : 2.0 * EI_[N_]);
-          value += lambda[0] * b.x() + lambda[1] * b.y() + gradient_tail[i].dot(b);
-        }
+    auto entry = [&](Index row, Index col, double value) {
+      if (values)
         values[e] = value;
+      else {
+        rows[e] = row;
+        cols[e] = col;
+      }
+      ++e;
+    };
+    for (int i = 0; i < N_; ++i) {
+      const double c = values ? std::cos(v[i]) : 0.0, s = values ? std::sin(v[i]) : 0.0;
+      entry(2 * i, i, h_ * s);
+      entry(2 * i + 1, i, -h_ * c);
+      if (i + 1 < N_) {
+        entry(2 * i, X(i + 1), 1.0);
+        entry(2 * i + 1, Y(i + 1), 1.0);
+      }
+      if (i > 0) {
+        entry(2 * i, X(i), -1.0);
+        entry(2 * i + 1, Y(i), -1.0);
       }
     }
+    for (int o = 0; o < obstacles(); ++o)
+      for (int k = 1; k < N_; ++k) {
+        const Vec3 grad = values ? rod_.obstacles[o].gradient(node(v, k)) : Vec3::Zero();
+        entry(gap_row(o, k), X(k), grad.x());
+        entry(gap_row(o, k), Y(k), grad.y());
+      }
     return true;
   }
 
-  // Nodes 0..N from the segment angles.
-  std::vector<Vec3> node_positions(const Number* t) const {
-    std::vector<Vec3> out(N_ + 1, rod_.start);
-    for (int k = 1; k <= N_; ++k) out[k] = out[k - 1] + h_ * Vec3(std::cos(t[k - 1]), std::sin(t[k - 1]), 0.0);
-    return out;
+  bool eval_h(Index, const Number* v, bool, Number obj_factor, Index, const Number* lambda, bool, Index,
+              Index* rows, Index* cols, Number* values) override {
+    Index e = 0;
+    auto entry = [&](Index row, Index col, double value) {
+      if (values)
+        values[e] = value;
+      else {
+        rows[e] = row;
+        cols[e] = col;
+      }
+      ++e;
+    };
+    for (int i = 0; i < N_; ++i) {
+      if (i > 0) entry(i, i - 1, values ? -obj_factor * EI_[i] / h_ : 0.0);
+      double diagonal = 0.0;
+      if (values) {
+        diagonal = obj_factor / h_ * (i > 0 ? EI_[i] : 2.0 * EI_[0]) +
+                   obj_factor / h_ * (i + 1 < N_ ? EI_[i + 1] : 2.0 * EI_[N_]);
+        // d2/dtheta2 of -h cos theta and -h sin theta.
+        diagonal += lambda[2 * i] * h_ * std::cos(v[i]) + lambda[2 * i + 1] * h_ * std::sin(v[i]);
+      }
+      entry(i, i, diagonal);
+    }
+    if (curved_)
+      for (int k = 1; k < N_; ++k) {
+        Mat3 H = Mat3::Zero();
+        if (values)
+          for (int o = 0; o < obstacles(); ++o)
+            if (!rod_.obstacles[o].is_flat()) H += lambda[gap_row(o, k)] * rod_.obstacles[o].hessian(node(v, k));
+        entry(X(k), X(k), H(0, 0));
+        entry(Y(k), X(k), H(1, 0));
+        entry(Y(k), Y(k), H(1, 1));
+      }
+    return true;
   }
 
-  void finalize_solution(Ipopt::SolverReturn status, Index n, const Number* t, const Number*, const Number*,
+  void finalize_solution(Ipopt::SolverReturn status, Index, const Number* v, const Number*, const Number*,
                          Index m, const Number* g, const Number* lambda, Number f, const Ipopt::IpoptData*,
                          Ipopt::IpoptCalculatedQuantities*) override {
     // Provisional: solve_discrete_elastica adds the KKT check's verdict.
     out_->converged = status == Ipopt::SUCCESS;
     out_->ipopt_status = status == Ipopt::SUCCESS ? "success" : "ipopt status " + std::to_string(static_cast<int>(status));
     out_->status = out_->ipopt_status;
-    out_->multipliers.assign(lambda, lambda + m);
     out_->energy = f;
-    out_->theta.assign(t, t + n);
+    const int n = N_;
+    out_->theta.assign(v, v + n);
+    // The nodes from the angles, as the angle formulation has them (the solver's own nodes agree
+    // to its constraint tolerance).
     out_->x.assign(1, rod_.start.x());
     out_->y.assign(1, rod_.start.y());
-    for (Index i = 0; i < n; ++i) {
-      out_->x.push_back(out_->x.back() + h_ * std::cos(t[i]));
-      out_->y.push_back(out_->y.back() + h_ * std::sin(t[i]));
+    for (int i = 0; i < n; ++i) {
+      out_->x.push_back(out_->x.back() + h_ * std::cos(v[i]));
+      out_->y.push_back(out_->y.back() + h_ * std::sin(v[i]));
     }
-    // Ipopt's Lagrangian is f + lambda^T g: the end constraints' multipliers are the end
-    // reaction, n(L) = -lambda (the force the constraint applies to the rod's end).
-    // The gap rows' multipliers give the contact forces -lambda grad g, so that across the
-    // contacts n(0) = n(L) + sum (-lambda_k) grad g_k (n' = -f; eq. 63 for a wall).
-    out_->P = lambda[0];
+    // The multipliers in the angle formulation (Lagrangian f + lambda^T g there, with the end
+    // position's two rows first): the last segment's row pair carries n(L) = mu_N-1, and the end
+    // rows' multipliers there are -mu_N-1; the gap rows' multipliers are the same.
+    out_->multipliers.assign(2 + obstacles() * (n - 1), 0.0);
+    out_->multipliers[0] = -lambda[2 * (n - 1)];
+    out_->multipliers[1] = -lambda[2 * (n - 1) + 1];
+    for (Index r = 2 * n; r < m; ++r) out_->multipliers[2 + (r - 2 * n)] = lambda[r];
+    // Ipopt's Lagrangian is f + lambda^T g: n(L) = -lambda_end (the force the end constraint
+    // applies to the rod). The gap multipliers give the contact forces -lambda grad g, so that
+    // across the contacts n(0) = n(L) + sum (-lambda_k) grad g_k (n' = -f; eq. 63 for a wall).
+    const std::vector<double>& lam = out_->multipliers;
+    out_->P = lam[0];
     out_->contact_force = 0.0;
     out_->node_forces.assign(rod_.obstacles.size(), std::vector<double>(n - 1, 0.0));
     out_->node_gaps = out_->node_forces;
     out_->min_gap = INFINITY;
-    Vec3 n_start(-lambda[0], -lambda[1], 0.0);
-    std::vector<Vec3> nodes(n + 1);
-    for (Index k = 0; k <= n; ++k) nodes[k] = Vec3(out_->x[k], out_->y[k], 0.0);
-    for (Index r = 2; r < m; ++r) {
-      const Index o = (r - 2) / (n - 1), k = (r - 2) % (n - 1) + 1;
-      const Vec3 grad = rod_.obstacles[o].gradient(nodes[k]);
-      out_->contact_force += -lambda[r] * grad.norm();
-      n_start += -lambda[r] * grad;
-      out_->min_gap = std::min(out_->min_gap, g[r]);
-      out_->node_forces[o][k - 1] = -lambda[r] * grad.norm();
-      out_->node_gaps[o][k - 1] = g[r];
-    }
+    Vec3 n_start(-lam[0], -lam[1], 0.0);
+    for (int o = 0; o < obstacles(); ++o)
+      for (int k = 1; k < n; ++k) {
+        const Index r = 2 + o * (n - 1) + (k - 1);
+        const Vec3 at(out_->x[k], out_->y[k], 0.0);
+        const Vec3 grad = rod_.obstacles[o].gradient(at);
+        const double gap = g[gap_row(o, k)];
+        out_->contact_force += -lam[r] * grad.norm();
+        n_start += -lam[r] * grad;
+        out_->min_gap = std::min(out_->min_gap, gap);
+        out_->node_forces[o][k - 1] = -lam[r] * grad.norm();
+        out_->node_gaps[o][k - 1] = gap;
+      }
     out_->n_y = n_start.y();
     out_->n_start = n_start;
-    out_->m_start = EI_[0] * (t[0] - rod_.start_angle) / (0.5 * h_);
+    out_->m_start = EI_[0] * (v[0] - rod_.start_angle) / (0.5 * h_);
   }
 
  private:

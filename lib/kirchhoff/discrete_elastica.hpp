@@ -4,12 +4,16 @@
 // find a starting point and contact set for them (discrete_seed.hpp).
 //
 // Clamped-clamped rod of length L and bending stiffness EI(s), clear of obstacles (planes,
-// cylinders, level sets). Unknowns: the angles theta_i of N equal segments (midpoint rule);
-// energy sum EI_k/(2 h) (theta_k - theta_{k-1})^2 over the interior nodes k with half cells
-// EI/h (theta - clamp angle)^2 at the clamps; equality constraints on the end position; one
-// inequality gap >= 0 per interior node and obstacle. The Hessian of the Lagrangian is given exactly:
-// tridiagonal with planes, dense with curved obstacles (their curvature couples every pair of
-// angles up to a node). Second-order accurate: errors fall as 1/N^2 - on a curved obstacle only
+// cylinders, level sets). Unknowns: the angles theta_i of N equal segments (midpoint rule) and
+// the interior nodes r_k; energy sum EI_k/(2 h) (theta_k - theta_{k-1})^2 over the interior nodes
+// k with half cells EI/h (theta - clamp angle)^2 at the clamps; equality constraints
+// r_i+1 - r_i = h (cos, sin) theta_i per segment (r_0, r_N the clamps); one inequality gap >= 0
+// per interior node and obstacle. Every constraint involves one angle and at most two nodes, so
+// the KKT matrix is banded (O(N) per iteration: 0.3 s at N = 1000, 1.2 s at 4000; with the
+// angles alone the gap rows were dense, 5.6 s at N = 1000). The Hessian of the Lagrangian is
+// given exactly: tridiagonal in the angles, and the obstacles' 2 x 2 curvature blocks at the
+// nodes. The results (P, n(0), the gap multipliers) are stated in the angles-only formulation,
+// in which the KKT check below verifies them. Second-order accurate: errors fall as 1/N^2 - on a curved obstacle only
 // where the contact falls on a node, since contact is imposed at nodes and its arclength is not an
 // unknown; elsewhere the forces converge at first order, irregularly (the energy still at second).
 //
