@@ -152,8 +152,8 @@ DiscreteRefinementCheck check_refinement(int segments, double P, double P_half, 
 // nodes, so the three stay on one branch), and checks the three by Richardson. Returns the
 // solution at N with `refinement` filled; converged only when all three solves pass their KKT
 // check and the refinement check passes. When a coarser solve fails, its result is returned
-// (not converged, the status naming N). N must be divisible by 4, N/4 >= 4. Costs ~1.3 times the
-// solve at N alone (the gap Jacobian is dense, so a solve costs ~N^2 to N^3).
+// (not converged, the status naming N). N must be divisible by 4, N/4 >= 4. Costs ~1.75 times the
+// solve at N alone (a solve costs O(N) per iteration).
 DiscreteElasticaResult solve_discrete_elastica_refined(const DiscreteClampedElastica& rod, int segments,
                                                        const DiscreteSolveOptions& options = {});
 
