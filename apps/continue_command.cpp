@@ -185,6 +185,12 @@ int run_continue(const ContinueArguments& args) {
     options.max_step = args.max_step;
     options.max_points = args.max_points;
     options.samples = args.samples;
+    if (!(args.max_seconds >= 0 && args.max_seconds <= 1e9)) throw CaseError("--max-seconds must be in [0, 1e9]");
+    if (args.max_seconds > 0) {
+      // One deadline for the whole run: the first solve, every branch and every contact leg.
+      limit_wall_clock(c.definition.options, args.max_seconds);
+      options.deadline = c.definition.options.newton.deadline;
+    }
     options.detect_branch_points = !args.no_branch_points;
     if (args.no_branch_points && args.switch_at_bp > 0)
       throw CaseError("--switch-at-bp needs branch points: drop --no-branch-points");
@@ -364,7 +370,7 @@ int run_continue(const ContinueArguments& args) {
                 << (r.result.message.empty() ? "" : " (" + r.result.message + ")") << "; " << state.row + 1
                 << " points in " << args.out_path << "\n";
       const bool failed = r.result.reason == StopReason::StartFailed || r.result.reason == StopReason::StepTooSmall ||
-                          r.result.reason == StopReason::Inadmissible;
+                          r.result.reason == StopReason::Inadmissible || r.result.reason == StopReason::TimeLimit;
       return failed ? kExitNotConverged : kExitOk;
     } catch (const std::exception& e) {
       progress.done();
@@ -416,7 +422,7 @@ int run_continue(const ContinueArguments& args) {
             << "; " << state.row + 1 << " points (last on branch " << branch << ") in " << args.out_path << "\n";
   if (result.refused_steps > 0) std::cerr << result.refused_steps << " steps refused and retried shorter\n";
   const bool ok = result.reason != StopReason::StartFailed && result.reason != StopReason::StepTooSmall &&
-                  result.reason != StopReason::Inadmissible;
+                  result.reason != StopReason::Inadmissible && result.reason != StopReason::TimeLimit;
   return ok ? kExitOk : kExitNotConverged;
 }
 

@@ -35,6 +35,7 @@ struct ContinueArguments {
   // point's value. start_param names it for state files written before they recorded it.
   std::string start_from;
   std::string start_param;
+  double max_seconds = 0.0;   // wall-clock limit of the run (0: none); it stops resumable, time_limit
 };
 
 int run_continue(const ContinueArguments& args);

@@ -119,6 +119,11 @@ int main(int argc, char** argv) {
   continue_cmd->add_option("--samples", cont.samples, "Profile samples per point (invariants, derived quantities)")
       ->capture_default_str();
   continue_cmd->add_flag("--resume", cont.resume, "Resume the run whose CSV is --out from its last written point");
+  continue_cmd
+      ->add_option("--max-seconds", cont.max_seconds,
+                   "Wall-clock limit of the run in seconds (0: none); it stops after the last point written, "
+                   "with time_limit and exit 1, and --resume goes on")
+      ->capture_default_str();
   continue_cmd->add_option("--set", cont.overrides, "Override a parameter: NAME=VALUE (repeatable)");
   continue_cmd->add_option("--phase-condition", cont.phase_condition, "As for solve")
       ->check(CLI::IsMember({"none", "axial"}));

@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -48,6 +50,27 @@ TEST_F(ContinueCli, KilledRunResumesWithoutLosingOrDuplicatingPoints) {
   const auto resumed = lines_of(killed);
   ASSERT_EQ(resumed.size(), expected.size()) << "killed after " << written << " lines";
   for (size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(resumed[i], expected[i]) << "line " << i;
+}
+
+// A run that reaches its --max-seconds stops after its last written point with time_limit (exit
+// 1), and --resume finishes it with the uninterrupted run's rows. The limit is a fraction of the
+// run's ~1 s, so whatever the machine's speed it stops part-way or, on a very fast one, ends.
+TEST_F(ContinueCli, TimeLimitedRunStopsResumably) {
+  const fs::path full = dir_ / "full.csv", limited = dir_ / "limited.csv";
+  ASSERT_EQ(run_to_end(continue_args(full), dir_ / "full.log"), 0);
+  auto args = continue_args(limited);
+  args.insert(args.end(), {"--max-seconds", "0.2"});
+  const int status = run_to_end(args, dir_ / "limited.log");
+  if (status != 0) {
+    EXPECT_EQ(status, 1);
+    std::ifstream log(dir_ / "limited.log");
+    const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("time_limit"), std::string::npos) << text;
+    args = continue_args(limited);
+    args.push_back("--resume");
+    ASSERT_EQ(run_to_end(args, dir_ / "resume.log"), 0);
+  }
+  EXPECT_EQ(lines_of(limited), lines_of(full));
 }
 
 // A contact run (the active set changes along it) killed with SIGKILL half-way and resumed writes

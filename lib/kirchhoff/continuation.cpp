@@ -60,6 +60,7 @@ const char* to_string(StopReason reason) {
     case StopReason::BranchPointStop: return "branch_point";
     case StopReason::StartFailed: return "start_failed";
     case StopReason::Inadmissible: return "inadmissible";
+    case StopReason::TimeLimit: return "time_limit";
   }
   return "?";
 }
@@ -134,7 +135,7 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
       for (; it <= options_.corrector_max_iterations; ++it) {
         if (!evaluate(z, &F, nullptr, &failure)) break;
         G << F, normal.dot(z - z_predicted);
-        const double norm = G.lpNorm<Eigen::Infinity>();
+        const double norm = max_abs_or_nan(G);  // NaN when G holds one (lpNorm would skip it)
         if (!std::isfinite(norm)) break;
         if (norm <= options_.corrector_tolerance) {
           *iterations = it;
@@ -158,7 +159,7 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
         return false;
       }
       G << F, normal.dot(z - z_predicted);
-      if (!(G.lpNorm<Eigen::Infinity>() <= kModifiedNewtonContraction * previous)) lu.reset();
+      if (!(max_abs_or_nan(G) <= kModifiedNewtonContraction * previous)) lu.reset();
     }
     if (!lu) {
       if (!evaluate(z, &F, &A, &failure)) {
@@ -270,6 +271,7 @@ void Continuation::describe(ContinuationPoint* point) {
     r.parameters = problem_.parameters_at(p.x);
     const Parameters at = r.parameters;
     const Solution s = make_solution(problem_, std::move(r), options_.samples, options_.derived);
+    if (!s.result.summary.converged()) p.check_failure = s.result.summary.message;
     p.derived = s.derived;
     // Parameters solved for belong on the branch too (e.g. the load of a displacement-controlled run).
     for (const auto& name : problem_.definition().unknown_parameters) p.derived[name] = at.get(name);
@@ -291,8 +293,15 @@ std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint
   // tangents cost three times the run time in harder correctors.)
   const bool reuse =
       by_chord && iterations <= options_.reuse_jacobian_iterations && from.jacobian && from.jacobian->rows() == n_;
-  return point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations,
-                  reuse ? from.jacobian : nullptr);
+  auto point = point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations,
+                        reuse ? from.jacobian : nullptr);
+  // A corrected point that is not an admissible solution is a failed step, as a corrector that
+  // did not converge is: the step shrinks, and the run ends saying why at the smallest step.
+  if (point && !point->check_failure.empty()) {
+    last_corrector_failure_ = point->check_failure;
+    return std::nullopt;
+  }
+  return point;
 }
 std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& from, double h_max,
                                                       const std::function<double(const ContinuationPoint&)>& monitor,
@@ -360,9 +369,10 @@ ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink&
   const double direction = std::isnan(options_.target) ? sign_of(options_.direction) : sign_of(options_.target - lambda0);
   std::optional<ContinuationPoint> start;
   if (correct(z, z, e, &iterations)) start = point_at(z, direction * e, PointType::Start, 0, 0.0, iterations);
-  if (!start) {
+  if (!start || !start->check_failure.empty()) {
     result.reason = StopReason::StartFailed;
-    result.message = "the starting point does not converge at " + options_.parameter + " = " + std::to_string(lambda0);
+    result.message = "the starting point does not converge at " + options_.parameter + " = " + std::to_string(lambda0) +
+                     (start ? ": " + start->check_failure : "");
     return result;
   }
   start->step = options_.initial_step;
@@ -527,6 +537,11 @@ ContinuationResult Continuation::march(MarchState state, const PointSink& sink, 
   };
 
   while (points_before + static_cast<int>(result.points.size()) < options_.max_points) {
+    if (std::chrono::steady_clock::now() >= options_.deadline) {
+      result.reason = StopReason::TimeLimit;
+      result.message = "the wall-clock limit was reached";
+      return result;
+    }
     auto candidate = step_from(current, ds, PointType::Regular);
     if (!candidate) {
       if (refresh_current()) continue;

@@ -16,6 +16,7 @@
 //   - events: a derived quantity crosses a given value.
 #pragma once
 
+#include <chrono>
 #include <functional>
 #include <limits>
 #include <map>
@@ -49,6 +50,9 @@ struct ContinuationOptions {
   double max_step = 0.5;
   double max_tangent_angle = 0.35;  // rad; a step turning the tangent more is retried shorter
   int max_points = 500;
+  // No step starts after this instant (a command's wall-clock limit; every point before it is
+  // reported and resumable). Stop reason time_limit.
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
   double parameter_min = -std::numeric_limits<double>::infinity();
   double parameter_max = std::numeric_limits<double>::infinity();
   int corrector_max_iterations = 8;
@@ -113,6 +117,9 @@ struct ContinuationPoint {
   std::map<std::string, double> derived;
   InvariantReport invariants;
   bool H_flat = true;       // false flags a point whose H spread exceeds 1e-9 of its scale
+  // Why the point failed the checks of a solution (verification.hpp: a profile with NaN, a rod
+  // beyond its soft wall), "" when it passed. Such a point is never put on a branch.
+  std::string check_failure;
   double step = 0.0;        // step size after this point
   // Test functions: det [F_x F_lambda; t^T], and the smallest singular value of that matrix
   // over its largest, with the count of singular values below branch_point_tolerance (both left
@@ -153,7 +160,7 @@ struct MarchState {
 // Inadmissible: a contact continuation reached a point that penetrates an obstacle or has a
 // pulling contact with no event located before it (reported, not followed).
 enum class StopReason { ReachedTarget, MaxPoints, ParameterBounds, StepTooSmall, EventStop, BranchPointStop, StartFailed,
-                        Inadmissible };
+                        Inadmissible, TimeLimit };
 const char* to_string(StopReason reason);
 
 struct ContinuationResult {
