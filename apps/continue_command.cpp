@@ -403,7 +403,7 @@ int run_continue(const ContinueArguments& args) {
     result = resuming ? run.resume(march_state(state), sink_for(*problem, branch, state.phase_condition))
                       : run.run(start_point.size() > 0 ? start_point : problem->initial_unknowns(c.start_guess),
                                 sink_for(*problem, 0, state.phase_condition));
-    if (branch == 0 && args.switch_at_bp > 0) {
+    if (branch == 0 && args.switch_at_bp > 0 && result.reason != StopReason::TimeLimit) {
       if (result.reason != StopReason::BranchPointStop) {
         progress.done();
         std::cerr << "error: no branch point " << args.switch_at_bp << " before the run stopped ("
@@ -421,6 +421,7 @@ int run_continue(const ContinueArguments& args) {
   std::cerr << "stopped: " << to_string(result.reason) << (result.message.empty() ? "" : " (" + result.message + ")")
             << "; " << state.row + 1 << " points (last on branch " << branch << ") in " << args.out_path << "\n";
   if (result.refused_steps > 0) std::cerr << result.refused_steps << " steps refused and retried shorter\n";
+  if (result.reason == StopReason::TimeLimit) std::cerr << "the run can go on with --resume\n";
   const bool ok = result.reason != StopReason::StartFailed && result.reason != StopReason::StepTooSmall &&
                   result.reason != StopReason::Inadmissible && result.reason != StopReason::TimeLimit;
   return ok ? kExitOk : kExitNotConverged;
