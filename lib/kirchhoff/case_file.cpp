@@ -8,7 +8,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -107,10 +106,8 @@ class Reader {
   int in_range(const Value& v, const std::string& key, double x, long low, long high, const std::string& why,
                const std::string& as_given = "") const {
     if (!(x >= static_cast<double>(low) && x <= static_cast<double>(high)))
-      fail(v, key, "must be " + (high == std::numeric_limits<int>::max() ? ">= " + std::to_string(low)
-                                                                          : "in [" + std::to_string(low) + ", " +
-                                                                                std::to_string(high) + "]") +
-                       why + ", got " + (as_given.empty() ? shown(x) : as_given));
+      fail(v, key, "must be in [" + std::to_string(low) + ", " + std::to_string(high) + "]" + why + ", got " +
+                       (as_given.empty() ? shown(x) : as_given));
     return static_cast<int>(x);
   }
   // A value in (0, kMaxTolerance].
@@ -193,7 +190,7 @@ class Reader {
 
   std::array<Expression, 3> vector(const Value& v, const std::string& key, bool uses_s = false) const {
     if (!v.is_array() || (v.as_array().size() != 3 && v.as_array().size() != 2))
-      fail(v, key, "must be an array of 2 or 3 numbers/expressions");  // (also bounds the array)
+      fail(v, key, "must be an array of 2 or 3 numbers/expressions");
     const auto& a = v.as_array();
     return {expression(a[0], key, uses_s), expression(a[1], key, uses_s),
             a.size() == 3 ? expression(a[2], key, uses_s) : Expression::constant(0.0)};
