@@ -134,6 +134,23 @@ TEST(Nesting, TheScanCountsLinesInsideStringsAndDottedKeysAcrossBrackets) {
   EXPECT_EQ(toml_line_beyond_nesting("a = \"[[[\n[[[\n", 2), 2);
 }
 
+// ---- UTF-8: toml11 overflows a heap buffer on invalid UTF-8 in literal strings ------------------
+
+TEST(Utf8, InvalidUtf8IsRefusedWithTheLineBeforeToml11) {
+  // The fuzzer's input, reduced: a byte 0x9D inside a multi-line literal string (and in a
+  // one-line one, which has the same bug) made toml11 read past a buffer.
+  const std::string base = read(kPlanar);
+  for (const std::string value : {"'''ab\x9d'''", "'a\x9d'", "\"a\xc0\xaf\"", "\"\xed\xa0\x80\"", "\"\xf4\x90\x80\x80\""}) {
+    const std::string text = edited(base, "model = \"planar\"", "model = " + value);
+    expect_refused(text, "", {"not valid UTF-8"}, line_of(text, "model = "));
+  }
+  // Valid UTF-8 of every length passes (an e-acute, a euro sign, an emoji in the title).
+  const std::string ok = edited(base, "title = \"", "title = \"\xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80 ");
+  EXPECT_NO_THROW(load_case_text(ok, "ok.toml"));
+  EXPECT_EQ(toml_invalid_utf8_at("ab\xe2\x82"), 2u);  // a truncated sequence
+  EXPECT_EQ(toml_invalid_utf8_at("ab"), 2u);
+}
+
 // ---- integer keys: range-checked before they become ints -----------------------------------
 
 TEST(IntegerKeys, SegmentsAsAnExpressionOrIntegerAreBounded) {

@@ -562,6 +562,11 @@ Case load_case_text(const std::string& text, const std::string& path, const Para
   if (const int line = toml_line_beyond_nesting(text, kMaxNesting))
     throw CaseError(path + ":" + std::to_string(line) + ": arrays, inline tables and dotted keys nest deeper than " +
                     std::to_string(kMaxNesting) + " levels (a case file needs 3)");
+  if (const std::size_t at = toml_invalid_utf8_at(text); at < text.size()) {
+    const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
+    throw CaseError(path + ":" + std::to_string(line) + ": not valid UTF-8 (byte " + std::to_string(at) +
+                    "); a TOML file is UTF-8 text");
+  }
   Value root;
   try {
     std::istringstream stream(text);

@@ -71,4 +71,33 @@ int toml_line_beyond_nesting(const std::string& text, int limit) {
   return 0;
 }
 
+std::size_t toml_invalid_utf8_at(const std::string& text) {
+  const std::size_t n = text.size();
+  auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+  auto continuation = [&](std::size_t k, unsigned char low = 0x80, unsigned char high = 0xBF) {
+    return k < n && byte(k) >= low && byte(k) <= high;
+  };
+  std::size_t i = 0;
+  while (i < n) {
+    const unsigned char b = byte(i);
+    std::size_t length = 0;
+    if (b <= 0x7F) {
+      length = 1;
+    } else if (b >= 0xC2 && b <= 0xDF) {
+      length = continuation(i + 1) ? 2 : 0;
+    } else if (b >= 0xE0 && b <= 0xEF) {
+      // E0: no overlong forms (A0..BF next); ED: no surrogates (80..9F next).
+      const unsigned char low = b == 0xE0 ? 0xA0 : 0x80, high = b == 0xED ? 0x9F : 0xBF;
+      length = continuation(i + 1, low, high) && continuation(i + 2) ? 3 : 0;
+    } else if (b >= 0xF0 && b <= 0xF4) {
+      // F0: no overlong forms (90..BF next); F4: nothing above U+10FFFF (80..8F next).
+      const unsigned char low = b == 0xF0 ? 0x90 : 0x80, high = b == 0xF4 ? 0x8F : 0xBF;
+      length = continuation(i + 1, low, high) && continuation(i + 2) && continuation(i + 3) ? 4 : 0;
+    }
+    if (length == 0) return i;
+    i += length;
+  }
+  return n;
+}
+
 }  // namespace kirchhoff
