@@ -2,13 +2,17 @@
 
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 namespace kirchhoff {
 namespace {
 
-// Fourth-order central difference of f along e with step h.
+// Fourth-order central difference of f along e with step h. The result type is f's (a double or
+// a Vec3), not `auto`: for a vector f, auto was an Eigen expression holding references to the
+// four f(...) temporaries, read after they died (AddressSanitizer: stack-use-after-scope in the
+// level set's hessian).
 template <class F>
-auto central_difference(const F& f, const Vec3& r, const Vec3& e, double h) {
+auto central_difference(const F& f, const Vec3& r, const Vec3& e, double h) -> std::decay_t<decltype(f(r))> {
   return (-f(r + 2 * h * e) + 8.0 * f(r + h * e) - 8.0 * f(r - h * e) + f(r - 2 * h * e)) / (12.0 * h);
 }
 
