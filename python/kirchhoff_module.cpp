@@ -178,7 +178,8 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   if (!(max_seconds >= 0 && max_seconds <= 1e9)) throw py::value_error("max_seconds must be in [0, 1e9] (0: no limit)");
   limit_wall_clock(c.definition.options, max_seconds);
   const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
-  if (samples < 2) throw py::value_error("samples must be >= 2 (got " + std::to_string(samples) + ")");
+  if (samples < 2 || samples > 100000)  // as a case file's [output] samples
+    throw py::value_error("samples must be in [2, 100000] (got " + std::to_string(samples) + ")");
   if (seed != "guess" && seed != "ipopt") throw py::value_error("seed must be 'guess' or 'ipopt' (got '" + seed + "')");
   if (seed_segments < 4) throw py::value_error("seed_segments must be >= 4");
   std::string seed_refused;  // raised as ValueError once the GIL is back

@@ -99,6 +99,18 @@ TEST(NewtonOptionsValidation, RefusesNonFiniteTimeLimit) {
   EXPECT_TRUE(o.validate().empty());
 }
 
+// continue --samples 1e9 or --max-points 1e12 ran out of memory instead of being refused.
+TEST(ContinuationOptionsValidation, BoundsSamplesAndPoints) {
+  ContinuationOptions o;
+  o.parameter = "P";
+  EXPECT_EQ(o.validate(), "");
+  o.samples = 100001;
+  EXPECT_NE(o.validate().find("samples"), std::string::npos);
+  o.samples = 101;
+  o.max_points = 10000001;
+  EXPECT_NE(o.validate().find("max_points"), std::string::npos);
+}
+
 TEST(ProfileFailure, NamesNaNAndTheSoftWall) {
   RodModel model;
   std::vector<RodPoint> profile(3);

@@ -68,11 +68,14 @@ const char* to_string(StopReason reason) {
 std::string ContinuationOptions::validate() const {
   if (parameter.empty()) return "no continuation parameter given";
   if (!(initial_step > 0) || !(min_step > 0) || !(max_step >= min_step)) return "steps must satisfy 0 < min_step <= max_step, initial_step > 0";
-  if (max_points < 1) return "max_points must be >= 1";
+  // Each point keeps its unknowns and derived quantities in memory: 1e7 of them is beyond any
+  // branch and still fits; more is a typo.
+  if (max_points < 1 || max_points > 10000000) return "max_points must be in [1, 1e7]";
   if (!(parameter_min < parameter_max)) return "parameter_min must be < parameter_max";
   if (corrector_max_iterations < 1 || !(corrector_tolerance > 0 || std::isnan(corrector_tolerance)))
     return "corrector settings must be positive";
-  if (samples < 2) return "samples must be >= 2";
+  // As a case file's [output] samples (case_file.hpp): 1e5 samples cost ~2 s per point already.
+  if (samples < 2 || samples > 100000) return "samples must be in [2, 100000]";
   if (!(0 <= grow_iterations && grow_iterations < shrink_iterations))
     return "grow_iterations must be >= 0 and below shrink_iterations";
   if (reuse_jacobian_iterations >= 0 && detect_branch_points)
