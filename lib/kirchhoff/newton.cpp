@@ -4,6 +4,7 @@
 #include <cmath>
 #include <nlopt.hpp>
 #include <sstream>
+#include <stdexcept>
 
 #include "kirchhoff/jacobian_lu.hpp"
 
@@ -46,18 +47,22 @@ double max_abs_or_nan(const Eigen::VectorXd& v) {
   return v.size() == 0 ? 0.0 : v.lpNorm<Eigen::Infinity>();
 }
 
+std::chrono::steady_clock::time_point deadline_after(double seconds) {
+  using Clock = std::chrono::steady_clock;
+  if (!(seconds >= 0 && seconds <= 1e9)) throw std::invalid_argument("the time limit must be in [0, 1e9] seconds");
+  if (seconds == 0) return Clock::time_point::max();
+  return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+}
+
 namespace {
 
 // Wall-clock deadline of a solve: the earlier of its own limit (none when 0) and the options'
 // deadline.
 class Deadline {
  public:
-  explicit Deadline(const NewtonOptions& options) : end_(options.deadline) {
-    using Clock = std::chrono::steady_clock;
-    if (options.max_seconds > 0)
-      end_ = std::min(end_, Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                               std::chrono::duration<double>(options.max_seconds)));
-  }
+  explicit Deadline(const NewtonOptions& options)
+      : end_(options.max_seconds > 0 ? std::min(options.deadline, deadline_after(options.max_seconds))
+                                     : options.deadline) {}
   bool limited() const { return end_ != std::chrono::steady_clock::time_point::max(); }
   bool passed() const { return limited() && std::chrono::steady_clock::now() >= end_; }
   double remaining_seconds() const {
@@ -161,9 +166,10 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
     }
     ++summary.iterations;
     if (!accepted) {
-      summary.status = deadline.passed() ? SolverStatus::TimeLimit : SolverStatus::LineSearchFailed;
+      const bool timed_out = deadline.passed();  // once: status and message must agree
+      summary.status = timed_out ? SolverStatus::TimeLimit : SolverStatus::LineSearchFailed;
       summary.message =
-          deadline.passed() ? "the wall-clock limit was reached in the line search" : "no step length decreased the residual";
+          timed_out ? "the wall-clock limit was reached in the line search" : "no step length decreased the residual";
       return summary;
     }
     x = x_trial;

@@ -77,6 +77,10 @@ NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, co
 // |F|^2 / 2 from the original guess followed by Newton again.
 NewtonSummary solve_with_fallback(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options);
 
+// The instant `seconds` from now (0: none, time_point::max()), for NewtonOptions::deadline.
+// Throws std::invalid_argument outside [0, 1e9].
+std::chrono::steady_clock::time_point deadline_after(double seconds);
+
 // max_i |v_i|, or NaN when any entry is NaN or infinite. (Eigen's lpNorm<Infinity> takes a
 // maximum whose comparisons ignore a NaN, so a NaN residual could pass a `<= tolerance` test.)
 double max_abs_or_nan(const Eigen::VectorXd& v);
