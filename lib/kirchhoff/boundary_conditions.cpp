@@ -107,6 +107,7 @@ EndCondition EndCondition::half_turn_symmetry(Vec3 axis, int director,
   if (rotation_axis.norm() < 1e-14) rotation_axis = Vec3::UnitZ();  // parallel or opposite: turn about e3
   const Eigen::AngleAxisd base(angle, rotation_axis.normalized());
   EndCondition c;
+  c.half_turn_ = true;
   c.add({Slot::Position, Directions::LateralToAxis, a, constant(Vec3::Zero()), {}, false, false});
   c.add({Slot::Force, Directions::AlongAxis, a, constant(Vec3::Zero()), {}, false, false});
   if (!rotation) {

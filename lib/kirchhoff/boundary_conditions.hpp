@@ -90,6 +90,9 @@ class EndCondition {
   // (link.hpp) builds the whole rod from it.
   const Vec3& half_turn_axis() const { return half_turn_axis_; }
   int half_turn_director() const { return half_turn_director_; }
+  // Whether this end is a half-turn symmetry point (with or without a turn of its own): the
+  // problem is then half of a symmetric rod.
+  bool is_half_turn_symmetry() const { return half_turn_; }
   int extra_count() const;
 
   // Checks that each work-conjugate pair is imposed exactly once along every admissible
@@ -109,6 +112,7 @@ class EndCondition {
   std::function<double(const Parameters&)> hamiltonian_;  // extra H condition, if any
   Vec3 half_turn_axis_ = Vec3::Zero();
   int half_turn_director_ = 0;
+  bool half_turn_ = false;
 };
 
 VectorTarget constant(const Vec3& v);

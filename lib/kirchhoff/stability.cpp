@@ -1,0 +1,617 @@
+// The index of an equilibrium by conjugate points (see stability.hpp for the method).
+#include "kirchhoff/stability.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <functional>
+#include <sstream>
+
+namespace kirchhoff {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Scales making the canonical coordinates dimensionless: lengths by L, forces by B / L^2,
+// moments by B / L. The symplectic form only gains the constant factor L / B.
+struct Scales {
+  double length = 1.0;
+  double bending = 1.0;
+};
+
+// Canonical coordinates of the rod's configuration (position, then rotation, along the
+// directions the equations admit) and their momenta.
+struct Coordinates {
+  Eigen::MatrixXd position_dirs;  // 3 x kr
+  Eigen::MatrixXd rotation_dirs;  // 3 x kpsi
+  int kr() const { return static_cast<int>(position_dirs.cols()); }
+  int size() const { return kr() + static_cast<int>(rotation_dirs.cols()); }
+};
+
+// A state perturbation dy in the coordinates (u, p_physical) = T dy; the canonical momentum is
+// p = p_physical + G u (G skew: 1/2 m x dpsi on the rotation pair).
+struct CanonicalMap {
+  Eigen::MatrixXd T;
+  Eigen::MatrixXd G;
+};
+
+Eigen::Matrix3d cross_matrix(const Vec3& a) {
+  Eigen::Matrix3d M;
+  M << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  return M;
+}
+
+CanonicalMap canonical_map(const RodEquations& eq, const Coordinates& c, const Scales& sc, const Eigen::VectorXd& y,
+                           double s) {
+  const int N = static_cast<int>(y.size()), n = c.size(), kr = c.kr();
+  const RodPoint point = eq.point(y, s);
+  const Mat3 reference = eq.is_planar() ? planar_reference_frame() : Mat3::Identity();
+  const Eigen::AngleAxisd frame(Mat3(point.R * reference.transpose()));
+  Eigen::MatrixXd rotation_jacobian;  // dy -> lab-frame rotation vector dpsi
+  eq.orientation_error(y, OrientationTarget{frame.axis(), frame.angle()}, false, &rotation_jacobian);
+  CanonicalMap map;
+  map.T = Eigen::MatrixXd::Zero(2 * n, N);
+  map.T.topRows(kr) = c.position_dirs.transpose() * eq.slot_map(Slot::Position) / sc.length;
+  map.T.middleRows(kr, n - kr) = c.rotation_dirs.transpose() * rotation_jacobian;
+  map.T.middleRows(n, kr) =
+      c.position_dirs.transpose() * eq.slot_map(Slot::Force) * (sc.length * sc.length / sc.bending);
+  map.T.bottomRows(n - kr) = c.rotation_dirs.transpose() * eq.slot_map(Slot::Moment) * (sc.length / sc.bending);
+  map.G = Eigen::MatrixXd::Zero(n, n);
+  map.G.bottomRightCorner(n - kr, n - kr) =
+      0.5 * (sc.length / sc.bending) * c.rotation_dirs.transpose() * cross_matrix(point.m) * c.rotation_dirs;
+  return map;
+}
+
+// Orthonormal basis of the column space of A (columns below `tol` times the largest dropped).
+Eigen::MatrixXd column_basis(const Eigen::MatrixXd& A, double tol = 1e-10) {
+  if (A.cols() == 0) return Eigen::MatrixXd(A.rows(), 0);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU);
+  int rank = 0;
+  for (int i = 0; i < svd.singularValues().size(); ++i)
+    if (svd.singularValues()[i] > tol) ++rank;
+  return svd.matrixU().leftCols(rank);
+}
+
+// Orthonormal basis of the orthogonal complement of the columns of C in R^n.
+Eigen::MatrixXd complement(const Eigen::MatrixXd& C, int n) {
+  if (C.cols() == 0) return Eigen::MatrixXd::Identity(n, n);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(C, Eigen::ComputeFullU);
+  const int rank = static_cast<int>(column_basis(C).cols());
+  return svd.matrixU().rightCols(n - rank);
+}
+
+// Orthonormal basis of the null space of A (singular values below tol), as columns.
+Eigen::MatrixXd null_space(const Eigen::MatrixXd& A, int cols, double tol) {
+  if (A.rows() == 0) return Eigen::MatrixXd::Identity(cols, cols);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
+  int rank = 0;
+  for (int i = 0; i < svd.singularValues().size(); ++i)
+    if (svd.singularValues()[i] > tol) ++rank;
+  return svd.matrixV().rightCols(cols - rank);
+}
+
+double parameter_step(double value) { return 1e-6 * std::max(1.0, std::abs(value)); }
+
+Vec3 orientation_vector(const OrientationTarget& t) { return t.axis.normalized() * t.angle; }
+
+// How a slot's imposed value changes with parameter `name` (central difference of a closed form).
+Vec3 slot_sensitivity(const SlotCondition& slot, const Parameters& p, const std::string& name) {
+  Parameters plus = p, minus = p;
+  const double h = parameter_step(p.get(name));
+  plus.set(name, p.get(name) + h);
+  minus.set(name, p.get(name) - h);
+  if (slot.slot == Slot::Orientation)
+    return (orientation_vector(slot.orientation(plus)) - orientation_vector(slot.orientation(minus))) / (2 * h);
+  return (slot.value(plus) - slot.value(minus)) / (2 * h);
+}
+
+// The unknown parameters that act as Lagrange multipliers (end loads), or why one does not.
+std::string classify_unknowns(const ShootingProblem& problem, const Parameters& p,
+                              std::vector<std::string>* multipliers) {
+  const ProblemDefinition& d = problem.definition();
+  for (const std::string& name : d.unknown_parameters) {
+    if (name == "unfolding") continue;  // zero at every equilibrium; its phase condition only selects
+    if (d.model_parameters.count(name) || d.obstacle_parameters.count(name))
+      return "the unknown parameter '" + name + "' changes the rod or an obstacle, not an end load";
+    bool load = false;
+    for (const EndCondition* end : {&d.start, &d.end}) {
+      for (const SlotCondition& slot : end->conditions()) {
+        if (slot.extra) continue;
+        const double change = slot_sensitivity(slot, p, name).norm();
+        if (change == 0.0) continue;
+        if (slot.slot == Slot::Position || slot.slot == Slot::Orientation)
+          return "the unknown parameter '" + name + "' moves an imposed " + to_string(slot.slot);
+        load = true;
+      }
+    }
+    if (!load) return "the unknown parameter '" + name + "' is not an end load";
+    multipliers->push_back(name);
+  }
+  return "";
+}
+
+// The configuration directions an end holds (columns, canonical u coordinates): imposed
+// positions and rotations, and the displacements conjugate to multiplier loads.
+Eigen::MatrixXd held_directions(const RodEquations& eq, const EndCondition& end, const Coordinates& c,
+                                const Parameters& p, const std::vector<std::string>& multipliers) {
+  std::vector<Eigen::VectorXd> columns;
+  auto add = [&](bool position, const Vec3& lab) {
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(c.size());
+    if (position) u.head(c.kr()) = c.position_dirs.transpose() * lab;
+    else u.tail(c.size() - c.kr()) = c.rotation_dirs.transpose() * lab;
+    columns.push_back(u);
+  };
+  for (const SlotCondition& slot : end.conditions()) {
+    if (slot.extra) continue;
+    const Eigen::MatrixXd basis = slot.basis(eq);
+    const bool position = slot.slot == Slot::Position || slot.slot == Slot::Force;
+    if (slot.slot == Slot::Position || slot.slot == Slot::Orientation) {
+      for (int k = 0; k < basis.cols(); ++k) add(position, basis.col(k));
+      continue;
+    }
+    for (const std::string& name : multipliers) {
+      const Eigen::VectorXd along = basis.transpose() * slot_sensitivity(slot, p, name);
+      if (along.norm() > 0) add(position, basis * along.normalized());
+    }
+  }
+  Eigen::MatrixXd C(c.size(), static_cast<int>(columns.size()));
+  for (size_t k = 0; k < columns.size(); ++k) C.col(static_cast<int>(k)) = columns[k];
+  return column_basis(C);
+}
+
+std::string unsupported(const ShootingProblem& problem, const Eigen::VectorXd& x) {
+  const ProblemDefinition& d = problem.definition();
+  if (!problem.contacts_at(x).empty())
+    return "active contacts: the second variation with sliding contact points is not implemented";
+  if (d.start.is_half_turn_symmetry() || d.end.is_half_turn_symmetry())
+    return "half of a symmetric rod (half-turn end): the whole rod's index needs the antisymmetric "
+           "perturbations too, which are not implemented";
+  return "";
+}
+
+double wrap(double angle) { return std::remainder(angle, 2 * kPi); }
+
+// Eigenphases of W = X X^T, X = U + iP (unitary for an orthonormal Lagrangian frame).
+Eigen::VectorXd eigenphases(const Eigen::MatrixXd& U, const Eigen::MatrixXd& P) {
+  const Eigen::MatrixXcd X = U.cast<std::complex<double>>() + std::complex<double>(0, 1) * P;
+  Eigen::ComplexEigenSolver<Eigen::MatrixXcd> solver(X * X.transpose(), false);
+  Eigen::VectorXd phase(U.cols());
+  for (int j = 0; j < phase.size(); ++j) phase[j] = std::arg(solver.eigenvalues()[j]);
+  return phase;
+}
+
+// The frame of Jacobi fields along the rod, in state coordinates, with its canonical blocks.
+struct Frame {
+  Eigen::VectorXd y;   // the equilibrium state here
+  double s = 0.0;
+  Eigen::MatrixXd dY;  // N x kpsi: state perturbations of the fields
+  Eigen::MatrixXd U, P, P_physical;  // rotation blocks, kpsi x kpsi each; [U; P] orthonormal
+  Eigen::MatrixXd R;                  // position perturbation of the fields (kr x kpsi), slaved
+  // One field per isoperimetric constraint: the response to a unit change of the end load along it.
+  Eigen::MatrixXd particular, particular_U, particular_P, particular_P_physical, particular_R;
+};
+
+// Follows lifted eigenphases, and where they pass odd multiples of pi (a stack per eigenphase:
+// a passage downwards pushes, one back upwards pops, so round-off cancels).
+struct PhaseTrack {
+  Eigen::VectorXd lifted;
+  Eigen::VectorXd lowest;  // running minimum of each lifted phase
+  std::vector<std::vector<std::pair<long, double>>> passages;  // (k of k pi, s) per eigenphase
+  bool reversed = false;  // a genuine passage against the Legendre direction
+  double reversed_at = 0.0;
+};
+
+int odd_multiples_between(double a, double b) {  // odd k with a < k pi < b (a < b)
+  const long lo = static_cast<long>(std::floor((a / kPi - 1) / 2)) + 1;
+  const long hi = static_cast<long>(std::ceil((b / kPi - 1) / 2)) - 1;
+  return static_cast<int>(std::max(0L, hi - lo + 1));
+}
+
+class StabilityAnalysis {
+ public:
+  StabilityAnalysis(const ShootingProblem& problem, const Eigen::VectorXd& x, const StabilityOptions& options)
+      : problem_(problem), x_(x), options_(options), p_(problem.parameters_at(x)), eq_(problem.equations(p_)) {
+    coords_.position_dirs = eq_->admissible_directions(Slot::Position);
+    coords_.rotation_dirs = eq_->admissible_directions(Slot::Orientation);
+    scales_.length = eq_->model().length;
+    scales_.bending = eq_->model().B[0](0.0);
+  }
+
+  StabilityReport run();
+
+ private:
+  struct Held {
+    Eigen::MatrixXd position;  // kr x a, position coordinates
+    Eigen::MatrixXd rotation;  // kpsi x b, rotation coordinates
+  };
+  Held held_at(const EndCondition& end, const std::vector<std::string>& multipliers) const;
+  std::string field_reason() const;
+  bool straight_inextensible() const;
+  Eigen::MatrixXd constraint_directions(const Held& start, const Held& end) const;
+  Frame start_frame(const Held& start, const Eigen::MatrixXd& constraints) const;
+  void canonical_blocks(Frame* f) const;
+  void orthonormalise(Frame* f) const;
+  void advance(Frame* f, double s1, PhaseTrack* track, int depth);
+  void record(const Eigen::VectorXd& before, double s0, const Eigen::VectorXd& after, double s1, PhaseTrack* track);
+  bool count_interior(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start,
+                      StabilityReport* report) const;
+  Eigen::MatrixXd end_terms(const Frame& f, const Held& end, StabilityReport* report) const;
+  void constraint_correction(const Frame& f, const Held& end, const Eigen::MatrixXd& constraints,
+                             const Eigen::MatrixXd& zero_modes, StabilityReport* report) const;
+
+  const ShootingProblem& problem_;
+  const Eigen::VectorXd& x_;
+  StabilityOptions options_;
+  Parameters p_;
+  std::shared_ptr<const RodEquations> eq_;
+  Coordinates coords_;
+  Scales scales_;
+  long rhs_ = 0;
+};
+
+StabilityAnalysis::Held StabilityAnalysis::held_at(const EndCondition& end,
+                                                   const std::vector<std::string>& multipliers) const {
+  const Eigen::MatrixXd C = held_directions(*eq_, end, coords_, p_, multipliers);
+  const int kr = coords_.kr(), kpsi = coords_.size() - kr;
+  Held h;
+  h.position = column_basis(C.topRows(kr));
+  h.rotation = column_basis(C.bottomRows(kpsi));
+  return h;
+}
+
+// A field whose force depends on position (a soft wall, a self-contact barrier) makes the
+// position a configuration variable of its own; only position-independent fields are covered.
+std::string StabilityAnalysis::field_reason() const {
+  const auto& field = eq_->model().field;
+  if (!field) return "";
+  const std::vector<double> s = {0.0, 0.25 * scales_.length, 0.5 * scales_.length, scales_.length};
+  for (const RodPoint& q : problem_.sample(x_, s))
+    if (field->force_gradient(q.s, q.r).norm() > 0)
+      return "the external field depends on position (a soft wall or barrier): its Hessian in the second "
+             "variation is not implemented";
+  return "";
+}
+
+bool StabilityAnalysis::straight_inextensible() const {
+  if (eq_->model().extensible) return false;
+  std::vector<double> s(65);
+  for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
+  const std::vector<RodPoint> points = problem_.sample(x_, s);
+  for (const RodPoint& q : points)
+    if ((q.R.col(2) - points.front().R.col(2)).norm() > 1e-9) return false;
+  return true;
+}
+
+// Directions along which both ends hold the position: the isoperimetric constraints
+// e.(r(L) - r(0)) = const, whose multipliers are the reactions. Along the axis of a straight
+// inextensible rod the constraint is empty to first order (the chord cannot change), so it is
+// dropped, as the vibration problem drops the axial pair.
+Eigen::MatrixXd StabilityAnalysis::constraint_directions(const Held& start, const Held& end) const {
+  const int kr = coords_.kr();
+  if (start.position.cols() == 0 || end.position.cols() == 0) return Eigen::MatrixXd(kr, 0);
+  Eigen::MatrixXd both(kr, start.position.cols() + end.position.cols());
+  both << start.position, -end.position;
+  const Eigen::MatrixXd pairs = null_space(both, static_cast<int>(both.cols()), 1e-10);
+  Eigen::MatrixXd shared = column_basis(start.position * pairs.topRows(start.position.cols()));
+  if (shared.cols() > 0 && straight_inextensible()) {
+    const Vec3 t = problem_.sample(x_, {0.0}).front().R.col(2);
+    const Eigen::VectorXd axial = coords_.position_dirs.transpose() * t;
+    shared = column_basis(shared - axial * (axial.transpose() * shared));
+  }
+  return shared;
+}
+
+// Jacobi fields of the load-controlled problem meeting the start's rotation conditions (dr = 0,
+// dn = 0), then one particular field per constraint direction: a unit change of the end load
+// along it (dn = e_j).
+Frame StabilityAnalysis::start_frame(const Held& start, const Eigen::MatrixXd& constraints) const {
+  const int n = coords_.size(), kr = coords_.kr(), kpsi = n - kr;
+  const Eigen::MatrixXd free_rotation = complement(start.rotation, kpsi);
+  const int columns = kpsi + static_cast<int>(constraints.cols());
+  Eigen::MatrixXd z = Eigen::MatrixXd::Zero(2 * n, columns);
+  z.block(kr, 0, kpsi, free_rotation.cols()) = free_rotation;
+  z.block(n + kr, free_rotation.cols(), kpsi, start.rotation.cols()) = start.rotation;
+  z.block(n, kpsi, kr, constraints.cols()) = constraints;
+  Frame f;
+  f.s = 0.0;
+  f.y = x_.head(problem_.state_size());
+  const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f.y, 0.0);
+  const Eigen::MatrixXd dY = map.T.completeOrthogonalDecomposition().solve(z);
+  f.dY = dY.leftCols(kpsi);
+  f.particular = dY.rightCols(constraints.cols());
+  canonical_blocks(&f);
+  return f;
+}
+
+void StabilityAnalysis::canonical_blocks(Frame* f) const {
+  const int n = coords_.size(), kr = coords_.kr(), kpsi = n - kr;
+  const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f->y, f->s);
+  auto blocks = [&](const Eigen::MatrixXd& dY, Eigen::MatrixXd* U, Eigen::MatrixXd* P, Eigen::MatrixXd* P_phys,
+                    Eigen::MatrixXd* R) {
+    const Eigen::MatrixXd z = map.T * dY;
+    *U = z.middleRows(kr, kpsi);
+    *P_phys = z.bottomRows(kpsi);
+    *P = *P_phys + map.G.bottomRightCorner(kpsi, kpsi) * *U;
+    *R = z.topRows(kr);
+  };
+  blocks(f->dY, &f->U, &f->P, &f->P_physical, &f->R);
+  blocks(f->particular, &f->particular_U, &f->particular_P, &f->particular_P_physical, &f->particular_R);
+}
+
+// Keeps the frame's columns orthonormal in (U, P) (the span, a Lagrangian plane, is unchanged).
+void StabilityAnalysis::orthonormalise(Frame* f) const {
+  const int m = static_cast<int>(f->U.cols());
+  Eigen::MatrixXd Z(2 * m, m);
+  Z << f->U, f->P;
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr(Z);
+  const Eigen::MatrixXd R = qr.matrixQR().topRows(m).triangularView<Eigen::Upper>();
+  const Eigen::MatrixXd Rinv = R.inverse();
+  f->dY = f->dY * Rinv;
+  f->U = f->U * Rinv;
+  f->P = f->P * Rinv;
+  f->P_physical = f->P_physical * Rinv;
+  f->R = f->R * Rinv;
+}
+
+// Matches new eigenphases to the lifted old ones (nearest on the circle) and lifts them. A phase
+// within 1e-9 of an odd multiple of pi is put on it: a field that stays at a conjugate point (held
+// at s = 0, or abnormal) then never passes it by round-off.
+void StabilityAnalysis::record(const Eigen::VectorXd& before, double s0, const Eigen::VectorXd& phases, double s1,
+                               PhaseTrack* track) {
+  const int m = static_cast<int>(phases.size());
+  std::vector<bool> used(m, false);
+  Eigen::VectorXd lifted(m);
+  for (int j = 0; j < m; ++j) {
+    int best = -1;
+    double best_move = 0.0;
+    for (int k = 0; k < m; ++k) {
+      if (used[k]) continue;
+      const double move = wrap(phases[k] - before[j]);
+      if (best < 0 || std::abs(move) < std::abs(best_move)) best = k, best_move = move;
+    }
+    used[best] = true;
+    lifted[j] = before[j] + best_move;
+    const double off = wrap(lifted[j] - kPi);
+    if (std::abs(off) < 1e-9) lifted[j] -= off;
+  }
+  const double h = 1e-3;  // a passage back needs a move well beyond round-off
+  for (int j = 0; j < m; ++j) {
+    auto& stack = track->passages[j];
+    const double lo = std::min(lifted[j], before[j]), hi = std::max(lifted[j], before[j]);
+    const int passed = odd_multiples_between(lo, hi);
+    const long first = static_cast<long>(std::floor((lo / kPi - 1) / 2)) + 1;  // lowest m of (2m+1) pi passed
+    for (int k = 0; k < passed; ++k) {
+      const long multiple = 2 * (lifted[j] < before[j] ? first + passed - 1 - k : first + k) + 1;
+      if (lifted[j] < before[j]) {
+        // Where: near a passage the phase goes as k pi - 2 atan(c (s - s*)), so tan of half its
+        // offset is close to linear in s and is interpolated.
+        const double ta = std::tan(0.5 * (before[j] - multiple * kPi)), tb = std::tan(0.5 * (lifted[j] - multiple * kPi));
+        stack.emplace_back(multiple, s0 + ta / (ta - tb) * (s1 - s0));
+      }
+      else if (!stack.empty() && stack.back().first == multiple) stack.pop_back();
+    }
+    track->lowest[j] = std::min(track->lowest[j], lifted[j]);
+    if (!track->reversed && odd_multiples_between(track->lowest[j] + h, lifted[j] - h) > 0) {
+      track->reversed = true;
+      track->reversed_at = s1;
+    }
+  }
+  track->lifted = lifted;
+}
+
+void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int depth) {
+  const SegmentFlow flow = eq_->flow(f->y, f->s, s1, true, problem_.definition().options.integrator);
+  rhs_ += flow.rhs_evaluations;
+  Frame next;
+  next.y = flow.y;
+  next.s = s1;
+  next.dY = flow.Phi * f->dY;
+  next.particular = flow.Phi * f->particular;
+  canonical_blocks(&next);
+  orthonormalise(&next);
+  const Eigen::VectorXd phases = eigenphases(next.U, next.P);
+  double largest = 0.0;
+  bool passage = false;
+  for (int j = 0; j < phases.size(); ++j) {
+    double nearest = kPi;
+    for (int k = 0; k < phases.size(); ++k) nearest = std::min(nearest, std::abs(wrap(phases[k] - track->lifted[j])));
+    largest = std::max(largest, nearest);
+    passage = passage || odd_multiples_between(track->lifted[j] - nearest, track->lifted[j] + nearest) > 0;
+  }
+  // Steps are halved while a phase moves too far, and around a passage until it is located to
+  // passage_resolution (the interpolation below is then exact to its square).
+  const bool locate = passage && s1 - f->s > options_.passage_resolution * scales_.length;
+  if ((largest > options_.max_phase_step || locate) && depth < options_.max_halvings) {
+    const double mid = 0.5 * (f->s + s1);
+    advance(f, mid, track, depth + 1);
+    advance(f, s1, track, depth + 1);
+    return;
+  }
+  record(track->lifted, f->s, phases, s1, track);
+  *f = next;
+}
+
+// Conjugate points in (0, L): net passages of the lifted eigenphases from start to end. Fields
+// with U c = 0 at s = L end exactly on a conjugate point, which is not inside (0, L).
+bool StabilityAnalysis::count_interior(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start,
+                                       StabilityReport* report) const {
+  const int m = static_cast<int>(f.U.cols());
+  Eigen::VectorXd end = track.lifted;
+  const int at_end = m - static_cast<int>(column_basis(f.U, options_.zero_tolerance).cols());
+  std::vector<int> order(m);
+  for (int j = 0; j < m; ++j) order[j] = j;
+  auto distance_to_odd = [&](double t) { return std::abs(wrap(t - kPi)); };
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return distance_to_odd(end[a]) < distance_to_odd(end[b]); });
+  for (int k = 0; k < at_end; ++k) end[order[k]] -= wrap(end[order[k]] - kPi);
+  int interior = 0;
+  for (int j = 0; j < m; ++j) {
+    const double a = std::min(start[j], end[j]) + 1e-9, b = std::max(start[j], end[j]) - 1e-9;
+    const int passed = a < b ? odd_multiples_between(a, b) : 0;
+    interior += end[j] <= start[j] ? passed : -passed;
+  }
+  if (interior < 0) {
+    report->reason = "the conjugate-point count came out negative: the Jacobi system is degenerate";
+    return false;
+  }
+  report->interior_count = interior;
+  // Where: the passages left on the stacks. When round-off made them disagree with the count,
+  // no positions are claimed.
+  for (int j = 0; j < m; ++j)
+    for (const auto& passage : track.passages[j])
+      if (passage.second < scales_.length * (1 - 1e-9)) report->conjugate_points.push_back(passage.second);
+  std::sort(report->conjugate_points.begin(), report->conjugate_points.end());
+  if (static_cast<int>(report->conjugate_points.size()) != interior) report->conjugate_points.clear();
+  return true;
+}
+
+// The count at s = L for the load-controlled problem: negative directions of q(c) = (P c).(U c)
+// over the fields meeting the held rotations, and the fields with U c = 0 whose natural (dead
+// moment) conditions fail, which are negative just before L. Returns the zero modes (fields
+// meeting every condition) as frame coefficients.
+Eigen::MatrixXd StabilityAnalysis::end_terms(const Frame& f, const Held& end, StabilityReport* report) const {
+  const int m = static_cast<int>(f.U.cols());
+  const double tol = options_.zero_tolerance;
+  const Eigen::MatrixXd free_rotation = complement(end.rotation, m);
+  const Eigen::MatrixXd kernel_U = null_space(f.U, m, tol);
+  const Eigen::MatrixXd admissible = null_space(end.rotation.transpose() * f.U, m, tol);
+  const Eigen::MatrixXd rest = column_basis(admissible - kernel_U * (kernel_U.transpose() * admissible));
+  const Eigen::MatrixXd q = f.P.transpose() * f.U;
+  const Eigen::MatrixXd q_rest = rest.transpose() * (0.5 * (q + q.transpose())) * rest;
+  int negative = 0;
+  if (q_rest.rows() > 0) {
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(q_rest);
+    for (int i = 0; i < eig.eigenvalues().size(); ++i)
+      if (eig.eigenvalues()[i] < -tol) ++negative;
+  }
+  const Eigen::MatrixXd natural_failure = free_rotation.transpose() * f.P_physical * kernel_U;
+  report->end_count = negative + static_cast<int>(column_basis(natural_failure, tol).cols());
+  Eigen::MatrixXd conditions(end.rotation.cols() + free_rotation.cols(), m);
+  conditions << end.rotation.transpose() * f.U, free_rotation.transpose() * f.P_physical;
+  return null_space(conditions, m, tol);
+}
+
+// The isoperimetric correction (Maddocks; Manning, Rogers & Maddocks 1998): with the end
+// positions held along k directions, index = index_dead + r_Z + n_+(D) - k, where D = dg/dF is how
+// the chord g = r(L) - r(0) along them moves per unit change of the end load (the multiplier),
+// along the load-controlled equilibria, and r_Z the rank of the chord change along the
+// load-controlled problem's zero modes (D is then taken on the loads that do no work on them).
+// Zero modes of the whole problem: fields meeting every condition, load changes included.
+void StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, const Eigen::MatrixXd& constraints,
+                                              const Eigen::MatrixXd& zero_modes, StabilityReport* report) const {
+  const int m = static_cast<int>(f.U.cols()), k = static_cast<int>(constraints.cols());
+  const double tol = options_.zero_tolerance;
+  const Eigen::MatrixXd free_rotation = complement(end.rotation, m);
+  Eigen::MatrixXd conditions(m, m), loads(m, k);
+  conditions << end.rotation.transpose() * f.U, free_rotation.transpose() * f.P_physical;
+  loads << end.rotation.transpose() * f.particular_U, free_rotation.transpose() * f.particular_P_physical;
+  report->zero_modes = 0;
+  int correction = 0;
+  if (k > 0) {
+    const Eigen::MatrixXd c = -conditions.completeOrthogonalDecomposition().solve(loads);
+    const Eigen::MatrixXd chord = constraints.transpose() * (f.R * c + f.particular_R);  // D, k x k
+    const Eigen::MatrixXd chord_zero = constraints.transpose() * f.R * zero_modes;     // k x z
+    const int r_z = static_cast<int>(column_basis(chord_zero, tol).cols());
+    const Eigen::MatrixXd quiet = null_space(chord_zero.transpose(), k, tol);  // loads doing no work on them
+    const Eigen::MatrixXd D = quiet.transpose() * (0.5 * (chord + chord.transpose())) * quiet;
+    int positive = 0;
+    if (D.rows() > 0) {
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(D);
+      for (int i = 0; i < eig.eigenvalues().size(); ++i)
+        if (eig.eigenvalues()[i] > tol) ++positive;
+    }
+    correction = r_z + positive - k;
+  }
+  Eigen::MatrixXd all(m + k, m + k);
+  all.topLeftCorner(m, m) = conditions;
+  all.topRightCorner(m, k) = loads;
+  all.bottomLeftCorner(k, m) = constraints.transpose() * f.R;
+  all.bottomRightCorner(k, k) = constraints.transpose() * f.particular_R;
+  report->zero_modes = static_cast<int>(null_space(all, m + k, tol).cols());
+  report->constraint_count = k;
+  report->constraint_correction = correction;
+}
+
+StabilityReport StabilityAnalysis::run() {
+  StabilityReport report;
+  std::vector<std::string> multipliers;
+  std::string why = unsupported(problem_, x_);
+  if (why.empty()) why = field_reason();
+  if (why.empty()) why = classify_unknowns(problem_, p_, &multipliers);
+  if (!why.empty()) {
+    report.reason = why;
+    return report;
+  }
+  const ProblemDefinition& d = problem_.definition();
+  const Held start = held_at(d.start, multipliers), end = held_at(d.end, multipliers);
+  const Eigen::MatrixXd constraints = constraint_directions(start, end);
+
+  Frame f = start_frame(start, constraints);
+  const int m = static_cast<int>(f.U.cols());
+  const Eigen::MatrixXd lagrange = f.U.transpose() * f.P - f.P.transpose() * f.U;
+  if (lagrange.norm() > 1e-8 * (1.0 + f.U.norm() * f.P.norm())) {
+    report.reason = "the start's loads are not conservative (a dead couple on an end free to rotate in 3D)";
+    return report;
+  }
+  orthonormalise(&f);
+  PhaseTrack track;
+  track.lifted = eigenphases(f.U, f.P);
+  // The fields held at s = 0 start exactly at a conjugate point (U c = 0): their eigenphase is pi,
+  // leaving it in the Legendre direction.
+  const int held_count = static_cast<int>(start.rotation.cols());
+  std::vector<int> order(m);
+  for (int j = 0; j < m; ++j) order[j] = j;
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return std::abs(wrap(track.lifted[a] - kPi)) < std::abs(wrap(track.lifted[b] - kPi)); });
+  for (int k = 0; k < held_count; ++k) track.lifted[order[k]] = kPi;
+  for (int j = 0; j < m; ++j)
+    if (track.lifted[j] < -kPi + 1e-9) track.lifted[j] += 2 * kPi;
+  const Eigen::VectorXd start_phases = track.lifted;
+  track.lowest = start_phases;
+  track.passages.assign(m, {});
+
+  std::vector<double> nodes = problem_.node_arclengths(x_);
+  nodes.push_back(scales_.length);
+  for (size_t i = 0; i + 1 < nodes.size(); ++i)
+    for (int k = 1; k <= options_.min_steps; ++k)
+      advance(&f, nodes[i] + (nodes[i + 1] - nodes[i]) * k / options_.min_steps, &track, 0);
+  report.rhs_evaluations = rhs_;
+  if (track.reversed) {
+    std::ostringstream reason;
+    reason << "an eigenphase passed against the Legendre direction near s = " << track.reversed_at
+           << ": the Jacobi system is degenerate there and the count is not valid";
+    report.reason = reason.str();
+    return report;
+  }
+  if (!count_interior(f, track, start_phases, &report)) return report;
+  const Eigen::MatrixXd zero_modes = end_terms(f, end, &report);
+  report.dead_load_index = report.interior_count + report.end_count;
+  constraint_correction(f, end, constraints, zero_modes, &report);
+  // Rigid translations along directions neither end holds map equilibria to equilibria.
+  Eigen::MatrixXd held(coords_.kr(), start.position.cols() + end.position.cols());
+  held << start.position, end.position;
+  report.zero_modes += coords_.kr() - static_cast<int>(column_basis(held).cols());
+  report.index = report.dead_load_index + report.constraint_correction;
+  if (*report.index < 0) {
+    report.reason = "the isoperimetric correction exceeds the load-controlled index: degenerate constraints";
+    report.index.reset();
+  }
+  return report;
+}
+
+}  // namespace
+
+StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::VectorXd& x,
+                                  const StabilityOptions& options) {
+  return StabilityAnalysis(problem, x, options).run();
+}
+
+std::string describe(const StabilityReport& report) {
+  if (!report.index) return "index undefined: " + report.reason;
+  std::ostringstream out;
+  out << (*report.index == 0 ? "stable" : "unstable (index " + std::to_string(*report.index) + ")");
+  if (report.zero_modes > 0) out << ", " << report.zero_modes << " zero mode" << (report.zero_modes > 1 ? "s" : "");
+  return out.str();
+}
+
+}  // namespace kirchhoff

@@ -1,0 +1,94 @@
+// Stability of an equilibrium: the index (number of negative eigenvalues) of the second variation
+// of the total potential energy, restricted to the perturbations the case admits, by counting
+// conjugate points of the Jacobi (linearised equilibrium) equations, which are the shooting
+// core's variational equations.
+//
+// The perturbations the case admits follow from its end conditions, read as the experiment holds
+// them: an imposed position or rotation holds its perturbation at zero; a load given at an end is
+// a dead load (its perturbation is zero, the conjugate displacement free); an unknown parameter
+// that is an end load (P of simply_supported.toml, balanced by the end slope) is a Lagrange
+// multiplier, so the displacement it is conjugate to is held instead (the end shortening is
+// imposed and P follows). Extra conditions (the end slope) only select the equilibrium.
+//
+// Method, in two steps (Manning, Rogers & Maddocks 1998 for the isoperimetric part):
+//  1. The load-controlled problem: every end position free under a dead load equal to the
+//     reaction. Its configuration is the rotation alone (the position follows from r' = d3) and
+//     its Jacobi fields keep dn = 0, so the Legendre condition (bending and twist stiffness > 0)
+//     holds strictly and Morse's index theorem applies. With the rotation pair in canonical
+//     coordinates u = dpsi (lab-frame rotation vector), p = (dm + 1/2 m x dpsi) L / B (the m x dpsi
+//     term makes the pair canonical on SO(3); zero in the plane), start the frame of Jacobi fields
+//     meeting the rotation conditions at s = 0 and count
+//       - the conjugate points in (0, L), where the frame's rotation block U(s) is singular, with
+//         multiplicity, as the passages through -1 of the eigenvalues of the unitary matrix
+//         W = (U + iP)(U - iP)^-1 (all in one direction under the Legendre condition; a passage
+//         the other way means the count is not valid and the index is reported undefined);
+//       - at s = L, the negative directions of the boundary form q(c) = (P c).(U c) on the fields
+//         meeting the rotation conditions there (a conjugate point exactly at L adds the fields
+//         whose dead-moment condition fails: they are negative just before L).
+//  2. Positions held at both ends are isoperimetric constraints on the chord g = r(L) - r(0), the
+//     reactions their multipliers. With D = dg/dF the change of the chord per unit change of the
+//     end load along the load-controlled equilibria (k x k for k held directions),
+//       index = index_dead + n_+(D) + r_Z - k,
+//     the bordered-Hessian (Haynsworth inertia) count; r_Z is the rank of the chord change along
+//     zero modes of the load-controlled problem (D is then taken on the loads doing no work on
+//     them). Along the axis of a straight inextensible rod the chord cannot change to first
+//     order, so that constraint is empty and dropped (the axial force is indeterminate).
+// Zero modes (Jacobi fields meeting every condition: symmetries such as the isotropic rod's
+// rotation about its axis, rigid motions, or the rod at a bifurcation) are reported apart from
+// the index, never counted in it.
+//
+// Not covered (index null with the reason): active contacts, half-turn symmetric half rods,
+// position-dependent fields (soft walls, barriers), unknown parameters that are not end loads,
+// non-conservative loads (a dead couple on a 3D end free to rotate), degenerate crossings.
+#pragma once
+
+#include <Eigen/Dense>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kirchhoff/shooting.hpp"
+
+namespace kirchhoff {
+
+struct StabilityOptions {
+  // Sub-intervals per shooting segment at least; each is halved while an eigenphase of W moves
+  // more than max_phase_step over it, so passages are never missed nor paired wrongly.
+  int min_steps = 32;
+  double max_phase_step = 0.25;  // rad
+  // Steps holding a conjugate point are halved down to this fraction of L, so its position is
+  // found to ~1e-6 L (the interpolation error is second order in the step).
+  double passage_resolution = 1e-3;
+  int max_halvings = 16;
+  // Singular values (of the orthonormal frame's blocks, dimensionless) and eigenvalues of the
+  // boundary form below this are zero: a conjugate point exactly at L, a zero mode. The frame is
+  // integrated to ~1e-10, so 1e-6 leaves four orders of margin; modes within 1e-6 of neutral
+  // (next to a bifurcation) are reported as zero modes, not guessed.
+  double zero_tolerance = 1e-6;
+};
+
+struct StabilityReport {
+  std::optional<int> index;  // number of negative eigenvalues; empty when not defined (reason)
+  std::string reason;        // why the index is not defined, else empty
+  int zero_modes = 0;        // Jacobi fields meeting every condition (symmetries, bifurcations)
+  std::vector<double> conjugate_points;  // s in (0, L) where U(s) is singular
+  int interior_count = 0;                // conjugate points in (0, L), with multiplicity
+  int end_count = 0;                     // negative directions added by the conditions at s = L
+  int dead_load_index = 0;               // interior_count + end_count: every end load dead
+  int constraint_count = 0;              // end positions held at both ends (isoperimetric)
+  int constraint_correction = 0;         // index - dead_load_index
+  std::string method = "conjugate_points";
+  long rhs_evaluations = 0;
+  bool defined() const { return index.has_value(); }
+  bool stable() const { return index && *index == 0; }
+};
+
+// The index of the equilibrium x of `problem` (x solved). Never throws for an unsupported case:
+// the report says why the index is not defined.
+StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::VectorXd& x,
+                                  const StabilityOptions& options = {});
+
+// "stable", "unstable (index k)", or "index undefined: reason".
+std::string describe(const StabilityReport& report);
+
+}  // namespace kirchhoff

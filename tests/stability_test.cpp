@@ -1,0 +1,142 @@
+// The index of equilibria by conjugate points (stability.hpp), against results known
+// independently of this code: Euler's critical loads, the clamped-clamped rod's modes, the
+// Greenhill threshold, and a discretised energy's Hessian (python reproduction in
+// docs/stability.md). The index is an integer: the tests compare it exactly; where positions of
+// conjugate points are checked, the tolerance is that of the phase interpolation over one step.
+#include "kirchhoff/stability.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/continuation.hpp"
+#include "test_support.hpp"
+
+namespace kirchhoff {
+namespace {
+
+using testing::solve_case;
+
+StabilityReport index_of(const testing::Solved& solved) {
+  return analyse_stability(*solved.problem, solved.solution.result.x);
+}
+
+// The pinned column under a dead load P (its end slides along e_x): the straight column is an
+// equilibrium for every P and its index is the number of Euler loads (k pi)^2 EI / L^2 below P.
+TEST(Stability, StraightColumnCountsTheEulerLoadsBelowTheLoad) {
+  for (double P : {5.0, 20.0, 50.0, 100.0, 200.0}) {
+    SCOPED_TRACE("P = " + std::to_string(P));
+    const auto solved = solve_case("euler_column.toml", {{"P", P}, {"theta_guess", 0.0}});
+    const StabilityReport r = index_of(solved);
+    ASSERT_TRUE(r.defined()) << r.reason;
+    int below = 0;
+    for (int k = 1; k * k * M_PI * M_PI < P; ++k) ++below;
+    EXPECT_EQ(*r.index, below);
+    EXPECT_EQ(r.zero_modes, 0);
+    // Load-controlled problem: theta'' + P theta = 0 with theta'(0) = 0, so its conjugate points
+    // are the zeros of cos(sqrt(P) s). Steps holding one are halved to 1e-3 L and the phase
+    // interpolated in between (error ~1e-7 L here): 1e-5 leaves two orders of margin.
+    std::vector<double> expected;
+    for (int j = 0; (2 * j + 1) * M_PI / (2 * std::sqrt(P)) < 1.0; ++j) expected.push_back((2 * j + 1) * M_PI / (2 * std::sqrt(P)));
+    ASSERT_EQ(r.conjugate_points.size(), expected.size());
+    for (size_t j = 0; j < expected.size(); ++j) EXPECT_NEAR(r.conjugate_points[j], expected[j], 1e-5);
+  }
+}
+
+// Buckled Elasticas of the same column: the first mode is stable, the second has index 1, the
+// third index 2. Past
+// the point where the ends meet (the roller passes the pin) the first mode loses its stability:
+// turning the whole rod about the pin then keeps the roller on its line to first order. A
+// discretised energy (400 elements, the Hessian projected on y(L) = 0) gives the same: lowest
+// eigenvalues 3.96 (P = 12), 1.60 (P = 20), -1.65 (P = 30, x(L) = -0.21), -0.68 (P = 50).
+TEST(Stability, BuckledColumnModeKHasIndexKMinusOneUntilTheEndsMeet) {
+  struct Row { double P, guess; int mode, index; };
+  for (const Row& row : {Row{12.0, 1.0, 1, 0}, Row{20.0, 2.0, 1, 0}, Row{30.0, 2.5, 1, 1}, Row{50.0, 2.8, 1, 1},
+                         Row{50.0, 1.0, 2, 1}, Row{60.0, 1.8, 2, 1}, Row{100.0, 1.5, 3, 2}}) {
+    SCOPED_TRACE("P = " + std::to_string(row.P) + ", mode " + std::to_string(row.mode));
+    const auto solved = solve_case("euler_column.toml", {{"P", row.P}, {"theta_guess", row.guess}});
+    // Which Elastica Newton reached: mode k has P = 4 k^2 K(sin(theta0 / 2))^2 (eq. 54).
+    const double theta0 = std::abs(solved.solution.derived.at("theta0"));
+    const double mode1_load = analytic::PinnedElastica{1.0, 1.0, theta0}.load();  // 4 K(k)^2
+    ASSERT_NEAR(row.mode * row.mode * mode1_load, row.P, 1e-6 * row.P);
+    const StabilityReport r = index_of(solved);
+    ASSERT_TRUE(r.defined()) << r.reason;
+    EXPECT_EQ(*r.index, row.index);
+    EXPECT_EQ(r.zero_modes, 0);
+  }
+}
+
+// Clamped-clamped rod with the end shortening imposed: the symmetric first mode is stable, the
+// S-shaped (antisymmetric) mode has index 1.
+TEST(Stability, ClampedRodWithImposedShorteningSymmetricStableSShapedIndexOne) {
+  const std::string text = R"(
+model = "planar"
+[parameters]
+D = 0.9
+fy = 0.0
+m0 = 0.0
+P = 50.0
+[rod]
+length = 1.0
+B = 1.0
+[start]
+type = "clamped"
+position = [0, 0]
+[end]
+type = "clamped"
+position = ["D", 0]
+[guess]
+force = ["-P", "fy"]
+moment = [0, 0, "m0"]
+)";
+  struct Row { double fy, m0; bool symmetric; int index; };
+  for (const Row& row : {Row{0.0, 6.0, true, 0}, Row{0.0, -6.0, true, 0}, Row{10.0, 0.0, false, 1}}) {
+    Case c = load_case_text(text, "clamped_clamped.toml", {{"fy", row.fy}, {"m0", row.m0}});
+    ShootingProblem problem(c.definition);
+    const ShootingResult solved = solve(problem, problem.initial_unknowns(c.start_guess));
+    ASSERT_TRUE(solved.summary.converged());
+    const RodPoint mid = problem.sample(solved.x, {0.5}).front();
+    ASSERT_EQ(std::abs(mid.r.y()) > 1e-6, row.symmetric);  // the S mode crosses the chord at mid-span
+    const StabilityReport r = analyse_stability(problem, solved.x);
+    ASSERT_TRUE(r.defined()) << r.reason;
+    EXPECT_EQ(*r.index, row.index);
+    EXPECT_EQ(r.constraint_count, 2);
+  }
+}
+
+// The straight twisted rod, clamped, its end sliding along the axis without tension: stable below
+// the critical twist (M L / B = 8.9868, phi = M L / B3), index 2 above it (the isotropic rod buckles
+// in a double mode: a circle of buckled rods leaves the branch point).
+TEST(Stability, TwistedStraightRodIndexTwoAboveTheGreenhillThreshold) {
+  const double B3 = 0.769230769230769;
+  const double phi_c = analytic::clamped_twisted_critical_moment(1.0, 0.0, 1.0) / B3;
+  for (double phi : {5.0, phi_c - 0.1, phi_c + 0.1, phi_c + 5.0}) {
+    SCOPED_TRACE("phi = " + std::to_string(phi));
+    const auto solved = solve_case("twisted_clamped.toml", {{"phi", phi}});
+    const StabilityReport r = index_of(solved);
+    ASSERT_TRUE(r.defined()) << r.reason;
+    EXPECT_EQ(*r.index, phi < phi_c ? 0 : 2);
+  }
+}
+
+TEST(Stability, SimplySupportedElasticaUnderImposedShorteningIsStable) {
+  for (double theta0 : {0.5, 1.0, 2.0}) {
+    const auto solved = solve_case("simply_supported.toml", {{"theta0", theta0}});
+    const StabilityReport r = index_of(solved);
+    ASSERT_TRUE(r.defined()) << r.reason;
+    EXPECT_EQ(*r.index, 0);
+    EXPECT_EQ(r.constraint_count, 2);  // P is a multiplier: both ends hold their positions
+  }
+}
+
+TEST(Stability, UnsupportedCasesSayWhy) {
+  const auto soft = solve_case("soft_wall.toml");
+  const StabilityReport r = index_of(soft);
+  EXPECT_FALSE(r.defined());
+  EXPECT_NE(r.reason.find("depends on position"), std::string::npos) << r.reason;
+  EXPECT_EQ(describe(r).rfind("index undefined", 0), 0u);
+}
+
+}  // namespace
+}  // namespace kirchhoff
