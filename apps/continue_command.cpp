@@ -61,7 +61,7 @@ std::string run_arguments(const ContinueArguments& a) {
     o << "none";
   o << " step=" << a.step
     << " min_step=" << a.min_step << " max_step=" << a.max_step << " max_points=" << a.max_points
-    << " switch_at_bp=" << a.switch_at_bp << " side=" << a.switch_side << " branch_points=" << !a.no_branch_points;
+    << " switch_at_bp=" << a.switch_at_bp << " side=" << a.switch_side << " branch_points=" << !a.no_branch_points << " stability=" << !a.no_stability;
   for (const auto& e : a.stop_events) o << " event=" << e;
   for (const auto& e : a.record_events) o << " record=" << e;
   o << " samples=" << a.samples << " seed=" << (a.seed.ipopt ? "ipopt" : "guess");
@@ -92,7 +92,8 @@ class BranchWriter {
     if (!append) {
       out_ << "index,branch," << parameter << ",arclength";
       for (const auto& d : derived_) out_ << ',' << d;
-      out_ << ",H_spread,m3_spread,n_dot_m_spread,H_flat,type,multiplicity,event,newton_iterations\n";
+      out_ << ",H_spread,m3_spread,n_dot_m_spread,H_flat,type,multiplicity,event,newton_iterations,stability_index,"
+              "zero_modes\n";
       out_.flush();
     }
   }
@@ -104,7 +105,10 @@ class BranchWriter {
     out_ << ',' << inv.H.relative_spread() + 0.0 << ',' << inv.m3.relative_spread() + 0.0 << ','
          << inv.n_dot_m.relative_spread() + 0.0
          << ',' << (p.H_flat ? 1 : 0) << ',' << to_string(p.type) << ',' << p.multiplicity << ',' << p.event << ','
-         << p.newton_iterations << '\n';
+         << p.newton_iterations << ',';
+    // Empty where the index is not defined (or not computed): never a guessed number.
+    if (p.stability_index) out_ << *p.stability_index;
+    out_ << ',' << p.zero_modes << '\n';
     out_.flush();
   }
 
@@ -124,6 +128,7 @@ class Progress {
          << p.parameter << "  step " << std::setprecision(3) << p.step;
     if (p.type != PointType::Regular && p.type != PointType::Start) line << "  [" << to_string(p.type) << "]";
     if (!p.H_flat) line << "  [H not flat]";
+    if (p.stability_index) line << (*p.stability_index == 0 ? "  stable" : "  index " + std::to_string(*p.stability_index));
     if (tty_) {
       std::cerr << "\r" << line.str() << "\033[K" << std::flush;
     } else if (row % 10 == 0 || p.type != PointType::Regular || !p.H_flat) {
@@ -192,6 +197,7 @@ int run_continue(const ContinueArguments& args) {
       options.deadline = c.definition.options.newton.deadline;
     }
     options.detect_branch_points = !args.no_branch_points;
+    options.compute_stability = !args.no_stability;
     if (args.no_branch_points && args.switch_at_bp > 0)
       throw CaseError("--switch-at-bp needs branch points: drop --no-branch-points");
     options.derived = c.derived;

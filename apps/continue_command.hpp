@@ -22,6 +22,7 @@ struct ContinueArguments {
   int max_points = 500;
   int switch_at_bp = 0;       // > 0: switch onto the branch bifurcating at the K-th branch point
   bool no_branch_points = false;  // skip the branch-point test functions (an SVD per point)
+  bool no_stability = false;      // skip the stability index of every point
   double switch_side = 1.0;   // +1 / -1: which side of the bifurcating branch
   std::vector<std::string> stop_events;    // NAME=VALUE: stop when crossed
   std::vector<std::string> record_events;  // NAME=VALUE: record when crossed

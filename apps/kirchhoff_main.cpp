@@ -96,6 +96,8 @@ int main(int argc, char** argv) {
   continue_cmd->add_option("--switch-at-bp", cont.switch_at_bp,
                            "Switch onto the branch bifurcating at the K-th branch point found (double branch points\n"
                            "of isotropic twisted rods switch with the axial phase condition)");
+  continue_cmd->add_flag("--no-stability", cont.no_stability,
+                         "Skip the stability index of every point (column stability_index left empty)");
   continue_cmd->add_flag("--no-branch-points", cont.no_branch_points,
                          "Do not look for branch points: their test functions cost an SVD per point, most of a\n"
                          "run on multiple-shooting cases of hundreds of unknowns (plectonemes); folds are still found");

@@ -27,7 +27,27 @@ nlohmann::json parameters_json(const Parameters& p) {
   return out;
 }
 
-nlohmann::json solution_json(const Case& c, const ShootingProblem& problem, const Solution& sol) {
+nlohmann::json stability_json(const StabilityReport& st) {
+  nlohmann::json j;
+  j["index"] = st.index ? nlohmann::json(*st.index) : nlohmann::json();
+  j["stable"] = st.index ? nlohmann::json(st.stable()) : nlohmann::json();
+  j["zero_modes"] = st.zero_modes;
+  j["conjugate_points"] = st.conjugate_points;
+  // The conjugate-point count gives no eigenvalues; the planar discretised check does.
+  j["lowest_eigenvalues"] = nlohmann::json::array();
+  j["method"] = st.method;
+  if (st.index) {
+    j["load_controlled_index"] = st.dead_load_index;
+    j["held_chord_directions"] = st.constraint_count;
+    j["constraint_correction"] = st.constraint_correction;
+  } else {
+    j["reason"] = st.reason;
+  }
+  return j;
+}
+
+nlohmann::json solution_json(const Case& c, const ShootingProblem& problem, const Solution& sol,
+                             const StabilityReport& stability) {
   nlohmann::json j;
   j["case"] = c.path;
   j["status"] = to_string(sol.result.summary.status);
@@ -54,6 +74,7 @@ nlohmann::json solution_json(const Case& c, const ShootingProblem& problem, cons
                              {"force_end", c.force_end},
                              {"H_before", c.H_before},
                              {"H_after", c.H_after}});
+  j["stability"] = stability_json(stability);
   if (sol.result.summary.used_fallback_search) j["note"] = "starting point from the NLopt fallback search";
   return j;
 }

@@ -12,7 +12,7 @@
 namespace kirchhoff::cli {
 namespace {
 
-void print_human(const Case& c, const Solution& sol) {
+void print_human(const Case& c, const Solution& sol, const StabilityReport& stability) {
   std::cout << (c.title.empty() ? c.path : c.title) << "\n";
   std::cout << "  " << sol.result.summary.brief_report() << "\n";
   std::cout.precision(12);
@@ -34,6 +34,7 @@ void print_human(const Case& c, const Solution& sol) {
     else
       std::cout << " at s = " << contact.s << ", force " << contact.force << "\n";
   }
+  std::cout << "  " << describe(stability) << "\n";
 }
 
 }  // namespace
@@ -136,10 +137,11 @@ int run_solve(const SolveArguments& args) {
       return kExitBadInput;
     }
   }
+  const StabilityReport stability = analyse_stability(*problem, sol.result.x);
   if (args.json)
-    std::cout << solution_json(c, *problem, sol).dump(2) << "\n";
+    std::cout << solution_json(c, *problem, sol, stability).dump(2) << "\n";
   else
-    print_human(c, sol);
+    print_human(c, sol, stability);
   return kExitOk;
 }
 

@@ -33,6 +33,7 @@
 #include "kirchhoff/invariants.hpp"
 #include "kirchhoff/shooting.hpp"
 #include "kirchhoff/solution.hpp"
+#include "kirchhoff/stability.hpp"
 #include "kirchhoff/vibration.hpp"
 #include "plectonemes_command.hpp"  // apps/: the sweep behind `kirchhoff plectonemes`
 
@@ -139,6 +140,7 @@ struct PySolution {
   std::vector<double> history;
   py::dict parameters, derived, invariants, profile;
   py::list contacts;  // as the CLI's JSON: report_contacts
+  py::object stability = py::none();  // as the CLI's JSON "stability"; None when not converged
 };
 
 struct PyBranch {
@@ -170,6 +172,25 @@ PyCase py_load_case(const std::string& path, const py::object& set, const std::s
   }
   out.phase_condition = phase_condition;
   return out;
+}
+
+// The CLI's JSON "stability" block as a dict (index None where it is not defined).
+py::dict stability_dict(const StabilityReport& st) {
+  py::dict d;
+  d["index"] = st.index ? py::object(py::int_(*st.index)) : py::object(py::none());
+  d["stable"] = st.index ? py::object(py::bool_(st.stable())) : py::object(py::none());
+  d["zero_modes"] = st.zero_modes;
+  d["conjugate_points"] = st.conjugate_points;
+  d["lowest_eigenvalues"] = py::list();
+  d["method"] = st.method;
+  if (st.index) {
+    d["load_controlled_index"] = st.dead_load_index;
+    d["held_chord_directions"] = st.constraint_count;
+    d["constraint_correction"] = st.constraint_correction;
+  } else {
+    d["reason"] = st.reason;
+  }
+  return d;
 }
 
 PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::string& seed, int seed_segments,
@@ -250,6 +271,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   for (const auto& name : c.derived) out.derived[py::str(name)] = sol->derived.at(name);
   out.invariants = invariants_dict(sol->invariants);
   out.profile = profile_dict(problem->equations(sol->result.parameters)->model(), sol->profile);
+  out.stability = stability_dict(analyse_stability(*problem, sol->result.x));
   for (const auto& contact : report_contacts(*problem, *sol)) {
     py::dict d;
     d["obstacle"] = contact.obstacle;
@@ -310,6 +332,11 @@ py::dict branch_points_dict(const std::vector<BranchPoint>& pts, const std::vect
   d["event"] = events;
   i("multiplicity", [](const BranchPoint& b) { return b.point.multiplicity; });
   i("newton_iterations", [](const BranchPoint& b) { return b.point.newton_iterations; });
+  // NaN where the index is not defined or was not computed (stability=False).
+  f("stability_index", [](const ContinuationPoint& p) {
+    return p.stability_index ? static_cast<double>(*p.stability_index) : std::numeric_limits<double>::quiet_NaN();
+  });
+  i("zero_modes", [](const BranchPoint& b) { return b.point.zero_modes; });
   return d;
 }
 
@@ -357,7 +384,7 @@ py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
 PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::object& to, double step,
                      double min_step, double max_step, int max_points, const py::object& events,
                      const py::object& record, int switch_at_bp, double side, int samples, double direction,
-                     bool branch_points) {
+                     bool branch_points, bool stability) {
   const Case& c = pc.c;
   ContinuationOptions options;
   options.parameter = parameter;
@@ -371,6 +398,7 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
   options.max_points = max_points;
   options.samples = samples;
   options.detect_branch_points = branch_points;
+  options.compute_stability = stability;
   options.derived = c.derived;
   options.events = events_from(events, true);
   for (auto& e : events_from(record, false)) options.events.push_back(e);
@@ -576,6 +604,9 @@ Attributes:
       .def_readonly("derived", &PySolution::derived)
       .def_readonly("invariants", &PySolution::invariants)
       .def_readonly("profile", &PySolution::profile)
+      .def_readonly("stability", &PySolution::stability,
+                    "Stability of the equilibrium (None when not converged): dict with index (None where not "
+                    "defined, with reason), stable, zero_modes, conjugate_points, method, as the CLI's JSON.")
       .def("__bool__", [](const PySolution& s) { return s.converged; }, "True when converged.")
       .def("__repr__", &repr_solution);
 
@@ -596,7 +627,8 @@ Attributes:
         unavailable), H_spread (max - min of H along the rod), H_relative_spread,
         m3_relative_spread, n_dot_m_relative_spread (spreads over their scale, as in the CLI's
         CSV), H_flat (bool), type (list of str: start, regular, fold, branch_point, event,
-        endpoint), event (list of str), multiplicity, newton_iterations.
+        endpoint), event (list of str), multiplicity, newton_iterations, stability_index (float:
+        the index, NaN where it is not defined or stability=False), zero_modes.
         With a switch, the branch point ends branch 0 and starts branch 1.)doc")
       .def_readonly("parameter", &PyBranch::parameter)
       .def_readonly("reason", &PyBranch::reason)
@@ -650,7 +682,7 @@ Returns:
            py::arg("step") = 0.05, py::arg("min_step") = 1e-7, py::arg("max_step") = 0.5,
            py::arg("max_points") = 500, py::arg("events") = py::none(), py::arg("record") = py::none(),
            py::arg("switch_at_bp") = 0, py::arg("side") = 1.0, py::arg("samples") = 101,
-           py::arg("direction") = 1.0, py::arg("branch_points") = true,
+           py::arg("direction") = 1.0, py::arg("branch_points") = true, py::arg("stability") = true,
            R"doc(Pseudo-arclength continuation in one parameter (the CLI's `continue`).
 
 Args:
@@ -668,6 +700,8 @@ Args:
     branch_points (bool): look for branch points (an SVD per point: most of the cost of a run on
         a multiple-shooting case of hundreds of unknowns, such as plectoneme.toml); folds are
         found either way.
+    stability (bool): the stability index of every point (column stability_index: NaN where
+        it is not defined; zero_modes beside it), as the CLI's CSV.
 
 Returns:
     Branch (points of both branches concatenated, with a `branch` column).

@@ -8,6 +8,7 @@
 
 #include "kirchhoff/jacobian_lu.hpp"
 #include "kirchhoff/solution.hpp"
+#include "kirchhoff/stability.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -280,6 +281,12 @@ void Continuation::describe(ContinuationPoint* point) {
     for (const auto& name : problem_.definition().unknown_parameters) p.derived[name] = at.get(name);
     p.invariants = s.invariants;
     p.H_flat = !s.invariants.H.applies || s.invariants.H.spread <= kFlatH * std::max(1.0, s.invariants.H.scale);
+  }
+  if (options_.compute_stability) {
+    problem_.set_parameter(options_.parameter, p.parameter);
+    const StabilityReport stability = analyse_stability(problem_, p.x);
+    p.stability_index = stability.index;
+    p.zero_modes = stability.zero_modes;
   }
 }
 

@@ -87,6 +87,9 @@ struct ContinuationOptions {
   std::vector<std::string> derived;   // computed at every point (and available to events)
   int samples = 101;                  // profile points for invariants and derived quantities
   bool compute_invariants = true;     // false skips sampling (derived from events need it)
+  // The stability index of every point (stability.hpp): about one Jacobian's worth of
+  // integration per point. Folds and branch points then show the exchange of stability.
+  bool compute_stability = false;
   // A check of each step that a converged corrector cannot make (that the rod did not pass
   // through itself: SelfPassageGuard): a non-empty answer refuses the step, which is retried
   // shorter; refused at the minimum step, the run stops as Inadmissible with that answer.
@@ -117,6 +120,9 @@ struct ContinuationPoint {
   std::map<std::string, double> derived;
   InvariantReport invariants;
   bool H_flat = true;       // false flags a point whose H spread exceeds 1e-9 of its scale
+  // With compute_stability: the index (empty where it is not defined) and the zero modes.
+  std::optional<int> stability_index;
+  int zero_modes = 0;
   // Why the point failed the checks of a solution (verification.hpp: a profile with NaN, a rod
   // beyond its soft wall), "" when it passed. Such a point is never put on a branch.
   std::string check_failure;

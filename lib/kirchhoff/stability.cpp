@@ -572,9 +572,10 @@ StabilityReport StabilityAnalysis::run() {
 
   std::vector<double> nodes = problem_.node_arclengths(x_);
   nodes.push_back(scales_.length);
-  for (size_t i = 0; i + 1 < nodes.size(); ++i)
-    for (int k = 1; k <= options_.min_steps; ++k)
-      advance(&f, nodes[i] + (nodes[i + 1] - nodes[i]) * k / options_.min_steps, &track, 0);
+  const int segments = static_cast<int>(nodes.size()) - 1;
+  const int steps = std::max(2, (options_.min_steps + segments - 1) / segments);
+  for (int i = 0; i < segments; ++i)
+    for (int k = 1; k <= steps; ++k) advance(&f, nodes[i] + (nodes[i + 1] - nodes[i]) * k / steps, &track, 0);
   report.rhs_evaluations = rhs_;
   if (track.reversed) {
     std::ostringstream reason;

@@ -52,13 +52,16 @@
 namespace kirchhoff {
 
 struct StabilityOptions {
-  // Sub-intervals per shooting segment at least; each is halved while an eigenphase of W moves
-  // more than max_phase_step over it, so passages are never missed nor paired wrongly.
-  int min_steps = 32;
-  double max_phase_step = 0.25;  // rad
+  // Sub-intervals along the whole rod at least (two per shooting segment at least); each is
+  // halved while an eigenphase of W moves more than max_phase_step over it, so passages are
+  // never missed nor paired wrongly. Too few (2 on the column at P = 200, whose phases turn
+  // through 9 pi) let a phase turn by more than pi unseen: 16 leaves a factor 4 on the cases
+  // of the tests.
+  int min_steps = 16;
+  double max_phase_step = 0.5;  // rad
   // Steps holding a conjugate point are halved down to this fraction of L, so its position is
-  // found to ~1e-6 L (the interpolation error is second order in the step).
-  double passage_resolution = 1e-3;
+  // found to ~1e-5 L (the interpolation of tan(phase / 2) is exact to second order in the step).
+  double passage_resolution = 1e-2;
   int max_halvings = 16;
   // Singular values (of the orthonormal frame's blocks, dimensionless) and eigenvalues of the
   // boundary form below this are zero: a conjugate point exactly at L, a zero mode. The frame is
