@@ -323,6 +323,29 @@ TEST_F(CliTest, NotConvergedExitsOneWithStatus) {
 // The documented stepper gives the same Elastica as the default one (it gave P = nan, y_max =
 // 0.0042, exit 0): Love's P = 11.2224184758 for theta0 = 1 (eq. 54), to the 1e-9 the residual and
 // the integrator tolerance 1e-12 leave.
+// The straight Euler column at P = 50 lies above the Euler loads pi^2 and 4 pi^2: index 2; the
+// conjugate points of its load-controlled problem are the zeros of cos(sqrt(P) s).
+TEST_F(CliTest, SolveReportsTheStabilityIndex) {
+  const CliRun r = run("solve " + quoted(case_path("euler_column.toml")) + " --set P=50 --set theta_guess=0 --json");
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const json st = parse(r)["stability"];
+  EXPECT_EQ(st["index"], 2);
+  EXPECT_EQ(st["stable"], false);
+  EXPECT_EQ(st["zero_modes"], 0);
+  EXPECT_EQ(st["method"], "conjugate_points");
+  ASSERT_EQ(st["conjugate_points"].size(), 2u);
+  EXPECT_NEAR(st["conjugate_points"][0].get<double>(), M_PI / (2 * std::sqrt(50.0)), 1e-5);
+  const CliRun text = run("solve " + quoted(case_path("euler_column.toml")) + " --set P=50 --set theta_guess=0");
+  EXPECT_NE(text.out.find("unstable (index 2)"), std::string::npos) << text.out;
+  // Where the index is not defined it is null, with the reason: never a guessed number.
+  const CliRun soft = run("solve " + quoted(case_path("soft_wall.toml")) + " --json");
+  ASSERT_EQ(soft.status, 0) << soft.out << soft.err;
+  const json undefined = parse(soft)["stability"];
+  EXPECT_TRUE(undefined["index"].is_null());
+  EXPECT_TRUE(undefined["stable"].is_null());
+  EXPECT_NE(undefined["reason"].get<std::string>().find("depends on position"), std::string::npos);
+}
+
 TEST_F(CliTest, Dopri5StepperGivesTheElastica) {
   const std::string path = variant("simply_supported.toml", "[solver]", "[solver]\nstepper = \"dopri5\"");
   const CliRun r = run("solve " + quoted(path) + " --json");

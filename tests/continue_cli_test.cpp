@@ -3,6 +3,8 @@
 // duplicating a point.
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -100,6 +102,46 @@ TEST_F(ContinueCli, KilledContactRunResumesToTheSameRows) {
   EXPECT_NE(after.back().find(",endpoint,"), std::string::npos);
 }
 
+// The stability index along the run: the straight column is stable below pi^2 and the branch
+// point there has a zero mode; the buckled branch is stable until its ends meet (theta0 =
+// 2.2813, where the continuation finds a second branch point, the rod free to turn about the
+// pin) and has index 1 past it (tests/stability_test.cpp checks this against a discretised
+// energy).
+TEST_F(ContinueCli, StabilityIndexExchangesAtTheBranchPoints) {
+  const fs::path csv = dir_ / "s.csv";
+  auto args = continue_args(csv);
+  args[args.size() - 3] = "21";
+  ASSERT_EQ(run_to_end(args, dir_ / "s.log"), 0);
+  const auto lines = lines_of(csv);
+  ASSERT_GT(lines.size(), 10u);
+  int stable_straight = 0, stable_buckled = 0, unstable_buckled = 0, branch_points_with_zero_mode = 0;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    std::vector<std::string> f;
+    std::stringstream row(lines[i]);
+    for (std::string cell; std::getline(row, cell, ',');) f.push_back(cell);
+    ASSERT_EQ(f.size(), 17u) << lines[i];
+    const int branch = std::stoi(f[1]), index = std::stoi(f[15]), zero_modes = std::stoi(f[16]);
+    const double theta0 = std::abs(std::stod(f[4]));
+    if (f[11] == "branch_point") {
+      branch_points_with_zero_mode += zero_modes >= 1;
+      continue;
+    }
+    if (branch == 0) stable_straight += index == 0;
+    if (branch == 1 && theta0 < 2.27) {
+      stable_buckled += index == 0;
+      EXPECT_EQ(index, 0) << lines[i];
+    }
+    if (branch == 1 && theta0 > 2.29) {
+      unstable_buckled += index == 1;
+      EXPECT_EQ(index, 1) << lines[i];
+    }
+  }
+  EXPECT_GT(stable_straight, 3);
+  EXPECT_GT(stable_buckled, 10);
+  EXPECT_GT(unstable_buckled, 10);
+  EXPECT_GE(branch_points_with_zero_mode, 3);  // pi^2 (ending branch 0, starting branch 1), ends meeting
+}
+
 TEST_F(ContinueCli, BranchCsvHasTheDocumentedColumnsAndPointTypes) {
   const fs::path csv = dir_ / "b.csv";
   auto args = continue_args(csv);
@@ -109,7 +151,7 @@ TEST_F(ContinueCli, BranchCsvHasTheDocumentedColumnsAndPointTypes) {
   const auto lines = lines_of(csv);
   EXPECT_EQ(lines[0],
             "index,branch,P,arclength,theta0,y_max,end_to_end,H_spread,m3_spread,n_dot_m_spread,H_flat,type,"
-            "multiplicity,event,newton_iterations");
+            "multiplicity,event,newton_iterations,stability_index,zero_modes");
   std::string all;
   for (const auto& l : lines) all += l + "\n";
   EXPECT_NE(all.find(",start,"), std::string::npos);

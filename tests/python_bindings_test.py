@@ -89,6 +89,19 @@ class SolveTest(unittest.TestCase):
         self.assertLess(abs(sol.parameters["P"] - P), 1e-8 * P)
         self.assertEqual(set(sol.derived), set(self.case.derived_names))
 
+    def test_stability(self):
+        # Fig. 3's Elastica under imposed end shortening (P is the multiplier of the chord): stable.
+        st = self.solution.stability
+        self.assertEqual(st["index"], 0)
+        self.assertTrue(st["stable"])
+        self.assertEqual(st["zero_modes"], 0)
+        self.assertEqual(st["method"], "conjugate_points")
+        straight = kirchhoff.load_case(case_path("euler_column.toml"), set={"P": 50.0, "theta_guess": 0.0}).solve()
+        self.assertEqual(straight.stability["index"], 2)  # pi^2 and 4 pi^2 below P = 50
+        soft = kirchhoff.load_case(case_path("soft_wall.toml")).solve()
+        self.assertIsNone(soft.stability["index"])
+        self.assertIn("depends on position", soft.stability["reason"])
+
     def test_profile_arrays(self):
         profile = self.solution.profile
         self.assertEqual(set(profile), PROFILE_KEYS)
@@ -232,6 +245,19 @@ class ContinuationTest(unittest.TestCase):
         self.assertTrue(re.match(r"theta0=3", b.points["event"][-1]))
         self.assertAlmostEqual(b.points["theta0"][-1], 3.0, places=8)
         self.assertEqual(b.points["branch"][-1], 1)
+
+    def test_stability_index_column(self):
+        # Straight and stable below pi^2, buckled and stable until the ends meet (theta0 = 2.28),
+        # index 1 past it; NaN never appears on this planar branch (the index is defined).
+        pts = self.branch.points
+        idx = pts["stability_index"]
+        self.assertFalse(np.any(np.isnan(idx)))
+        regular = np.array([t == "regular" for t in pts["type"]])
+        theta0 = np.abs(pts["theta0"])
+        self.assertTrue(np.all(idx[regular & (pts["branch"] == 0)] == 0))
+        self.assertTrue(np.all(idx[regular & (pts["branch"] == 1) & (theta0 < 2.27)] == 0))
+        self.assertTrue(np.all(idx[regular & (pts["branch"] == 1) & (theta0 > 2.29)] == 1))
+        self.assertGreaterEqual(int(pts["zero_modes"][[t == "branch_point" for t in pts["type"]]].min()), 1)
 
     def test_columns(self):
         pts = self.branch.points
