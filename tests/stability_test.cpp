@@ -120,6 +120,53 @@ TEST(Stability, TwistedStraightRodIndexTwoAboveTheGreenhillThreshold) {
   }
 }
 
+// The buckled branch leaving the Greenhill point. It bifurcates backwards (subcritically: phi
+// decreases along it) and carries index 1 and one zero mode: of the straight rod's two negative
+// directions past the double branch point, one is the circle of buckled rods itself (turning the
+// rod about its axis while twisting its sections back costs nothing for an isotropic rod, the
+// zero mode), the other remains - under an imposed end rotation and a dead axial load these rods
+// are unstable, as the classical analyses of the twisted rod find.
+TEST(Stability, TwistedRodBuckledBranchIndexOneWithTheRotationZeroMode) {
+  Case c = load_case(testing::case_path("twisted_clamped.toml"), {{"phi", 6.0}});
+  ShootingProblem problem(c.definition);
+  ContinuationOptions o;
+  o.parameter = "phi";
+  o.target = 15.0;
+  o.initial_step = 0.5;
+  o.max_step = 1.0;
+  o.samples = 41;
+  o.derived = {"end_to_end"};
+  o.stop_at_branch_point = 1;
+  o.compute_stability = true;
+  Continuation straight(problem, o);
+  const ContinuationResult to_bp = straight.run(problem.initial_unknowns(c.start_guess));
+  ASSERT_EQ(to_bp.reason, StopReason::BranchPointStop);
+  EXPECT_EQ(to_bp.points.back().zero_modes, 2);  // the double branch point
+  const SymmetricBranchStart start = axial_symmetry_branch(straight, to_bp.points.back());
+  const ShootingProblem switched(start.definition);
+  ContinuationOptions b = o;
+  b.target = NAN;
+  b.stop_at_branch_point = 0;
+  b.initial_step = 0.05;
+  b.max_step = 0.2;
+  b.events = {{"end_to_end", 0.5, true}};
+  Continuation branch(switched, b);
+  const ContinuationResult r = branch.run_along(start.x, start.parameter, start.direction, PointType::BranchPoint);
+  ASSERT_EQ(r.reason, StopReason::EventStop) << r.message;
+  int checked = 0;
+  for (const auto& p : r.points) {
+    // Right next to the branch point the second mode is still within the zero tolerance (there
+    // the two zero modes are reported, as at the branch point itself).
+    if (p.type != PointType::Regular || start.parameter - p.parameter < 1e-3) continue;
+    ASSERT_TRUE(p.stability_index.has_value()) << "phi = " << p.parameter;
+    EXPECT_EQ(*p.stability_index, 1) << "phi = " << p.parameter;
+    EXPECT_EQ(p.zero_modes, 1) << "phi = " << p.parameter;
+    EXPECT_LT(p.parameter, 11.6828645906);  // subcritical
+    ++checked;
+  }
+  EXPECT_GT(checked, 20);
+}
+
 TEST(Stability, SimplySupportedElasticaUnderImposedShorteningIsStable) {
   for (double theta0 : {0.5, 1.0, 2.0}) {
     const auto solved = solve_case("simply_supported.toml", {{"theta0", theta0}});
