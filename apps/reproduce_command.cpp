@@ -20,6 +20,7 @@
 #include "kirchhoff/continuation.hpp"
 #include "kirchhoff/discrete_elastica.hpp"
 #include "kirchhoff/solution.hpp"
+#include "kirchhoff/stability.hpp"
 #include "kirchhoff/vibration.hpp"
 #include "plectonemes_command.hpp"
 #include "solve_command.hpp"
@@ -38,6 +39,7 @@ struct ReportRow {
   double reference_scale = 0.0;    // |analytic|, or the quantity's scale when analytic is 0
   double tolerance = 0.0;          // on rel_error, justified by the method's accuracy
   std::string note;
+  std::string stability;  // of the equilibrium the row reports (stability.hpp), when it is one
 
   double rel_error() const { return analytic ? std::abs(numeric - *analytic) / reference_scale : 0.0; }
   bool pass() const { return !analytic || rel_error() <= tolerance; }
@@ -46,6 +48,7 @@ struct ReportRow {
 struct Solved {
   std::unique_ptr<ShootingProblem> problem;
   Solution solution;
+  std::string stability;  // describe(analyse_stability(...))
 };
 
 Solved solve_case(const fs::path& file, const ParameterOverrides& overrides, int samples) {
@@ -56,6 +59,7 @@ Solved solve_case(const fs::path& file, const ParameterOverrides& overrides, int
   if (!r.summary.converged())
     throw std::runtime_error(file.string() + ": " + r.summary.brief_report());
   out.solution = make_solution(*out.problem, std::move(r), samples, c.derived);
+  out.stability = describe(analyse_stability(*out.problem, out.solution.result.x));
   return out;
 }
 
@@ -88,6 +92,7 @@ void simply_supported(const fs::path& cases, const fs::path& out, std::vector<Re
                      1e-8, ""});
     rows->push_back({id, "H spread / scale (eq. 53 invariant)", {}, 0.0, s.solution.invariants.H.spread,
                      s.solution.invariants.H.scale, 1e-9, "H = EI kappa^2/2 + n3 flat along the rod"});
+    for (auto it = rows->end() - 4; it != rows->end(); ++it) it->stability = s.stability;
     // Profile with the elliptic-function shape beside the numeric one.
     std::ofstream csv(out / ("fig3_theta0_" + label.str() + ".csv"));
     csv.precision(15);
@@ -167,16 +172,18 @@ void continuation(const fs::path& cases, const fs::path& out, std::vector<Report
   b.initial_step = 0.05;
   b.max_step = 1.0;
   b.events = {{"theta0", 3.0, true}};
+  b.compute_stability = true;  // make_figures.py draws stable parts solid, unstable ones dashed
   Continuation buckled(problem, b);
   const ContinuationResult branch = buckled.switch_branch(bps[0]);
   std::ofstream csv(out / "euler_buckled_branch.csv");
   csv.precision(15);
-  csv << "P,theta0,P_elliptic,type\n";
+  csv << "P,theta0,P_elliptic,type,stability_index\n";
   double worst = 0.0;
   for (const auto& p : branch.points) {
     const double theta0 = p.derived.at("theta0");
     const double exact = theta0 > 1e-6 ? analytic::PinnedElastica{1.0, 1.0, theta0}.load() : M_PI * M_PI;
-    csv << p.parameter << ',' << theta0 << ',' << exact << ',' << to_string(p.type) << '\n';
+    csv << p.parameter << ',' << theta0 << ',' << exact << ',' << to_string(p.type) << ','
+        << (p.stability_index ? *p.stability_index : -1) << '\n';
     if (p.type == PointType::Regular && theta0 > 1e-3) worst = std::max(worst, std::abs(p.parameter / exact - 1.0));
   }
   rows->push_back({"Fig. 3 branch, P(theta0) to theta0 = 3", "max abs(P / 4K(k)^2 - 1) over " +
@@ -734,8 +741,8 @@ void write_report(const fs::path& out, const std::vector<ReportRow>& rows, doubl
   md << "# Kirchhoff: the reference paper's results, recomputed\n\n"
      << "Numeric values from shooting (RK78 at 1e-12, Newton to 1e-10); analytic values from the closed forms\n"
      << "(GSL elliptic integrals, eq. 54, closed-form invariants). rel. error = |numeric - analytic| / scale.\n\n"
-     << "| result | quantity | paper | analytic | numeric | rel. error | tolerance | pass | note |\n"
-     << "|---|---|---|---|---|---|---|---|---|\n";
+     << "| result | quantity | paper | analytic | numeric | rel. error | tolerance | pass | stability | note |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|\n";
   nlohmann::json json = nlohmann::json::array();
   int failed = 0;
   for (const auto& r : rows) {
@@ -745,9 +752,10 @@ void write_report(const fs::path& out, const std::vector<ReportRow>& rows, doubl
     const bool checked = r.analytic.has_value();
     md << "| " << r.id << " | " << r.quantity << " | " << format(r.paper) << " | " << format(r.analytic) << " | "
        << format(r.numeric) << " | " << (checked ? err.str() : "") << " | " << (checked ? tol.str() : "") << " | "
-       << (checked ? (r.pass() ? "pass" : "**FAIL**") : "info") << " | " << r.note << " |\n";
+       << (checked ? (r.pass() ? "pass" : "**FAIL**") : "info") << " | " << r.stability << " | " << r.note << " |\n";
     failed += r.pass() ? 0 : 1;
-    nlohmann::json j = {{"id", r.id}, {"quantity", r.quantity}, {"numeric", r.numeric}, {"note", r.note}};
+    nlohmann::json j = {{"id", r.id}, {"quantity", r.quantity}, {"numeric", r.numeric}, {"note", r.note},
+                        {"stability", r.stability}};
     j["paper"] = r.paper ? nlohmann::json(*r.paper) : nlohmann::json();
     j["analytic"] = r.analytic ? nlohmann::json(*r.analytic) : nlohmann::json();
     j["rel_error"] = checked ? nlohmann::json(r.rel_error()) : nlohmann::json();
@@ -761,6 +769,44 @@ void write_report(const fs::path& out, const std::vector<ReportRow>& rows, doubl
 }
 
 }  // namespace
+
+// Stability (stability.hpp): indices of classical equilibria, against what is known of them
+// independently (Euler's loads, the modes of the clamped rod, Greenhill). A row passes when the
+// index is the expected integer.
+ReportRow index_row(const std::string& id, const std::string& quantity, int expected, const Solved& s,
+                    const std::string& note) {
+  const StabilityReport r = analyse_stability(*s.problem, s.solution.result.x);
+  ReportRow row{id, quantity, {}, static_cast<double>(expected), r.index ? *r.index : NAN, 1.0, 0.0, note};
+  row.stability = describe(r);
+  return row;
+}
+
+void stability(const fs::path& cases, std::vector<ReportRow>* rows) {
+  const fs::path column = cases / "euler_column.toml";
+  for (double P : {5.0, 20.0, 50.0})
+    rows->push_back(index_row("Stability: straight Euler column, P = " + format_short(P), "index = #{(k pi)^2 < P}",
+                              static_cast<int>(std::floor(std::sqrt(P) / M_PI)),
+                              solve_case(column, {{"P", P}, {"theta_guess", 0.0}}, 41), "dead load, roller end"));
+  rows->push_back(index_row("Stability: Euler column, first mode, P = 20", "index", 0,
+                            solve_case(column, {{"P", 20.0}, {"theta_guess", 2.0}}, 41), "before the ends meet"));
+  rows->push_back(index_row("Stability: Euler column, first mode, P = 50", "index", 1,
+                            solve_case(column, {{"P", 50.0}, {"theta_guess", 2.8}}, 41),
+                            "ends crossed (theta0 > 2.2813): the rod turns about the pin; a 400-element energy "
+                            "Hessian gives -0.68"));
+  rows->push_back(index_row("Stability: Euler column, second mode, P = 50", "index", 1,
+                            solve_case(column, {{"P", 50.0}, {"theta_guess", 1.0}}, 41), ""));
+  const fs::path clamped = cases / "clamped_clamped.toml";
+  rows->push_back(index_row("Stability: clamped-clamped, D = 0.9, symmetric mode", "index", 0,
+                            solve_case(clamped, {}, 41), "end shortening imposed"));
+  rows->push_back(index_row("Stability: clamped-clamped, D = 0.9, S-shaped mode", "index", 1,
+                            solve_case(clamped, {{"s_mode", 1.0}}, 41), "end shortening imposed"));
+  const double phi_c = analytic::clamped_twisted_critical_moment(1.0, 0.0, 1.0) / 0.769230769230769;
+  const fs::path twisted = cases / "twisted_clamped.toml";
+  rows->push_back(index_row("Stability: twisted straight rod below the Greenhill point", "index", 0,
+                            solve_case(twisted, {{"phi", phi_c - 0.5}}, 41), ""));
+  rows->push_back(index_row("Stability: twisted straight rod above the Greenhill point", "index", 2,
+                            solve_case(twisted, {{"phi", phi_c + 0.5}}, 41), "double branch point"));
+}
 
 int run_reproduce(const std::string& out_dir, const std::string& cases_dir, bool full) {
   const auto start = std::chrono::steady_clock::now();
@@ -777,6 +823,8 @@ int run_reproduce(const std::string& out_dir, const std::string& cases_dir, bool
     invariants(cases, &rows);
     progress("Continuation: Euler column and twisted rod bifurcations");
     continuation(cases, out / "profiles", &rows);
+    progress("Stability: indices of the Euler column, the clamped rod and the twisted rod");
+    stability(cases, &rows);
     progress("Figs. 6-8: sliding sleeve and arm scale");
     sleeves(cases, out / "profiles", &rows);
     progress("Fig. 12: hard and soft walls");

@@ -124,14 +124,33 @@ def sleeves(profiles, figures):
     plt.close(fig)
 
 
+def plot_by_stability(ax, x, y, index, label):
+    """A branch in AUTO's convention: solid where stable (index 0), dashed where unstable, dotted
+    where the index is not defined (-1). Consecutive points of equal kind form one line."""
+    style = {0: "-", -1: ":"}
+    kinds = np.where(index > 0, 1, index).astype(int)
+    start, colour, labelled = 0, None, set()
+    for end in range(1, len(x) + 1):
+        if end < len(x) and kinds[end] == kinds[start]:
+            continue
+        kind = kinds[start]
+        name = {0: "stable", 1: "unstable", -1: "index undefined"}[kind]
+        stop = min(end + 1, len(x))  # overlap one point so the line is unbroken
+        line, = ax.plot(x[start:stop], y[start:stop], style.get(kind, "--"), lw=1.6, color=colour,
+                        label=f"{label}, {name}" if name not in labelled else None)
+        colour = line.get_color()
+        labelled.add(name)
+        start = end
+
+
 def euler_branch(profiles, figures):
     d = read(profiles / "euler_buckled_branch.csv")
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(d["P_elliptic"], d["theta0"], "-", lw=3, alpha=0.4, label="elliptic integrals, 4K(k)$^2$")
-    ax.plot(d["P"], d["theta0"], ".", ms=3, label="pseudo-arclength continuation")
+    plot_by_stability(ax, d["P"], d["theta0"], d["stability_index"], "pseudo-arclength continuation")
     ax.set_xlabel("P L$^2$ / EI")
     ax.set_ylabel("$\\theta_0$ (rad)")
-    ax.set_title("Fig. 3 rod: the first buckled branch")
+    ax.set_title("Fig. 3 rod: the first buckled branch (dead load)")
     ax.legend()
     fig.tight_layout()
     fig.savefig(figures / "fig3_branch.png", dpi=130)

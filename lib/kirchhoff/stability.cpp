@@ -65,7 +65,7 @@ CanonicalMap canonical_map(const RodEquations& eq, const Coordinates& c, const S
 
 // Orthonormal basis of the column space of A (columns below `tol` times the largest dropped).
 Eigen::MatrixXd column_basis(const Eigen::MatrixXd& A, double tol = 1e-10) {
-  if (A.cols() == 0) return Eigen::MatrixXd(A.rows(), 0);
+  if (A.cols() == 0 || A.rows() == 0) return Eigen::MatrixXd(A.rows(), 0);
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU);
   int rank = 0;
   for (int i = 0; i < svd.singularValues().size(); ++i)
@@ -227,7 +227,6 @@ class StabilityAnalysis {
   };
   Held held_at(const EndCondition& end, const std::vector<std::string>& multipliers) const;
   std::string field_reason() const;
-  bool straight_inextensible() const;
   Eigen::MatrixXd constraint_directions(const Held& start, const Held& end) const;
   Frame start_frame(const Held& start, const Eigen::MatrixXd& constraints) const;
   void canonical_blocks(Frame* f) const;
@@ -237,6 +236,7 @@ class StabilityAnalysis {
   bool count_interior(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start,
                       StabilityReport* report) const;
   Eigen::MatrixXd end_terms(const Frame& f, const Held& end, StabilityReport* report) const;
+  std::string end_moment_reason(const Frame& f, const Held& end) const;
   void constraint_correction(const Frame& f, const Held& end, const Eigen::MatrixXd& constraints,
                              const Eigen::MatrixXd& zero_modes, StabilityReport* report) const;
 
@@ -273,33 +273,15 @@ std::string StabilityAnalysis::field_reason() const {
   return "";
 }
 
-bool StabilityAnalysis::straight_inextensible() const {
-  if (eq_->model().extensible) return false;
-  std::vector<double> s(65);
-  for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
-  const std::vector<RodPoint> points = problem_.sample(x_, s);
-  for (const RodPoint& q : points)
-    if ((q.R.col(2) - points.front().R.col(2)).norm() > 1e-9) return false;
-  return true;
-}
-
 // Directions along which both ends hold the position: the isoperimetric constraints
-// e.(r(L) - r(0)) = const, whose multipliers are the reactions. Along the axis of a straight
-// inextensible rod the constraint is empty to first order (the chord cannot change), so it is
-// dropped, as the vibration problem drops the axial pair.
+// e.(r(L) - r(0)) = const, whose multipliers are the reactions.
 Eigen::MatrixXd StabilityAnalysis::constraint_directions(const Held& start, const Held& end) const {
   const int kr = coords_.kr();
   if (start.position.cols() == 0 || end.position.cols() == 0) return Eigen::MatrixXd(kr, 0);
   Eigen::MatrixXd both(kr, start.position.cols() + end.position.cols());
   both << start.position, -end.position;
   const Eigen::MatrixXd pairs = null_space(both, static_cast<int>(both.cols()), 1e-10);
-  Eigen::MatrixXd shared = column_basis(start.position * pairs.topRows(start.position.cols()));
-  if (shared.cols() > 0 && straight_inextensible()) {
-    const Vec3 t = problem_.sample(x_, {0.0}).front().R.col(2);
-    const Eigen::VectorXd axial = coords_.position_dirs.transpose() * t;
-    shared = column_basis(shared - axial * (axial.transpose() * shared));
-  }
-  return shared;
+  return column_basis(start.position * pairs.topRows(start.position.cols()));
 }
 
 // Jacobi fields of the load-controlled problem meeting the start's rotation conditions (dr = 0,
@@ -432,6 +414,19 @@ void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int dept
   *f = next;
 }
 
+// A dead couple on an end free to turn about two or more axes does work that depends on the path
+// of the rotation (Ziegler): not conservative, and the second variation is not defined. In the
+// canonical coordinates the end's natural conditions then fail to be a Lagrangian plane.
+std::string StabilityAnalysis::end_moment_reason(const Frame& f, const Held& end) const {
+  const int kpsi = coords_.size() - coords_.kr();
+  const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f.y, f.s);
+  const Eigen::MatrixXd G = map.G.bottomRightCorner(kpsi, kpsi);
+  const Eigen::MatrixXd free_rotation = complement(end.rotation, kpsi);
+  if ((free_rotation.transpose() * G * free_rotation).norm() > 1e-10 * (1.0 + G.norm()))
+    return "the end's loads are not conservative (a dead couple on an end free to rotate in 3D)";
+  return "";
+}
+
 // Conjugate points in (0, L): net passages of the lifted eigenphases from start to end. Fields
 // with U c = 0 at s = L end exactly on a conjugate point, which is not inside (0, L).
 bool StabilityAnalysis::count_interior(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start,
@@ -499,18 +494,27 @@ Eigen::MatrixXd StabilityAnalysis::end_terms(const Frame& f, const Held& end, St
 // Zero modes of the whole problem: fields meeting every condition, load changes included.
 void StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, const Eigen::MatrixXd& constraints,
                                               const Eigen::MatrixXd& zero_modes, StabilityReport* report) const {
-  const int m = static_cast<int>(f.U.cols()), k = static_cast<int>(constraints.cols());
+  const int m = static_cast<int>(f.U.cols());
   const double tol = options_.zero_tolerance;
+  // A held direction along which no perturbation changes the chord to first order (the axis of
+  // a straight inextensible rod: its axial force is indeterminate) constrains nothing: dropped.
+  Eigen::MatrixXd chord_changes(constraints.cols(), f.R.cols() + f.particular_R.cols());
+  chord_changes << constraints.transpose() * f.R, constraints.transpose() * f.particular_R;
+  const Eigen::MatrixXd active = column_basis(chord_changes, tol);  // in constraint coordinates
+  const Eigen::MatrixXd held = constraints * active;
+  const Eigen::MatrixXd particular_R = f.particular_R * active, particular_U = f.particular_U * active,
+                        particular_P_physical = f.particular_P_physical * active;
+  const int k = static_cast<int>(held.cols());
   const Eigen::MatrixXd free_rotation = complement(end.rotation, m);
   Eigen::MatrixXd conditions(m, m), loads(m, k);
   conditions << end.rotation.transpose() * f.U, free_rotation.transpose() * f.P_physical;
-  loads << end.rotation.transpose() * f.particular_U, free_rotation.transpose() * f.particular_P_physical;
+  loads << end.rotation.transpose() * particular_U, free_rotation.transpose() * particular_P_physical;
   report->zero_modes = 0;
   int correction = 0;
   if (k > 0) {
     const Eigen::MatrixXd c = -conditions.completeOrthogonalDecomposition().solve(loads);
-    const Eigen::MatrixXd chord = constraints.transpose() * (f.R * c + f.particular_R);  // D, k x k
-    const Eigen::MatrixXd chord_zero = constraints.transpose() * f.R * zero_modes;     // k x z
+    const Eigen::MatrixXd chord = held.transpose() * (f.R * c + particular_R);  // D, k x k
+    const Eigen::MatrixXd chord_zero = held.transpose() * f.R * zero_modes;     // k x z
     const int r_z = static_cast<int>(column_basis(chord_zero, tol).cols());
     const Eigen::MatrixXd quiet = null_space(chord_zero.transpose(), k, tol);  // loads doing no work on them
     const Eigen::MatrixXd D = quiet.transpose() * (0.5 * (chord + chord.transpose())) * quiet;
@@ -525,8 +529,8 @@ void StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
   Eigen::MatrixXd all(m + k, m + k);
   all.topLeftCorner(m, m) = conditions;
   all.topRightCorner(m, k) = loads;
-  all.bottomLeftCorner(k, m) = constraints.transpose() * f.R;
-  all.bottomRightCorner(k, k) = constraints.transpose() * f.particular_R;
+  all.bottomLeftCorner(k, m) = held.transpose() * f.R;
+  all.bottomRightCorner(k, k) = held.transpose() * particular_R;
   report->zero_modes = static_cast<int>(null_space(all, m + k, tol).cols());
   report->constraint_count = k;
   report->constraint_correction = correction;
@@ -585,6 +589,10 @@ StabilityReport StabilityAnalysis::run() {
     return report;
   }
   if (!count_interior(f, track, start_phases, &report)) return report;
+  if (std::string why = end_moment_reason(f, end); !why.empty()) {
+    report.reason = why;
+    return report;
+  }
   const Eigen::MatrixXd zero_modes = end_terms(f, end, &report);
   report.dead_load_index = report.interior_count + report.end_count;
   constraint_correction(f, end, constraints, zero_modes, &report);
