@@ -18,6 +18,7 @@
 #include "kirchhoff/hard_self_contact.hpp"
 #include "kirchhoff/plectoneme.hpp"
 #include "kirchhoff/self_passage.hpp"
+#include "kirchhoff/solution.hpp"
 #include "run_state.hpp"
 
 namespace kirchhoff::cli {
@@ -388,10 +389,92 @@ RunState solved_start(const HardPlyStart& seed, double slenderness, double turns
   return start;
 }
 
-// The hard-contact ply legs of a branch (--hard-from): from the barrier solution `at` (a ply), the
-// contact set read off the discretised hard solution (Ipopt), the shooting problem with exact
-// self-contact solved from the barrier's states, then follow_hard_legs. The start is saved beside
-// hard_csv (+ ".start.json"), so a resumed run skips the re-solution.
+// The barrier ply is handed to exact contact once its strands are at most this far apart (in 2R),
+// stiffened to it by continuation in log_softness; when the exact ply's Newton solve does not
+// converge from there, the next, closer gap is tried. Why so close: the exact ply's Newton solve
+// starts from the barrier's states, and its basin is narrow (measured at L/2R = 300 and 5 turns,
+// where the case's log_softness -4 leaves 1.324: from 1.05 Newton stalls at a residual of 62 after
+// 50 iterations, from 1.02 its Jacobian turns singular, from 1.01 it converges in 5 iterations and
+// from 1.002, log_softness -7.8, in 3, the whole handover then fastest: Ipopt too starts nearer its
+// minimum, 56 iterations against 196 from 1.05). At L/2R = 100 the case's -4 leaves 1.108 and
+// Newton converged from there, but not at 300: the gap a fixed log_softness leaves grows with
+// the slenderness, so the stiffness is chosen by the gap, not set. (Not enough everywhere: at
+// L/2R = 500 and 15 turns, a ply 173 R long, Newton stalls from both gaps - the seed's residual,
+// ~5e3, sits at the isolated contacts beside the line and does not fall as the barrier stiffens.)
+constexpr double kHandoverSelfDistances[] = {1.002, 1.0005};
+// The stiffening stops here: a ply whose strands the barrier still holds further apart is not
+// handed over (a branch without a ply at these turns never gets there).
+constexpr double kStiffestLogSoftness = -10.0;
+
+// The barrier ply's self_distance (in 2R) at x: the smallest distance between its strands.
+double barrier_self_distance(const ShootingProblem& barrier, const Eigen::VectorXd& x, double slenderness) {
+  ShootingResult at;
+  at.x = x;
+  at.summary.status = SolverStatus::Converged;
+  at.parameters = barrier.parameters_at(x);
+  return make_solution(barrier, at, 10 * static_cast<int>(slenderness) + 1, {"self_distance"})
+      .derived.at("self_distance");
+}
+
+// The barrier ply `at` (at `turns`) stiffened until its strands are at most `gap` x 2R apart: continued in
+// log_softness towards kStiffestLogSoftness, stopping at the event self_distance = gap. A ply already that
+// close is returned as it is. Sets `barrier`'s log_softness to the returned point's. Throws when the
+// stiffest barrier still holds the strands further apart or the continuation stops short.
+ContinuationPoint stiffened_to(ShootingProblem& barrier, const ContinuationPoint& at, double gap, double slenderness,
+                               const PlectonemeRunOptions& options) {
+  const double distance = barrier_self_distance(barrier, at.x, slenderness);
+  const double log_softness = barrier.parameters().get("log_softness");
+  std::cerr << "  the barrier ply at turns = " << at.parameter << ", log_softness " << std::setprecision(6)
+            << log_softness << ": self_distance " << distance << "\n";
+  if (distance <= gap) return at;
+  // Continued like the barrier branch (its Jacobian at sensitivity_tol); `barrier` itself keeps the
+  // case's, as the exact ply made from it must for its first solve.
+  ProblemDefinition loose = barrier.definition();
+  if (options.sensitivity_tol > 0) loose.options.integrator.sensitivity_tol = options.sensitivity_tol;
+  ShootingProblem moving(loose);
+  ContinuationOptions o = ply_continuation(moving, "log_softness", kStiffestLogSoftness, slenderness, options);
+  o.derived = {"self_distance"};
+  o.samples = 10 * static_cast<int>(slenderness) + 1;  // R/10 apart, as on the branch
+  o.events = {{"self_distance", gap, true, "the strands within the handover's gap"}};
+  const ContinuationResult r = Continuation(moving, o).run(at.x);
+  if (r.reason != StopReason::EventStop || r.points.empty()) {
+    std::ostringstream e;
+    e << "the barrier ply (self_distance " << distance << " at log_softness " << log_softness
+      << ") did not stiffen to self_distance " << gap << " by log_softness " << kStiffestLogSoftness << ": "
+      << stop_text(r) << (r.reason == StopReason::ReachedTarget ? " (is there a ply at these turns?)" : "");
+    throw std::runtime_error(e.str());
+  }
+  ContinuationPoint stiff = r.points.back();
+  barrier.set_parameter("log_softness", stiff.parameter);
+  std::cerr << "  stiffened to log_softness " << stiff.parameter << " (" << r.points.size() << " steps)\n";
+  stiff.parameter = at.parameter;
+  return stiff;
+}
+
+// The exact ply's start from the barrier ply `at` (of `barrier`, at its parameters): the contact set
+// read off the discretised hard solution (Ipopt, seeded by it), the shooting problem with exact
+// self-contact solved from the barrier's states. Throws "hard contact at turns = ...: ..." when either
+// does not solve.
+RunState exact_ply_start(const ShootingProblem& barrier, const ContinuationPoint& at, double slenderness,
+                         const PlectonemeRunOptions& options) {
+  const std::string where = "hard contact at turns = " + std::to_string(at.parameter);
+  HardSelfContactOptions discrete_options;
+  discrete_options.spacing = options.hard_spacing;
+  const HardSelfContactPlectoneme discrete = solve_hard_self_contact(barrier, at.x, discrete_options);
+  if (!discrete.converged)
+    throw std::runtime_error(where + ": the discretised hard problem (Ipopt), whose contacts seed the shooting, did not "
+                             "solve: " + discrete.status +
+                             " (a thinner rod's exact ply is reached from a thicker one's: --from-ply)");
+  const HardPlyStart seed = hard_ply_from_barrier(barrier, at.x, ply_contacts(discrete));
+  return solved_start(seed, slenderness, at.parameter,
+                      where + ": the shooting problem with the discretised solution's " +
+                          std::to_string(seed.definition.contacts.size()) + " contacts");
+}
+
+// The hard-contact ply legs of a branch (--hard-from): from the barrier solution `at` (a ply),
+// stiffened until its strands nearly touch, the exact ply solved from it (exact_ply_start; from
+// each of kHandoverSelfDistances in turn until it solves), then follow_hard_legs. The start is saved
+// beside hard_csv (+ ".start.json"), so a resumed run skips the re-solution.
 void follow_hard_ply(const Case& c, double slenderness, const ContinuationPoint& at, double turns_min,
                      double turns_max, const std::string& hard_csv, const PlectonemeRunOptions& options,
                      PlectonemeBranchSummary* summary) {
@@ -407,19 +490,22 @@ void follow_hard_ply(const Case& c, double slenderness, const ContinuationPoint&
   } else {
     ShootingProblem barrier(with_scaled_tolerance(c.definition, slenderness));
     barrier.set_parameter("turns", at.parameter);
-    HardSelfContactOptions discrete_options;
-    discrete_options.spacing = options.hard_spacing;
-    const HardSelfContactPlectoneme discrete = solve_hard_self_contact(barrier, at.x, discrete_options);
-    if (!discrete.converged)
-      throw std::runtime_error("hard contact at turns = " + std::to_string(at.parameter) +
-                               ": the discretised hard problem (Ipopt), whose contacts seed the shooting, did not "
-                               "solve: " + discrete.status +
-                               " (a thinner rod's exact ply is reached from a thicker one's: --from-ply)");
-    const HardPlyStart seed = hard_ply_from_barrier(barrier, at.x, ply_contacts(discrete));
-    start = solved_start(seed, slenderness, at.parameter,
-                         "hard contact at turns = " + std::to_string(at.parameter) +
-                             ": the shooting problem with the discretised solution's " +
-                             std::to_string(seed.definition.contacts.size()) + " contacts");
+    ContinuationPoint stiff = at;
+    std::string failures;
+    for (double gap : kHandoverSelfDistances) {
+      stiff = stiffened_to(barrier, stiff, gap, slenderness, options);
+      try {
+        start = exact_ply_start(barrier, stiff, slenderness, options);
+        failures.clear();
+        break;
+      } catch (const std::runtime_error& e) {
+        std::cerr << "  " << e.what() << "\n";
+        failures += (failures.empty() ? "" : "; ") + ("from self_distance " + std::to_string(gap) + ": ") + e.what();
+      }
+    }
+    if (!failures.empty())
+      throw std::runtime_error("the handover of the barrier ply to exact contact failed from every gap tried: " +
+                               failures);
     save_state(start_path, start);
   }
   follow_hard_legs(c, slenderness, start, turns_min, turns_max, hard_csv, options, summary);
