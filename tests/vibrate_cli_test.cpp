@@ -84,6 +84,36 @@ TEST_F(VibrateCliTest, BuckledElasticaJsonOnStdout) {
   EXPECT_GT(j["modes"][0]["H_vib_relative_spread"].get<double>(), 1e-3);
 }
 
+// The straight column above its second Euler load: two imaginary frequencies, in the JSON (omega2,
+// negative_omega2_count, unstable_modes with their growth rates and profiles) and in the text.
+// omega_k^2 = (k pi)^2 ((k pi)^2 - P); the search is exact to ~1e-10, and P = 50 is exact here.
+TEST_F(VibrateCliTest, UnstableColumnReportsNegativeOmega2) {
+  const fs::path profiles = dir_ / "modes";
+  ASSERT_EQ(run("vibrate " + case_path("euler_column.toml") + " --set P=50 --set theta_guess=0 --modes 1 --json" +
+                " --profiles " + profiles.string()),
+            0)
+      << err_;
+  const auto j = nlohmann::json::parse(out_);
+  ASSERT_EQ(j["negative_omega2_count"].get<int>(), 2);
+  const double k2[] = {4 * M_PI * M_PI, M_PI * M_PI};  // most negative first: k = 2, then k = 1
+  for (int i = 0; i < 2; ++i) {
+    const double exact = k2[i] * (k2[i] - 50.0);
+    const auto& mode = j["unstable_modes"][i];
+    EXPECT_NEAR(mode["omega2"].get<double>() / exact, 1.0, 1e-9);
+    EXPECT_NEAR(mode["growth_rate"].get<double>(), std::sqrt(-exact), 1e-8 * std::sqrt(-exact));
+    EXPECT_FALSE(mode.contains("omega"));
+    EXPECT_TRUE(fs::exists(mode["profile"].get<std::string>()));
+    EXPECT_NEAR(j["omega2"][i].get<double>(), mode["omega2"].get<double>(), 0.0);
+  }
+  EXPECT_GT(j["omega2"][2].get<double>(), 0.0);  // then the vibrations
+  EXPECT_TRUE(j["unstable_search"]["searched"].get<bool>());
+  EXPECT_TRUE(fs::exists(profiles / "unstable_mode_2.csv"));
+  ASSERT_EQ(run("vibrate " + case_path("euler_column.toml") + " --set P=50 --set theta_guess=0 --modes 1"), 0) << err_;
+  EXPECT_THAT(out_, HasSubstr("unstable: 2 modes with omega^2 < 0"));
+  ASSERT_EQ(run("vibrate " + case_path("euler_column.toml") + " --set P=12 --set theta_guess=1 --modes 1"), 0) << err_;
+  EXPECT_THAT(out_, HasSubstr("no mode with omega^2 < 0"));
+}
+
 TEST_F(VibrateCliTest, RefusesSpatialCasesAndBadOptions) {
   EXPECT_EQ(run("vibrate " + case_path("twisted_clamped.toml")), 2);
   EXPECT_THAT(err_, HasSubstr("planar"));

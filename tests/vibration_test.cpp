@@ -3,9 +3,11 @@
 // vibrations about the buckled Elastica.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "kirchhoff/analytic.hpp"
+#include "kirchhoff/stability.hpp"
 #include "kirchhoff/vibration.hpp"
 #include "test_support.hpp"
 
@@ -295,6 +297,161 @@ TEST(Vibration, RefusesWhatItDoesNotModel) {
   short_grid.omega_max = 50.0;  // the 5th frequency is near 25 pi^2 = 247
   const VibrationProblem vib(*column.problem, column.solution.result.x, short_grid);
   EXPECT_THROW(vib.frequencies(), std::invalid_argument);
+}
+
+// Unstable equilibria: omega^2 = -sigma^2 < 0. The straight pinned column under the dead load P has
+// omega_k^2 = (k pi)^2 ((k pi)^2 - P) / rhoS (eq. 96 for every P), negative for the k with
+// (k pi)^2 < P: at P = 50, k = 1 and 2 (-396.07 and -415.38, 0.48 apart in sigma, beyond the grid's
+// 0.2).
+TEST(Vibration, StraightColumnAtP50HasExactlyTwoNegativeOmega2) {
+  const double P = 50.0;
+  const auto column = straight_euler_column(P);
+  VibrationOptions options;
+  options.modes = 1;
+  const VibrationProblem vib(*column.problem, column.solution.result.x, options);
+  const VibrationAnalysis analysis = vib.analyse();
+  ASSERT_EQ(analysis.negative_omega2_count(), 2);
+  std::vector<double> exact;
+  for (int k = 1; k <= 2; ++k) exact.push_back(std::pow(k * M_PI, 2) * (std::pow(k * M_PI, 2) - P));
+  std::sort(exact.begin(), exact.end());
+  for (int k = 0; k < 2; ++k) {
+    const VibrationMode& mode = analysis.unstable_modes[k];
+    EXPECT_LE(relative_error(mode.omega2, exact[k]), kFrequencyTolerance) << "mode " << k;
+    EXPECT_EQ(mode.omega, 0.0);
+    EXPECT_NEAR(mode.growth_rate(), std::sqrt(-exact[k]), kFrequencyTolerance * std::sqrt(-exact[k]));
+    EXPECT_LE(mode.matching_residual, 1e-8);
+    // The straight column's H_vib (eq. 95b, and eq. 97) stays invariant with omega^2 < 0.
+    EXPECT_TRUE(mode.H_vib_stats.applies);
+    EXPECT_LE(mode.H_vib_stats.relative_spread(), kFlatTolerance);
+  }
+  // The positive frequencies are unchanged: the next one is k = 3.
+  EXPECT_LE(relative_error(analysis.modes[0].omega2, std::pow(3 * M_PI, 2) * (std::pow(3 * M_PI, 2) - P)),
+            kFrequencyTolerance);
+  EXPECT_EQ(analysis.omega2().size(), 3u);
+  EXPECT_LT(analysis.omega2()[0], analysis.omega2()[1]);
+  // The search reached beyond the most negative: the bound sigma^2 >= P^2 / 4 of a uniform straight
+  // column (the infimum of k^2 (k^2 - P) over all wave numbers), and twice further.
+  EXPECT_GE(vib.sigma_bound(), 0.5 * P);
+  EXPECT_DOUBLE_EQ(vib.sigma_max(), 2 * vib.sigma_bound());
+}
+
+TEST(Vibration, StableBuckledColumnHasNoNegativeOmega2) {
+  const auto buckled = testing::solve_case("euler_column.toml", {{"P", 12.0}, {"theta_guess", 1.0}});
+  VibrationOptions options;
+  options.modes = 1;
+  const VibrationProblem vib(*buckled.problem, buckled.solution.result.x, options);
+  EXPECT_FALSE(vib.straight_equilibrium());
+  EXPECT_GT(vib.sigma_max(), 0.0);  // it is compressed: the search was made
+  EXPECT_TRUE(vib.negative_omega2().empty());
+}
+
+// A rod under tension only, without field gradient, cannot have omega^2 < 0: nothing is searched.
+TEST(Vibration, RodUnderTensionSearchesNoGrowthRates) {
+  const auto hanging = testing::solve_case("heavy_cantilever.toml");
+  const VibrationProblem vib(*hanging.problem, hanging.solution.result.x);
+  EXPECT_EQ(vib.sigma_max(), 0.0);
+  EXPECT_TRUE(vib.negative_omega2().empty());
+}
+
+const char* kClampedClamped = R"(
+model = "planar"
+[parameters]
+D = 0.9
+fy = 0.0
+m0 = 0.0
+P = 50.0
+[rod]
+length = 1.0
+B = 1.0
+[start]
+type = "clamped"
+position = [0, 0]
+[end]
+type = "clamped"
+position = ["D", 0]
+[guess]
+force = ["-P", "fy"]
+moment = [0, 0, "m0"]
+)";
+
+struct IndexRow {
+  std::string label, case_name;  // case_name "" for the clamped-clamped text
+  ParameterOverrides overrides;
+  int index;  // known: Euler loads, the issue's acceptance list, and stability_test.cpp
+};
+
+// By Sylvester's law of inertia the number of negative omega^2 is the index of the second
+// variation. On these cases the vibration problem and stability.hpp read the ends alike (no
+// unknown end load), so the count equals analyse_stability's index.
+TEST(Vibration, NegativeOmega2CountEqualsTheStabilityIndex) {
+  const std::vector<IndexRow> rows = {
+      {"straight column P = 5", "euler_column.toml", {{"P", 5.0}, {"theta_guess", 0.0}}, 0},
+      {"straight column P = 20", "euler_column.toml", {{"P", 20.0}, {"theta_guess", 0.0}}, 1},
+      {"straight column P = 100", "euler_column.toml", {{"P", 100.0}, {"theta_guess", 0.0}}, 3},
+      {"buckled mode 1 P = 12", "euler_column.toml", {{"P", 12.0}, {"theta_guess", 1.0}}, 0},
+      {"mode 1 past the ends meeting P = 30", "euler_column.toml", {{"P", 30.0}, {"theta_guess", 2.5}}, 1},
+      {"buckled mode 2 P = 50", "euler_column.toml", {{"P", 50.0}, {"theta_guess", 1.0}}, 1},
+      {"buckled mode 3 P = 100", "euler_column.toml", {{"P", 100.0}, {"theta_guess", 1.5}}, 2},
+      {"clamped-clamped symmetric", "", {{"m0", 6.0}}, 0},
+      {"clamped-clamped S-shaped", "", {{"fy", 10.0}}, 1},
+      {"heavy_cantilever", "heavy_cantilever.toml", {}, 0},
+      {"tapered_column P = 20", "tapered_column.toml", {{"P", 20.0}}, 1},
+      {"tapered_column P = 60", "tapered_column.toml", {{"P", 60.0}}, 2},
+      {"shallow_arch", "shallow_arch.toml", {}, 0},
+      {"shallow_arch w = 40", "shallow_arch.toml", {{"w", 40.0}}, 1},
+  };
+  VibrationOptions options;
+  options.modes = 1;
+  for (const IndexRow& row : rows) {
+    SCOPED_TRACE(row.label);
+    std::unique_ptr<ShootingProblem> problem;
+    Eigen::VectorXd x;
+    if (row.case_name.empty()) {
+      const Case c = load_case_text(kClampedClamped, "clamped_clamped.toml", row.overrides);
+      problem = std::make_unique<ShootingProblem>(c.definition);
+      const ShootingResult r = solve(*problem, problem->initial_unknowns(c.start_guess));
+      ASSERT_TRUE(r.summary.converged());
+      x = r.x;
+    } else {
+      auto solved = testing::solve_case(row.case_name, row.overrides);
+      problem = std::move(solved.problem);
+      x = solved.solution.result.x;
+    }
+    const StabilityReport report = analyse_stability(*problem, x);
+    ASSERT_TRUE(report.defined()) << report.reason;
+    const int negative = static_cast<int>(VibrationProblem(*problem, x, options).negative_omega2().size());
+    EXPECT_EQ(negative, *report.index);
+    EXPECT_EQ(negative, row.index);
+  }
+}
+
+// simply_supported.toml's P is an unknown end load. stability.hpp reads it as a Lagrange multiplier
+// (the end shortening held); the vibration problem keeps the sliding end's load fixed while the rod
+// vibrates, a dead load. At theta0 = 1 and 2 both readings give index 0. At theta0 = 2.8 the ends
+// meet: with the shortening held the rod can only turn about the shared pin (a zero mode, index 0);
+// under the dead load that turn lets the load do work and the rod is unstable, as stability.hpp
+// says of the same equilibrium posed with the load given (euler_column.toml at that P).
+TEST(Vibration, SimplySupportedLoadIsReadAsADeadLoad) {
+  VibrationOptions options;
+  options.modes = 1;
+  for (const auto& [theta0, dead_index] : std::vector<std::pair<double, int>>{{1.0, 0}, {2.0, 0}, {2.8, 1}}) {
+    SCOPED_TRACE("theta0 = " + std::to_string(theta0));
+    const auto solved = testing::solve_case("simply_supported.toml", {{"theta0", theta0}});
+    const Eigen::VectorXd& x = solved.solution.result.x;
+    const int negative = static_cast<int>(VibrationProblem(*solved.problem, x, options).negative_omega2().size());
+    EXPECT_EQ(negative, dead_index);
+    const StabilityReport multiplier = analyse_stability(*solved.problem, x);
+    ASSERT_TRUE(multiplier.defined()) << multiplier.reason;
+    EXPECT_EQ(*multiplier.index, 0);
+    EXPECT_EQ(multiplier.zero_modes, theta0 > 2.5 ? 1 : 0);
+    // The same equilibrium with the load given: the case's definition without the unknown.
+    const Case dead = load_case(testing::case_path("euler_column.toml"), {{"P", solved.solution.derived.at("P")}});
+    const ShootingProblem dead_problem(dead.definition);
+    const Eigen::VectorXd dead_x = x.head(dead_problem.size());  // the state at s = 0, without P
+    const StabilityReport dead_report = analyse_stability(dead_problem, dead_x);
+    ASSERT_TRUE(dead_report.defined()) << dead_report.reason;
+    EXPECT_EQ(*dead_report.index, dead_index);
+  }
 }
 
 }  // namespace

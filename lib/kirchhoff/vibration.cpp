@@ -36,6 +36,10 @@ constexpr double kRootRelativeTolerance = 1e-13;
 constexpr std::uintmax_t kRootMaxIterations = 100;
 // Points sampled to decide whether the equilibrium is straight.
 constexpr int kStraightnessSamples = 65;
+// Points sampled for the bound on the growth rates: the largest compression, curvature and field
+// gradient vary on the rod's own scale, which 257 points resolve to a fraction of a percent, and
+// the search goes twice beyond the bound.
+constexpr int kBoundSamples = 257;
 
 std::string format(double v) {
   std::ostringstream os;
@@ -51,7 +55,7 @@ template <int K>
 struct LinearisedFlow {
   using State = std::array<double, kState * (K + 1)>;
   const RodEquations* equations;
-  double inertia;  // rhoS omega^2
+  double inertia;  // rhoS omega^2 (negative for the unstable modes)
 
   void operator()(const State& y, State& dy, double s) const {
     const Eigen::Map<const Eigen::Matrix<double, kState, 1>> y_e(y.data());
@@ -86,13 +90,13 @@ Eigen::MatrixXd orthonormal_columns(const Eigen::MatrixXd& A) {
 }
 
 // The terms of eq. (95b), in order: 1/2 EI thetabar'^2, -thetabar (nbar x d3).e_z,
-// 1/2 rhoS omega^2 |rbar|^2, -1/2 thetabar^2 n_e.d3.
-std::array<double, 4> eq95b_terms(double EI, double rho_s, double omega, double theta_e, double n_xe, double n_ye,
+// 1/2 rhoS omega^2 |rbar|^2, -1/2 thetabar^2 n_e.d3 (omega2 = omega^2, negative for unstable modes).
+std::array<double, 4> eq95b_terms(double EI, double rho_s, double omega2, double theta_e, double n_xe, double n_ye,
                                   const VibrationState& q) {
   const double c = std::cos(theta_e), sn = std::sin(theta_e);
   const double theta_prime = q[kMoment] / EI;
   return {0.5 * EI * theta_prime * theta_prime, -q[kTheta] * (q[kNx] * sn - q[kNy] * c),
-          0.5 * rho_s * omega * omega * (q[kX] * q[kX] + q[kY] * q[kY]),
+          0.5 * rho_s * omega2 * (q[kX] * q[kX] + q[kY] * q[kY]),
           -0.5 * q[kTheta] * q[kTheta] * (n_xe * c + n_ye * sn)};
 }
 
@@ -115,6 +119,13 @@ void march_through_nodes(State& state, double from, double to, const Flow& flow,
   }
   detail::march(state, at, to, flow, options);
 }
+
+// Eq. (97) with omega^2 signed.
+double eq97_terms(double EI, double rho_s, double omega2, double P, const ColumnDeflection& d, bool as_printed) {
+  const double P_term = as_printed ? d.w * d.w : d.w1 * d.w1;
+  return 0.5 * EI * d.w2 * d.w2 + 0.5 * rho_s * omega2 * d.w * d.w - 0.5 * P * P_term - EI * d.w1 * d.w3;
+}
+
 }  // namespace
 
 std::string VibrationOptions::validate() const {
@@ -124,9 +135,19 @@ std::string VibrationOptions::validate() const {
   if (!(omega_min > 0.0) || !std::isfinite(omega_min))
     return "omega_min must be > 0 (omega = 0 is a root for every free rigid motion), got " + format(omega_min);
   if (!(omega_max == 0.0 || omega_max > omega_min)) return "omega_max must be 0 (no limit) or > omega_min";
+  if (!(sigma_max == 0.0 || sigma_max > omega_min)) return "sigma_max must be 0 (the bound) or > omega_min";
   if (max_grid_points < 2) return "max_grid_points must be >= 2";
   if (profile_samples < 3) return "profile_samples must be >= 3, got " + std::to_string(profile_samples);
   return integrator.validate();
+}
+
+double VibrationMode::growth_rate() const { return omega2 < 0.0 ? std::sqrt(-omega2) : 0.0; }
+
+std::vector<double> VibrationAnalysis::omega2() const {
+  std::vector<double> out;
+  for (const auto* list : {&unstable_modes, &modes})
+    for (const auto& m : *list) out.push_back(m.omega2);
+  return out;
 }
 
 std::vector<double> VibrationAnalysis::frequencies() const {
@@ -182,6 +203,9 @@ VibrationProblem::VibrationProblem(const ShootingProblem& problem, const Eigen::
     for (const RodPoint& point : problem.sample(x, s))
       theta_range = std::max(theta_range, std::abs(point.turn_angle - y_start_[kTheta]));
     straight_ = theta_range <= kStraightTolerance;
+    std::vector<double> fine(kBoundSamples);
+    for (int i = 0; i < kBoundSamples; ++i) fine[i] = length_ * i / (kBoundSamples - 1);
+    bound_growth_rate(problem.sample(x, fine), definition);
   } catch (const IntegrationError& e) {
     throw std::invalid_argument(std::string("vibrations: the equilibrium cannot be integrated: ") + e.what());
   }
@@ -255,9 +279,32 @@ VibrationProblem::VibrationProblem(const ShootingProblem& problem, const Eigen::
   row_scale_ << 1.0 / length_, 1.0 / length_, 1.0, length_ * length_ / EI, length_ * length_ / EI, length_ / EI;
 }
 
-VibrationProblem::Matching VibrationProblem::matching(double omega) const {
+void VibrationProblem::bound_growth_rate(const std::vector<RodPoint>& points, const ProblemDefinition& definition) {
+  const RodModel& model = equations_->model();
+  double compression = 0.0, curvature = 0.0, stiffness = INFINITY, gradient = 0.0;
+  for (const RodPoint& q : points) {
+    compression = std::max(compression, -q.n.dot(q.R.col(2)));
+    curvature = std::max(curvature, std::abs(q.u.y()));
+    stiffness = std::min(stiffness, model.B[1](q.s));
+    if (model.field) gradient = std::max(gradient, model.field->force_gradient(q.s, q.r).topLeftCorner<2, 2>().norm());
+  }
+  // A free end (position not held along some direction) admits the rigid turn's boundary term.
+  bool free_end = false;
+  for (const EndCondition* end : {&definition.start, &definition.end}) {
+    int held = 0;
+    for (const auto& c : end->conditions())
+      if (c.slot == Slot::Position && !c.extra) held += static_cast<int>(c.basis(*equations_).cols());
+    free_end = free_end || held < 2;
+  }
+  const double turn = free_end ? 12.0 * compression / (length_ * length_) : 0.0;
+  sigma_bound_ = std::sqrt((compression * compression / stiffness + compression * curvature * curvature + turn +
+                            gradient) / options_.rho_s);
+  sigma_max_ = options_.sigma_max > 0.0 ? options_.sigma_max * omega_scale_ : 2.0 * sigma_bound_;
+}
+
+VibrationProblem::Matching VibrationProblem::matching(double omega2) const {
   using Flow = LinearisedFlow<kColumns>;
-  const Flow flow{equations_.get(), options_.rho_s * omega * omega};
+  const Flow flow{equations_.get(), options_.rho_s * omega2};
   auto shoot = [&](const Eigen::VectorXd& y_e, const Eigen::MatrixXd& basis, double from) {
     Flow::State state{};
     for (int i = 0; i < kState; ++i) state[i] = y_e[i];
@@ -281,11 +328,42 @@ VibrationProblem::Matching VibrationProblem::matching(double omega) const {
 double VibrationProblem::scaled_determinant(double omega) const {
   if (!(omega >= 0.0) || !std::isfinite(omega))
     throw std::invalid_argument("vibrations: omega must be finite and >= 0, got " + format(omega));
+  return scaled_determinant_at(omega * omega);
+}
+
+double VibrationProblem::scaled_determinant_at(double omega2) const {
+  if (!std::isfinite(omega2)) throw std::invalid_argument("vibrations: omega^2 must be finite, got " + format(omega2));
   try {
-    return matching(omega).M.determinant();
+    return matching(omega2).M.determinant();
   } catch (const IntegrationError& e) {
-    throw std::invalid_argument("vibrations: integration failed at omega = " + format(omega) + ": " + e.what());
+    throw std::invalid_argument("vibrations: integration failed at omega^2 = " + format(omega2) + ": " + e.what());
   }
+}
+
+template <class Omega2>
+double VibrationProblem::bracketed_root(double a, double fa, double b, double fb, const Omega2& omega2_of,
+                                        const char* name) const {
+  auto det = [&](double v) { return scaled_determinant_at(omega2_of(v)); };
+  double root = b;
+  if (fb != 0.0) {
+    std::uintmax_t iterations = kRootMaxIterations;
+    auto close_enough = [](double lo, double hi) { return std::abs(hi - lo) <= kRootRelativeTolerance * std::abs(hi); };
+    const auto [lo, hi] = boost::math::tools::toms748_solve(det, a, b, fa, fb, close_enough, iterations);
+    // Each TOMS 748 iteration shrinks the bracket, so running out of iterations with a wide one
+    // means the determinant is not behaving like a continuous function there.
+    if (!close_enough(lo, hi))
+      throw std::invalid_argument(std::string("vibrations: the root bracketed in ") + name + " in [" + format(a) +
+                                  ", " + format(b) + "] did not converge");
+    root = 0.5 * (lo + hi);
+  }
+  // A sign change must be a singular matching matrix, not a numerical jump.
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(matching(omega2_of(root)).M);
+  const double residual = svd.singularValues().tail(1)[0] / svd.singularValues()[0];
+  if (residual > kMatchingResidualLimit)
+    throw std::invalid_argument(std::string("vibrations: the determinant changes sign near ") + name + " = " +
+                                format(root) + " but the boundary conditions are not met there (sigma_min/sigma_max = " +
+                                format(residual) + ")");
+  return root;
 }
 
 std::vector<double> VibrationProblem::frequencies() const {
@@ -300,41 +378,44 @@ std::vector<double> VibrationProblem::frequencies() const {
                                   std::to_string(options_.modes) + " frequencies requested below omega = " +
                                   format(previous_omega) + " (end of the search grid: raise omega_max or max_grid_points)");
     const double value = det(omega);
-    if (value == 0.0 || (value > 0.0) != (previous > 0.0)) {
-      double root = omega;
-      if (value != 0.0) {
-        std::uintmax_t iterations = kRootMaxIterations;
-        auto close_enough = [](double a, double b) { return std::abs(b - a) <= kRootRelativeTolerance * std::abs(b); };
-        const auto [lo, hi] = boost::math::tools::toms748_solve(det, previous_omega, omega, previous, value,
-                                                                 close_enough, iterations);
-        // Each TOMS 748 iteration shrinks the bracket, so running out of iterations with a wide one
-        // means the determinant is not behaving like a continuous function there.
-        if (!close_enough(lo, hi))
-          throw std::invalid_argument("vibrations: the root bracketed in [" + format(previous_omega) + ", " +
-                                      format(omega) + "] did not converge");
-        root = 0.5 * (lo + hi);
-      }
-      // A sign change must be a singular matching matrix, not a numerical jump.
-      const Eigen::JacobiSVD<Eigen::MatrixXd> svd(matching(root).M);
-      const double residual = svd.singularValues().tail(1)[0] / svd.singularValues()[0];
-      if (residual > kMatchingResidualLimit)
-        throw std::invalid_argument("vibrations: the determinant changes sign near omega = " + format(root) +
-                                    " but the boundary conditions are not met there (sigma_min/sigma_max = " +
-                                    format(residual) + ")");
-      found.push_back(root);
-    }
+    if (value == 0.0 || (value > 0.0) != (previous > 0.0))
+      found.push_back(bracketed_root(previous_omega, previous, omega, value, [](double w) { return w * w; }, "omega"));
     previous_omega = omega;
     previous = value;
   }
   return found;
 }
 
+std::vector<double> VibrationProblem::negative_omega2() const {
+  std::vector<double> found;
+  auto omega2_of = [](double sigma) { return -sigma * sigma; };
+  auto det = [&](double sigma) { return scaled_determinant_at(omega2_of(sigma)); };
+  double previous_sigma = omega_scale_ * options_.omega_min;
+  if (!(sigma_max_ > previous_sigma)) return found;  // no compression, no field gradient: none exist
+  double previous = det(previous_sigma);
+  for (int i = 1;; ++i) {
+    const double sigma = omega_scale_ * (options_.omega_min + i * options_.grid_step);
+    if (sigma > sigma_max_) break;
+    if (i >= options_.max_grid_points)
+      throw std::invalid_argument("vibrations: the search for omega^2 < 0 needs more than max_grid_points = " +
+                                  std::to_string(options_.max_grid_points) + " points to reach sigma = " +
+                                  format(sigma_max_));
+    const double value = det(sigma);
+    if (value == 0.0 || (value > 0.0) != (previous > 0.0))
+      found.push_back(omega2_of(bracketed_root(previous_sigma, previous, sigma, value, omega2_of, "sigma")));
+    previous_sigma = sigma;
+    previous = value;
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
 std::vector<Eigen::Matrix<double, 12, 1>> VibrationProblem::integrate_samples(const Eigen::VectorXd& y_e,
                                                                               const VibrationState& qbar,
                                                                               const std::vector<double>& s,
-                                                                              double omega) const {
+                                                                              double omega2) const {
   using Flow = LinearisedFlow<1>;
-  const Flow flow{equations_.get(), options_.rho_s * omega * omega};
+  const Flow flow{equations_.get(), options_.rho_s * omega2};
   Flow::State state{};
   for (int i = 0; i < kState; ++i) {
     state[i] = y_e[i];
@@ -351,11 +432,15 @@ std::vector<Eigen::Matrix<double, 12, 1>> VibrationProblem::integrate_samples(co
   return out;
 }
 
-VibrationMode VibrationProblem::mode(double omega) const {
-  const Matching m = matching(omega);
+VibrationMode VibrationProblem::mode(double omega) const { return mode_at(omega * omega); }
+
+VibrationMode VibrationProblem::mode_at(double omega2) const {
+  const Matching m = matching(omega2);
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(m.M, Eigen::ComputeFullV);
   VibrationMode out;
-  out.omega = omega;
+  out.omega2 = omega2;
+  out.omega = std::sqrt(std::max(omega2, 0.0));
+  const std::string where = "omega^2 = " + format(omega2);
   out.matching_residual = svd.singularValues().tail(1)[0] / svd.singularValues()[0];
   // M c = 0 with M = raw diag(1/norms): raw (c / norms) = 0, i.e. Y0 c0 = -YL cL at mid-span.
   const Eigen::VectorXd c = svd.matrixV().col(m.M.cols() - 1).cwiseQuotient(m.column_norms);
@@ -373,14 +458,13 @@ VibrationMode VibrationProblem::mode(double omega) const {
   std::reverse(right.begin(), right.end());
   std::vector<Eigen::Matrix<double, 12, 1>> samples;
   try {
-    samples = integrate_samples(y_start_, from_start, left, omega);
+    samples = integrate_samples(y_start_, from_start, left, omega2);
     if (!right.empty()) {
-      auto tail = integrate_samples(y_end_, from_end, right, omega);
+      auto tail = integrate_samples(y_end_, from_end, right, omega2);
       samples.insert(samples.end(), tail.rbegin(), tail.rend());
     }
   } catch (const IntegrationError& e) {
-    throw std::invalid_argument("vibrations: integration of the mode at omega = " + format(omega) +
-                                " failed: " + e.what());
+    throw std::invalid_argument("vibrations: integration of the mode at " + where + " failed: " + e.what());
   }
   std::reverse(right.begin(), right.end());
   out.s = left;
@@ -396,7 +480,7 @@ VibrationMode VibrationProblem::mode(double omega) const {
     for (const auto& y : samples)
       if (std::abs(y[kState + kTheta]) > std::abs(largest)) largest = y[kState + kTheta];
   }
-  if (largest == 0.0) throw std::invalid_argument("vibrations: the mode at omega = " + format(omega) + " is zero");
+  if (largest == 0.0) throw std::invalid_argument("vibrations: the mode at " + where + " is zero");
   const double normalisation = 1.0 / largest;
 
   const RodModel& model = equations_->model();
@@ -411,7 +495,7 @@ VibrationMode VibrationProblem::mode(double omega) const {
     const VibrationState q = samples[k].tail<kState>() * normalisation;
     out.state.push_back(q);
     const double EI = model.B[1](s);
-    const auto terms = eq95b_terms(EI, rho_s, omega, y_e[kTheta], y_e[kNx], y_e[kNy], q);
+    const auto terms = eq95b_terms(EI, rho_s, omega2, y_e[kTheta], y_e[kNx], y_e[kNy], q);
     const double H = terms[0] + terms[1] + terms[2] + terms[3];
     out.H_vib.push_back(H);
     h_min = std::min(h_min, H);
@@ -422,7 +506,7 @@ VibrationMode VibrationProblem::mode(double omega) const {
       // w = rbar.normal and its derivatives through (B.4); m' = -nbar.normal - P thetabar here.
       const double mbar_prime = -(q[kNx] * normal.x() + q[kNy] * normal.y()) - P * q[kTheta];
       const ColumnDeflection d{q[kX] * normal.x() + q[kY] * normal.y(), q[kTheta], q[kMoment] / EI, mbar_prime / EI};
-      out.H_vib_column.push_back(eq97_hamiltonian(EI, rho_s, omega, P, d));
+      out.H_vib_column.push_back(eq97_terms(EI, rho_s, omega2, P, d, false));
     }
   }
   out.H_vib_stats.min = h_min;
@@ -440,17 +524,20 @@ VibrationAnalysis VibrationProblem::analyse() const {
   out.axial_indeterminate = axial_indeterminate_;
   out.omega_scale = omega_scale_;
   for (double omega : frequencies()) out.modes.push_back(mode(omega));
+  out.sigma_max = sigma_max_;
+  out.unstable_searched = options_.unstable_modes;
+  if (options_.unstable_modes)
+    for (double omega2 : negative_omega2()) out.unstable_modes.push_back(mode_at(omega2));
   return out;
 }
 
 double eq97_hamiltonian(double EI, double rho_s, double omega, double P, const ColumnDeflection& d, bool as_printed) {
-  const double P_term = as_printed ? d.w * d.w : d.w1 * d.w1;
-  return 0.5 * EI * d.w2 * d.w2 + 0.5 * rho_s * omega * omega * d.w * d.w - 0.5 * P * P_term - EI * d.w1 * d.w3;
+  return eq97_terms(EI, rho_s, omega * omega, P, d, as_printed);
 }
 
 double eq95b_hamiltonian(double EI, double rho_s, double omega, double theta_e, double n_xe, double n_ye,
                          const VibrationState& qbar) {
-  const auto terms = eq95b_terms(EI, rho_s, omega, theta_e, n_xe, n_ye, qbar);
+  const auto terms = eq95b_terms(EI, rho_s, omega * omega, theta_e, n_xe, n_ye, qbar);
   return terms[0] + terms[1] + terms[2] + terms[3];
 }
 
