@@ -27,6 +27,9 @@ long march(State& x, double s0, double s1, const System& system, const Integrato
     while ((span > 0) ? (s < s1) : (s > s1)) {
       if ((span > 0) ? (s + ds > s1) : (s + ds < s1)) ds = s1 - s;
       if (stepper.try_step(system, x, s, ds) == odeint::success) ++steps;
+      // A step meant to land on s1 can stop an ulp short of it (s + (s1 - s) rounds): the sliver
+      // left is below round-off, not a step to take (taking it read as a step-size underflow).
+      if (std::abs(s1 - s) <= 1e-14 * std::abs(span)) break;
       if (steps + 1 > opt.max_steps) throw IntegrationError("more than max_steps integration steps");
       if (!std::isfinite(ds) || std::abs(ds) < 1e-14 * std::abs(span))
         throw IntegrationError("step size underflow near s = " + std::to_string(s));

@@ -162,8 +162,15 @@ Eigen::MatrixXd held_directions(const RodEquations& eq, const EndCondition& end,
 
 std::string unsupported(const ShootingProblem& problem, const Eigen::VectorXd& x) {
   const ProblemDefinition& d = problem.definition();
-  if (!problem.contacts_at(x).empty())
-    return "active contacts: the second variation with sliding contact points is not implemented";
+  const std::vector<Obstacle> obstacles = problem.obstacles(problem.parameters_at(x));
+  for (const PointContact& c : problem.contacts_at(x)) {
+    if (c.extended)
+      return "an extended contact (the rod lying on the obstacle): its second variation is not implemented";
+    if (!obstacles[c.obstacle].is_flat())
+      return "a contact with a curved obstacle: its second variation (the obstacle's curvature) is not implemented";
+    if (problem.equations(problem.parameters_at(x))->model().extensible)
+      return "a contact of an extensible rod: not implemented";
+  }
   if (d.start.is_half_turn_symmetry() || d.end.is_half_turn_symmetry())
     return "half of a symmetric rod (half-turn end): the whole rod's index needs the antisymmetric "
            "perturbations too, which are not implemented";
@@ -172,8 +179,14 @@ std::string unsupported(const ShootingProblem& problem, const Eigen::VectorXd& x
 
 double wrap(double angle) { return std::remainder(angle, 2 * kPi); }
 
-// Eigenphases of W = X X^T, X = U + iP (unitary for an orthonormal Lagrangian frame).
-Eigen::VectorXd eigenphases(const Eigen::MatrixXd& U, const Eigen::MatrixXd& P) {
+// Eigenphases of W = (U + iP)(U - iP)^-1: with the frame made orthonormal, W = X X^T for the
+// unitary X = U + iP.
+Eigen::VectorXd eigenphases(const Eigen::MatrixXd& U_in, const Eigen::MatrixXd& P_in) {
+  const int m = static_cast<int>(U_in.cols());
+  Eigen::MatrixXd Z(2 * m, m);
+  Z << U_in, P_in;
+  const Eigen::MatrixXd Q = Eigen::HouseholderQR<Eigen::MatrixXd>(Z).householderQ() * Eigen::MatrixXd::Identity(2 * m, m);
+  const Eigen::MatrixXd U = Q.topRows(m), P = Q.bottomRows(m);
   const Eigen::MatrixXcd X = U.cast<std::complex<double>>() + std::complex<double>(0, 1) * P;
   Eigen::ComplexEigenSolver<Eigen::MatrixXcd> solver(X * X.transpose(), false);
   Eigen::VectorXd phase(U.cols());
@@ -188,8 +201,13 @@ struct Frame {
   Eigen::MatrixXd dY;  // N x kpsi: state perturbations of the fields
   Eigen::MatrixXd U, P, P_physical;  // rotation blocks, kpsi x kpsi each; [U; P] orthonormal
   Eigen::MatrixXd R;                  // position perturbation of the fields (kr x kpsi), slaved
-  // One field per isoperimetric constraint: the response to a unit change of the end load along it.
+  // One field per isoperimetric constraint: the response to a unit change of the end load along
+  // it, then one per point contact, zero up to its contact, the response to a unit change of its
+  // force beyond.
   Eigen::MatrixXd particular, particular_U, particular_P, particular_P_physical, particular_R;
+  // The contacts' constraints nu.dr(s_c) / L on the frame's fields and on the particular ones,
+  // recorded as each contact is passed.
+  Eigen::MatrixXd contact_rows_frame, contact_rows_particular;
 };
 
 // Follows lifted eigenphases, and where they pass odd multiples of pi (a stack per eigenphase:
@@ -201,6 +219,17 @@ struct PhaseTrack {
   bool reversed = false;  // a genuine passage against the Legendre direction
   double reversed_at = 0.0;
 };
+
+// How far the eigenphases moved: the largest distance from a lifted phase to its nearest new one.
+double largest_phase_move(const Eigen::VectorXd& phases, const Eigen::VectorXd& lifted) {
+  double largest = 0.0;
+  for (int j = 0; j < lifted.size(); ++j) {
+    double nearest = kPi;
+    for (int k = 0; k < phases.size(); ++k) nearest = std::min(nearest, std::abs(wrap(phases[k] - lifted[j])));
+    largest = std::max(largest, nearest);
+  }
+  return largest;
+}
 
 int odd_multiples_between(double a, double b) {  // odd k with a < k pi < b (a < b)
   const long lo = static_cast<long>(std::floor((a / kPi - 1) / 2)) + 1;
@@ -228,7 +257,9 @@ class StabilityAnalysis {
   Held held_at(const EndCondition& end, const std::vector<std::string>& multipliers) const;
   std::string field_reason() const;
   Eigen::MatrixXd constraint_directions(const Held& start, const Held& end) const;
-  Frame start_frame(const Held& start, const Eigen::MatrixXd& constraints) const;
+  Frame start_frame(const Held& start, const Eigen::MatrixXd& constraints, int contacts) const;
+  std::string pass_contact(Frame* f, const PointContact& contact, int number, int chord_count, PhaseTrack* track,
+                           double* shear);
   void canonical_blocks(Frame* f) const;
   void orthonormalise(Frame* f) const;
   void advance(Frame* f, double s1, PhaseTrack* track, int depth);
@@ -237,7 +268,7 @@ class StabilityAnalysis {
                       StabilityReport* report) const;
   Eigen::MatrixXd end_terms(const Frame& f, const Held& end, StabilityReport* report) const;
   std::string end_moment_reason(const Frame& f, const Held& end) const;
-  void constraint_correction(const Frame& f, const Held& end, const Eigen::MatrixXd& constraints,
+  bool constraint_correction(const Frame& f, const Held& end, const Eigen::MatrixXd& constraints,
                              const Eigen::MatrixXd& zero_modes, StabilityReport* report) const;
 
   const ShootingProblem& problem_;
@@ -287,7 +318,7 @@ Eigen::MatrixXd StabilityAnalysis::constraint_directions(const Held& start, cons
 // Jacobi fields of the load-controlled problem meeting the start's rotation conditions (dr = 0,
 // dn = 0), then one particular field per constraint direction: a unit change of the end load
 // along it (dn = e_j).
-Frame StabilityAnalysis::start_frame(const Held& start, const Eigen::MatrixXd& constraints) const {
+Frame StabilityAnalysis::start_frame(const Held& start, const Eigen::MatrixXd& constraints, int contacts) const {
   const int n = coords_.size(), kr = coords_.kr(), kpsi = n - kr;
   const Eigen::MatrixXd free_rotation = complement(start.rotation, kpsi);
   const int columns = kpsi + static_cast<int>(constraints.cols());
@@ -301,7 +332,10 @@ Frame StabilityAnalysis::start_frame(const Held& start, const Eigen::MatrixXd& c
   const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f.y, 0.0);
   const Eigen::MatrixXd dY = map.T.completeOrthogonalDecomposition().solve(z);
   f.dY = dY.leftCols(kpsi);
-  f.particular = dY.rightCols(constraints.cols());
+  f.particular = Eigen::MatrixXd::Zero(dY.rows(), constraints.cols() + contacts);
+  f.particular.leftCols(constraints.cols()) = dY.rightCols(constraints.cols());
+  f.contact_rows_frame = Eigen::MatrixXd::Zero(contacts, kpsi);
+  f.contact_rows_particular = Eigen::MatrixXd::Zero(contacts, constraints.cols() + contacts);
   canonical_blocks(&f);
   return f;
 }
@@ -334,6 +368,7 @@ void StabilityAnalysis::orthonormalise(Frame* f) const {
   f->P = f->P * Rinv;
   f->P_physical = f->P_physical * Rinv;
   f->R = f->R * Rinv;
+  f->contact_rows_frame = f->contact_rows_frame * Rinv;
 }
 
 // Matches new eigenphases to the lifted old ones (nearest on the circle) and lifts them. A phase
@@ -390,17 +425,15 @@ void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int dept
   next.s = s1;
   next.dY = flow.Phi * f->dY;
   next.particular = flow.Phi * f->particular;
+  next.contact_rows_frame = f->contact_rows_frame;
+  next.contact_rows_particular = f->contact_rows_particular;
   canonical_blocks(&next);
   orthonormalise(&next);
   const Eigen::VectorXd phases = eigenphases(next.U, next.P);
-  double largest = 0.0;
+  const double largest = largest_phase_move(phases, track->lifted);
   bool passage = false;
-  for (int j = 0; j < phases.size(); ++j) {
-    double nearest = kPi;
-    for (int k = 0; k < phases.size(); ++k) nearest = std::min(nearest, std::abs(wrap(phases[k] - track->lifted[j])));
-    largest = std::max(largest, nearest);
-    passage = passage || odd_multiples_between(track->lifted[j] - nearest, track->lifted[j] + nearest) > 0;
-  }
+  for (int j = 0; j < phases.size(); ++j)
+    passage = passage || odd_multiples_between(track->lifted[j] - largest, track->lifted[j] + largest) > 0;
   // Steps are halved while a phase moves too far, and around a passage until it is located to
   // passage_resolution (the interpolation below is then exact to its square).
   const bool locate = passage && s1 - f->s > options_.passage_resolution * scales_.length;
@@ -412,6 +445,76 @@ void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int dept
   }
   record(track->lifted, f->s, phases, s1, track);
   *f = next;
+}
+
+// Across a point contact on a plane (normal nu, force f > 0, the rod curving away at the rate
+// g'' = nu.d3' > 0):
+//  - the equilibrium's force jumps by -f nu; in the load-controlled problem the contact force is
+//    a dead load on its material point, so the fields' dn is continuous;
+//  - the contact point slides: to second order the rod stays off the plane iff min_s of its gap
+//    does, and that minimum over the sliding contact point adds f (nu.dr')^2 / (2 g'') to the
+//    second variation, with nu.dr' = dpsi.(d3 x nu). (Holding the contact at its material point
+//    instead leaves this term out and gives another, wrong count.) For the fields this is a jump
+//    of the moment dm += (f / g'') w (w.dpsi), w = d3 x nu: a shear p += S u that leaves U, so
+//    no conjugate point, unchanged; the eigenphases are followed through it in small steps;
+//  - nu.dr(s_c) = 0 is one more isoperimetric constraint, its multiplier the change of the force:
+//    its particular field starts here with dn = -nu.
+std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contact, int number, int chord_count,
+                                            PhaseTrack* track, double* shear) {
+  const int n = coords_.size(), kr = coords_.kr(), kpsi = n - kr;
+  const RodPoint here = eq_->point(f->y, f->s);
+  const Obstacle& obstacle = problem_.obstacles(p_)[contact.obstacle];
+  const Vec3 nu = obstacle.normal(here.r);
+  const Vec3 d3 = here.R.col(2), curving = here.R * here.u.cross(Vec3::UnitZ());  // d3' of an inextensible rod
+  const double g2 = nu.dot(curving), scale = 1.0 / scales_.length;
+  if (!(contact.force > 1e-10 * scales_.bending / (scales_.length * scales_.length)))
+    return "a contact with zero force (weakly active): the index depends on higher-order terms, not defined here";
+  if (!(g2 > 1e-9 * scale))
+    return "a contact where the rod does not curve away from the plane (g'' = 0: it is about to flatten onto it)";
+  const Eigen::VectorXd nu_r = coords_.position_dirs.transpose() * nu;
+  f->contact_rows_frame.row(number) = nu_r.transpose() * f->R;
+  f->contact_rows_particular.row(number) = nu_r.transpose() * f->particular_R;
+  // The equilibrium's jump.
+  f->y += eq_->slot_map(Slot::Force).transpose() * (-contact.force * nu);
+  // The shear, followed in small steps (it cannot move an eigenphase across -1).
+  const Eigen::VectorXd w = coords_.rotation_dirs.transpose() * d3.cross(nu);
+  const double stiffness = options_.contact_sliding ? contact.force / g2 : 0.0;  // f / g''
+  const Eigen::MatrixXd S = (scales_.length / scales_.bending) * stiffness * w * w.transpose();
+  *shear = S.norm();
+  // Steps in the shear's size t are shortened until no eigenphase moves more than
+  // max_phase_step (a large f / g'', next to the contact flattening, turns them far).
+  // The shear leaves U, so no eigenphase passes -1 through it: each stays in its sheet between
+  // consecutive odd multiples of pi (it may turn almost a whole turn inside it, so it is not
+  // followed by small steps, which could not tell such a turn from a small one back).
+  const Eigen::VectorXd sheared = eigenphases(f->U, f->P + S * f->U);
+  std::vector<bool> used(sheared.size(), false);
+  for (int j = 0; j < track->lifted.size(); ++j) {
+    const double sheet = 2 * kPi * std::round(track->lifted[j] / (2 * kPi));
+    int best = -1;
+    for (int k = 0; k < sheared.size(); ++k)
+      if (!used[k] && (best < 0 || std::abs(wrap(sheared[k] - track->lifted[j])) <
+                                       std::abs(wrap(sheared[best] - track->lifted[j]))))
+        best = k;
+    used[best] = true;
+    track->lifted[j] = sheet + sheared[best];
+    track->lowest[j] = std::min(track->lowest[j], track->lifted[j]);
+  }
+  Eigen::MatrixXd rotation_jacobian;
+  const Mat3 reference = eq_->is_planar() ? planar_reference_frame() : Mat3::Identity();
+  const Eigen::AngleAxisd frame(Mat3(here.R * reference.transpose()));
+  eq_->orientation_error(f->y, OrientationTarget{frame.axis(), frame.angle()}, false, &rotation_jacobian);
+  const Vec3 w_lab = d3.cross(nu);
+  f->dY += eq_->slot_map(Slot::Moment).transpose() * (stiffness * w_lab * w_lab.transpose()) *
+           rotation_jacobian * f->dY;
+  // The force's particular field.
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * n);
+  z.segment(n, kr) = -nu_r;
+  const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f->y, f->s);
+  f->particular.col(chord_count + number) = map.T.completeOrthogonalDecomposition().solve(z);
+  canonical_blocks(f);
+  orthonormalise(f);
+  (void)kpsi;
+  return "";
 }
 
 // A dead couple on an end free to turn about two or more axes does work that depends on the path
@@ -492,19 +595,32 @@ Eigen::MatrixXd StabilityAnalysis::end_terms(const Frame& f, const Held& end, St
 // along the load-controlled equilibria, and r_Z the rank of the chord change along the
 // load-controlled problem's zero modes (D is then taken on the loads that do no work on them).
 // Zero modes of the whole problem: fields meeting every condition, load changes included.
-void StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, const Eigen::MatrixXd& constraints,
+bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, const Eigen::MatrixXd& constraints,
                                               const Eigen::MatrixXd& zero_modes, StabilityReport* report) const {
   const int m = static_cast<int>(f.U.cols());
   const double tol = options_.zero_tolerance;
-  // A held direction along which no perturbation changes the chord to first order (the axis of
-  // a straight inextensible rod: its axial force is indeterminate) constrains nothing: dropped.
-  Eigen::MatrixXd chord_changes(constraints.cols(), f.R.cols() + f.particular_R.cols());
-  chord_changes << constraints.transpose() * f.R, constraints.transpose() * f.particular_R;
-  const Eigen::MatrixXd active = column_basis(chord_changes, tol);  // in constraint coordinates
-  const Eigen::MatrixXd held = constraints * active;
-  const Eigen::MatrixXd particular_R = f.particular_R * active, particular_U = f.particular_U * active,
+  // Every isoperimetric constraint's value on the frame's fields and on the particular ones:
+  // the chord along the held directions at s = L, then the contacts' nu.dr(s_c).
+  const int all_constraints = static_cast<int>(f.particular.cols());
+  Eigen::MatrixXd values(all_constraints, m + all_constraints);
+  values.topRows(constraints.cols()) << constraints.transpose() * f.R, constraints.transpose() * f.particular_R;
+  values.bottomRows(f.contact_rows_frame.rows()) << f.contact_rows_frame, f.contact_rows_particular;
+  // A constraint that no perturbation changes to first order - the chord of a straight
+  // inextensible rod held at its full length - is degenerate: it holds at second order only
+  // (every perturbation shortens the chord), and its multiplier (the axial force) is
+  // indeterminate though it enters the second variation. The index is then not defined.
+  const Eigen::MatrixXd active = column_basis(values, tol);  // in constraint coordinates
+  if (active.cols() < all_constraints) {
+    report->reason = "a degenerate constraint: a held chord (or contact) that no perturbation changes to first "
+                     "order, as a straight inextensible rod held at its full length; its multiplier is "
+                     "indeterminate";
+    return false;
+  }
+  const Eigen::MatrixXd frame_values = active.transpose() * values.leftCols(m);
+  const Eigen::MatrixXd particular_values = active.transpose() * values.rightCols(all_constraints) * active;
+  const Eigen::MatrixXd particular_U = f.particular_U * active,
                         particular_P_physical = f.particular_P_physical * active;
-  const int k = static_cast<int>(held.cols());
+  const int k = static_cast<int>(active.cols());
   const Eigen::MatrixXd free_rotation = complement(end.rotation, m);
   Eigen::MatrixXd conditions(m, m), loads(m, k);
   conditions << end.rotation.transpose() * f.U, free_rotation.transpose() * f.P_physical;
@@ -513,8 +629,8 @@ void StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
   int correction = 0;
   if (k > 0) {
     const Eigen::MatrixXd c = -conditions.completeOrthogonalDecomposition().solve(loads);
-    const Eigen::MatrixXd chord = held.transpose() * (f.R * c + particular_R);  // D, k x k
-    const Eigen::MatrixXd chord_zero = held.transpose() * f.R * zero_modes;     // k x z
+    const Eigen::MatrixXd chord = frame_values * c + particular_values;  // D, k x k
+    const Eigen::MatrixXd chord_zero = frame_values * zero_modes;        // k x z
     const int r_z = static_cast<int>(column_basis(chord_zero, tol).cols());
     const Eigen::MatrixXd quiet = null_space(chord_zero.transpose(), k, tol);  // loads doing no work on them
     const Eigen::MatrixXd D = quiet.transpose() * (0.5 * (chord + chord.transpose())) * quiet;
@@ -525,15 +641,17 @@ void StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
         if (eig.eigenvalues()[i] > tol) ++positive;
     }
     correction = r_z + positive - k;
+
   }
   Eigen::MatrixXd all(m + k, m + k);
   all.topLeftCorner(m, m) = conditions;
   all.topRightCorner(m, k) = loads;
-  all.bottomLeftCorner(k, m) = held.transpose() * f.R;
-  all.bottomRightCorner(k, k) = held.transpose() * particular_R;
+  all.bottomLeftCorner(k, m) = frame_values;
+  all.bottomRightCorner(k, k) = particular_values;
   report->zero_modes = static_cast<int>(null_space(all, m + k, tol).cols());
   report->constraint_count = k;
   report->constraint_correction = correction;
+  return true;
 }
 
 StabilityReport StabilityAnalysis::run() {
@@ -549,8 +667,9 @@ StabilityReport StabilityAnalysis::run() {
   const ProblemDefinition& d = problem_.definition();
   const Held start = held_at(d.start, multipliers), end = held_at(d.end, multipliers);
   const Eigen::MatrixXd constraints = constraint_directions(start, end);
+  const std::vector<PointContact> contacts = problem_.contacts_at(x_);
 
-  Frame f = start_frame(start, constraints);
+  Frame f = start_frame(start, constraints, static_cast<int>(contacts.size()));
   const int m = static_cast<int>(f.U.cols());
   const Eigen::MatrixXd lagrange = f.U.transpose() * f.P - f.P.transpose() * f.U;
   if (lagrange.norm() > 1e-8 * (1.0 + f.U.norm() * f.P.norm())) {
@@ -574,12 +693,37 @@ StabilityReport StabilityAnalysis::run() {
   track.lowest = start_phases;
   track.passages.assign(m, {});
 
-  std::vector<double> nodes = problem_.node_arclengths(x_);
-  nodes.push_back(scales_.length);
-  const int segments = static_cast<int>(nodes.size()) - 1;
-  const int steps = std::max(2, (options_.min_steps + segments - 1) / segments);
-  for (int i = 0; i < segments; ++i)
-    for (int k = 1; k <= steps; ++k) advance(&f, nodes[i] + (nodes[i + 1] - nodes[i]) * k / steps, &track, 0);
+  // The rod in pieces between shooting nodes and contacts; the equilibrium is integrated across
+  // them from its start (each contact applies its jump).
+  std::vector<double> breaks = problem_.node_arclengths(x_);
+  for (const PointContact& c : contacts) breaks.push_back(c.s);
+  breaks.push_back(scales_.length);
+  std::sort(breaks.begin(), breaks.end());
+  breaks.erase(std::unique(breaks.begin(), breaks.end(),
+                           [&](double a, double b) { return std::abs(a - b) < 1e-12 * scales_.length; }),
+               breaks.end());
+  const int pieces = static_cast<int>(breaks.size()) - 1;
+  const int steps = std::max(2, (options_.min_steps + pieces - 1) / pieces);
+  double shear = 0.0;  // of the contact just passed
+  for (int i = 0; i < pieces; ++i) {
+    const double step = (breaks[i + 1] - breaks[i]) / steps;
+    // Past a contact whose shear S is large (the contact near flattening, f / g'' large) the
+    // fields turn on the length L / S: steps grow geometrically from a fraction of it, so no
+    // eigenphase turns a whole turn within one (which a step could not tell from no turn).
+    for (double h = 0.25 * scales_.length / (1.0 + shear); shear > 0 && h < step; h *= 2)
+      advance(&f, breaks[i] + h, &track, 0);
+    shear = 0.0;
+    for (int k = 1; k <= steps; ++k) advance(&f, breaks[i] + step * k, &track, 0);
+    for (size_t c = 0; c < contacts.size(); ++c) {
+      if (std::abs(contacts[c].s - breaks[i + 1]) > 1e-12 * scales_.length) continue;
+      if (std::string why = pass_contact(&f, contacts[c], static_cast<int>(c), static_cast<int>(constraints.cols()),
+                                         &track, &shear);
+          !why.empty()) {
+        report.reason = why;
+        return report;
+      }
+    }
+  }
   report.rhs_evaluations = rhs_;
   if (track.reversed) {
     std::ostringstream reason;
@@ -595,7 +739,7 @@ StabilityReport StabilityAnalysis::run() {
   }
   const Eigen::MatrixXd zero_modes = end_terms(f, end, &report);
   report.dead_load_index = report.interior_count + report.end_count;
-  constraint_correction(f, end, constraints, zero_modes, &report);
+  if (!constraint_correction(f, end, constraints, zero_modes, &report)) return report;
   // Rigid translations along directions neither end holds map equilibria to equilibria.
   Eigen::MatrixXd held(coords_.kr(), start.position.cols() + end.position.cols());
   held << start.position, end.position;
@@ -612,7 +756,13 @@ StabilityReport StabilityAnalysis::run() {
 
 StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::VectorXd& x,
                                   const StabilityOptions& options) {
-  return StabilityAnalysis(problem, x, options).run();
+  try {
+    return StabilityAnalysis(problem, x, options).run();
+  } catch (const IntegrationError& e) {
+    StabilityReport report;
+    report.reason = std::string("the Jacobi fields could not be integrated: ") + e.what();
+    return report;
+  }
 }
 
 std::string describe(const StabilityReport& report) {

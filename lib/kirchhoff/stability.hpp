@@ -33,13 +33,19 @@
 //     zero modes of the load-controlled problem (D is then taken on the loads doing no work on
 //     them). Along the axis of a straight inextensible rod the chord cannot change to first
 //     order, so that constraint is empty and dropped (the axial force is indeterminate).
+// Point contacts on a plane (force f > 0, the rod curving away at g'' > 0): the contact force is
+// a dead load of the load-controlled problem, nu.dr(s_c) = 0 one more isoperimetric constraint
+// (multiplier: the change of the force), and the contact point slides along the plane, which
+// adds f (nu.dr')^2 / (2 g'') to the second variation (a jump of the Jacobi fields' moment).
 // Zero modes (Jacobi fields meeting every condition: symmetries such as the isotropic rod's
 // rotation about its axis, rigid motions, or the rod at a bifurcation) are reported apart from
 // the index, never counted in it.
 //
-// Not covered (index null with the reason): active contacts, half-turn symmetric half rods,
-// position-dependent fields (soft walls, barriers), unknown parameters that are not end loads,
-// non-conservative loads (a dead couple on a 3D end free to rotate), degenerate crossings.
+// Not covered (index null with the reason): extended contacts and contacts with curved
+// obstacles, contacts with zero force (weakly active) or at the point of flattening (g'' = 0),
+// half-turn symmetric half rods, position-dependent fields (soft walls, barriers), unknown
+// parameters that are not end loads, non-conservative loads (a dead couple on a 3D end free to
+// rotate), degenerate constraints (a straight rod held at its full length), degenerate crossings.
 #pragma once
 
 #include <Eigen/Dense>
@@ -68,6 +74,9 @@ struct StabilityOptions {
   // integrated to ~1e-10, so 1e-6 leaves four orders of margin; modes within 1e-6 of neutral
   // (next to a bifurcation) are reported as zero modes, not guessed.
   double zero_tolerance = 1e-6;
+  // Let point contacts slide along their plane (the right second variation). false holds them at
+  // their material point instead, only to show the difference (tests, docs).
+  bool contact_sliding = true;
 };
 
 struct StabilityReport {
