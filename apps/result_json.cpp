@@ -27,14 +27,25 @@ nlohmann::json parameters_json(const Parameters& p) {
   return out;
 }
 
-nlohmann::json stability_json(const StabilityReport& st) {
+nlohmann::json stability_json(const StabilityReport& st, const DiscreteStability* discrete) {
   nlohmann::json j;
   j["index"] = st.index ? nlohmann::json(*st.index) : nlohmann::json();
   j["stable"] = st.index ? nlohmann::json(st.stable()) : nlohmann::json();
   j["zero_modes"] = st.zero_modes;
   j["conjugate_points"] = st.conjugate_points;
-  // The conjugate-point count gives no eigenvalues; the planar discretised check does.
+  // The conjugate-point count gives no eigenvalues; the planar discretised check does, once it
+  // has passed its own checks.
   j["lowest_eigenvalues"] = nlohmann::json::array();
+  if (discrete && discrete->defined()) {
+    if (discrete->trustworthy) j["lowest_eigenvalues"] = discrete->lowest_eigenvalues;
+    j["cross_check"] = {{"method", "discretised_energy"},
+                        {"elements", discrete->elements},
+                        {"index", *discrete->index},
+                        {"zero_modes", discrete->zero_modes},
+                        {"trustworthy", discrete->trustworthy},
+                        {"check", discrete->check_message},
+                        {"agrees", discrete->trustworthy && st.index && *st.index == *discrete->index}};
+  }
   j["method"] = st.method;
   if (st.index) {
     j["load_controlled_index"] = st.dead_load_index;
@@ -47,7 +58,7 @@ nlohmann::json stability_json(const StabilityReport& st) {
 }
 
 nlohmann::json solution_json(const Case& c, const ShootingProblem& problem, const Solution& sol,
-                             const StabilityReport& stability) {
+                             const StabilityReport& stability, const DiscreteStability* discrete) {
   nlohmann::json j;
   j["case"] = c.path;
   j["status"] = to_string(sol.result.summary.status);
@@ -74,7 +85,7 @@ nlohmann::json solution_json(const Case& c, const ShootingProblem& problem, cons
                              {"force_end", c.force_end},
                              {"H_before", c.H_before},
                              {"H_after", c.H_after}});
-  j["stability"] = stability_json(stability);
+  j["stability"] = stability_json(stability, discrete);
   if (sol.result.summary.used_fallback_search) j["note"] = "starting point from the NLopt fallback search";
   return j;
 }

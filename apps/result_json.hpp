@@ -6,14 +6,15 @@
 
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/solution.hpp"
+#include "kirchhoff/discrete_stability.hpp"
 #include "kirchhoff/stability.hpp"
 
 namespace kirchhoff::cli {
 
 nlohmann::json solution_json(const Case& c, const ShootingProblem& problem, const Solution& sol,
-                             const StabilityReport& stability);
+                             const StabilityReport& stability, const DiscreteStability* discrete = nullptr);
 // {"index": k or null, "zero_modes", "stable", "conjugate_points", "method", "reason", ...}.
-nlohmann::json stability_json(const StabilityReport& stability);
+nlohmann::json stability_json(const StabilityReport& stability, const DiscreteStability* discrete = nullptr);
 // A failed solve: status word, iterations, best residual, reason; no result fields.
 nlohmann::json failure_json(const Case& c, const std::string& status, int iterations, double residual,
                             const std::string& message);

@@ -12,7 +12,8 @@
 namespace kirchhoff::cli {
 namespace {
 
-void print_human(const Case& c, const Solution& sol, const StabilityReport& stability) {
+void print_human(const Case& c, const Solution& sol, const StabilityReport& stability,
+                 const DiscreteStability& discrete) {
   std::cout << (c.title.empty() ? c.path : c.title) << "\n";
   std::cout << "  " << sol.result.summary.brief_report() << "\n";
   std::cout.precision(12);
@@ -35,6 +36,8 @@ void print_human(const Case& c, const Solution& sol, const StabilityReport& stab
       std::cout << " at s = " << contact.s << ", force " << contact.force << "\n";
   }
   std::cout << "  " << describe(stability) << "\n";
+  if (discrete.defined() && discrete.trustworthy && stability.index && *stability.index != *discrete.index)
+    std::cout << "  warning: the discretised energy's check finds index " << *discrete.index << "\n";
 }
 
 }  // namespace
@@ -138,10 +141,13 @@ int run_solve(const SolveArguments& args) {
     }
   }
   const StabilityReport stability = analyse_stability(*problem, sol.result.x);
+  // The independent check where it applies (planar rods without contacts): its lowest
+  // eigenvalues, and whether its index agrees.
+  const DiscreteStability discrete = discrete_stability(*problem, sol.result.x);
   if (args.json)
-    std::cout << solution_json(c, *problem, sol, stability).dump(2) << "\n";
+    std::cout << solution_json(c, *problem, sol, stability, &discrete).dump(2) << "\n";
   else
-    print_human(c, sol, stability);
+    print_human(c, sol, stability, discrete);
   return kExitOk;
 }
 

@@ -33,6 +33,7 @@
 #include "kirchhoff/invariants.hpp"
 #include "kirchhoff/shooting.hpp"
 #include "kirchhoff/solution.hpp"
+#include "kirchhoff/discrete_stability.hpp"
 #include "kirchhoff/stability.hpp"
 #include "kirchhoff/vibration.hpp"
 #include "plectonemes_command.hpp"  // apps/: the sweep behind `kirchhoff plectonemes`
@@ -175,13 +176,25 @@ PyCase py_load_case(const std::string& path, const py::object& set, const std::s
 }
 
 // The CLI's JSON "stability" block as a dict (index None where it is not defined).
-py::dict stability_dict(const StabilityReport& st) {
+py::dict stability_dict(const StabilityReport& st, const DiscreteStability& discrete) {
   py::dict d;
   d["index"] = st.index ? py::object(py::int_(*st.index)) : py::object(py::none());
   d["stable"] = st.index ? py::object(py::bool_(st.stable())) : py::object(py::none());
   d["zero_modes"] = st.zero_modes;
   d["conjugate_points"] = st.conjugate_points;
-  d["lowest_eigenvalues"] = py::list();
+  d["lowest_eigenvalues"] = discrete.defined() && discrete.trustworthy ? py::cast(discrete.lowest_eigenvalues)
+                                                                       : py::object(py::list());
+  if (discrete.defined()) {
+    py::dict check;
+    check["method"] = "discretised_energy";
+    check["elements"] = discrete.elements;
+    check["index"] = *discrete.index;
+    check["zero_modes"] = discrete.zero_modes;
+    check["trustworthy"] = discrete.trustworthy;
+    check["check"] = discrete.check_message;
+    check["agrees"] = discrete.trustworthy && st.index && *st.index == *discrete.index;
+    d["cross_check"] = check;
+  }
   d["method"] = st.method;
   if (st.index) {
     d["load_controlled_index"] = st.dead_load_index;
@@ -271,7 +284,8 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   for (const auto& name : c.derived) out.derived[py::str(name)] = sol->derived.at(name);
   out.invariants = invariants_dict(sol->invariants);
   out.profile = profile_dict(problem->equations(sol->result.parameters)->model(), sol->profile);
-  out.stability = stability_dict(analyse_stability(*problem, sol->result.x));
+  out.stability = stability_dict(analyse_stability(*problem, sol->result.x),
+                                 discrete_stability(*problem, sol->result.x));
   for (const auto& contact : report_contacts(*problem, *sol)) {
     py::dict d;
     d["obstacle"] = contact.obstacle;

@@ -335,6 +335,10 @@ TEST_F(CliTest, SolveReportsTheStabilityIndex) {
   EXPECT_EQ(st["method"], "conjugate_points");
   ASSERT_EQ(st["conjugate_points"].size(), 2u);
   EXPECT_NEAR(st["conjugate_points"][0].get<double>(), M_PI / (2 * std::sqrt(50.0)), 1e-5);
+  // The planar cross-check (discretised energy, 400 elements) agrees, and its lowest eigenvalue
+  // is pi^2 - 50 to its O(h^2) discretisation error (pi^4 h^2 / 12 = 5e-5 here).
+  EXPECT_EQ(st["cross_check"]["agrees"], true);
+  EXPECT_NEAR(st["lowest_eigenvalues"][0].get<double>(), M_PI * M_PI - 50.0, 1e-4);
   const CliRun text = run("solve " + quoted(case_path("euler_column.toml")) + " --set P=50 --set theta_guess=0");
   EXPECT_NE(text.out.find("unstable (index 2)"), std::string::npos) << text.out;
   // Where the index is not defined it is null, with the reason: never a guessed number.

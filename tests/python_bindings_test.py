@@ -98,6 +98,8 @@ class SolveTest(unittest.TestCase):
         self.assertEqual(st["method"], "conjugate_points")
         straight = kirchhoff.load_case(case_path("euler_column.toml"), set={"P": 50.0, "theta_guess": 0.0}).solve()
         self.assertEqual(straight.stability["index"], 2)  # pi^2 and 4 pi^2 below P = 50
+        self.assertTrue(straight.stability["cross_check"]["agrees"])
+        self.assertAlmostEqual(straight.stability["lowest_eigenvalues"][0], np.pi ** 2 - 50.0, places=3)
         soft = kirchhoff.load_case(case_path("soft_wall.toml")).solve()
         self.assertIsNone(soft.stability["index"])
         self.assertIn("depends on position", soft.stability["reason"])
