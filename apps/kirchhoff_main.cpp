@@ -147,7 +147,9 @@ int main(int argc, char** argv) {
       "        + 1/2 rhoS omega^2 (xbar^2 + ybar^2) - 1/2 thetabar^2 (n_xe cos theta_e + n_ye sin theta_e)\n"
       "is conserved along s only when the equilibrium is straight; its spread is reported either way.\n"
       "omega is in the case's units; sqrt(EI / (rhoS L^4)) sets its scale. Mode shapes are scaled to a\n"
-      "largest displacement of 1. Exit status: 0 done, 1 the equilibrium did not converge, 2 refused\n"
+      "largest displacement of 1. An unstable equilibrium also has omega^2 < 0 (imaginary frequencies,\n"
+      "listed first as unstable modes with their growth rates): their number is its stability index\n"
+      "under dead loads. Exit status: 0 done, 1 the equilibrium did not converge, 2 refused\n"
       "(spatial case, extensible rod, active contacts, a sleeve end, or fewer frequencies than asked).\n\n"
       "Examples:\n"
       "  kirchhoff vibrate cases/euler_column.toml --set P=4.934802200544679 --set theta_guess=0\n"
@@ -164,7 +166,8 @@ int main(int argc, char** argv) {
   vibrate_cmd->add_option("--out", vib.out_path,
                           "Write JSON {\"frequencies\": [...], \"modes\": [{\"omega\", \"H_vib_spread\", ...}]}");
   vibrate_cmd->add_option("--profiles", vib.profiles_dir,
-                          "Write each mode as DIR/mode_K.csv: s, xbar, ybar, thetabar, mbar, nbarx, nbary, H_vib");
+                          "Write each mode as DIR/mode_K.csv (unstable ones DIR/unstable_mode_K.csv): s, xbar, ybar, "
+                          "thetabar, mbar, nbarx, nbary, H_vib");
   vibrate_cmd->add_flag("--json", vib.json, "Print the JSON on stdout instead of the table");
 
   std::string out_dir = "out";

@@ -372,10 +372,11 @@ py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
       throw std::runtime_error(c.path + ": the equilibrium did not converge: " + solved.result.summary.brief_report());
     analysis = VibrationProblem(*solved.problem, solved.result.x, options).analyse();  // invalid_argument -> ValueError
   }
-  py::list mode_list;
-  for (const VibrationMode& m : analysis.modes) {
+  auto mode_dict = [](const VibrationMode& m) {
     py::dict d;
     d["omega"] = m.omega;
+    d["omega2"] = m.omega2;
+    d["growth_rate"] = m.growth_rate();
     d["H_vib"] = stats_dict(m.H_vib_stats);
     d["matching_residual"] = m.matching_residual;
     const size_t n = m.s.size();
@@ -386,9 +387,17 @@ py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
     for (const auto& [name, index] : components)
       d[name] = column<double>(n, [&, index = index](size_t i) { return m.state[i][index]; });
     d["H_vib_along_s"] = column<double>(n, [&](size_t i) { return m.H_vib[i]; });
-    mode_list.append(d);
-  }
+    return d;
+  };
+  py::list mode_list, unstable_list;
+  for (const VibrationMode& m : analysis.modes) mode_list.append(mode_dict(m));
+  for (const VibrationMode& m : analysis.unstable_modes) unstable_list.append(mode_dict(m));
   py::dict out;
+  // Imaginary frequencies: omega^2 < 0, their number the index under dead loads.
+  out["unstable_modes"] = unstable_list;
+  out["negative_omega2_count"] = analysis.negative_omega2_count();
+  out["unstable_searched"] = analysis.unstable_searched;
+  out["omega2"] = analysis.omega2();
   out["frequencies"] = column<double>(analysis.modes.size(), [&](size_t k) { return analysis.modes[k].omega; });
   out["straight_equilibrium"] = analysis.straight_equilibrium;
   out["modes"] = mode_list;
@@ -738,7 +747,10 @@ Returns:
     dict: "frequencies" (numpy array, increasing), "straight_equilibrium" (bool), "modes": a list
     of dicts with "omega", "H_vib" (mean, min, max, spread, relative_spread, applies: invariant of
     eq. 95b only on a straight equilibrium), "matching_residual", and numpy arrays "s", "xbar",
-    "ybar", "thetabar", "nbarx", "nbary", "mbar", "H_vib_along_s".
+    "ybar", "thetabar", "nbarx", "nbary", "mbar", "H_vib_along_s" (and "omega2", "growth_rate").
+    "unstable_modes": the same for omega^2 < 0 (imaginary frequencies: the equilibrium is unstable
+    under dead loads; their number, "negative_omega2_count", is its index), most negative first;
+    "unstable_searched" (bool) and "omega2" (every mode's omega^2, increasing).
 
 Raises:
     ValueError: a spatial case, bad options, or a rod the vibration equations do not cover.

@@ -359,6 +359,16 @@ class VibrateTest(unittest.TestCase):
             kirchhoff.load_case(case_path("euler_column.toml")).vibrate(rho_s=-1.0)
 
 
+class UnstableVibrationTest(unittest.TestCase):
+    def test_straight_column_above_two_euler_loads_has_two_negative_omega2(self):
+        case = kirchhoff.load_case(case_path("euler_column.toml"), set={"P": 50.0, "theta_guess": 0.0})
+        v = case.vibrate(modes=2)
+        self.assertTrue(v["unstable_searched"])
+        self.assertEqual(v["negative_omega2_count"], 2)
+        self.assertEqual(v["negative_omega2_count"], case.solve().stability["index"])
+        self.assertTrue(all(m["omega2"] < 0 and m["growth_rate"] > 0 for m in v["unstable_modes"]))
+
+
 class AnalyticHelixTest(unittest.TestCase):
     def test_closed_forms_of_the_ply_and_the_column(self):
         theta = 0.3
