@@ -130,6 +130,7 @@ void tapered(const fs::path& cases, const fs::path& out, std::vector<ReportRow>*
                    "H' by central differences (h = 1e-4, error ~1e-8)"});
   rows->push_back({"Fig. 9", "H spread / scale (not invariant: explicit s)", {}, {},
                    s.solution.invariants.H.relative_spread(), 1.0, 0.0, "non-zero, as section 7.5 explains"});
+  for (auto it = rows->end() - 2; it != rows->end(); ++it) it->stability = s.stability;
 }
 
 // Section 5: the straight twisted rod and the heavy rod's field term.
@@ -140,9 +141,11 @@ void invariants(const fs::path& cases, std::vector<ReportRow>* rows) {
                    t.solution.invariants.m3.mean, exact.twisting_moment(), 1e-10, ""});
   rows->push_back({"eq. (33)", "H of the straight twisted rod (m3^2/2C + T)", {}, exact.hamiltonian(),
                    t.solution.invariants.H.mean, exact.hamiltonian(), 1e-10, ""});
+  for (auto it = rows->end() - 2; it != rows->end(); ++it) it->stability = t.stability;
   const Solved g = solve_case(cases / "heavy_cantilever.toml", {}, 201);
   rows->push_back({"eq. (29) with W_ext", "H spread / scale, heavy cantilever", {}, 0.0, g.solution.invariants.H.spread,
                    g.solution.invariants.H.scale, 1e-9, "H includes -W_ext = -w y"});
+  rows->back().stability = g.stability;
 }
 
 // Continuation (issue: pseudo-arclength): the Euler column's branch points, its first buckled
@@ -236,6 +239,10 @@ void wall(const fs::path& cases, const fs::path& out, std::vector<ReportRow>* ro
     rows->push_back({"Fig. 12, hard wall (wall.toml)", "contact force, active set from the free arch", 18.1,
                      exact.contact_force, sol.derived.at("contact_force"), exact.contact_force, 1e-8,
                      "contact found at s = " + format_short(sol.derived.at("contact_s"))});
+    // The whole rod's stability (the sliding point contact; wall_symmetric's half rod is not the
+    // whole rod's problem): stated on the hard-wall rows.
+    const std::string whole_rod = describe(analyse_stability(p, contact.result.x));
+    for (auto it = rows->end() - 4; it != rows->end(); ++it) it->stability = whole_rod;
     const std::vector<Obstacle> plane{Obstacle::plane(Vec3(0, 0.1, 0), Vec3(0, -1, 0), "wall")};
     // A solve that fails its own KKT check gives NaN, which fails its rows (never a wrong P).
     auto ipopt_P = [&](int N) {
@@ -353,9 +360,11 @@ void sleeves(const fs::path& cases, const fs::path& out, std::vector<ReportRow>*
   rows->push_back({"eq. (55)", "P + EI kappa_B^2 / 2 (= P')", {}, P_prime, P + 0.5 * kB * kB, P_prime, 1e-9,
                    "length outside the sleeve solved for: " + format_short(sleeve.solution.result.parameters["ell"])});
   rows->push_back({"Fig. 7", "H_out at the exit (= H_in = -P)", {}, -P, d.at("H_end"), P, 1e-9, ""});
+  for (auto it = rows->end() - 2; it != rows->end(); ++it) it->stability = sleeve.stability;
   const Solved arm = solve_case(cases / "arm_scale.toml", {}, 201);
   rows->push_back({"Fig. 8", "theta_C, tangent at the weight (horizontal)", 0.0, 0.0, arm.solution.derived.at("theta_end"),
                    1.0, 1e-9, "H_A = 0 = H_C = -W sin(theta_C)"});
+  rows->back().stability = arm.stability;
   for (const auto& [name, s] : {std::pair{"fig6_sleeve.csv", &sleeve}, std::pair{"fig8_arm_scale.csv", &arm}}) {
     std::ofstream csv(out / name);
     csv.precision(15);
