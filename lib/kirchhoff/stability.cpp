@@ -463,7 +463,7 @@ std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contac
                                             PhaseTrack* track, double* shear) {
   const int n = coords_.size(), kr = coords_.kr(), kpsi = n - kr;
   const RodPoint here = eq_->point(f->y, f->s);
-  const Obstacle& obstacle = problem_.obstacles(p_)[contact.obstacle];
+  const Obstacle obstacle = problem_.obstacles(p_)[contact.obstacle];  // obstacles() returns a copy
   const Vec3 nu = obstacle.normal(here.r);
   const Vec3 d3 = here.R.col(2), curving = here.R * here.u.cross(Vec3::UnitZ());  // d3' of an inextensible rod
   const double g2 = nu.dot(curving), scale = 1.0 / scales_.length;
