@@ -6,6 +6,7 @@
 #include <cmath>
 #include <complex>
 #include <functional>
+#include <limits>
 #include <sstream>
 
 namespace kirchhoff {
@@ -18,6 +19,12 @@ constexpr double kPi = 3.14159265358979323846;
 struct Scales {
   double length = 1.0;
   double bending = 1.0;
+  // The rotation pair's momentum is divided by this as well (a symplectic rescaling u -> u,
+  // p -> p / rate: it changes no crossing nor the inertia of any boundary form). Under loads the
+  // fields oscillate with wavenumber ~ sqrt(|n| / B): scaled so, their eigenphases turn at a
+  // nearly uniform rate ~ 2 rate / L, instead of spending most of a turn within a short stretch
+  // near each conjugate point, where a step could pass a whole turn unseen.
+  double rate = 1.0;
 };
 
 // Canonical coordinates of the rod's configuration (position, then rotation, along the
@@ -56,10 +63,12 @@ CanonicalMap canonical_map(const RodEquations& eq, const Coordinates& c, const S
   map.T.middleRows(kr, n - kr) = c.rotation_dirs.transpose() * rotation_jacobian;
   map.T.middleRows(n, kr) =
       c.position_dirs.transpose() * eq.slot_map(Slot::Force) * (sc.length * sc.length / sc.bending);
-  map.T.bottomRows(n - kr) = c.rotation_dirs.transpose() * eq.slot_map(Slot::Moment) * (sc.length / sc.bending);
+  map.T.bottomRows(n - kr) =
+      c.rotation_dirs.transpose() * eq.slot_map(Slot::Moment) * (sc.length / (sc.bending * sc.rate));
   map.G = Eigen::MatrixXd::Zero(n, n);
   map.G.bottomRightCorner(n - kr, n - kr) =
-      0.5 * (sc.length / sc.bending) * c.rotation_dirs.transpose() * cross_matrix(point.m) * c.rotation_dirs;
+      0.5 * (sc.length / (sc.bending * sc.rate)) * c.rotation_dirs.transpose() * cross_matrix(point.m) *
+      c.rotation_dirs;
   return map;
 }
 
@@ -245,6 +254,20 @@ class StabilityAnalysis {
     coords_.rotation_dirs = eq_->admissible_directions(Slot::Orientation);
     scales_.length = eq_->model().length;
     scales_.bending = eq_->model().B[0](0.0);
+  }
+
+  // The wavenumber of the Jacobi fields, L sqrt(|n| / B) and L |m| / B at their largest over the
+  // rod (at least 1): sets the momentum's scale and the number of steps.
+  double field_rate() const {
+    const RodModel& model = eq_->model();
+    double stiffness = std::numeric_limits<double>::infinity(), rate = 1.0;
+    std::vector<double> s(17);
+    for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
+    for (const RodPoint& q : problem_.sample(x_, s))
+      for (int k = 0; k < 3; ++k) stiffness = std::min(stiffness, model.B[k](q.s));
+    for (const RodPoint& q : problem_.sample(x_, s))
+      rate = std::max({rate, scales_.length * std::sqrt(q.n.norm() / stiffness), scales_.length * q.m.norm() / stiffness});
+    return rate;
   }
 
   StabilityReport run();
@@ -436,7 +459,7 @@ void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int dept
     passage = passage || odd_multiples_between(track->lifted[j] - largest, track->lifted[j] + largest) > 0;
   // Steps are halved while a phase moves too far, and around a passage until it is located to
   // passage_resolution (the interpolation below is then exact to its square).
-  const bool locate = passage && s1 - f->s > options_.passage_resolution * scales_.length;
+  const bool locate = passage && s1 - f->s > options_.passage_resolution * scales_.length / scales_.rate;
   if ((largest > options_.max_phase_step || locate) && depth < options_.max_halvings) {
     const double mid = 0.5 * (f->s + s1);
     advance(f, mid, track, depth + 1);
@@ -479,7 +502,7 @@ std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contac
   // The shear, followed in small steps (it cannot move an eigenphase across -1).
   const Eigen::VectorXd w = coords_.rotation_dirs.transpose() * d3.cross(nu);
   const double stiffness = options_.contact_sliding ? contact.force / g2 : 0.0;  // f / g''
-  const Eigen::MatrixXd S = (scales_.length / scales_.bending) * stiffness * w * w.transpose();
+  const Eigen::MatrixXd S = (scales_.length / (scales_.bending * scales_.rate)) * stiffness * w * w.transpose();
   *shear = S.norm();
   // Steps in the shear's size t are shortened until no eigenphase moves more than
   // max_phase_step (a large f / g'', next to the contact flattening, turns them far).
@@ -668,6 +691,7 @@ StabilityReport StabilityAnalysis::run() {
   const Held start = held_at(d.start, multipliers), end = held_at(d.end, multipliers);
   const Eigen::MatrixXd constraints = constraint_directions(start, end);
   const std::vector<PointContact> contacts = problem_.contacts_at(x_);
+  scales_.rate = field_rate();
 
   Frame f = start_frame(start, constraints, static_cast<int>(contacts.size()));
   const int m = static_cast<int>(f.U.cols());
@@ -703,7 +727,9 @@ StabilityReport StabilityAnalysis::run() {
                            [&](double a, double b) { return std::abs(a - b) < 1e-12 * scales_.length; }),
                breaks.end());
   const int pieces = static_cast<int>(breaks.size()) - 1;
-  const int steps = std::max(2, (options_.min_steps + pieces - 1) / pieces);
+  // Enough steps that the eigenphases, turning at ~2 rate / L, move ~0.5 rad per step.
+  const int wanted = std::max(options_.min_steps, static_cast<int>(std::ceil(4.0 * scales_.rate)));
+  const int steps = std::max(2, (wanted + pieces - 1) / pieces);
   double shear = 0.0;  // of the contact just passed
   for (int i = 0; i < pieces; ++i) {
     const double step = (breaks[i + 1] - breaks[i]) / steps;

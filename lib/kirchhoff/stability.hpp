@@ -65,8 +65,9 @@ struct StabilityOptions {
   // of the tests.
   int min_steps = 16;
   double max_phase_step = 0.5;  // rad
-  // Steps holding a conjugate point are halved down to this fraction of L, so its position is
-  // found to ~1e-5 L (the interpolation of tan(phase / 2) is exact to second order in the step).
+  // Steps holding a conjugate point are halved down to this fraction of L (divided by the fields'
+  // wavenumber L sqrt(|n| / B) under large loads), so its position is found to ~1e-5 L (the
+  // interpolation of tan(phase / 2) is exact to second order in the step).
   double passage_resolution = 1e-2;
   int max_halvings = 16;
   // Singular values (of the orthonormal frame's blocks, dimensionless) and eigenvalues of the
