@@ -151,31 +151,9 @@ TEST(DiscreteStability, FreeRodCountsTranslationsAsZeroModesAndRotationAsMinusP)
   }
 }
 
-const char* kClampedClamped = R"(
-model = "planar"
-[parameters]
-D = 0.9
-fy = 0.0
-m0 = 0.0
-P = 50.0
-[rod]
-length = 1.0
-B = 1.0
-[start]
-type = "clamped"
-position = [0, 0]
-[end]
-type = "clamped"
-position = ["D", 0]
-[guess]
-force = ["-P", "fy"]
-moment = [0, 0, "m0"]
-)";
-
 struct Row {
   std::string label;
-  std::string case_name;  // a shipped case, or "" for `text`
-  const char* text = nullptr;
+  std::string case_name;  // a shipped case
   ParameterOverrides overrides;
   int index = 0;       // known independently (Euler loads, the issue's acceptance list)
   int zero_modes = 0;
@@ -185,7 +163,7 @@ struct Row {
 // check trustworthy.
 void expect_agreement(const Row& row) {
   SCOPED_TRACE(row.label);
-  const Solved s = row.case_name.empty() ? solve_text(row.text, row.overrides) : solve_shipped(row.case_name, row.overrides);
+  const Solved s = solve_shipped(row.case_name, row.overrides);
   const StabilityReport conjugate = analyse_stability(*s.problem, s.x);
   const DiscreteStability d = discrete_stability(*s.problem, s.x, kElements);
   ASSERT_TRUE(conjugate.defined()) << conjugate.reason;
@@ -199,15 +177,15 @@ void expect_agreement(const Row& row) {
 
 TEST(DiscreteStability, AgreesWithConjugatePointsOnTheEulerColumn) {
   const std::vector<Row> rows = {
-      {"straight P = 5", "euler_column.toml", nullptr, {{"P", 5.0}, {"theta_guess", 0.0}}, 0},
-      {"straight P = 20", "euler_column.toml", nullptr, {{"P", 20.0}, {"theta_guess", 0.0}}, 1},
-      {"straight P = 50", "euler_column.toml", nullptr, {{"P", 50.0}, {"theta_guess", 0.0}}, 2},
-      {"straight P = 100", "euler_column.toml", nullptr, {{"P", 100.0}, {"theta_guess", 0.0}}, 3},
-      {"mode 1, P = 12", "euler_column.toml", nullptr, {{"P", 12.0}, {"theta_guess", 1.0}}, 0},
+      {"straight P = 5", "euler_column.toml", {{"P", 5.0}, {"theta_guess", 0.0}}, 0},
+      {"straight P = 20", "euler_column.toml", {{"P", 20.0}, {"theta_guess", 0.0}}, 1},
+      {"straight P = 50", "euler_column.toml", {{"P", 50.0}, {"theta_guess", 0.0}}, 2},
+      {"straight P = 100", "euler_column.toml", {{"P", 100.0}, {"theta_guess", 0.0}}, 3},
+      {"mode 1, P = 12", "euler_column.toml", {{"P", 12.0}, {"theta_guess", 1.0}}, 0},
       // Past the point where the ends meet the first mode loses its stability.
-      {"mode 1 past the ends meeting, P = 30", "euler_column.toml", nullptr, {{"P", 30.0}, {"theta_guess", 2.5}}, 1},
-      {"mode 2, P = 50", "euler_column.toml", nullptr, {{"P", 50.0}, {"theta_guess", 1.0}}, 1},
-      {"mode 3, P = 100", "euler_column.toml", nullptr, {{"P", 100.0}, {"theta_guess", 1.5}}, 2},
+      {"mode 1 past the ends meeting, P = 30", "euler_column.toml", {{"P", 30.0}, {"theta_guess", 2.5}}, 1},
+      {"mode 2, P = 50", "euler_column.toml", {{"P", 50.0}, {"theta_guess", 1.0}}, 1},
+      {"mode 3, P = 100", "euler_column.toml", {{"P", 100.0}, {"theta_guess", 1.5}}, 2},
   };
   for (const Row& row : rows) expect_agreement(row);
 }
@@ -216,16 +194,16 @@ TEST(DiscreteStability, AgreesWithConjugatePointsOnTheEulerColumn) {
 // ends at one point, so turning the whole rod about the shared pin keeps every constraint: a
 // zero mode.
 TEST(DiscreteStability, AgreesWithConjugatePointsOnTheSimplySupportedElastica) {
-  for (const Row& row : {Row{"theta0 = 1", "simply_supported.toml", nullptr, {{"theta0", 1.0}}, 0, 0},
-                         Row{"theta0 = 2", "simply_supported.toml", nullptr, {{"theta0", 2.0}}, 0, 0},
-                         Row{"theta0 = 2.8, ends meet", "simply_supported.toml", nullptr, {{"theta0", 2.8}}, 0, 1}})
+  for (const Row& row : {Row{"theta0 = 1", "simply_supported.toml", {{"theta0", 1.0}}, 0, 0},
+                         Row{"theta0 = 2", "simply_supported.toml", {{"theta0", 2.0}}, 0, 0},
+                         Row{"theta0 = 2.8, ends meet", "simply_supported.toml", {{"theta0", 2.8}}, 0, 1}})
     expect_agreement(row);
 }
 
 TEST(DiscreteStability, AgreesWithConjugatePointsOnTheClampedRodWithImposedShortening) {
-  for (const Row& row : {Row{"symmetric, up", "", kClampedClamped, {{"m0", 6.0}}, 0},
-                         Row{"symmetric, down", "", kClampedClamped, {{"m0", -6.0}}, 0},
-                         Row{"S-shaped", "", kClampedClamped, {{"fy", 10.0}}, 1}})
+  for (const Row& row : {Row{"symmetric, up", "clamped_clamped.toml", {}, 0},
+                         Row{"symmetric, down", "clamped_clamped.toml", {{"side", -1.0}}, 0},
+                         Row{"S-shaped", "clamped_clamped.toml", {{"s_mode", 1.0}}, 1}})
     expect_agreement(row);
 }
 
@@ -235,14 +213,14 @@ TEST(DiscreteStability, AgreesWithConjugatePointsOnTheClampedRodWithImposedShort
 // the independent evidence.
 TEST(DiscreteStability, AgreesWithConjugatePointsOnTheShippedPlanarCases) {
   const std::vector<Row> rows = {
-      {"heavy_cantilever", "heavy_cantilever.toml", nullptr, {}, 0},
-      {"tapered", "tapered.toml", nullptr, {}, 0},
-      {"tapered_column", "tapered_column.toml", nullptr, {}, 0},
-      {"tapered_column P = 20", "tapered_column.toml", nullptr, {{"P", 20.0}}, 1},
-      {"tapered_column P = 60", "tapered_column.toml", nullptr, {{"P", 60.0}}, 2},
-      {"shallow_arch", "shallow_arch.toml", nullptr, {}, 0},
-      {"shallow_arch w = 20", "shallow_arch.toml", nullptr, {{"w", 20.0}}, 0},
-      {"shallow_arch w = 40", "shallow_arch.toml", nullptr, {{"w", 40.0}}, 1},
+      {"heavy_cantilever", "heavy_cantilever.toml", {}, 0},
+      {"tapered", "tapered.toml", {}, 0},
+      {"tapered_column", "tapered_column.toml", {}, 0},
+      {"tapered_column P = 20", "tapered_column.toml", {{"P", 20.0}}, 1},
+      {"tapered_column P = 60", "tapered_column.toml", {{"P", 60.0}}, 2},
+      {"shallow_arch", "shallow_arch.toml", {}, 0},
+      {"shallow_arch w = 20", "shallow_arch.toml", {{"w", 20.0}}, 0},
+      {"shallow_arch w = 40", "shallow_arch.toml", {{"w", 40.0}}, 1},
   };
   for (const Row& row : rows) expect_agreement(row);
 }
