@@ -49,14 +49,21 @@ Eigen::Matrix3d cross_matrix(const Vec3& a) {
   return M;
 }
 
+// dy -> the lab-frame rotation vector dpsi of the frame at state y (whose frame is R): the
+// Jacobian of the orientation error against the frame itself as target.
+Eigen::MatrixXd lab_rotation_jacobian(const RodEquations& eq, const Eigen::VectorXd& y, const Mat3& R) {
+  const Mat3 reference = eq.is_planar() ? planar_reference_frame() : Mat3::Identity();
+  const Eigen::AngleAxisd frame(Mat3(R * reference.transpose()));
+  Eigen::MatrixXd jacobian;
+  eq.orientation_error(y, OrientationTarget{frame.axis(), frame.angle()}, false, &jacobian);
+  return jacobian;
+}
+
 CanonicalMap canonical_map(const RodEquations& eq, const Coordinates& c, const Scales& sc, const Eigen::VectorXd& y,
                            double s) {
   const int N = static_cast<int>(y.size()), n = c.size(), kr = c.kr();
   const RodPoint point = eq.point(y, s);
-  const Mat3 reference = eq.is_planar() ? planar_reference_frame() : Mat3::Identity();
-  const Eigen::AngleAxisd frame(Mat3(point.R * reference.transpose()));
-  Eigen::MatrixXd rotation_jacobian;  // dy -> lab-frame rotation vector dpsi
-  eq.orientation_error(y, OrientationTarget{frame.axis(), frame.angle()}, false, &rotation_jacobian);
+  const Eigen::MatrixXd rotation_jacobian = lab_rotation_jacobian(eq, y, point.R);
   CanonicalMap map;
   map.T = Eigen::MatrixXd::Zero(2 * n, N);
   map.T.topRows(kr) = c.position_dirs.transpose() * eq.slot_map(Slot::Position) / sc.length;
@@ -254,6 +261,9 @@ class StabilityAnalysis {
     coords_.rotation_dirs = eq_->admissible_directions(Slot::Orientation);
     scales_.length = eq_->model().length;
     scales_.bending = eq_->model().B[0](0.0);
+    std::vector<double> s(17);
+    for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
+    profile_ = problem_.sample(x_, s);
   }
 
   // The wavenumber of the Jacobi fields, L sqrt(|n| / B) and L |m| / B at their largest over the
@@ -261,11 +271,9 @@ class StabilityAnalysis {
   double field_rate() const {
     const RodModel& model = eq_->model();
     double stiffness = std::numeric_limits<double>::infinity(), rate = 1.0;
-    std::vector<double> s(17);
-    for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
-    for (const RodPoint& q : problem_.sample(x_, s))
+    for (const RodPoint& q : profile_)
       for (int k = 0; k < 3; ++k) stiffness = std::min(stiffness, model.B[k](q.s));
-    for (const RodPoint& q : problem_.sample(x_, s))
+    for (const RodPoint& q : profile_)
       rate = std::max({rate, scales_.length * std::sqrt(q.n.norm() / stiffness), scales_.length * q.m.norm() / stiffness});
     return rate;
   }
@@ -301,6 +309,7 @@ class StabilityAnalysis {
   std::shared_ptr<const RodEquations> eq_;
   Coordinates coords_;
   Scales scales_;
+  std::vector<RodPoint> profile_;  // the equilibrium at 17 equally spaced points, for the checks above
   long rhs_ = 0;
 };
 
@@ -319,8 +328,7 @@ StabilityAnalysis::Held StabilityAnalysis::held_at(const EndCondition& end,
 std::string StabilityAnalysis::field_reason() const {
   const auto& field = eq_->model().field;
   if (!field) return "";
-  const std::vector<double> s = {0.0, 0.25 * scales_.length, 0.5 * scales_.length, scales_.length};
-  for (const RodPoint& q : problem_.sample(x_, s))
+  for (const RodPoint& q : profile_)
     if (field->force_gradient(q.s, q.r).norm() > 0)
       return "the external field depends on position (a soft wall or barrier): its Hessian in the second "
              "variation is not implemented";
@@ -484,7 +492,7 @@ void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int dept
 //    its particular field starts here with dn = -nu.
 std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contact, int number, int chord_count,
                                             PhaseTrack* track, double* shear) {
-  const int n = coords_.size(), kr = coords_.kr(), kpsi = n - kr;
+  const int n = coords_.size(), kr = coords_.kr();
   const RodPoint here = eq_->point(f->y, f->s);
   const Obstacle obstacle = problem_.obstacles(p_)[contact.obstacle];  // obstacles() returns a copy
   const Vec3 nu = obstacle.normal(here.r);
@@ -499,13 +507,11 @@ std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contac
   f->contact_rows_particular.row(number) = nu_r.transpose() * f->particular_R;
   // The equilibrium's jump.
   f->y += eq_->slot_map(Slot::Force).transpose() * (-contact.force * nu);
-  // The shear, followed in small steps (it cannot move an eigenphase across -1).
+  // The shear p += S u in canonical coordinates.
   const Eigen::VectorXd w = coords_.rotation_dirs.transpose() * d3.cross(nu);
   const double stiffness = options_.contact_sliding ? contact.force / g2 : 0.0;  // f / g''
   const Eigen::MatrixXd S = (scales_.length / (scales_.bending * scales_.rate)) * stiffness * w * w.transpose();
   *shear = S.norm();
-  // Steps in the shear's size t are shortened until no eigenphase moves more than
-  // max_phase_step (a large f / g'', next to the contact flattening, turns them far).
   // The shear leaves U, so no eigenphase passes -1 through it: each stays in its sheet between
   // consecutive odd multiples of pi (it may turn almost a whole turn inside it, so it is not
   // followed by small steps, which could not tell such a turn from a small one back).
@@ -522,13 +528,10 @@ std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contac
     track->lifted[j] = sheet + sheared[best];
     track->lowest[j] = std::min(track->lowest[j], track->lifted[j]);
   }
-  Eigen::MatrixXd rotation_jacobian;
-  const Mat3 reference = eq_->is_planar() ? planar_reference_frame() : Mat3::Identity();
-  const Eigen::AngleAxisd frame(Mat3(here.R * reference.transpose()));
-  eq_->orientation_error(f->y, OrientationTarget{frame.axis(), frame.angle()}, false, &rotation_jacobian);
+  // The same shear on the fields' state: dm += (f / g'') w (w.dpsi).
   const Vec3 w_lab = d3.cross(nu);
   f->dY += eq_->slot_map(Slot::Moment).transpose() * (stiffness * w_lab * w_lab.transpose()) *
-           rotation_jacobian * f->dY;
+           lab_rotation_jacobian(*eq_, f->y, here.R) * f->dY;
   // The force's particular field.
   Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * n);
   z.segment(n, kr) = -nu_r;
@@ -536,7 +539,6 @@ std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contac
   f->particular.col(chord_count + number) = map.T.completeOrthogonalDecomposition().solve(z);
   canonical_blocks(f);
   orthonormalise(f);
-  (void)kpsi;
   return "";
 }
 
