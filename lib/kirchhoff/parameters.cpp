@@ -26,4 +26,14 @@ int Parameters::index_of(const std::string& name) const {
   return -1;
 }
 
+void complete(Parameters* p, const std::vector<DependentParameter>& dependents) {
+  for (const auto& d : dependents) p->set(d.name, d.value(*p));
+}
+
+const DependentParameter* find_dependent(const std::vector<DependentParameter>& dependents, const std::string& name) {
+  for (const auto& d : dependents)
+    if (d.name == name) return &d;
+  return nullptr;
+}
+
 }  // namespace kirchhoff

@@ -2,6 +2,7 @@
 // Continuation moves one of them; shooting may treat some as unknowns.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -26,5 +27,19 @@ class Parameters {
   std::vector<std::string> names_;
   std::vector<double> values_;
 };
+
+// A parameter computed from others: a case's `A = "pi*r^2"`, or a homotopy's interpolation
+// between two sets of values. It is never set directly: wherever a problem uses its parameters
+// it recomputes these from the others, so that continuing in r moves A with it.
+struct DependentParameter {
+  std::string name;
+  std::function<double(const Parameters&)> value;
+  std::vector<std::string> uses;  // the parameters `value` reads (the rod model depends on them if on it)
+};
+
+// Recomputes each dependent parameter in order (a later one may use an earlier one).
+void complete(Parameters* p, const std::vector<DependentParameter>& dependents);
+// The rule computing `name`, or nullptr when `name` is not a dependent parameter.
+const DependentParameter* find_dependent(const std::vector<DependentParameter>& dependents, const std::string& name);
 
 }  // namespace kirchhoff

@@ -44,6 +44,7 @@ std::string IntegratorOptions::validate() const {
 ShootingProblem::ShootingProblem(ProblemDefinition definition) : definition_(std::move(definition)) {
   if (std::string e = definition_.options.validate(); !e.empty()) throw std::invalid_argument(e);
   if (!definition_.model) throw std::invalid_argument("no rod model given");
+  adopt_dependent_parameters();
   const auto eq = equations(definition_.parameters);
   state_size_ = eq->state_size();
   if (std::string e = definition_.start.check(*eq); !e.empty()) throw std::invalid_argument("start: " + e);
@@ -100,8 +101,29 @@ int ShootingProblem::size() const {
   return n;
 }
 
+void ShootingProblem::adopt_dependent_parameters() {
+  const auto& dependents = definition_.dependent_parameters;
+  for (const auto& name : definition_.unknown_parameters)
+    if (find_dependent(dependents, name))
+      throw std::invalid_argument("unknown parameter '" + name + "' is computed from other parameters");
+  // Later rules may use earlier ones: walking backwards reaches every parameter a chain uses.
+  for (auto d = dependents.rbegin(); d != dependents.rend(); ++d) {
+    for (auto* depends : {&definition_.model_parameters, &definition_.obstacle_parameters})
+      if (depends->count(d->name)) depends->insert(d->uses.begin(), d->uses.end());
+  }
+  complete(&definition_.parameters, dependents);
+  if (definition_.moving_obstacles) definition_.obstacles = definition_.moving_obstacles(definition_.parameters);
+}
+
+Parameters ShootingProblem::completed(Parameters p) const {
+  complete(&p, definition_.dependent_parameters);
+  return p;
+}
+
 std::vector<Obstacle> ShootingProblem::obstacles(const Parameters& p) const {
-  return definition_.moving_obstacles ? definition_.moving_obstacles(p) : definition_.obstacles;
+  if (!definition_.moving_obstacles) return definition_.obstacles;
+  return definition_.dependent_parameters.empty() ? definition_.moving_obstacles(p)
+                                                  : definition_.moving_obstacles(completed(p));
 }
 
 double ShootingProblem::contact_bending(const Eigen::VectorXd& x, const PointContact& contact) const {
@@ -152,7 +174,11 @@ std::shared_ptr<const RodEquations> ShootingProblem::build_equations(const Param
                                              : make_spatial_equations(std::move(model));
 }
 
-std::shared_ptr<const RodEquations> ShootingProblem::equations(const Parameters& p) const {
+std::shared_ptr<const RodEquations> ShootingProblem::equations(const Parameters& given) const {
+  // Callers that changed a parameter by hand may pass values whose dependents are stale.
+  Parameters recomputed;
+  if (!definition_.dependent_parameters.empty()) recomputed = completed(given);
+  const Parameters& p = definition_.dependent_parameters.empty() ? given : recomputed;
   std::vector<double> key;
   for (const auto& name : definition_.model_parameters)
     if (p.contains(name)) key.push_back(p.get(name));
@@ -212,11 +238,15 @@ Parameters ShootingProblem::parameters_at(const Eigen::VectorXd& x) const {
   Parameters p = definition_.parameters;
   const int offset = segments() * state_size_;
   for (size_t j = 0; j < unknown_index_.size(); ++j) p.value_at(unknown_index_[j]) = x[offset + j];
+  complete(&p, definition_.dependent_parameters);
   return p;
 }
 
 void ShootingProblem::set_parameter(const std::string& name, double value) {
+  if (find_dependent(definition_.dependent_parameters, name))
+    throw std::invalid_argument("parameter '" + name + "' is computed from other parameters: set those instead");
   definition_.parameters.set(name, value);
+  complete(&definition_.parameters, definition_.dependent_parameters);
   if (definition_.moving_obstacles && definition_.obstacle_parameters.count(name))
     definition_.obstacles = definition_.moving_obstacles(definition_.parameters);
 }
@@ -236,9 +266,13 @@ bool ShootingProblem::parameter_derivative(const Eigen::VectorXd& x, const std::
                                            std::string* failure, const Eigen::VectorXd* y_end) const {
   const double value = definition_.parameters.get(name);
   const double h = kParameterStep * (1.0 + std::abs(value));
+  if (find_dependent(definition_.dependent_parameters, name))
+    throw std::invalid_argument("parameter '" + name + "' is computed from other parameters");
   Parameters plus = parameters_at(x), minus = plus;
   plus.set(name, value + h);
   minus.set(name, value - h);
+  complete(&plus, definition_.dependent_parameters);
+  complete(&minus, definition_.dependent_parameters);
   if (definition_.model_parameters.count(name) || definition_.obstacle_parameters.count(name)) {
     Eigen::VectorXd Fp, Fm;
     if (!residual(x, plus, &Fp, nullptr, failure) || !residual(x, minus, &Fm, nullptr, failure)) return false;

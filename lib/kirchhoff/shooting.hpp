@@ -86,6 +86,9 @@ struct ProblemDefinition {
   std::set<std::string> model_parameters;  // parameters the model depends on
   EndCondition start, end;
   Parameters parameters;                   // current values (guesses for the unknown ones)
+  // Parameters computed from the others (parameters.hpp), recomputed wherever the problem uses
+  // its parameters; one the model or an obstacle depends on makes the parameters it uses do too.
+  std::vector<DependentParameter> dependent_parameters;
   std::vector<std::string> unknown_parameters;
   ShootingOptions options;
   std::vector<Obstacle> obstacles;       // what the rod may touch (see solve_with_contacts)
@@ -125,6 +128,9 @@ class ShootingProblem final : public NonlinearSystem {
   void set_parameter(const std::string& name, double value);
   const Parameters& parameters() const { return definition_.parameters; }
   const ProblemDefinition& definition() const { return definition_; }
+
+  // The parameters with the dependent ones recomputed from the others.
+  Parameters completed(Parameters p) const;
 
   // Equations for the given parameters (rebuilt when a model parameter changes).
   std::shared_ptr<const RodEquations> equations(const Parameters& p) const;
@@ -222,6 +228,9 @@ class ShootingProblem final : public NonlinearSystem {
   std::vector<int> piece_segments_;  // multiple shooting with contacts: segments per piece  // index of each unknown parameter in Parameters
   // A new equations object for these parameters (uncached; a thread's own copy).
   std::shared_ptr<const RodEquations> build_equations(const Parameters& p) const;
+  // Checks the dependent parameters, extends the model's and obstacles' parameters by those they
+  // use, and computes their values.
+  void adopt_dependent_parameters();
   // Calls work(i, equations) for every segment i of multiple shooting, in parallel (see
   // ShootingOptions::threads); each thread has its own equations. Rethrows the first exception.
   // (Serially when `parallel` is false: starting threads costs more than a few samples.)
