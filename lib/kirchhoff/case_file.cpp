@@ -555,6 +555,10 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
   return load_case_text(text, path, overrides, phase_condition);
 }
 
+Case reload_case(const Case& c, const ParameterOverrides& overrides) {
+  return load_case_text(c.text, c.path, overrides, c.phase_condition);
+}
+
 Case load_case_text(const std::string& text, const std::string& path, const ParameterOverrides& overrides,
                     const std::string& phase_condition) {
   if (text.size() > kMaxFileBytes)
@@ -597,6 +601,10 @@ Case load_case_text(const std::string& text, const std::string& path, const Para
       parameters.set(name, plain.number(value, "parameters." + name));  // finite, within kMaxMagnitude
     }
   }
+  c.file_parameters = parameters;
+  c.overrides = overrides;
+  c.text = text;
+  c.phase_condition = phase_condition;
   for (const auto& [name, value] : overrides) {
     if (!parameters.contains(name)) {
       std::set<std::string> names(parameters.names().begin(), parameters.names().end());

@@ -19,6 +19,8 @@ struct CaseError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+using ParameterOverrides = std::vector<std::pair<std::string, double>>;
+
 struct Case {
   std::string path;
   std::string title;
@@ -27,9 +29,13 @@ struct Case {
   RodPoint start_guess;                 // completed by the start conditions before solving
   std::vector<std::string> derived;     // names from derived_catalogue()
   int samples = 201;                    // profile points
+  // The parameters as the file gives them, and the overrides (--set) the definition's values
+  // include: a solve at the overridden values may reach them from the file's (homotopy.hpp).
+  Parameters file_parameters;
+  ParameterOverrides overrides;
+  std::string text;             // the file's text and the options it was read with (reload_case)
+  std::string phase_condition;
 };
-
-using ParameterOverrides = std::vector<std::pair<std::string, double>>;
 
 // What a case file may ask for. Input beyond these bounds is refused (file, line, key, reason)
 // rather than left to exhaust the stack, the memory or the range of doubles; each bound is far
@@ -77,6 +83,9 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides = {}
 // The same from the text of a case file; `path` names it in messages (and in Case::path).
 Case load_case_text(const std::string& text, const std::string& path, const ParameterOverrides& overrides = {},
                     const std::string& phase_condition = "");
+
+// The same case read again with other overrides (and the options it was read with).
+Case reload_case(const Case& c, const ParameterOverrides& overrides);
 
 // Parses "NAME=VALUE" (--set); throws std::invalid_argument with the reason: no '=', an empty
 // name or one that is not an identifier, a value that is not a finite number with |value| <= 1e100.

@@ -62,6 +62,7 @@ const char* to_string(StopReason reason) {
     case StopReason::StartFailed: return "start_failed";
     case StopReason::Inadmissible: return "inadmissible";
     case StopReason::TimeLimit: return "time_limit";
+    case StopReason::FoldStop: return "fold";
   }
   return "?";
 }
@@ -665,6 +666,11 @@ ContinuationResult Continuation::march(MarchState state, const PointSink& sink, 
     for (auto& [h, p] : special) {
       accept(p);
       if (p.type == PointType::BranchPoint) ++branch_points_found;
+      if (p.type == PointType::Fold && options_.stop_at_fold) {
+        result.reason = StopReason::FoldStop;
+        result.message = "fold at " + options_.parameter + " = " + std::to_string(p.parameter);
+        return result;
+      }
       if (p.type == PointType::BranchPoint && options_.stop_at_branch_point > 0 &&
           branch_points_found >= options_.stop_at_branch_point) {
         result.reason = StopReason::BranchPointStop;

@@ -84,6 +84,7 @@ struct ContinuationOptions {
   double branch_point_tolerance = 1e-7;
   std::vector<ContinuationEvent> events;
   int stop_at_branch_point = 0;       // > 0: stop once this many branch points have been found
+  bool stop_at_fold = false;          // stop at the first fold (a homotopy that must not turn back)
   std::vector<std::string> derived;   // computed at every point (and available to events)
   int samples = 101;                  // profile points for invariants and derived quantities
   bool compute_invariants = true;     // false skips sampling (derived from events need it)
@@ -166,7 +167,7 @@ struct MarchState {
 // Inadmissible: a contact continuation reached a point that penetrates an obstacle or has a
 // pulling contact with no event located before it (reported, not followed).
 enum class StopReason { ReachedTarget, MaxPoints, ParameterBounds, StepTooSmall, EventStop, BranchPointStop, StartFailed,
-                        Inadmissible, TimeLimit };
+                        Inadmissible, TimeLimit, FoldStop };
 const char* to_string(StopReason reason);
 
 struct ContinuationResult {
