@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "kirchhoff/analytic.hpp"
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/shooting.hpp"
 
@@ -232,9 +233,15 @@ TEST_F(CaseFileTest, ModelIsMisspelt) {
   expect_refused(text, "model", {"'planer'", "not 'planar' or 'spatial'"}, line_of(text, "model"));
 }
 
-TEST_F(CaseFileTest, ParameterIsString) {
+TEST_F(CaseFileTest, ParameterIsBoolean) {
+  const std::string text = replaced(kBase, "EI = 1.0", "EI = true");
+  expect_refused(text, "parameters.EI", {"must be a number", "boolean"}, line_of(text, "EI = true"));
+}
+
+// A string is an expression of the parameters above it; a word that is none of them is refused.
+TEST_F(CaseFileTest, ParameterIsAWord) {
   const std::string text = replaced(kBase, "EI = 1.0", "EI = \"one\"");
-  expect_refused(text, "parameters.EI", {"must be a number", "string"}, line_of(text, "EI = \"one\""));
+  expect_refused(text, "parameters.EI", {"unknown variable 'one'"}, line_of(text, "EI = \"one\""));
 }
 
 // ---- non-physical values -------------------------------------------------------------------
@@ -412,6 +419,91 @@ TEST_F(CaseFileTest, ArclengthOutsideMaterialProperties) {
 TEST_F(CaseFileTest, ArclengthCannotBeAParameter) {
   const std::string text = replaced(kBase, "EI = 1.0", "EI = 1.0\ns = 0.5");
   expect_refused(text, "parameters.s", {"reserved for the arclength"}, line_of(text, "s = 0.5"));
+}
+
+// ---- [parameters] expressions ---------------------------------------------------------------
+
+// kBase with EI computed from E and I, given above it.
+std::string with_computed_stiffness() { return replaced(kBase, "EI = 1.0", "E = 2.0\nI = 0.25\nEI = \"E*I\""); }
+
+TEST_F(CaseFileTest, ParameterExpressionIsComputedFromTheParametersAboveIt) {
+  const Case c = load_case(write(with_computed_stiffness()), {{"E", 8.0}});
+  EXPECT_EQ(c.definition.parameters.get("EI"), 2.0);  // 8 * 0.25, the override included
+  EXPECT_EQ(c.file_parameters.get("EI"), 0.5);        // the file's own values
+  ASSERT_EQ(c.definition.dependent_parameters.size(), 1u);
+  EXPECT_EQ(c.definition.dependent_parameters[0].name, "EI");
+  EXPECT_EQ(c.definition.dependent_parameters[0].uses, (std::vector<std::string>{"E", "I"}));
+
+  // The rod follows E wherever the problem takes its parameters: set by hand, as continuation does.
+  ShootingProblem problem(c.definition);
+  problem.set_parameter("E", 12.0);
+  EXPECT_EQ(problem.parameters().get("EI"), 3.0);
+  EXPECT_EQ(problem.equations(problem.parameters())->model().B[1](0.0), 3.0);
+  EXPECT_THROW(problem.set_parameter("EI", 1.0), std::invalid_argument);
+}
+
+TEST_F(CaseFileTest, ComputedStiffnessGivesTheElasticaOfThatStiffness) {
+  const Case c = load_case(write(with_computed_stiffness()), {{"E", 8.0}});
+  ShootingProblem problem(c.definition);
+  const ShootingResult r = solve(problem, problem.initial_unknowns(c.start_guess));
+  ASSERT_TRUE(r.summary.converged()) << r.summary.brief_report();
+  // P = 4 K(k)^2 EI / L^2 (eq. 54) with EI = 2: the load scales with the computed stiffness
+  // (Newton's tolerance 1e-10 and the analytic solution's 1e-12 leave 1e-9 of margin).
+  const double P = r.parameters.get("P");
+  const double expected = analytic::PinnedElastica{1.0, 2.0, 1.0}.load();
+  EXPECT_NEAR(P, expected, 1e-9 * expected);
+  EXPECT_EQ(r.parameters.get("EI"), 2.0);
+}
+
+TEST_F(CaseFileTest, PiIsAConstantAndAnExpressionOfNoParameterIsAParameterOfItsOwn) {
+  const std::string text = replaced(kBase, "theta0 = 1.0", "theta0 = \"pi/3\"");
+  const Case c = load_case(write(text));
+  EXPECT_DOUBLE_EQ(c.definition.parameters.get("theta0"), std::acos(0.5));
+  EXPECT_TRUE(c.definition.dependent_parameters.empty());
+  EXPECT_EQ(load_case(write(text), {{"theta0", 2.0}}).definition.parameters.get("theta0"), 2.0);
+  // pi in any expression; _pi, muParser's name, is the same double (muParser's own is 3.141592653589).
+  const Case d = load_case(write(replaced(kBase, "length = \"L\"", "length = \"L*pi/_pi\"")));
+  EXPECT_EQ(d.definition.model(d.definition.parameters).length, 1.0);
+  const Case e = load_case(write(replaced(kBase, "B = \"EI\"", "B = \"EI*(1 + s*(pi - _pi))\"")));
+  EXPECT_EQ(e.definition.model(e.definition.parameters).B[1](0.5), 1.0);  // a profile in s: bound apart
+}
+
+TEST_F(CaseFileTest, ParameterUsingOneBelowItIsRefusedByName) {
+  const std::string text = replaced(kBase, "theta0 = 1.0", "theta0 = \"EI/2\"");
+  expect_refused(text, "parameters.theta0",
+                 {"uses 'EI', which is given below it (line " + std::to_string(line_of(text, "EI = 1.0")) + ")",
+                  "only the parameters above it"},
+                 line_of(text, "theta0 = "));
+}
+
+TEST_F(CaseFileTest, CycleOfParametersIsRefusedByName) {
+  const std::string text = replaced(kBase, "L = 1.0\nEI = 1.0", "L = \"EI\"\nEI = \"L\"");
+  expect_refused(text, "parameters.L", {"uses 'EI', which is given below it"}, line_of(text, "L = \"EI\""));
+  const std::string self = replaced(kBase, "EI = 1.0", "EI = \"2*EI\"");
+  expect_refused(self, "parameters.EI", {"uses itself"}, line_of(self, "EI = \"2*EI\""));
+}
+
+TEST_F(CaseFileTest, ParameterNamedLikeAConstantIsRefused) {
+  const std::string text = replaced(kBase, "EI = 1.0", "EI = 1.0\npi = 3.14");
+  expect_refused(text, "parameters.pi", {"is a constant in expressions"}, line_of(text, "pi = 3.14"));
+}
+
+TEST_F(CaseFileTest, ComputedParameterCannotBeSetOrSolvedFor) {
+  const std::string path = write(with_computed_stiffness());
+  try {
+    load_case(path, {{"EI", 3.0}});
+    ADD_FAILURE() << "--set of a computed parameter was accepted";
+  } catch (const CaseError& e) {
+    EXPECT_THAT(e.what(), HasSubstr(path + ": --set EI: EI is computed from E, I"));
+    EXPECT_THAT(e.what(), HasSubstr("set E, I instead"));
+  }
+  const std::string text = replaced(with_computed_stiffness(), "unknowns = [\"P\"]", "unknowns = [\"EI\"]");
+  expect_refused(text, "solver.unknowns", {"EI is computed from E, I", "solve for E, I instead"},
+                 line_of(text, "unknowns"));
+  // Chains name the parameters a user can set.
+  std::vector<DependentParameter> chain{{"A", {}, {"r"}}, {"B", {}, {"A", "t"}}};
+  EXPECT_THAT(dependent_parameter_refusal(chain, "B", "continue in"), HasSubstr("B is computed from r, t"));
+  EXPECT_EQ(dependent_parameter_refusal(chain, "r", "set"), "");
 }
 
 // ---- --set overrides -----------------------------------------------------------------------

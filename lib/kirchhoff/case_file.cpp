@@ -506,6 +506,18 @@ bool is_identifier(const std::string& name) {
                      [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
 }
 
+// The parameters a dependent one is ultimately computed from (those a user can set).
+std::set<std::string> free_roots(const std::vector<DependentParameter>& dependents, const std::string& name) {
+  const DependentParameter* d = find_dependent(dependents, name);
+  if (!d) return {name};
+  std::set<std::string> out;
+  for (const auto& used : d->uses) {
+    const auto roots = free_roots(dependents, used);
+    out.insert(roots.begin(), roots.end());
+  }
+  return out;
+}
+
 }  // namespace
 
 std::pair<std::string, double> parse_override(const std::string& text) {
@@ -529,6 +541,15 @@ std::pair<std::string, double> parse_override(const std::string& text) {
   return {name, v};
 }
 
+std::string dependent_parameter_refusal(const std::vector<DependentParameter>& dependents, const std::string& name,
+                                       const std::string& action) {
+  if (!find_dependent(dependents, name)) return "";
+  std::string roots;
+  for (const auto& r : free_roots(dependents, name)) roots += (roots.empty() ? "" : ", ") + r;
+  return name + " is computed from " + roots + " (an expression in [parameters]); " + action + " " + roots +
+         " instead";
+}
+
 namespace {
 void apply_phase_condition(const Reader& reader, const Value* where, const std::string& name, ProblemDefinition& d) {
   if (name == "axial") {
@@ -538,6 +559,89 @@ void apply_phase_condition(const Reader& reader, const Value* where, const std::
     add_axial_phase_condition(d);
   } else if (name != "none") {
     reader.fail(*where, "solver.phase_condition", "'" + name + "' is not 'none' or 'axial'");
+  }
+}
+
+// [parameters] entries in the order of the file: toml11 keeps a table's keys unordered, and an
+// expression may use only the parameters above it.
+std::vector<std::pair<std::string, const Value*>> in_file_order(const toml::table& table) {
+  std::vector<std::pair<std::string, const Value*>> entries;
+  for (const auto& [name, value] : table) entries.emplace_back(name, &value);
+  std::sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+    const auto &la = a.second->location(), &lb = b.second->location();
+    return std::pair(la.line(), la.column()) < std::pair(lb.line(), lb.column());
+  });
+  return entries;
+}
+
+// A [parameters] expression: compiled against every name so that one naming a parameter below
+// it is refused as such (not as an unknown variable), then checked to use only those above.
+Expression parameter_expression(const Reader& plain, const Value& v, const std::string& name,
+                                const std::vector<std::pair<std::string, const Value*>>& entries, std::size_t index) {
+  std::vector<std::string> names;
+  for (const auto& [n, value] : entries) names.push_back(n);
+  std::optional<Expression> e;
+  try {
+    e.emplace(v.as_string().str, names, false);
+  } catch (const std::invalid_argument& error) {
+    plain.fail(v, "parameters." + name, error.what());
+  }
+  for (const auto& used : e->used_parameters()) {
+    const auto at = static_cast<std::size_t>(std::find(names.begin(), names.end(), used) - names.begin());
+    if (at == index) plain.fail(v, "parameters." + name, "uses itself");
+    if (at > index)
+      plain.fail(v, "parameters." + name,
+                 "uses '" + used + "', which is given below it (line " +
+                     std::to_string(entries[at].second->location().line()) +
+                     "): a parameter may use only the parameters above it (so that none is computed in a cycle)");
+  }
+  return *e;
+}
+
+// Reads [parameters] into values and dependent parameters, with the overrides applied to the
+// parameters that are numbers. A number, or an expression using no parameter ("pi/2"), is a
+// parameter of its own (it can be set and continued in); an expression of the parameters above
+// it ("pi*r^2") is a DependentParameter, recomputed wherever the problem uses its parameters.
+void read_parameters(const Reader& plain, const Value& root, const ParameterOverrides& overrides, Parameters* values,
+                     std::vector<DependentParameter>* dependents) {
+  const Value* table = Reader::find(root, "parameters");
+  if (!table) return;
+  if (!table->is_table()) plain.fail(*table, "parameters", "must be a table of named numbers and expressions");
+  if (table->as_table().size() > static_cast<std::size_t>(kMaxParameters))
+    plain.fail(*table, "parameters", "has " + std::to_string(table->as_table().size()) + " entries, at most " +
+                                         std::to_string(kMaxParameters) + " are allowed");
+  const auto entries = in_file_order(table->as_table());
+  for (const auto& [name, value] : entries) {
+    if (name == "s") plain.fail(*value, "parameters.s", "'s' is reserved for the arclength");
+    if (!is_identifier(name))
+      plain.fail(*value, "parameters." + name, "is not a name expressions can use (letters, digits and _)");
+    const auto& reserved = reserved_constant_names();
+    if (std::find(reserved.begin(), reserved.end(), name) != reserved.end())
+      plain.fail(*value, "parameters." + name, "is a constant in expressions (pi = 3.14159...); name the parameter otherwise");
+    values->set(name, 0.0);  // every name bound, so that each expression compiles against all of them
+  }
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const auto& [name, v] = entries[i];
+    const std::string key = "parameters." + name;
+    const auto given = std::find_if(overrides.begin(), overrides.end(), [&](const auto& o) { return o.first == name; });
+    if (!v->is_string()) {
+      values->set(name, plain.number(*v, key));  // finite, within kMaxMagnitude
+    } else {
+      const Expression e = parameter_expression(plain, *v, name, entries, i);
+      double x = 0.0;
+      try {
+        x = e(*values);
+      } catch (const std::invalid_argument& error) {
+        plain.fail(*v, key, error.what());
+      }
+      plain.check_magnitude(*v, key, x);
+      values->set(name, x);
+      if (!e.used_parameters().empty()) {
+        dependents->push_back({name, [e](const Parameters& p) { return e(p); }, e.used_parameters()});
+        continue;  // an override of it is refused by the caller
+      }
+    }
+    if (given != overrides.end()) values->set(name, given->second);
   }
 }
 }  // namespace
@@ -589,39 +693,32 @@ Case load_case_text(const std::string& text, const std::string& path, const Para
   const Reader plain(path, {});
   plain.allow_keys(root, "", {"title", "description", "model", "parameters", "rod", "start", "end", "guess",
                               "solver", "output", "obstacles"});
-  if (const Value* table = Reader::find(root, "parameters")) {
-    if (!table->is_table()) plain.fail(*table, "parameters", "must be a table of named numbers");
-    if (table->as_table().size() > static_cast<std::size_t>(kMaxParameters))
-      plain.fail(*table, "parameters", "has " + std::to_string(table->as_table().size()) + " entries, at most " +
-                                           std::to_string(kMaxParameters) + " are allowed");
-    for (const auto& [name, value] : table->as_table()) {
-      if (name == "s") plain.fail(value, "parameters.s", "'s' is reserved for the arclength");
-      if (!is_identifier(name))
-        plain.fail(value, "parameters." + name, "is not a name expressions can use (letters, digits and _)");
-      parameters.set(name, plain.number(value, "parameters." + name));  // finite, within kMaxMagnitude
-    }
-  }
-  c.file_parameters = parameters;
+  std::vector<DependentParameter> dependents;
+  read_parameters(plain, root, {}, &c.file_parameters, &dependents);
   c.overrides = overrides;
   c.text = text;
   c.phase_condition = phase_condition;
   for (const auto& [name, value] : overrides) {
-    if (!parameters.contains(name)) {
-      std::set<std::string> names(parameters.names().begin(), parameters.names().end());
+    if (!c.file_parameters.contains(name)) {
+      std::set<std::string> names(c.file_parameters.names().begin(), c.file_parameters.names().end());
       throw CaseError(path + ": --set " + name + ": no parameter '" + name + "' in [parameters] (have: " +
                       join(names) + ")");
     }
+    if (find_dependent(dependents, name))
+      throw CaseError(path + ": --set " + name + ": " + dependent_parameter_refusal(dependents, name, "set"));
     // The CLI's parse_override checks this too; load_case is also called with overrides directly.
     if (!std::isfinite(value) || std::abs(value) > kMaxMagnitude)
       throw CaseError(path + ": --set " + name + ": " + shown(value) + " is not a finite number with magnitude <= " +
                       shown(kMaxMagnitude));
-    parameters.set(name, value);
   }
+  dependents.clear();
+  read_parameters(plain, root, overrides, &parameters, &dependents);
   const Reader reader(path, parameters);
   if (const Value* v = Reader::find(root, "title")) c.title = reader.string(*v, "title");
   if (const Value* v = Reader::find(root, "description")) c.description = reader.string(*v, "description");
   ProblemDefinition& d = c.definition;
   d.parameters = parameters;
+  d.dependent_parameters = dependents;
   if (const Value* v = Reader::find(root, "model")) {
     const std::string kind = reader.string(*v, "model");
     if (kind == "planar") d.kind = RodKind::Planar;
@@ -798,9 +895,12 @@ Case load_case_text(const std::string& text, const std::string& path, const Para
     ShootingOptions& o = d.options;
     if (const Value* v = Reader::find(*s, "unknowns")) {
       d.unknown_parameters = reader.strings(*v, "solver.unknowns");
-      for (const auto& name : d.unknown_parameters)
+      for (const auto& name : d.unknown_parameters) {
         if (!parameters.contains(name))
           reader.fail(*v, "solver.unknowns", "'" + name + "' is not in [parameters] (give it there with a guess)");
+        if (find_dependent(dependents, name))
+          reader.fail(*v, "solver.unknowns", dependent_parameter_refusal(dependents, name, "solve for"));
+      }
     }
     if (const Value* v = Reader::find(*s, "segments")) {
       // An integer, or an expression of the parameters rounded (e.g. "slenderness / 5": long

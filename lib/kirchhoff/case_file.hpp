@@ -87,6 +87,12 @@ Case load_case_text(const std::string& text, const std::string& path, const Para
 // The same case read again with other overrides (and the options it was read with).
 Case reload_case(const Case& c, const ParameterOverrides& overrides);
 
+// Why `name` cannot be set, continued in or solved for when it is computed from other
+// parameters ([parameters] A = "pi*r^2"): "A is computed from r (...); <action> r instead",
+// naming the parameters it is ultimately computed from. Empty when `name` is not computed.
+std::string dependent_parameter_refusal(const std::vector<DependentParameter>& dependents, const std::string& name,
+                                       const std::string& action);
+
 // Parses "NAME=VALUE" (--set); throws std::invalid_argument with the reason: no '=', an empty
 // name or one that is not an identifier, a value that is not a finite number with |value| <= 1e100.
 std::pair<std::string, double> parse_override(const std::string& text);

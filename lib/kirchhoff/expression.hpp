@@ -1,5 +1,7 @@
 // Scalar expressions in case files ("-P", "EI*(1 + taper*(s/L - 0.5))"), evaluated by muParser
 // with the problem's parameters and, for material profiles, the arclength s as variables.
+// Besides muParser's functions and constants (_pi, _e), `pi` is defined; a variable may not
+// be named pi, _pi or _e (reserved_constant_names()).
 #pragma once
 
 #include <functional>
@@ -10,6 +12,9 @@
 #include "kirchhoff/parameters.hpp"
 
 namespace kirchhoff {
+
+// The constants every expression knows: no parameter may take these names.
+const std::vector<std::string>& reserved_constant_names();
 
 class Expression {
  public:
