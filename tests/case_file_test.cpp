@@ -522,6 +522,57 @@ TEST_F(CaseFileTest, OverrideOfUnknownParameter) {
   }
 }
 
+// ---- --solver overrides ----------------------------------------------------------------------
+
+TEST_F(CaseFileTest, SolverOverridesReplaceAndAddSolverKeys) {
+  const Case c = load_case(write(kBase), {}, "",
+                           {{"tolerance", "1e-11"}, {"stepper", "dopri5"}, {"fallback_search", "true"},
+                            {"max_iterations", "7"}, {"unknowns", "[\"P\"]"}});
+  const ShootingOptions& o = c.definition.options;
+  EXPECT_EQ(o.newton.residual_tolerance, 1e-11);
+  EXPECT_EQ(o.integrator.stepper, IntegratorOptions::Stepper::Dopri5);
+  EXPECT_TRUE(o.newton.fallback_search);
+  EXPECT_EQ(o.newton.max_iterations, 7);
+  EXPECT_EQ(c.definition.unknown_parameters, std::vector<std::string>{"P"});
+  // A case without [solver] gains one; a reload keeps the overrides.
+  const Case s = load_case(write(kSpatialBase), {}, "", {{"abs_tol", "1e-9"}});
+  EXPECT_EQ(s.definition.options.integrator.abs_tol, 1e-9);
+  EXPECT_EQ(reload_case(s, {}).definition.options.integrator.abs_tol, 1e-9);
+  // A string value may be quoted as in the file.
+  const Case q = load_case(write(kBase), {}, "", {{"stepper", "\"dopri5\""}});
+  EXPECT_EQ(q.definition.options.integrator.stepper, IntegratorOptions::Stepper::Dopri5);
+}
+
+// Refused as the file's value would be, the message naming the option instead of a line.
+TEST_F(CaseFileTest, BadSolverOverridesAreRefusedAsInTheFile) {
+  const std::string path = write(kBase);
+  auto message = [&](const std::string& key, const std::string& value) -> std::string {
+    try {
+      load_case(path, {}, "", {{key, value}});
+    } catch (const CaseError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "--solver " << key << "=" << value << " was accepted";
+    return "";
+  };
+  const std::string tolerance = message("tolerance", "1");
+  EXPECT_THAT(tolerance, HasSubstr(path + ": --solver tolerance=1: key 'solver.tolerance': must be in (0, 0.01]"));
+  EXPECT_THAT(message("tolerance", "small"), HasSubstr("key 'solver.tolerance': must be a number, got string"));
+  EXPECT_THAT(message("tolernace", "1e-9"), HasSubstr("--solver tolernace=1e-9: key 'solver.tolernace': unknown key"));
+  EXPECT_THAT(message("stepper", "rk4"), HasSubstr("key 'solver.stepper': 'rk4' is not 'rk78' or 'dopri5'"));
+  EXPECT_THAT(message("segments", "1.5"), HasSubstr("key 'solver.segments': must be an integer"));
+  EXPECT_THAT(message("unknowns", "P"), HasSubstr("key 'solver.unknowns': must be an array of strings"));
+  EXPECT_THAT(message("max_iterations", "0"), HasSubstr("must be in [1, 10000]"));
+}
+
+TEST(ParseSolverOverride, SplitsKeyAndValueText) {
+  EXPECT_EQ(parse_solver_override("tolerance=1e-10"), (std::pair<std::string, std::string>{"tolerance", "1e-10"}));
+  EXPECT_EQ(parse_solver_override("unknowns=[\"P\", \"Q\"]"),
+            (std::pair<std::string, std::string>{"unknowns", "[\"P\", \"Q\"]"}));
+  for (const char* bad : {"tolerance", "=1", "tolerance=", "solver.tolerance=1"})
+    EXPECT_THROW(parse_solver_override(bad), std::invalid_argument) << bad;
+}
+
 TEST(ParseOverride, AcceptsNameEqualsNumber) {
   EXPECT_EQ(parse_override("theta0=2.5"), (std::pair<std::string, double>{"theta0", 2.5}));
   EXPECT_EQ(parse_override("P=-1e-3"), (std::pair<std::string, double>{"P", -1e-3}));

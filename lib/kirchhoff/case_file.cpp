@@ -44,6 +44,11 @@ std::string join(const std::set<std::string>& names) {
   return out;
 }
 
+// Values given on the command line (--solver KEY=VALUE) are parsed under this source name, so
+// that messages name the option instead of a line of the file.
+constexpr const char* kSolverOption = "--solver ";
+bool is_command_line(const Value& v) { return v.location().file_name().rfind(kSolverOption, 0) == 0; }
+
 // Reads typed values out of the TOML tree, turning every problem into a CaseError that names
 // the file, the line, the key and the reason.
 class Reader {
@@ -56,7 +61,8 @@ class Reader {
     std::ostringstream os;
     os << path_;
     const auto line = v.location().line();
-    if (line > 0) os << ":" << line;
+    if (is_command_line(v)) os << ": " << v.location().file_name();  // "--solver tolerance=..."
+    else if (line > 0) os << ":" << line;
     os << ": key '" << key << "': " << reason;
     throw CaseError(os.str());
   }
@@ -562,6 +568,54 @@ void apply_phase_condition(const Reader& reader, const Value* where, const std::
   }
 }
 
+// A --solver value as TOML ("1e-10", "true", "[\"P\"]"); text that is not one TOML value (rk78)
+// is the string it spells. Either carries the option as its source, for messages.
+Value solver_value(const std::string& path, const std::string& key, const std::string& text) {
+  const std::string source = kSolverOption + key + "=" + text;
+  auto parsed = [&](const std::string& toml_text) -> std::optional<Value> {
+    try {
+      std::istringstream in("value = " + toml_text);
+      const Value table = toml::parse(in, source);
+      if (table.as_table().size() == 1) return table.as_table().at("value");
+    } catch (const std::exception&) {
+    }
+    return std::nullopt;
+  };
+  if (auto v = parsed(text)) return *v;
+  std::string quoted = "\"";
+  for (const char ch : text) {
+    if (ch == '"' || ch == '\\') quoted += '\\';
+    if (static_cast<unsigned char>(ch) < 0x20) throw CaseError(path + ": " + source + ": control characters in the value");
+    quoted += ch;
+  }
+  if (auto v = parsed(quoted + "\"")) return *v;
+  throw CaseError(path + ": " + source + ": neither a TOML value nor a string");
+}
+
+// --solver KEY=VALUE in place of [solver] KEY, so that each is validated, and refused, exactly
+// as the file's own value would be.
+void merge_solver_overrides(Value& root, const SolverOverrides& solver, const std::string& path) {
+  if (solver.empty()) return;
+  auto& table = root.as_table();
+  if (!table.count("solver")) table["solver"] = toml::table{};
+  Value& solver_table = table["solver"];
+  if (!solver_table.is_table()) return;  // refused as the file's [solver] when read
+  for (const auto& [key, text] : solver) solver_table.as_table()[key] = solver_value(path, key, text);
+}
+
+}  // namespace
+
+std::pair<std::string, std::string> parse_solver_override(const std::string& text) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
+    throw std::invalid_argument("'" + text + "' is not KEY=VALUE (a [solver] key and its value, e.g. tolerance=1e-10)");
+  const std::string key = text.substr(0, eq);
+  if (!is_identifier(key)) throw std::invalid_argument("'" + key + "' in '" + text + "' is not a [solver] key");
+  return {key, text.substr(eq + 1)};
+}
+
+namespace {
+
 // [parameters] entries in the order of the file: toml11 keeps a table's keys unordered, and an
 // expression may use only the parameters above it.
 std::vector<std::pair<std::string, const Value*>> in_file_order(const toml::table& table) {
@@ -646,7 +700,8 @@ void read_parameters(const Reader& plain, const Value& root, const ParameterOver
 }
 }  // namespace
 
-Case load_case(const std::string& path, const ParameterOverrides& overrides, const std::string& phase_condition) {
+Case load_case(const std::string& path, const ParameterOverrides& overrides, const std::string& phase_condition,
+               const SolverOverrides& solver) {
   // Read with a cap, not by size: a FIFO or /dev/zero has none.
   std::ifstream in(path, std::ios::binary);
   if (!in) throw CaseError(path + ": cannot open the file (" + std::strerror(errno) + ")");
@@ -656,15 +711,15 @@ Case load_case(const std::string& path, const ParameterOverrides& overrides, con
   text.resize(static_cast<std::size_t>(in.gcount()));
   if (text.size() > kMaxFileBytes)
     throw CaseError(path + ": larger than " + std::to_string(kMaxFileBytes >> 20) + " MiB: not a case file");
-  return load_case_text(text, path, overrides, phase_condition);
+  return load_case_text(text, path, overrides, phase_condition, solver);
 }
 
 Case reload_case(const Case& c, const ParameterOverrides& overrides) {
-  return load_case_text(c.text, c.path, overrides, c.phase_condition);
+  return load_case_text(c.text, c.path, overrides, c.phase_condition, c.solver_overrides);
 }
 
 Case load_case_text(const std::string& text, const std::string& path, const ParameterOverrides& overrides,
-                    const std::string& phase_condition) {
+                    const std::string& phase_condition, const SolverOverrides& solver) {
   if (text.size() > kMaxFileBytes)
     throw CaseError(path + ": larger than " + std::to_string(kMaxFileBytes >> 20) + " MiB: not a case file");
   if (const int line = toml_line_beyond_nesting(text, kMaxNesting))
@@ -686,8 +741,11 @@ Case load_case_text(const std::string& text, const std::string& path, const Para
     throw CaseError(path + ": TOML syntax error: " + e.what());
   }
 
+  merge_solver_overrides(root, solver, path);
+
   Case c;
   c.path = path;
+  c.solver_overrides = solver;
   // Parameters first: every expression may use them.
   Parameters parameters;
   const Reader plain(path, {});

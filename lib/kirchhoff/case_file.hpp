@@ -20,6 +20,8 @@ struct CaseError : std::runtime_error {
 };
 
 using ParameterOverrides = std::vector<std::pair<std::string, double>>;
+// [solver] keys and their values as TOML text (--solver tolerance=1e-10, stepper=rk78).
+using SolverOverrides = std::vector<std::pair<std::string, std::string>>;
 
 struct Case {
   std::string path;
@@ -35,6 +37,7 @@ struct Case {
   ParameterOverrides overrides;
   std::string text;             // the file's text and the options it was read with (reload_case)
   std::string phase_condition;
+  SolverOverrides solver_overrides;
 };
 
 // What a case file may ask for. Input beyond these bounds is refused (file, line, key, reason)
@@ -78,11 +81,13 @@ constexpr double kMaxTolerance = 1e-2;
 // inconsistent boundary conditions are reported here). Overrides replace [parameters] values
 // and must name existing parameters.
 // phase_condition, when non-empty, replaces [solver] phase_condition ("none" or "axial").
+// Solver overrides replace (or add) [solver] keys, each validated as in the file; a value that is
+// not TOML is a string (stepper=rk78), and messages name the option ("--solver KEY=VALUE").
 Case load_case(const std::string& path, const ParameterOverrides& overrides = {},
-               const std::string& phase_condition = "");
+               const std::string& phase_condition = "", const SolverOverrides& solver = {});
 // The same from the text of a case file; `path` names it in messages (and in Case::path).
 Case load_case_text(const std::string& text, const std::string& path, const ParameterOverrides& overrides = {},
-                    const std::string& phase_condition = "");
+                    const std::string& phase_condition = "", const SolverOverrides& solver = {});
 
 // The same case read again with other overrides (and the options it was read with).
 Case reload_case(const Case& c, const ParameterOverrides& overrides);
@@ -92,6 +97,11 @@ Case reload_case(const Case& c, const ParameterOverrides& overrides);
 // naming the parameters it is ultimately computed from. Empty when `name` is not computed.
 std::string dependent_parameter_refusal(const std::vector<DependentParameter>& dependents, const std::string& name,
                                        const std::string& action);
+
+// Parses "KEY=VALUE" (--solver) into the key and the value's text; throws std::invalid_argument
+// when there is no '=', no value or a key that is not a name. The key and value are checked
+// when the case is loaded.
+std::pair<std::string, std::string> parse_solver_override(const std::string& text);
 
 // Parses "NAME=VALUE" (--set); throws std::invalid_argument with the reason: no '=', an empty
 // name or one that is not an identifier, a value that is not a finite number with |value| <= 1e100.
