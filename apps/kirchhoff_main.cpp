@@ -7,6 +7,7 @@
 #include "reproduce_command.hpp"
 #include "solve_command.hpp"
 #include "vibrate_command.hpp"
+#include "equilibria_command.hpp"
 
 namespace {
 
@@ -129,6 +130,36 @@ int main(int argc, char** argv) {
   continue_cmd->add_option("--set", cont.overrides, "Override a parameter: NAME=VALUE (repeatable)");
   continue_cmd->add_option("--phase-condition", cont.phase_condition, "As for solve")
       ->check(CLI::IsMember({"none", "axial"}));
+
+  EquilibriaArguments eq;
+  auto* equilibria_cmd = app.add_subcommand(
+      "equilibria",
+      "List the distinct equilibria at one set of parameters, by deflated Newton, sorted by energy,\n"
+      "with stability index, contact set, derived quantities and invariants");
+  equilibria_cmd->footer(
+      "Starts from the case's guess, its mirror images, perturbations along the low modes of every\n"
+      "equilibrium found and, for planar rods clamped at both ends, Ipopt's discretised minimisers;\n"
+      "deflation keeps Newton from converging to an equilibrium already found. Equilibria are\n"
+      "compared by their profiles relative to L; every one listed has converged and, with obstacles,\n"
+      "satisfies 0 <= gap perp force >= 0. The energy is the elastic energy plus the potential of the\n"
+      "field and of the given end loads (-F.r, -M theta). See docs/equilibria.md. Exit status: 0 at\n"
+      "least one equilibrium, 1 none found, 2 input refused.\n\n"
+      "Examples:\n"
+      "  kirchhoff equilibria cases/euler_column.toml --set P=50\n"
+      "  kirchhoff equilibria cases/wall.toml --set Delta=0.033 --max 6 --json --profiles wall_eq/");
+  equilibria_cmd->add_option("case", eq.case_path, "Case file (TOML)")->required()->check(CLI::ExistingFile);
+  equilibria_cmd->add_option("--set", eq.overrides, "Override a parameter: NAME=VALUE (repeatable)");
+  equilibria_cmd->add_option("--max", eq.max_equilibria, "Stop once this many distinct equilibria are found")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  equilibria_cmd->add_flag("--json", eq.json,
+                           "Print JSON: {\"equilibria\": [solve's object with \"energy\", \"rank\", \"found_by\"], "
+                           "\"rejected\", \"stopped_because\", \"log\"}");
+  equilibria_cmd->add_option("--profiles", eq.profiles_dir,
+                             "Write each equilibrium's profile as DIR/equilibrium_K.csv (K as in the table)");
+  equilibria_cmd
+      ->add_option("--max-seconds", eq.max_seconds, "Wall-clock limit of the search in seconds (0: none)")
+      ->capture_default_str();
 
   VibrateArguments vib;
   auto* vibrate_cmd = app.add_subcommand(
@@ -284,6 +315,7 @@ int main(int argc, char** argv) {
       return run_continue(cont);
     }
     if (*vibrate_cmd) return run_vibrate(vib);
+    if (*equilibria_cmd) return run_equilibria(eq);
     if (*plectonemes_cmd) return run_plectonemes(plect);
   } catch (const std::exception& e) {
     // The commands report the errors they expect; anything else still ends with a message

@@ -1,0 +1,134 @@
+#include "equilibria_command.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "kirchhoff/case_file.hpp"
+#include "kirchhoff/equilibria.hpp"
+#include "result_json.hpp"
+#include "solve_command.hpp"
+
+namespace kirchhoff::cli {
+namespace {
+
+std::string index_text(const StabilityReport& s) {
+  if (!s.index) return "-";
+  return s.stable() ? "0 (stable)" : std::to_string(*s.index);
+}
+
+std::string contacts_text(const Solution& sol) {
+  if (sol.contacts.empty()) return "none";
+  std::ostringstream out;
+  out << std::setprecision(4);
+  for (size_t i = 0; i < sol.contacts.size(); ++i) {
+    const PointContact& c = sol.contacts[i];
+    out << (i ? "; " : "");
+    if (c.extended)
+      out << "flat [" << c.s << ", " << c.s_end << "]";
+    else
+      out << "s=" << c.s;
+  }
+  return out.str();
+}
+
+void print_table(const Case& c, const EquilibriaSearch& search) {
+  std::cout << (c.title.empty() ? c.path : c.title) << "\n";
+  std::cout << "  " << search.equilibria.size() << " distinct equilibria (" << search.stopped_because << ", "
+            << search.newton_runs << " Newton runs), by increasing energy:\n";
+  std::cout << "  " << std::setw(3) << "#" << std::setw(16) << "energy" << std::setw(12) << "index" << std::setw(11)
+            << "residual" << std::setw(11) << "H spread";
+  for (const auto& name : c.derived) std::cout << std::setw(15) << name;
+  std::cout << "  contacts\n";
+  for (size_t i = 0; i < search.equilibria.size(); ++i) {
+    const Equilibrium& e = search.equilibria[i];
+    const Solution& sol = e.solution;
+    std::cout << "  " << std::setw(3) << i + 1 << std::setw(16) << std::setprecision(10) << e.energy << std::setw(12)
+              << index_text(e.stability) << std::setw(11) << std::setprecision(2) << sol.result.summary.residual_norm
+              << std::setw(11) << sol.invariants.H.relative_spread() << std::setprecision(8);
+    for (const auto& name : c.derived) std::cout << std::setw(15) << sol.derived.at(name);
+    std::cout << "  " << contacts_text(sol) << "\n";
+  }
+  for (size_t i = 0; i < search.equilibria.size(); ++i) {
+    const StabilityReport& s = search.equilibria[i].stability;
+    if (!s.index) std::cout << "  #" << i + 1 << ": index undefined: " << s.reason << "\n";
+  }
+  if (!search.rejected.empty())
+    std::cout << "  " << search.rejected.size() << " converged points rejected (not admissible or failed checks; "
+              << "see --json)\n";
+}
+
+nlohmann::json search_json(const Case& c, const EquilibriaSearch& search) {
+  nlohmann::json out;
+  out["case"] = c.path;
+  out["title"] = c.title;
+  out["parameters"] = parameters_json(c.definition.parameters);
+  out["stopped_because"] = search.stopped_because;
+  out["newton_runs"] = search.newton_runs;
+  out["equilibria"] = nlohmann::json::array();
+  for (size_t i = 0; i < search.equilibria.size(); ++i) {
+    const Equilibrium& e = search.equilibria[i];
+    nlohmann::json j = solution_json(c, *e.problem, e.solution, e.stability);
+    j["rank"] = i + 1;
+    j["energy"] = std::isfinite(e.energy) ? nlohmann::json(e.energy) : nlohmann::json();
+    j["found_by"] = e.found_by;
+    out["equilibria"].push_back(std::move(j));
+  }
+  out["rejected"] = nlohmann::json::array();
+  for (const auto& r : search.rejected)
+    out["rejected"].push_back({{"found_by", r.found_by},
+                               {"reason", r.reason},
+                               {"residual", std::isfinite(r.residual) ? nlohmann::json(r.residual) : nlohmann::json()}});
+  out["log"] = search.log;
+  return out;
+}
+
+// equilibrium_1.csv, ... in increasing energy, as the table numbers them.
+void write_profiles(const std::string& dir, const EquilibriaSearch& search) {
+  std::filesystem::create_directories(dir);
+  for (size_t i = 0; i < search.equilibria.size(); ++i) {
+    const Equilibrium& e = search.equilibria[i];
+    const std::string path = (std::filesystem::path(dir) / ("equilibrium_" + std::to_string(i + 1) + ".csv")).string();
+    write_profile_csv(path, e.problem->equations(e.solution.result.parameters)->model(), e.solution.profile);
+  }
+}
+
+}  // namespace
+
+int run_equilibria(const EquilibriaArguments& args) {
+  Case c;
+  EquilibriaOptions options;
+  try {
+    c = load_case(args.case_path, parse_overrides(args.overrides));
+    if (args.max_equilibria < 1) throw CaseError("--max: at least 1");
+    if (!(args.max_seconds >= 0)) throw CaseError("--max-seconds: not negative");
+    options.max_equilibria = args.max_equilibria;
+    options.max_seconds = args.max_seconds;
+  } catch (const CaseError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  const EquilibriaSearch search = find_equilibria(c.definition, c.start_guess, c.derived, c.samples, options);
+  if (!args.profiles_dir.empty()) {
+    try {
+      write_profiles(args.profiles_dir, search);
+    } catch (const std::exception& e) {
+      std::cerr << "error: --profiles: " << e.what() << "\n";
+      return kExitBadInput;
+    }
+  }
+  if (args.json)
+    std::cout << search_json(c, search).dump(2) << "\n";
+  else
+    print_table(c, search);
+  if (search.equilibria.empty()) {
+    std::cerr << "error: " << c.path << ": no equilibrium found (" << search.stopped_because << ")\n";
+    return kExitNotConverged;
+  }
+  return kExitOk;
+}
+
+}  // namespace kirchhoff::cli
