@@ -12,6 +12,7 @@
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "kirchhoff/case_file.hpp"
@@ -64,6 +65,8 @@ std::string run_arguments(const ContinueArguments& a) {
     << " switch_at_bp=" << a.switch_at_bp << " side=" << a.switch_side << " branch_points=" << !a.no_branch_points << " stability=" << !a.no_stability;
   for (const auto& e : a.stop_events) o << " event=" << e;
   for (const auto& e : a.record_events) o << " record=" << e;
+  // (Only when given, so that the line of a run without it is the one older state files hold.)
+  if (!a.start_from.empty()) o << " start_from=" << fs::weakly_canonical(a.start_from, ec).string();
   o << " samples=" << a.samples << " seed=" << (a.seed.ipopt ? "ipopt" : "guess");
   if (a.seed.ipopt) o << " seed_segments=" << a.seed.segments << " seed_amplitude=" << a.seed.amplitude;
   return o.str();
@@ -154,6 +157,41 @@ std::vector<ContinuationEvent> parse_events(const std::vector<std::string>& text
   return out;
 }
 
+// A run started from another case's run: the names its state brings that this case lacks, said
+// as such (load_case would call them a --set the user never typed).
+void refuse_foreign_parameters(const RunStart& start, const ContinueArguments& args) {
+  const Case plain = load_case(args.case_path, {}, args.phase_condition);
+  for (size_t k = 0; k < start.parameters.size(); ++k)
+    if (!plain.file_parameters.contains(start.parameters[k].first))
+      throw CaseError(args.start_from + ": its run's parameter '" + start.parameters[k].first + "' (" +
+                      start.sources[k] + ") is not a parameter of " + args.case_path);
+}
+
+// The parameter values a run started from another one starts with: each that differs from the
+// case file's or was given (whence it comes), and the continued one.
+void print_start(const RunStart& start, const Case& c, const std::string& parameter) {
+  std::cerr << std::setprecision(15) << "start: from row " << start.at.row << " (" << to_string(start.at.point.type)
+            << ") of the run in " << start.from_parameter;
+  if (!start.at.contacts.empty()) std::cerr << ", " << start.at.contacts.size() << " active contact(s)";
+  std::cerr << "; parameters other than the case file's:\n";
+  const Parameters& now = c.definition.parameters;
+  for (int k = 0; k < now.size(); ++k) {
+    const std::string& name = now.names()[static_cast<size_t>(k)];
+    const auto given = std::find_if(start.parameters.begin(), start.parameters.end(),
+                                    [&](const auto& p) { return p.first == name; });
+    const bool differs = !c.file_parameters.contains(name) || c.file_parameters.get(name) != now.values()[k];
+    if (given == start.parameters.end() && !differs) continue;
+    std::cerr << "  " << name << " = " << now.values()[k];
+    if (given != start.parameters.end())
+      std::cerr << "  (" << start.sources[static_cast<size_t>(given - start.parameters.begin())] << ")";
+    else
+      std::cerr << "  (computed from the others)";
+    std::cerr << "\n";
+  }
+  std::cerr << "continuing in " << parameter << " from " << now.get(parameter) << "\n" << std::setprecision(6);
+  for (const auto& note : start.notes) std::cerr << "note: " << note << "\n";
+}
+
 }  // namespace
 
 int run_continue(const ContinueArguments& args) {
@@ -177,9 +215,22 @@ int run_continue(const ContinueArguments& args) {
               << ": the run was stopped before its first point was saved, so it starts from the beginning\n";
     resuming = false;
   }
+  std::optional<RunState> saved;  // --resume: the interrupted run's state
+  std::optional<RunStart> start;  // --start-from: where and with which parameters the run starts
+  ParameterOverrides overrides;   // the run's parameter values beyond the case file's
   try {
-    ParameterOverrides overrides;
     for (const auto& t : args.overrides) overrides.push_back(parse_override(t));
+    if (resuming) {
+      saved = load_state(state_path);
+      // A run started from another one keeps the values it started with (the other run's, which
+      // its arguments line does not hold).
+      if (saved->has_set_parameters) overrides = saved->set_parameters;
+    } else if (!args.start_from.empty()) {
+      if (args.seed.ipopt) throw CaseError("--start-from does not combine with --seed");
+      start = plan_start_from(args.start_from, args.start_param, overrides);
+      overrides = start->parameters;
+      refuse_foreign_parameters(*start, args);
+    }
     c = load_case(args.case_path, overrides, args.phase_condition);
     options.parameter = args.parameter;
     if (!c.definition.parameters.contains(args.parameter))
@@ -204,20 +255,13 @@ int run_continue(const ContinueArguments& args) {
     options.events = parse_events(args.stop_events, true);
     for (auto& e : parse_events(args.record_events, false)) options.events.push_back(e);
     if (std::string e = options.validate(); !e.empty()) throw CaseError(e);
-    if (!args.start_from.empty()) {
-      if (args.resume || args.seed.ipopt) throw CaseError("--start-from does not combine with --resume or --seed");
-      if (!c.definition.obstacles.empty())
-        throw CaseError("--start-from is not implemented for cases with obstacles (their active set)");
-      const RunState from = load_state(args.start_from);
-      const std::string name = from.parameter_name.empty() ? args.start_param : from.parameter_name;
-      if (name.empty())
-        throw CaseError(args.start_from + " does not name its parameter: give it with --start-param");
-      if (!c.definition.parameters.contains(name))
-        throw CaseError(args.start_from + ": its parameter '" + name + "' is not a parameter of the case");
-      if (name != args.parameter) c.definition.parameters.set(name, from.last.parameter);
-      start_point = from.last.x;
-      std::cerr << "start: the point at " << name << " = " << std::setprecision(15) << from.last.parameter << " of "
-                << args.start_from << "\n" << std::setprecision(6);
+    if (start) {
+      if (!start->at.contacts.empty() && c.definition.obstacles.empty())
+        throw CaseError(args.start_from + ": its point has active contacts, and " + args.case_path +
+                        " has no obstacles");
+      c.definition.contacts = start->at.contacts;  // the active set the point's unknowns belong to
+      start_point = start->at.point.x;
+      print_start(*start, c, args.parameter);
     }
     if (args.seed.ipopt && !resuming) {
       // The first point from Ipopt's shape and contact set instead of the case's guess.
@@ -228,6 +272,9 @@ int run_continue(const ContinueArguments& args) {
     }
   } catch (const CaseError& e) {
     std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const nlohmann::json::exception& e) {  // a state file that is not one
+    std::cerr << "error: " << state_path.string() << ": not a state file of this command: " << e.what() << "\n";
     return kExitBadInput;
   } catch (const std::invalid_argument& e) {
     std::cerr << "error: " << e.what() << "\n";
@@ -254,21 +301,24 @@ int run_continue(const ContinueArguments& args) {
 
   try {
     if (resuming) {
-      RunState saved = load_state(state_path);
       // Without the march's whole state (files written before 2026-12-02) or with other
       // arguments, the resumed run would not be the interrupted one continued: refused, not
       // approximated.
-      if (!saved.has_march)
+      if (!saved->has_march)
         throw CaseError("cannot resume from " + state_path.string() +
                         ": it was written by an older kirchhoff that did not save the march's whole state, so a "
                         "resumed run would not repeat the uninterrupted one; run again without --resume");
-      if (saved.arguments != state.arguments)
+      if (saved->arguments != state.arguments)
         throw CaseError("cannot resume from " + state_path.string() + ": it belongs to a run with other arguments\n  saved: " +
-                        saved.arguments + "\n  now:   " + state.arguments);
-      state = std::move(saved);
+                        saved->arguments + "\n  now:   " + state.arguments);
+      state = std::move(*saved);
       truncate_csv(csv, state.row);
+      // The rows after the saved point are gone: the last one is the saved point's.
+      state.written = WrittenPoint{state.saved_row, state.branch, state.phase_condition, state.last, state.contacts};
     }
     state.parameter_name = args.parameter;
+    state.has_set_parameters = true;
+    state.set_parameters = overrides;
     std::vector<std::string> columns = c.definition.unknown_parameters;  // solved-for parameters first
     columns.insert(columns.end(), options.derived.begin(), options.derived.end());
     writer = std::make_unique<BranchWriter>(csv, args.parameter, columns, resuming);
@@ -309,11 +359,20 @@ int run_continue(const ContinueArguments& args) {
     state.saved_row = state.row;
     save_state(state_path, state);
   };
+  // The row just written, where a run started from this one starts (--start-from): saved now
+  // unless the point is resumable (then the march's state is saved right after it).
+  auto record_written = [&](const ContinuationPoint& p, int branch, const std::string& phase,
+                            const std::vector<PointContact>& contacts) {
+    state.written = WrittenPoint{state.row, branch, phase, p, contacts};
+    state.written->point.jacobian.reset();
+    if (!resumable(p) && state.has_march) save_state(state_path, state);
+  };
   auto sink_for = [&](const ShootingProblem& problem, int branch, const std::string& phase) {
     return [&, branch, phase](const ContinuationPoint& p) {
       ++state.row;
       writer->write(state.row, p, branch);
       if (state.row == kill_after) kill(getpid(), SIGKILL);
+      record_written(p, branch, phase, {});
       if (resumable(p)) {
         state.branch = branch;
         state.phase_condition = phase;
@@ -346,10 +405,12 @@ int run_continue(const ContinueArguments& args) {
     // Contact: the active set changes along the branch (each change is an event row).
     try {
       std::unique_ptr<ShootingProblem> leg_problem;  // for --profiles
+      std::vector<PointContact> leg_contacts;         // the active set of the leg's points
       auto sink = [&](const ContinuationPoint& p) {
         ++state.row;
         writer->write(state.row, p, 0);
         if (state.row == kill_after) kill(getpid(), SIGKILL);
+        record_written(p, 0, state.phase_condition, leg_contacts);
         progress.point(state.row, p, 0);
         if (leg_problem) write_profile(*leg_problem, p);
       };
@@ -360,6 +421,7 @@ int run_continue(const ContinueArguments& args) {
         save_state(state_path, state);
       };
       auto on_active_set = [&](const std::vector<PointContact>& contacts) {
+        leg_contacts = contacts;
         if (args.profiles_dir.empty()) return;
         // The points that follow belong to this leg's problem (its active set).
         ProblemDefinition d = c.definition;
@@ -369,8 +431,11 @@ int run_continue(const ContinueArguments& args) {
       ContactContinuationResult r;
       r = resuming
               ? resume_with_contacts(c.definition, contact_march_state(state), options, sink, {}, on_active_set, save_leg)
+          : start_point.size() > 0
+              ? continue_with_contacts_from(c.definition, start_point, options, sink, {}, on_active_set, save_leg)
               : continue_with_contacts(c.definition, c.start_guess, options, sink, {}, on_active_set, save_leg);
       progress.done();
+      if (state.has_march) save_state(state_path, state);  // with the last row written
       for (const auto& line : r.changes) std::cerr << "contact: " << line << "\n";
       std::cerr << "stopped: " << to_string(r.result.reason)
                 << (r.result.message.empty() ? "" : " (" + r.result.message + ")") << "; " << state.row + 1
@@ -424,6 +489,7 @@ int run_continue(const ContinueArguments& args) {
     return kExitNotConverged;
   }
   progress.done();
+  if (state.has_march) save_state(state_path, state);  // with the last row written
   std::cerr << "stopped: " << to_string(result.reason) << (result.message.empty() ? "" : " (" + result.message + ")")
             << "; " << state.row + 1 << " points (last on branch " << branch << ") in " << args.out_path << "\n";
   if (result.refused_steps > 0) std::cerr << result.refused_steps << " steps refused and retried shorter\n";

@@ -1,10 +1,14 @@
 #include "run_state.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <stdexcept>
+
+#include "kirchhoff/case_file.hpp"
 
 namespace kirchhoff::cli {
 namespace {
@@ -47,6 +51,48 @@ PointType point_type_from(const std::string& name) {
   return PointType::Regular;
 }
 
+nlohmann::json contacts_json(const std::vector<PointContact>& contacts) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& c : contacts)
+    j.push_back({{"obstacle", c.obstacle}, {"s", c.s}, {"force", c.force}, {"extended", c.extended},
+                 {"s_end", c.s_end}, {"force_end", c.force_end}});
+  return j;
+}
+
+std::vector<PointContact> contacts_from(const nlohmann::json& j) {
+  std::vector<PointContact> out;
+  for (const auto& c : j)
+    out.push_back({c.at("obstacle").get<int>(), c.at("s").get<double>(), c.at("force").get<double>(),
+                   c.at("extended").get<bool>(), c.at("s_end").get<double>(), c.at("force_end").get<double>()});
+  return out;
+}
+
+nlohmann::json written_json(const WrittenPoint& w) {
+  return {{"row", w.row},           {"branch", w.branch},
+          {"phase_condition", w.phase_condition}, {"point", point_json(w.point)},
+          {"contacts", contacts_json(w.contacts)}};
+}
+
+WrittenPoint written_from(const nlohmann::json& j) {
+  WrittenPoint w;
+  w.row = j.at("row");
+  w.branch = j.at("branch");
+  w.phase_condition = j.at("phase_condition");
+  w.point = point_from(j.at("point"));
+  w.contacts = contacts_from(j.at("contacts"));
+  return w;
+}
+
+// The --set values of a run whose state file predates set_parameters, from its arguments line
+// (" set=NAME=VALUE" each, as the user typed them: parsed again they are the same doubles).
+std::vector<std::pair<std::string, double>> set_values_in(const std::string& arguments) {
+  std::vector<std::pair<std::string, double>> out;
+  std::istringstream words(arguments);
+  for (std::string word; words >> word;)
+    if (word.rfind("set=", 0) == 0) out.push_back(parse_override(word.substr(4)));
+  return out;
+}
+
 }  // namespace
 
 bool resumable(const ContinuationPoint& p) { return p.type == PointType::Start || p.type == PointType::Regular; }
@@ -58,10 +104,7 @@ void save_state(const std::filesystem::path& path, const RunState& s) {
                       {"x", to_json(s.last.x)},    {"tangent", to_json(s.last.tangent)},
                       {"type", to_string(s.last.type)}};
   j["parameter_name"] = s.parameter_name;
-  j["contacts"] = nlohmann::json::array();
-  for (const auto& c : s.contacts)
-    j["contacts"].push_back({{"obstacle", c.obstacle}, {"s", c.s}, {"force", c.force}, {"extended", c.extended},
-                             {"s_end", c.s_end}, {"force_end", c.force_end}});
+  j["contacts"] = contacts_json(s.contacts);
   j["piece_segments"] = s.piece_segments;
   j["newton_iterations"] = s.last.newton_iterations;
   if (s.has_march) {
@@ -76,6 +119,12 @@ void save_state(const std::filesystem::path& path, const RunState& s) {
                         {"first_leg", s.first_leg}};
     if (s.before) m["before"] = point_json(*s.before);
     j["march"] = m;
+  }
+  if (s.written) j["written"] = written_json(*s.written);
+  if (s.has_set_parameters) {
+    // Pairs, not an object: the order is the order they were applied in.
+    j["set_parameters"] = nlohmann::json::array();
+    for (const auto& [name, value] : s.set_parameters) j["set_parameters"].push_back({name, value});
   }
   if (!s.arguments.empty()) j["arguments"] = s.arguments;
   const fs::path tmp = path.string() + ".tmp";
@@ -110,10 +159,7 @@ RunState load_state(const std::filesystem::path& path) {
   s.last.x = vector_from(j.at("x"));
   s.last.tangent = vector_from(j.at("tangent"));
   s.last.type = point_type_from(j.at("type"));
-  if (j.contains("contacts"))
-    for (const auto& c : j.at("contacts"))
-      s.contacts.push_back({c.at("obstacle").get<int>(), c.at("s").get<double>(), c.at("force").get<double>(),
-                            c.at("extended").get<bool>(), c.at("s_end").get<double>(), c.at("force_end").get<double>()});
+  if (j.contains("contacts")) s.contacts = contacts_from(j.at("contacts"));
   if (j.contains("piece_segments")) s.piece_segments = j.at("piece_segments").get<std::vector<int>>();
   s.last.newton_iterations = j.value("newton_iterations", 0);
   if (j.contains("march")) {
@@ -132,8 +178,77 @@ RunState load_state(const std::filesystem::path& path) {
     s.reported = m.at("reported");
     s.first_leg = m.at("first_leg");
   }
+  if (j.contains("written")) s.written = written_from(j.at("written"));
+  if (j.contains("set_parameters")) {
+    s.has_set_parameters = true;
+    for (const auto& pair : j.at("set_parameters"))
+      s.set_parameters.emplace_back(pair.at(0).get<std::string>(), pair.at(1).get<double>());
+  }
   s.arguments = j.value("arguments", "");
   return s;
+}
+
+namespace {
+
+// The point a run started from `from` starts at: the last row it wrote. Where that row is also
+// the last saved point (or an event whose new leg's start was saved after it, same parameter
+// and rod, with the active set after the change) the saved point is taken, with its active set.
+WrittenPoint start_point_of(const RunState& from) {
+  if (from.written && from.written->row > from.saved_row) return *from.written;
+  return {from.saved_row, from.branch, from.phase_condition, from.last, from.contacts};
+}
+
+bool names(const std::vector<std::pair<std::string, double>>& values, const std::string& name) {
+  return std::any_of(values.begin(), values.end(), [&](const auto& v) { return v.first == name; });
+}
+
+}  // namespace
+
+RunStart plan_start_from(const std::filesystem::path& state_path, const std::string& start_param,
+                         const std::vector<std::pair<std::string, double>>& command_line) {
+  const std::string file = state_path.string();
+  RunState from;
+  try {
+    from = load_state(state_path);
+  } catch (const std::exception& e) {
+    throw std::invalid_argument("--start-from " + file + ": not a state file of `kirchhoff continue` (" + e.what() +
+                                ")");
+  }
+  RunStart out;
+  out.from_parameter = from.parameter_name.empty() ? start_param : from.parameter_name;
+  if (out.from_parameter.empty())
+    throw std::invalid_argument(file + " does not name its parameter: give it with --start-param");
+  out.at = start_point_of(from);
+  if (!from.written)
+    out.notes.push_back(file + " predates the record of a run's last row: starting from its last saved point (row " +
+                        std::to_string(from.saved_row) +
+                        "), which is before the CSV's last row when that row is an endpoint, fold, branch point or event");
+
+  std::vector<std::pair<std::string, double>> kept = from.set_parameters;
+  if (!from.has_set_parameters) {
+    kept = set_values_in(from.arguments);
+    if (from.arguments.empty())
+      out.notes.push_back(file + " does not record its run's --set values: give them again with --set");
+  }
+  for (const auto& [name, value] : kept) {
+    if (name == out.from_parameter || names(command_line, name)) continue;
+    out.parameters.emplace_back(name, value);
+    out.sources.push_back("kept from " + file);
+  }
+  out.parameters.emplace_back(out.from_parameter, out.at.point.parameter);
+  out.sources.push_back("the point's, row " + std::to_string(out.at.row) + " of that run");
+  for (const auto& [name, value] : command_line) {
+    if (name == out.from_parameter) {
+      std::ostringstream why;
+      why << std::setprecision(15) << "--set " << name << " conflicts with --start-from " << file
+          << ": its point is a solution at " << name << " = " << out.at.point.parameter
+          << " only (continue in " << name << " to move it)";
+      throw std::invalid_argument(why.str());
+    }
+    out.parameters.emplace_back(name, value);
+    out.sources.push_back("--set");
+  }
+  return out;
 }
 
 MarchState march_state(const RunState& s) {

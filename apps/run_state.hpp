@@ -14,6 +14,16 @@
 
 namespace kirchhoff::cli {
 
+// A row a run wrote, with what a run started from it (--start-from) needs beside the point: the
+// active set its unknowns belong to, the phase condition of its problem and its branch.
+struct WrittenPoint {
+  int row = -1;
+  int branch = 0;
+  std::string phase_condition;
+  ContinuationPoint point;              // x, parameter, tangent, arclength, index, type
+  std::vector<PointContact> contacts;   // contact runs: the active set of the point's leg
+};
+
 struct RunState {
   int row = -1;                   // index of the last CSV row written (continuous across branches)
   int saved_row = -1;             // the row of `last`, the point a resume starts from
@@ -39,6 +49,14 @@ struct RunState {
   int leg_max_points = 0;
   int reported = 0;
   bool first_leg = true;
+  // The last row written, which may be a point a resume does not start from (an endpoint at
+  // --to, a fold, a branch point, an event): where --start-from starts. Absent in older files.
+  std::optional<WrittenPoint> written;
+  // The run's parameter values beyond the case file's (its --set values and, for a run started
+  // from another one, those it started with), in order; a run started from this one keeps them.
+  // has_set_parameters is false in files older than the record.
+  bool has_set_parameters = false;
+  std::vector<std::pair<std::string, double>> set_parameters;
   // The run's arguments, as `continue` words them (a resume with others would not continue the
   // same run); empty in files that did not record them.
   std::string arguments;
@@ -56,6 +74,23 @@ void save_state(const std::filesystem::path& path, const RunState& s);
 // Makes p, the point of the row last written, the one to resume from, and saves the state.
 void save_resume_point(const std::filesystem::path& path, const ContinuationPoint& p, RunState* state);
 RunState load_state(const std::filesystem::path& path);
+// Where a run started from another run's state file (--start-from) starts, and with which
+// parameter values: the case file's, replaced by that run's set values, then by its continued
+// parameter at the point, then by the new command line's --set (which may not name that
+// parameter: the point is a solution at its own value only).
+struct RunStart {
+  WrittenPoint at;                 // the point and its active set
+  std::string from_parameter;      // the parameter the earlier run continued in
+  std::vector<std::pair<std::string, double>> parameters;  // the overrides to load the case with
+  // Where each of `parameters` comes from, for the message that lists them ("that run's --set").
+  std::vector<std::string> sources;
+  std::vector<std::string> notes;  // what an older state file could not say (printed as notes)
+};
+// Throws std::invalid_argument naming the file and the reason when it cannot be started from.
+// start_param names the parameter for files older than parameter_name.
+RunStart plan_start_from(const std::filesystem::path& state_path, const std::string& start_param,
+                         const std::vector<std::pair<std::string, double>>& command_line);
+
 // Keeps the header and the rows whose first column (the row index) is at most `last_index`.
 void truncate_csv(const std::filesystem::path& path, int last_index);
 

@@ -12,6 +12,10 @@
 #include <string>
 #include <vector>
 
+#include <algorithm>
+#include <iomanip>
+#include <nlohmann/json.hpp>
+
 #include "cli_run_support.hpp"
 
 namespace {
@@ -218,8 +222,8 @@ TEST_F(ContinueCli, ContactRunWritesEveryPointsProfile) {
 
 // --start-from: a run in one parameter starts where another run (in another parameter) stopped.
 // The straight twisted rod followed in phi to 8, then from there in tension: its first point is
-// the first run's last saved one (twisting moment M = GJ phi / L at that phi).
-TEST_F(ContinueCli, StartsFromAnotherRunsSavedPoint) {
+// the first run's last one (twisting moment M = GJ phi / L at that phi).
+TEST_F(ContinueCli, StartsFromAnotherRunsLastPoint) {
   const std::string twisted = std::string(KIRCHHOFF_CASES_DIR) + "/twisted_clamped.toml";
   const fs::path first = dir_ / "phi.csv", second = dir_ / "tension.csv";
   ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", twisted, "--param", "phi", "--to", "8", "--max-step", "0.5",
@@ -234,9 +238,11 @@ TEST_F(ContinueCli, StartsFromAnotherRunsSavedPoint) {
   ASSERT_EQ(run_to_end(args, dir_ / "tension.log"), 0);
   const auto log = lines_of(dir_ / "tension.log");
   ASSERT_FALSE(log.empty());
-  EXPECT_NE(log.front().find("start: the point at phi = "), std::string::npos) << log.front();
-  const double phi = std::stod(log.front().substr(log.front().find("phi = ") + 6));
-  EXPECT_GT(phi, 7.0);
+  ASSERT_GE(log.size(), 2u);
+  EXPECT_NE(log[0].find("(endpoint) of the run in phi"), std::string::npos) << log[0];
+  EXPECT_NE(log[1].find("phi = 8"), std::string::npos) << log[1];
+  const double phi = std::stod(log[1].substr(log[1].find("phi = ") + 6));
+  EXPECT_NEAR(phi, 8.0, 1e-12);  // the endpoint at --to, not the last point before it
   const auto rows = lines_of(second);
   ASSERT_GT(rows.size(), 2u);
   EXPECT_EQ(csv_field(rows[1], 2), 0.0);  // tension starts at the case's value
@@ -248,7 +254,170 @@ TEST_F(ContinueCli, StartsFromAnotherRunsSavedPoint) {
                         state.string(), "--out", (dir_ / "p.csv").string()},
                        dir_ / "p.log"),
             2);
-  EXPECT_NE(lines_of(dir_ / "p.log").back().find("'phi' is not a parameter"), std::string::npos);
+  EXPECT_NE(lines_of(dir_ / "p.log").back().find("parameter 'phi' (the point's, row "), std::string::npos);
+  EXPECT_NE(lines_of(dir_ / "p.log").back().find("is not a parameter of"), std::string::npos);
+}
+
+// The columns of a branch CSV row from column `first` on (the parameter is column 2), as numbers
+// (an empty field, such as a stability index not defined there, as NaN; text fields as NaN).
+std::vector<double> numbers_of(const std::string& row, int first, int count) {
+  std::vector<double> out;
+  for (int k = first; k < first + count; ++k) out.push_back(csv_field(row, k));
+  return out;
+}
+
+// Whether `lines` has a line containing every one of `parts`.
+bool has_line_with(const std::vector<std::string>& lines, const std::vector<std::string>& parts) {
+  for (const auto& line : lines) {
+    bool all = true;
+    for (const auto& part : parts) all = all && line.find(part) != std::string::npos;
+    if (all) return true;
+  }
+  return false;
+}
+
+// The new-user scenario: soft_wall followed in Delta to 0.026 with --set log_b=-4, then
+// from that run in log_b. The second run starts at the first run's endpoint (Delta = 0.026, not
+// the last point before it, which is where the state file's resumable point is) with log_b = -4
+// kept, so its first row is the first run's last row with log_b in place of Delta. A third run
+// started from the second keeps Delta = 0.026 (which the second run had from the first) and the
+// second run's endpoint log_b = -3.
+TEST_F(ContinueCli, StartFromBeginsAtTheEndpointWithThatRunsSetValues) {
+  const std::string soft_wall = std::string(KIRCHHOFF_CASES_DIR) + "/soft_wall.toml";
+  const fs::path first = dir_ / "delta.csv", second = dir_ / "log_b.csv", third = dir_ / "back.csv";
+  const std::string first_state = first.string() + ".state.json", second_state = second.string() + ".state.json";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", soft_wall, "--set", "log_b=-4", "--set", "Delta=0.02", "--set",
+                        "m_guess=1", "--param", "Delta", "--to", "0.026", "--out", first.string()},
+                       dir_ / "delta.log"),
+            0);
+  const auto rows1 = lines_of(first);
+  ASSERT_GT(rows1.size(), 3u);
+  ASSERT_NE(rows1.back().find(",endpoint,"), std::string::npos);
+  ASSERT_NEAR(csv_field(rows1.back(), 2), 0.026, 1e-12);
+
+  // m_guess given again: the new command line wins over the kept value.
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", soft_wall, "--start-from", first_state, "--set", "m_guess=1.5",
+                        "--param", "log_b", "--to", "-3", "--out", second.string()},
+                       dir_ / "log_b.log"),
+            0);
+  const auto log = lines_of(dir_ / "log_b.log");
+  EXPECT_TRUE(has_line_with(log, {"start: from row " + std::to_string(rows1.size() - 2), "(endpoint)"}));
+  EXPECT_TRUE(has_line_with(log, {"Delta = 0.026", "the point's"}));
+  EXPECT_TRUE(has_line_with(log, {"log_b = -4", "kept from"}));
+  EXPECT_TRUE(has_line_with(log, {"m_guess = 1.5", "(--set)"}));
+  EXPECT_TRUE(has_line_with(log, {"continuing in log_b from -4"}));
+  const auto rows2 = lines_of(second);
+  ASSERT_GT(rows2.size(), 3u);
+  EXPECT_EQ(csv_field(rows2[1], 2), -4.0);
+  // P, E_wall, gap, ny_jump, kappa_mid, H: the same equilibrium, corrected again only to round-off.
+  const auto end1 = numbers_of(rows1.back(), 4, 6), start2 = numbers_of(rows2[1], 4, 6);
+  for (size_t k = 0; k < end1.size(); ++k)
+    EXPECT_NEAR(start2[k], end1[k], 1e-12 * std::max(1.0, std::abs(end1[k]))) << "column " << k + 4;
+  ASSERT_NE(rows2.back().find(",endpoint,"), std::string::npos);
+
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", soft_wall, "--start-from", second_state, "--param", "Delta",
+                        "--to", "0.025", "--out", third.string()},
+                       dir_ / "back.log"),
+            0);
+  const auto back = lines_of(dir_ / "back.log");
+  EXPECT_TRUE(has_line_with(back, {"Delta = 0.026", "kept from"}));
+  EXPECT_TRUE(has_line_with(back, {"log_b = -3", "the point's"}));
+  EXPECT_TRUE(has_line_with(back, {"m_guess = 1.5", "kept from"}));
+  const auto rows3 = lines_of(third);
+  ASSERT_GT(rows3.size(), 2u);
+  EXPECT_NEAR(csv_field(rows3[1], 2), 0.026, 1e-12);
+  const auto end2 = numbers_of(rows2.back(), 4, 6), start3 = numbers_of(rows3[1], 4, 6);
+  for (size_t k = 0; k < end2.size(); ++k)
+    EXPECT_NEAR(start3[k], end2[k], 1e-12 * std::max(1.0, std::abs(end2[k]))) << "column " << k + 4;
+
+  // The parameter of the point cannot be set too: the point is a solution at its own value only.
+  EXPECT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", soft_wall, "--start-from", first_state, "--set", "Delta=0.03",
+                        "--param", "log_b", "--to", "-3", "--out", (dir_ / "x.csv").string()},
+                       dir_ / "x.log"),
+            2);
+  EXPECT_TRUE(has_line_with(lines_of(dir_ / "x.log"), {"--set Delta conflicts with --start-from"}));
+}
+
+// A state file written before the last row and the --set values were recorded still starts a run:
+// from its last saved point (said in a note), with the --set values read from its arguments line.
+TEST_F(ContinueCli, StartFromAnOlderStateFileSaysWhatItCannotKnow) {
+  const std::string soft_wall = std::string(KIRCHHOFF_CASES_DIR) + "/soft_wall.toml";
+  const fs::path first = dir_ / "delta.csv", second = dir_ / "log_b.csv";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", soft_wall, "--set", "log_b=-4", "--set", "Delta=0.02", "--set",
+                        "m_guess=1", "--param", "Delta", "--to", "0.026", "--out", first.string()},
+                       dir_ / "delta.log"),
+            0);
+  const fs::path state = first.string() + ".state.json";
+  nlohmann::json j;
+  {
+    std::ifstream in(state);
+    in >> j;
+  }
+  j.erase("written");
+  j.erase("set_parameters");
+  const int saved_row = j.at("row");
+  {
+    std::ofstream out(state);
+    out << std::setprecision(17) << j.dump();
+  }
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", soft_wall, "--start-from", state.string(), "--param", "log_b",
+                        "--to", "-3.5", "--out", second.string()},
+                       dir_ / "log_b.log"),
+            0);
+  const auto log = lines_of(dir_ / "log_b.log");
+  EXPECT_TRUE(has_line_with(log, {"note:", "predates", "row " + std::to_string(saved_row)}));
+  EXPECT_TRUE(has_line_with(log, {"log_b = -4", "kept from"}));
+  const auto rows1 = lines_of(first), rows2 = lines_of(second);
+  ASSERT_GT(rows2.size(), 2u);
+  const std::string& saved = rows1[static_cast<size_t>(saved_row) + 1];
+  EXPECT_NEAR(csv_field(rows2[1], 4), csv_field(saved, 4), 1e-10 * csv_field(saved, 4));  // P there
+}
+
+// Contact: the state carries the point's active set. wall.toml followed in Delta to 0.028 (a
+// point contact since 0.02507), continued from its endpoint in Delta to 0.034 (the contact
+// flattens at 0.03075 on the way), then from there in the wall's height a: each run's first row
+// is the previous one's last, its contact included.
+TEST_F(ContinueCli, StartFromKeepsTheActiveContactSet) {
+  const std::string wall = std::string(KIRCHHOFF_CASES_DIR) + "/wall.toml";
+  const fs::path point = dir_ / "point.csv", flat = dir_ / "flat.csv", height = dir_ / "height.csv";
+  auto state_of = [](const fs::path& csv) { return csv.string() + ".state.json"; };
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", wall, "--param", "Delta", "--to", "0.028", "--set", "Delta=0.005",
+                        "--set", "m_guess=0.9", "--max-step", "2", "--max-points", "3000", "--out", point.string()},
+                       dir_ / "point.log"),
+            0);
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", wall, "--start-from", state_of(point), "--param", "Delta", "--to",
+                        "0.034", "--max-step", "2", "--max-points", "3000", "--out", flat.string()},
+                       dir_ / "flat.log"),
+            0);
+  EXPECT_TRUE(has_line_with(lines_of(dir_ / "flat.log"), {"(endpoint)", "1 active contact"}));
+  EXPECT_TRUE(has_line_with(lines_of(dir_ / "flat.log"), {"flattens into an extended contact"}));
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", wall, "--start-from", state_of(flat), "--param", "a", "--to",
+                        "0.095", "--max-step", "2", "--max-points", "3000", "--out", height.string()},
+                       dir_ / "height.log"),
+            0);
+  const auto rows_point = lines_of(point), rows_flat = lines_of(flat), rows_height = lines_of(height);
+  ASSERT_GT(rows_flat.size(), 2u);
+  ASSERT_GT(rows_height.size(), 2u);
+  // Columns: P, contact_force, kappa_contact, contact_s, contact_length, H (4 to 9).
+  // The point contact's row: P is ~3e4 times as sensitive to the residual as the residual itself
+  // (the case's tolerance note), so the corrected start agrees to ~1e-12 of P's scale.
+  const auto end_point = numbers_of(rows_point.back(), 4, 6), start_flat = numbers_of(rows_flat[1], 4, 6);
+  EXPECT_NEAR(csv_field(rows_flat[1], 2), 0.028, 1e-12);
+  for (size_t k = 0; k < end_point.size(); ++k)
+    EXPECT_NEAR(start_flat[k], end_point[k], 1e-12 * std::max(100.0, std::abs(end_point[k]))) << "column " << k + 4;
+  EXPECT_EQ(csv_field(rows_flat[1], 8), 0.0);  // still a point contact
+  // The flat contact's row: P, the forces and H as closely; where the flat part starts only to
+  // ~1e-9, since the solution is isolated at second order only there (contact.cpp: the arc
+  // between clamp and flat part can slide along itself to first order).
+  const auto end_flat = numbers_of(rows_flat.back(), 4, 6), start_height = numbers_of(rows_height[1], 4, 6);
+  EXPECT_NEAR(csv_field(rows_height[1], 2), 0.1, 0.0);  // the case's a
+  for (size_t k : {0, 1, 5})
+    EXPECT_NEAR(start_height[k], end_flat[k], 1e-12 * std::max(100.0, std::abs(end_flat[k]))) << "column " << k + 4;
+  // (To second order: a residual of the tolerance, 1e-12, moves it by up to ~sqrt(1e-12).)
+  EXPECT_NEAR(start_height[3], end_flat[3], 1e-6);
+  EXPECT_NEAR(start_height[4], end_flat[4], 1e-6);
+  EXPECT_GT(start_height[4], 0.09);  // the extended contact it ended with
+  EXPECT_NE(rows_height.back().find(",endpoint,"), std::string::npos);
 }
 
 TEST_F(ContinueCli, ContinuingAnUnknownParameterIsRefused) {

@@ -474,6 +474,14 @@ ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodP
                   state_sink, std::move(out));
 }
 
+ContactContinuationResult continue_with_contacts_from(ProblemDefinition d, const Eigen::VectorXd& x,
+                                                      ContinuationOptions options, const PointSink& sink,
+                                                      const ContactOptions& contact,
+                                                      const ActiveSetSink& active_set_sink,
+                                                      const ContactStateSink& state_sink) {
+  return run_legs(std::move(d), x, nullptr, std::move(options), sink, contact, active_set_sink, state_sink, {});
+}
+
 ContactContinuationResult resume_with_contacts(ProblemDefinition d, const ContactMarchState& state,
                                                ContinuationOptions options, const PointSink& sink,
                                                const ContactOptions& contact, const ActiveSetSink& active_set_sink,

@@ -110,6 +110,15 @@ ContactContinuationResult continue_with_contacts(ProblemDefinition definition, c
                                                  const ContactOptions& contact = {},
                                                  const ActiveSetSink& active_set_sink = {},
                                                  const ContactStateSink& state_sink = {});
+// Starts such a run from unknowns x of the definition's problem, its contacts being x's active set
+// (a point another run wrote, continued now in another parameter, say). Like Continuation::run,
+// x is corrected at the definition's parameter values first; a start that breaks
+// complementarity ends the run as Inadmissible.
+ContactContinuationResult continue_with_contacts_from(ProblemDefinition definition, const Eigen::VectorXd& x,
+                                                      ContinuationOptions options, const PointSink& sink = {},
+                                                      const ContactOptions& contact = {},
+                                                      const ActiveSetSink& active_set_sink = {},
+                                                      const ContactStateSink& state_sink = {});
 // Resumes such a run from a state its state_sink was given (the definition's contacts are
 // replaced by the state's), taking the same steps and active-set changes as the uninterrupted
 // run with the same options. The state's point is not reported again.
