@@ -751,6 +751,25 @@ TEST(ShippedCases, EveryCaseLoadsAndConstructs) {
     EXPECT_TRUE(seen.count(name)) << name << ".toml missing from " << KIRCHHOFF_CASES_DIR;
 }
 
+// The guess is the internal n(0), m(0): for the cantilever the clamp holds the weight w L up,
+// so n(0) = -w L e_y exactly (statics of the whole rod) and m(0) = -|m(0)| e_z; the guess has
+// those signs, and Newton from it reaches the equilibrium hanging down.
+TEST(ShippedCases, HeavyCantileverGuessHasTheSignsOfItsEquilibrium) {
+  const Case c = load_case(std::string(KIRCHHOFF_CASES_DIR) + "/heavy_cantilever.toml");
+  const double w = c.definition.parameters.get("w"), L = c.definition.parameters.get("L");
+  EXPECT_EQ(c.start_guess.n.y(), -w * L);
+  EXPECT_EQ(c.start_guess.m.z(), -w * L * L / 2);
+  ShootingProblem problem(c.definition);
+  const ShootingResult r = solve(problem, problem.initial_unknowns(c.start_guess));
+  ASSERT_TRUE(r.summary.converged()) << r.summary.brief_report();
+  const auto ends = problem.sample(r.x, {0.0, L});
+  const RodPoint &start = ends.front(), &tip = ends.back();
+  // n(L) = 0 holds to Newton's tolerance (1e-10) and n' = w e_y integrates exactly.
+  EXPECT_NEAR(start.n.y(), -w * L, 1e-9);
+  EXPECT_LT(start.m.z(), 0.0);
+  EXPECT_LT(tip.r.y(), 0.0);
+}
+
 TEST(ShippedCases, TwistedClampedAcceptsTheAxialPhaseCondition) {
   const Case c = load_case(std::string(KIRCHHOFF_CASES_DIR) + "/twisted_clamped.toml", {{"phi", 11.58}}, "axial");
   EXPECT_TRUE(c.definition.parameters.contains("unfolding"));
