@@ -161,6 +161,60 @@ TEST_F(ResumeTest, RunKilledBeforeItsFirstSaveStartsOver) {
   EXPECT_EQ(lines_of(wall), lines_of(dir_ / "wall_full.csv"));
 }
 
+// (d) A run started from another one (--start-from), killed and resumed with the same command:
+// the resumed run keeps the parameter values it started with (the first run's --set and its
+// endpoint, which its own --set does not hold) and repeats the uninterrupted run. Resumed
+// without --start-from it is refused (other arguments). Without obstacles (soft_wall from its
+// endpoint at Delta = 0.026 with log_b = -4, in log_b) and with (the wall from its point
+// contact at Delta = 0.028, in the wall's height a, through the contact's flattening).
+TEST_F(ResumeTest, RunStartedFromAnotherResumesWithItsStartingValues) {
+  const std::string soft_wall = std::string(KIRCHHOFF_CASES_DIR) + "/soft_wall.toml";
+  const fs::path first = dir_ / "first.csv";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", soft_wall, "--set", "log_b=-4", "--set", "Delta=0.02", "--set",
+                        "m_guess=1", "--param", "Delta", "--to", "0.026", "--out", first.string()},
+                       dir_ / "first.log"),
+            0);
+  auto from_first = [&](const fs::path& csv) {
+    return std::vector<std::string>{KIRCHHOFF_CLI, "continue", soft_wall, "--start-from",
+                                    first.string() + ".state.json", "--param", "log_b", "--to", "-3",
+                                    "--out", csv.string()};
+  };
+  const fs::path full = dir_ / "full.csv", csv = dir_ / "killed.csv";
+  ASSERT_EQ(run_to_end(from_first(full), dir_ / "full.log"), 0);
+  const auto expected = lines_of(full);
+  ASSERT_GT(expected.size(), 30u);
+  for (int row : {0, 10, 25}) expect_resume_repeats(from_first(csv), csv, expected, row);
+
+  ASSERT_NO_FATAL_FAILURE(run_killed_after(from_first(csv), csv, 10));
+  auto without = from_first(csv);
+  without.erase(without.begin() + 3, without.begin() + 5);  // --start-from FILE
+  EXPECT_EQ(run_to_end(with_resume(without), dir_ / "without.log"), 2);
+  EXPECT_NE(lines_of(dir_ / "without.log").front().find("other arguments"), std::string::npos);
+
+  const fs::path point = dir_ / "point.csv";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/wall.toml", "--param",
+                        "Delta", "--to", "0.028", "--set", "Delta=0.005", "--set", "m_guess=0.9", "--max-step", "2",
+                        "--out", point.string()},
+                       dir_ / "point.log"),
+            0);
+  auto wall_from_point = [&](const fs::path& out) {
+    return std::vector<std::string>{KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/wall.toml",
+                                    "--start-from", point.string() + ".state.json", "--param", "a", "--to", "0.09",
+                                    "--max-step", "2", "--max-points", "3000", "--out", out.string()};
+  };
+  const fs::path wall_full = dir_ / "wall_full.csv", wall_csv = dir_ / "wall_killed.csv";
+  ASSERT_EQ(run_to_end(wall_from_point(wall_full), dir_ / "wall_full.log"), 0);
+  const auto wall_expected = lines_of(wall_full);
+  size_t flattens = 0;
+  for (size_t i = 0; i < wall_expected.size(); ++i)
+    if (wall_expected[i].find("flattens") != std::string::npos) flattens = i;
+  ASSERT_GT(flattens, 0u);
+  ASSERT_GT(wall_expected.size(), flattens + 50);
+  // On the point contact's leg, and on the flat contact's.
+  for (int row : {20, static_cast<int>(flattens) + 30})
+    expect_resume_repeats(wall_from_point(wall_csv), wall_csv, wall_expected, row);
+}
+
 // What cannot be resumed is refused with the reason, and the CSV is left as it was: rows with
 // no state file (it was removed: nothing says where the march stood), and a state saved by a run
 // with other arguments (resuming it would not continue that run).
