@@ -4,13 +4,17 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <iterator>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -520,6 +524,95 @@ TEST_F(CaseFileTest, OverrideOfUnknownParameter) {
     EXPECT_THAT(message, HasSubstr("no parameter 'Q'"));
     EXPECT_THAT(message, HasSubstr("theta0"));  // the names it has
   }
+}
+
+// ---- frames: axis and angle, a rotation matrix, or directors ----------------------------------
+
+// F at the unknowns the first problem's guess gives, for both problems: equal when their ends
+// impose the same frames.
+double residual_difference(const Case& a, const Case& b) {
+  const ShootingProblem pa(a.definition), pb(b.definition);
+  const Eigen::VectorXd x = pa.initial_unknowns(a.start_guess);
+  Eigen::VectorXd Fa, Fb;
+  std::string failure;
+  EXPECT_TRUE(pa.evaluate(x, &Fa, nullptr, &failure)) << failure;
+  EXPECT_TRUE(pb.evaluate(x, &Fb, nullptr, &failure)) << failure;
+  return (Fa - Fb).cwiseAbs().maxCoeff();
+}
+
+std::string shipped(const std::string& name) {
+  std::ifstream in(std::string(KIRCHHOFF_CASES_DIR) + "/" + name);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+TEST_F(CaseFileTest, PlanarClampFrameAsDirectorsOrMatrixIsTheAxisAngleFrame) {
+  // heavy_cantilever clamped at 0.3 rad: d3 = (cos, sin, 0) the tangent, d1 = (-sin, cos, 0).
+  auto clamped = [&](const std::string& orientation) {
+    return load_case(write(replaced(shipped("heavy_cantilever.toml"), "position = [0, 0]\n",
+                                    "position = [0, 0]\norientation = " + orientation + "\n")));
+  };
+  const Case angle = clamped("{ axis = [0, 0, 1], angle = 0.3 }");
+  // Written out to 1e-16, the frame reproduces the rotation to rounding (F is O(1)).
+  EXPECT_LT(residual_difference(angle, clamped("{ d3 = [\"cos(0.3)\", \"sin(0.3)\", 0], d2 = [0, 0, 1] }")), 1e-14);
+  EXPECT_LT(residual_difference(angle, clamped("{ d1 = [\"-sin(0.3)\", \"cos(0.3)\", 0], d3 = [\"cos(0.3)\", "
+                                               "\"sin(0.3)\", 0] }")), 1e-14);
+  EXPECT_LT(residual_difference(angle, clamped("{ matrix = [[\"-sin(0.3)\", 0, \"cos(0.3)\"], "
+                                               "[\"cos(0.3)\", 0, \"sin(0.3)\"], [0, 1, 0]] }")), 1e-14);
+  // And differs from another angle's (the comparison can fail).
+  EXPECT_GT(residual_difference(angle, clamped("{ axis = [0, 0, 1], angle = 0.31 }")), 1e-3);
+}
+
+TEST_F(CaseFileTest, SpatialClampFrameAsDirectorsIsTheAxisAngleFrame) {
+  auto clamped = [&](const std::string& orientation) {
+    return load_case(write(replaced(kSpatialBase, "position = [0, 0, 0]\n\n[end]",
+                                    "position = [0, 0, 0]\norientation = " + orientation + "\n\n[end]")));
+  };
+  // A quarter turn about e1 + e3 ... as directors: the rotation's columns.
+  const Mat3 R = Eigen::AngleAxisd(0.7, Vec3(1, 0, 1).normalized()).toRotationMatrix();
+  auto row = [&](int i, const Mat3& M) {
+    std::ostringstream os;
+    os.precision(17);
+    os << "[" << M(i, 0) << ", " << M(i, 1) << ", " << M(i, 2) << "]";
+    return os.str();
+  };
+  const Mat3 Rt = R.transpose();  // rows of R^T: the directors
+  const Case angle = clamped("{ axis = [1, 0, 1], angle = 0.7 }");
+  EXPECT_LT(residual_difference(angle, clamped("{ d1 = " + row(0, Rt) + ", d2 = " + row(1, Rt) + " }")), 1e-14);
+  EXPECT_LT(residual_difference(angle, clamped("{ matrix = [" + row(0, R) + ", " + row(1, R) + ", " + row(2, R) + "] }")),
+            1e-14);
+  EXPECT_GT(residual_difference(angle, clamped("{ axis = [1, 0, 1], angle = 0.71 }")), 1e-3);
+}
+
+TEST_F(CaseFileTest, GuessFrameAsDirectors) {
+  const std::string text = replaced(kBase, "[guess]\n", "[guess]\norientation = { d3 = [0, 1, 0], d2 = [0, 0, 1] }\n");
+  const Case c = load_case(write(text));
+  // A planar guess turned a quarter turn: the tangent along e_y.
+  EXPECT_LT((c.start_guess.R.col(2) - Vec3::UnitY()).norm(), 1e-15);
+  EXPECT_NEAR(c.start_guess.turn_angle, std::acos(0.0), 1e-15);
+}
+
+TEST_F(CaseFileTest, FramesThatAreNoRotationAreRefused) {
+  auto guess = [&](const std::string& orientation) {
+    return replaced(kBase, "[guess]\n", "[guess]\norientation = " + orientation + "\n");
+  };
+  std::string text = guess("{ d3 = [1, 0.001, 0], d2 = [0, 0, 1] }");
+  expect_refused(text, "guess.orientation", {"not orthonormal", "1e-09"}, line_of(text, "orientation"));
+  text = guess("{ matrix = [[0, 0, 1], [1, 0, 0], [0, -1, 0]] }");
+  expect_refused(text, "guess.orientation", {"left-handed", "det = -1"}, line_of(text, "orientation"));
+  text = guess("{ d3 = [1, 0, 0] }");
+  expect_refused(text, "guess.orientation", {"two or three of d1, d2, d3"}, line_of(text, "orientation"));
+  text = guess("{ d3 = [1, 0, 0], d2 = [0, 0, 1], angle = 1 }");
+  expect_refused(text, "guess.orientation", {"give one of"}, line_of(text, "orientation"));
+  text = guess("{ d3 = [\"cos(theta0)\", \"sin(theta0)\", 0], d2 = [0, 0, 1] }");
+  expect_refused(text, "guess.orientation.d3", {"is fixed", "'theta0'", "axis and angle"}, line_of(text, "orientation"));
+  text = guess("{ d3 = [1, 0, 0], d2 = [0, 1, 0] }");  // spatial frame on a planar rod
+  expect_refused(text, "guess.orientation", {"a planar rod's frame has d2 = e_z"}, line_of(text, "orientation"));
+  text = guess("{ matrix = [[1, 0], [0, 1, 0], [0, 0, 1]] }");
+  expect_refused(text, "guess.orientation.matrix", {"each row has 3 numbers"}, line_of(text, "orientation"));
+  // Whole turns are counted about an axis: a frame cannot say how many.
+  text = replaced(kSpatialBase, "orientation = { axis = [0, 0, 1], angle = \"phi\" }",
+                  "orientation = { d1 = [1, 0, 0], d2 = [0, 1, 0] }");
+  expect_refused(text, "end.orientation", {"with track_turns, give axis and angle"}, line_of(text, "orientation"));
 }
 
 // ---- --solver overrides ----------------------------------------------------------------------

@@ -227,9 +227,91 @@ VectorTarget vector_target(const std::array<Expression, 3>& e) {
   return [e](const Parameters& p) { return Vec3(e[0](p), e[1](p), e[2](p)); };
 }
 
-// An orientation table {axis = [..], angle = expr}.
-OrientationFunction orientation_target(const Reader& reader, const Value& v, const std::string& key) {
-  reader.allow_keys(v, key, {"axis", "angle"});
+// A frame given as a matrix or as directors is a rotation when its columns are orthonormal and
+// right-handed to this: 10 significant digits ("0.8660254038" for sqrt(3)/2) are 1e-10 off, and
+// a frame further off than 1e-9 is a typing error, not rounding (expressions give exact values).
+constexpr double kFrameTolerance = 1e-9;
+
+// One constant direction of a frame (a director or a matrix column): no parameters, since the
+// frame is checked to be a rotation once, here.
+Vec3 frame_vector(const Reader& reader, const std::array<Expression, 3>& e, const Value& where, const std::string& key,
+                  const Parameters& parameters) {
+  for (const auto& component : e)
+    if (!component.used_parameters().empty())
+      reader.fail(where, key, "a frame given by a matrix or directors is fixed: a frame that moves with '" +
+                                  component.used_parameters().front() + "' is given as axis and angle");
+  return Vec3(e[0](parameters), e[1](parameters), e[2](parameters));
+}
+
+// The frame {matrix = [[..], [..], [..]]} (rows; its columns are d1, d2, d3) or two or three of
+// {d1, d2, d3} (the third d3 = d1 x d2, d1 = d2 x d3, d2 = d3 x d1), checked to be a rotation.
+Mat3 frame_from_table(const Reader& reader, const Value& v, const std::string& key, const Parameters& parameters) {
+  Mat3 R = Mat3::Zero();
+  if (const Value* m = Reader::find(v, "matrix")) {
+    if (!m->is_array() || m->as_array().size() != 3)
+      reader.fail(*m, key + ".matrix", "must be 3 rows of 3 numbers: [[R11, R12, R13], [R21, ...], [R31, ...]]");
+    for (int i = 0; i < 3; ++i) {
+      const Value& row = m->as_array()[static_cast<std::size_t>(i)];
+      if (!row.is_array() || row.as_array().size() != 3) reader.fail(row, key + ".matrix", "each row has 3 numbers");
+      R.row(i) = frame_vector(reader, reader.vector(row, key + ".matrix"), row, key + ".matrix", parameters);
+    }
+  } else {
+    std::array<const Value*, 3> d{Reader::find(v, "d1"), Reader::find(v, "d2"), Reader::find(v, "d3")};
+    const int given = (d[0] != nullptr) + (d[1] != nullptr) + (d[2] != nullptr);
+    if (given < 2) reader.fail(v, key, "give two or three of d1, d2, d3 (one leaves the frame free to turn about it)");
+    for (int i = 0; i < 3; ++i) {
+      const std::string name = key + ".d" + std::to_string(i + 1);
+      if (d[i]) R.col(i) = frame_vector(reader, reader.vector(*d[i], name), *d[i], name, parameters);
+    }
+    for (int i = 0; i < 3; ++i)  // the missing one completes a right-handed frame
+      if (!d[i]) R.col(i) = R.col((i + 1) % 3).cross(R.col((i + 2) % 3));
+  }
+  const double off = (R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff();
+  std::ostringstream why;
+  why.precision(3);
+  if (!(off <= kFrameTolerance)) {
+    why << "the directors are not orthonormal: |R^T R - I| = " << off << " > " << kFrameTolerance
+        << " (give 10 digits or expressions such as \"sqrt(3)/2\")";
+    reader.fail(v, key, why.str());
+  }
+  if (R.determinant() < 0)
+    reader.fail(v, key, "the directors are left-handed (det = -1, a reflection): d3 must be d1 x d2");
+  return R;
+}
+
+// Whether an orientation table gives the frame itself (a matrix or directors).
+bool gives_frame(const Value& v) {
+  return Reader::find(v, "matrix") || Reader::find(v, "d1") || Reader::find(v, "d2") || Reader::find(v, "d3");
+}
+
+// The rotation that takes the equations' reference frame to R, as the axis and angle the end
+// conditions impose; a planar rod's turns about e_z only (its d2 stays e_z).
+OrientationTarget rotation_to(const Reader& reader, const Value& v, const std::string& key, const Mat3& R,
+                              RodKind kind) {
+  const Mat3 reference = kind == RodKind::Planar ? planar_reference_frame() : Mat3::Identity();
+  const Eigen::AngleAxisd rotation(Eigen::Quaterniond(R * reference.transpose()).normalized());
+  OrientationTarget t{rotation.axis(), rotation.angle()};
+  if (t.angle == 0.0) t.axis = Vec3::UnitZ();
+  if (t.axis.z() < 0) t = {-t.axis, -t.angle};
+  if (kind == RodKind::Planar && (t.axis - Vec3::UnitZ()).norm() > kFrameTolerance)
+    reader.fail(v, key, "a planar rod's frame has d2 = e_z = [0, 0, 1] (d3 = [cos a, sin a, 0] the tangent)");
+  return t;
+}
+
+// An orientation table: {axis = [..], angle = expr}, the reference frame turned by angle about
+// axis (a planar rod's reference: d1 = e_y, d2 = e_z, d3 = e_x; a spatial rod's: the lab frame),
+// or the frame itself as {matrix = ..} or directors {d1, d2, d3} (frame_from_table).
+OrientationFunction orientation_target(const Reader& reader, const Value& v, const std::string& key, RodKind kind,
+                                       const Parameters& parameters) {
+  reader.allow_keys(v, key, {"axis", "angle", "matrix", "d1", "d2", "d3"});
+  const bool axis_angle = Reader::find(v, "axis") || Reader::find(v, "angle");
+  const bool directors = Reader::find(v, "d1") || Reader::find(v, "d2") || Reader::find(v, "d3");
+  if (axis_angle + (Reader::find(v, "matrix") != nullptr) + directors > 1)
+    reader.fail(v, key, "give one of: axis and angle, matrix, or directors d1, d2, d3");
+  if (gives_frame(v)) {
+    const OrientationTarget t = rotation_to(reader, v, key, frame_from_table(reader, v, key, parameters), kind);
+    return [t](const Parameters&) { return t; };
+  }
   const Value* axis_value = Reader::find(v, "axis");
   const Vec3 axis = axis_value ? reader.unit_vector(*axis_value, key + ".axis") : Vec3::UnitZ();
   const Value* angle_value = Reader::find(v, "angle");
@@ -438,7 +520,10 @@ EndCondition read_end(const Reader& reader, const Value& root, const std::string
   auto orientation = [&]() -> OrientationFunction {
     const Value* v = Reader::find(*table, "orientation");
     if (!v) return OrientationFunction{};
-    OrientationFunction f = orientation_target(reader, *v, name + ".orientation");
+    OrientationFunction f = orientation_target(reader, *v, name + ".orientation", kind, parameters);
+    if (track_turns && gives_frame(*v))
+      reader.fail(*v, name + ".orientation", "with track_turns, give axis and angle: a matrix or directors fix no "
+                                             "count of whole turns");
     check_rotation_axis(reader, *v, name + ".orientation.axis", f(parameters).axis, kind, track_turns);
     return f;
   };
@@ -1018,7 +1103,7 @@ Case load_case_text(const std::string& text, const std::string& path, const Para
     vec("force", &c.start_guess.n);
     vec("moment", &c.start_guess.m);
     if (const Value* v = Reader::find(*g, "orientation")) {
-      const OrientationTarget t = orientation_target(reader, *v, "guess.orientation")(parameters);
+      const OrientationTarget t = orientation_target(reader, *v, "guess.orientation", d.kind, parameters)(parameters);
       c.start_guess.R = Eigen::AngleAxisd(t.angle, t.axis).toRotationMatrix() * c.start_guess.R;
       c.start_guess.turn_angle = t.angle;
     }
