@@ -164,12 +164,44 @@ struct PyCase {
   std::string phase_condition;  // as given to load_case ("" = the case's own)
 };
 
-PyCase py_load_case(const std::string& path, const py::object& set, const std::string& phase_condition) {
+// A Python value as the TOML text of a [solver] value (the CLI's --solver KEY=VALUE): True,
+// 7, 1e-10, "rk78", ["P"].
+std::string toml_text(const py::handle& value) {
+  if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
+  if (py::isinstance<py::int_>(value)) return py::str(value);
+  if (py::isinstance<py::float_>(value)) return py::repr(value);  // shortest round-trip digits
+  if (py::isinstance<py::str>(value)) {
+    std::string out = "\"";
+    for (const char ch : value.cast<std::string>()) {
+      if (ch == '"' || ch == '\\') out += '\\';
+      out += ch;
+    }
+    return out + "\"";
+  }
+  if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
+    std::string out = "[";
+    for (const py::handle item : value) out += (out.size() > 1 ? ", " : "") + toml_text(item);
+    return out + "]";
+  }
+  throw py::type_error("solver values are bool, int, float, str or lists of them, got " +
+                       std::string(py::str(value.get_type())));
+}
+
+SolverOverrides solver_values(const py::object& solver) {
+  SolverOverrides out;
+  if (solver.is_none()) return out;
+  for (const auto& [key, value] : solver.cast<py::dict>()) out.emplace_back(key.cast<std::string>(), toml_text(value));
+  return out;
+}
+
+PyCase py_load_case(const std::string& path, const py::object& set, const std::string& phase_condition,
+                    const py::object& solver) {
   ParameterOverrides overrides = named_values(set);
+  const SolverOverrides solver_overrides = solver_values(solver);
   PyCase out;
   {
     py::gil_scoped_release release;
-    out.c = load_case(path, overrides, phase_condition);
+    out.c = load_case(path, overrides, phase_condition, solver_overrides);
   }
   out.phase_condition = phase_condition;
   return out;
@@ -413,6 +445,9 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
   options.parameter = parameter;
   if (!c.definition.parameters.contains(parameter))
     throw CaseError(c.path + ": --param " + parameter + ": not a parameter of the case");
+  if (const std::string why = dependent_parameter_refusal(c.definition.dependent_parameters, parameter, "continue in");
+      !why.empty())
+    throw CaseError(c.path + ": --param " + parameter + ": " + why);
   if (!to.is_none()) options.target = to.cast<double>();
   options.direction = direction;
   options.initial_step = step;
@@ -760,12 +795,16 @@ Raises:
       });
 
   m.def("load_case", &py_load_case, py::arg("path"), py::arg("set") = py::none(), py::arg("phase_condition") = "",
+        py::arg("solver") = py::none(),
         R"doc(Reads and checks a TOML case file.
 
 Args:
     path (str): the case file.
-    set (dict name -> value, optional): replaces [parameters] values (names must exist).
+    set (dict name -> value, optional): replaces [parameters] values (names must exist; one
+        computed from others, A = "pi*r^2", is refused: set r).
     phase_condition (str): "" (the case's own), "none" or "axial".
+    solver (dict key -> value, optional): replaces or adds [solver] keys, checked as in the file,
+        as the CLI's --solver KEY=VALUE: {"tolerance": 1e-10, "stepper": "dopri5", "unknowns": ["P"]}.
 
 Returns:
     Case.

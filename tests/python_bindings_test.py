@@ -70,6 +70,48 @@ class LoadCaseTest(unittest.TestCase):
             kirchhoff.load_case(case_path("does_not_exist.toml"))
 
 
+class CaseOptionsTest(unittest.TestCase):
+    """Computed parameters and solver settings, as the CLI's --set and --solver take them."""
+
+    def test_solver_overrides_are_checked_as_in_the_file(self):
+        case = kirchhoff.load_case(case_path("simply_supported.toml"),
+                                   solver={"stepper": "dopri5", "tolerance": 1e-11, "unknowns": ["P"]})
+        sol = case.solve()
+        self.assertTrue(sol.converged, sol.message)
+        self.assertLess(sol.residual, 1e-11)
+        # Love's P for theta0 = 1 (eq. 54); the 1e-11 residual and the 1e-12 integrator leave ~1e-10
+        self.assertAlmostEqual(sol.derived["P"], 11.2224184758, delta=1e-8)
+        with self.assertRaises(kirchhoff.CaseError) as cm:
+            kirchhoff.load_case(case_path("simply_supported.toml"), solver={"tolerance": 1})
+        self.assertIn("--solver tolerance=1: key 'solver.tolerance': must be in (0, 0.01]", str(cm.exception))
+        with self.assertRaises(kirchhoff.CaseError) as cm:
+            kirchhoff.load_case(case_path("simply_supported.toml"), solver={"stepper": "rk4"})
+        self.assertIn("'rk4' is not 'rk78' or 'dopri5'", str(cm.exception))
+
+    def test_computed_parameter_follows_its_inputs(self):
+        text = pathlib.Path(case_path("simply_supported.toml")).read_text()
+        self.assertIn("\nEI = 1.0", text)
+        text = text.replace("\nEI = 1.0", '\nr = 0.5\nEI = "pi*r^2"')
+        with tempfile.TemporaryDirectory() as tmp:
+            path = pathlib.Path(tmp) / "computed.toml"
+            path.write_text(text)
+            case = kirchhoff.load_case(str(path), set={"r": 0.6})
+            self.assertAlmostEqual(case.parameters["EI"], math.pi * 0.36, places=14)
+            sol = case.solve()
+            self.assertTrue(sol.converged, sol.message)
+            self.assertAlmostEqual(sol.parameters["EI"], math.pi * 0.36, places=14)
+            P = kirchhoff.analytic_pinned_load(1.0, math.pi * 0.36, 1.0)
+            self.assertLess(abs(sol.derived["P"] - P), 1e-8 * P)
+            with self.assertRaises(kirchhoff.CaseError) as cm:
+                kirchhoff.load_case(str(path), set={"EI": 2.0})
+            self.assertIn("EI is computed from r", str(cm.exception))
+            self.assertIn("set r instead", str(cm.exception))
+            with self.assertRaises(kirchhoff.CaseError) as cm:
+                case.continue_("EI", to=2.0)
+            self.assertIn("--param EI: EI is computed from r", str(cm.exception))
+            self.assertIn("continue in r instead", str(cm.exception))
+
+
 class SolveTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
