@@ -1,12 +1,18 @@
 // The equilibria search (equilibria.hpp) and deflated Newton (deflation.hpp): counts, indices and
-// energies of coexisting equilibria against closed forms and the classical results.
+// energies of coexisting equilibria against closed forms, independent solves and the classical
+// results; the CLI's `equilibria` command.
 #include "kirchhoff/equilibria.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
-#include <boost/math/special_functions/ellint_1.hpp>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/case_file.hpp"
@@ -17,28 +23,253 @@ namespace {
 
 using testing::case_path;
 
+// Every search in these tests has the residual tolerance of its case; the solution's own checks
+// passed, so these are what each listed equilibrium must satisfy.
+void expect_all_sound(const EquilibriaSearch& s, double tolerance) {
+  for (size_t i = 0; i < s.equilibria.size(); ++i) {
+    const Equilibrium& e = s.equilibria[i];
+    EXPECT_TRUE(e.solution.result.summary.converged()) << i;
+    EXPECT_LE(e.solution.result.summary.residual_norm, tolerance) << i;
+    if (i > 0) EXPECT_LE(s.equilibria[i - 1].energy, e.energy) << "sorted by energy";
+    // Never the same equilibrium twice: pairwise profiles apart by more than the tolerance.
+    for (size_t j = 0; j < i; ++j) {
+      const Equilibrium& o = s.equilibria[j];
+      EXPECT_GT(profile_distance(*o.problem, o.solution.result.x, *e.problem, e.solution.result.x, 1.0), 1e-6)
+          << i << " and " << j;
+    }
+  }
+}
+
 EquilibriaSearch search(const std::string& name, const ParameterOverrides& overrides, EquilibriaOptions options = {}) {
   const Case c = load_case(case_path(name), overrides);
   EquilibriaSearch s = find_equilibria(c.definition, c.start_guess, c.derived, c.samples, options);
-  for (const auto& line : s.log) std::cout << "  " << line << "\n";
   for (const auto& e : s.equilibria)
-    std::cout << "  E = " << e.energy << " index " << (e.stability.index ? std::to_string(*e.stability.index) : "-")
-              << " theta0 " << e.solution.profile.front().turn_angle << " derived:" << [&] { std::string t; for (auto& [k, v] : e.solution.derived) t += " " + k + "=" + std::to_string(v); return t; }()
-              << " contacts " << e.solution.contacts.size() << " by " << e.found_by << "\n";
+    std::cout << "  E = " << e.energy << "  " << describe(e.stability) << "  contacts " << e.solution.contacts.size()
+              << "  (" << e.found_by << ")\n";
+  expect_all_sound(s, c.definition.options.newton.residual_tolerance);
   return s;
 }
 
-TEST(Equilibria, Explore) {
-  const char* env = std::getenv("EQ_CASE");
-  if (!env) GTEST_SKIP();
-  ParameterOverrides o;
-  if (const char* p = std::getenv("EQ_SET")) o.push_back(parse_override(p));
-  search(env, o);
+// A cubic with roots 1, 2, 3 in x0 and x1 = x0: deflation from one start must give the three roots,
+// each once, and then fail.
+class Cubic final : public NonlinearSystem {
+ public:
+  int size() const override { return 2; }
+  bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, std::string*) const override {
+    const double a = x[0];
+    *F = Eigen::Vector2d((a - 1) * (a - 2) * (a - 3), x[1] - a);
+    if (J) {
+      J->resize(2, 2);
+      *J << 3 * a * a - 12 * a + 11, 0, -1, 1;
+    }
+    return true;
+  }
+};
+
+TEST(Deflation, FindsEachRootOfACubicOnceFromOneStart) {
+  const Cubic cubic;
+  DeflationOperator deflation(Eigen::Vector2d(1.0, 1.0));
+  std::vector<double> found;
+  for (int run = 0; run < 4; ++run) {
+    Eigen::VectorXd x = Eigen::Vector2d(0.0, 0.0);
+    const NewtonSummary s = deflated_newton(cubic, x, deflation);
+    if (!s.converged()) break;
+    deflation.add_root(x);
+    found.push_back(x[0]);
+  }
+  ASSERT_EQ(found.size(), 3u);
+  std::sort(found.begin(), found.end());
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(found[k], k + 1.0, 1e-9);
 }
 
-TEST(Equilibria, EulerColumnAtP50HasFive) {
-  const EquilibriaSearch s = search("euler_column.toml", {{"P", 50.0}});
-  ASSERT_EQ(s.equilibria.size(), 5u);
+TEST(Deflation, ScaledLogGradientMatchesFiniteDifferences) {
+  DeflationOperator d(Eigen::Vector3d(1.0, 50.0, 0.1));
+  d.add_root(Eigen::Vector3d(0.1, 20.0, 0.01));
+  d.add_root(Eigen::Vector3d(-0.3, -5.0, 0.02));
+  const Eigen::Vector3d x(0.2, 3.0, -0.05);
+  const Eigen::VectorXd g = d.log_gradient(x);
+  for (int j = 0; j < 3; ++j) {
+    // Central differences with h = 1e-6 of the scale: error ~ h^2 |f'''| ~ 1e-10 relative.
+    const double h = 1e-6 * d.scale()[j];
+    Eigen::Vector3d e = Eigen::Vector3d::Zero();
+    e[j] = h;
+    const double fd = (std::log(d.value(x + e)) - std::log(d.value(x - e))) / (2 * h);
+    EXPECT_NEAR(g[j], fd, 1e-7 * (std::abs(fd) + 1.0 / d.scale()[j])) << j;
+  }
+}
+
+// The pinned-pinned Elastica of n half-waves under P: theta0 from 2 n K(sin(theta0 / 2)) = sqrt(P / EI) L
+// (PinnedElastica::load() of one half-wave of length L / n, increasing in theta0: bisection).
+double elastica_theta0(double P, double EI, double L, int n) {
+  double lo = 1e-6, hi = M_PI - 1e-9;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (analytic::PinnedElastica{L / n, EI, mid}.load() < P ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+TEST(Equilibria, EulerColumnAtP50) {
+  const double P = 50.0, EI = 1.0, L = 1.0;
+  const EquilibriaSearch s = search("euler_column.toml", {{"P", P}});
+  // Besides the five classical equilibria the dead-load column has rods whose ends meet
+  // (x(L) = 0: the roller's lateral reaction then does no moment about the pin, so n_y != 0 is
+  // allowed). The five are the ones with the ends apart.
+  std::vector<const Equilibrium*> apart;
+  for (const auto& e : s.equilibria)
+    if (e.solution.derived.at("end_to_end") > 1e-9) apart.push_back(&e);
+    else EXPECT_LT(e.solution.derived.at("end_to_end"), 1e-9);
+  ASSERT_EQ(apart.size(), 5u);
+  // By energy: mode 1 (both mirror images), mode 2 (both), the straight column.
+  const int expected_modes[5] = {1, 1, 2, 2, 0};
+  for (int k = 0; k < 5; ++k) {
+    const Equilibrium& e = *apart[k];
+    const double theta0 = e.solution.profile.front().turn_angle;
+    const double x_L = e.solution.profile.back().r.x();
+    const int n = expected_modes[k];
+    if (n == 0) {
+      EXPECT_NEAR(std::sin(theta0), 0.0, 1e-9);
+      EXPECT_NEAR(e.energy, P * L, 1e-9 * P * L);  // -F.r(L) = P L, no bending
+      ASSERT_TRUE(e.stability.index);
+      EXPECT_EQ(*e.stability.index, 2);  // two Euler loads, pi^2 and 4 pi^2, below P
+      continue;
+    }
+    const double closed = elastica_theta0(P, EI, L, n);
+    // theta0 up to its sign (the mirror image) and whole turns.
+    EXPECT_NEAR(std::cos(theta0), std::cos(closed), 1e-8) << k;
+    EXPECT_NEAR(std::abs(std::sin(theta0)), std::sin(closed), 1e-8) << k;
+    // Chord: n half-waves of length L / n.
+    const analytic::PinnedElastica half_wave{L / n, EI, closed};
+    EXPECT_NEAR(x_L, n * half_wave.end_to_end(), 1e-8) << k;
+    // H = 1/2 EI theta'^2 - P cos(theta) = -P cos(theta0), so the bending energy is
+    // P (x(L) - L cos(theta0)) and the total with the load's P x(L) is 2 P x(L) - P L cos(theta0).
+    EXPECT_NEAR(e.energy, 2 * P * x_L - P * L * std::cos(closed), 1e-8 * P * L) << k;
+    // Mode 2: index 1 (k - 1). Mode 1: index 1 too, because at P = 50 its ends have crossed
+    // (theta0 = 2.906 > 2.2813, docs/stability.md: the ends meeting is a loss of stability).
+    ASSERT_TRUE(e.stability.index) << k;
+    EXPECT_EQ(*e.stability.index, 1) << k;
+  }
+}
+
+TEST(Equilibria, ClampedClampedModesAgreeWithTheirSolvesFromTheCaseGuess) {
+  const EquilibriaSearch s = search("clamped_clamped.toml", {});
+  // The default search stops at 16 equilibria: the first eight modes.
+  ASSERT_EQ(s.equilibria.size(), 16u);
+  // Each mode with its mirror image, the index rising by one per mode: symmetric 0, S-shaped 1, ...
+  for (int k = 0; k < 16; ++k) {
+    ASSERT_TRUE(s.equilibria[k].stability.index) << k;
+    EXPECT_EQ(*s.equilibria[k].stability.index, k / 2) << k;
+  }
+  for (const double s_mode : {0.0, 1.0}) {
+    const auto solved = testing::solve_case("clamped_clamped.toml", {{"s_mode", s_mode}});
+    const double E = total_potential_energy(*solved.problem, solved.solution.result.x);
+    // Both ends held: no load potential, the energy is the elastic energy, which solution.cpp
+    // integrates on its own (Simpson on 4000 intervals): both quadratures are ~1e-12 accurate.
+    const Solution with = make_solution(*solved.problem, solved.solution.result, 101, {"elastic_energy"});
+    EXPECT_NEAR(E, with.derived.at("elastic_energy"), 1e-10 * E);
+    const int k = s_mode == 0.0 ? 0 : 2;
+    // Newton from the guess converges to 1e-10 in the residual; energies agree to ~1e-9.
+    EXPECT_NEAR(s.equilibria[k].energy, E, 1e-8 * E) << s_mode;
+    EXPECT_NEAR(s.equilibria[k + 1].energy, E, 1e-8 * E) << s_mode;
+  }
+}
+
+// Complementarity of every listed equilibrium with obstacles.
+void expect_admissible(const Equilibrium& e) {
+  EXPECT_GE(e.solution.derived.at("min_gap"), -1e-9);
+  for (const auto& c : e.solution.contacts) {
+    EXPECT_GE(c.force, 0.0);
+    if (c.extended) EXPECT_GE(c.force_end, 0.0);
+  }
+}
+
+TEST(Equilibria, WallNearFlatteningHasSymmetricAndAsymmetricContacts) {
+  const EquilibriaSearch s = search("wall.toml", {{"Delta", 0.0307}});
+  int symmetric = 0, asymmetric = 0, free_down = 0;
+  std::vector<double> asymmetric_s;
+  for (const auto& e : s.equilibria) {
+    expect_admissible(e);
+    if (e.solution.contacts.empty()) {
+      if (e.stability.stable()) ++free_down;  // buckled away from the wall: the stable free arch
+      continue;
+    }
+    ASSERT_EQ(e.solution.contacts.size(), 1u);
+    const PointContact& c = e.solution.contacts.front();
+    ASSERT_FALSE(c.extended);
+    ASSERT_TRUE(e.stability.index);
+    if (std::abs(c.s - 0.5) < 1e-8) {
+      ++symmetric;
+      EXPECT_EQ(*e.stability.index, 0);  // docs/stability.md: stable up to the flattening
+    } else {
+      ++asymmetric;
+      asymmetric_s.push_back(c.s);
+      EXPECT_EQ(*e.stability.index, 1);  // docs/stability.md: -2.57 in the discretised energy
+    }
+  }
+  EXPECT_EQ(symmetric, 1);
+  EXPECT_EQ(free_down, 1);
+  // The asymmetric contacts come in mirror pairs s, L - s.
+  ASSERT_GE(asymmetric, 2);
+  EXPECT_EQ(asymmetric % 2, 0);
+  std::sort(asymmetric_s.begin(), asymmetric_s.end());
+  for (size_t i = 0; i < asymmetric_s.size(); ++i)
+    EXPECT_NEAR(asymmetric_s[i], 1.0 - asymmetric_s[asymmetric_s.size() - 1 - i], 1e-7);
+}
+
+TEST(Equilibria, WallBeyondFlatteningHasAFlatContactBesideAsymmetricOnes) {
+  const EquilibriaSearch s = search("wall.toml", {{"Delta", 0.033}});
+  const Equilibrium* flat = nullptr;
+  int asymmetric = 0;
+  for (const auto& e : s.equilibria) {
+    expect_admissible(e);
+    if (e.solution.contacts.size() != 1) continue;
+    const PointContact& c = e.solution.contacts.front();
+    if (c.extended) {
+      flat = &e;
+    } else if (std::abs(c.s - 0.5) > 1e-3) {
+      ++asymmetric;
+      ASSERT_TRUE(e.stability.index);
+      EXPECT_EQ(*e.stability.index, 1);
+    }
+  }
+  ASSERT_NE(flat, nullptr);
+  EXPECT_EQ(asymmetric, 2);
+  const PointContact& c = flat->solution.contacts.front();
+  // Symmetric about mid-span, and on the flat part H = -P (section 7.2).
+  EXPECT_NEAR(c.s + c.s_end, 1.0, 1e-7);
+  EXPECT_NEAR(flat->solution.derived.at("H"), -flat->solution.derived.at("P"), 1e-7 * flat->solution.derived.at("P"));
+  EXPECT_FALSE(flat->stability.index);  // not defined for extended contacts (docs/stability.md)
+}
+
+int run(const std::string& arguments, const std::string& out) {
+  const std::string command = std::string(KIRCHHOFF_CLI) + " " + arguments + " > " + out + " 2>/dev/null";
+  return WEXITSTATUS(std::system(command.c_str()));
+}
+
+TEST(EquilibriaCli, JsonListsTheModesWithEnergyIndexAndProfiles) {
+  const auto dir = std::filesystem::temp_directory_path() / "kirchhoff_equilibria_cli";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string out = (dir / "out.json").string();
+  ASSERT_EQ(run("equilibria " + case_path("clamped_clamped.toml") + " --max 4 --json --profiles " +
+                    (dir / "profiles").string(),
+                out),
+            0);
+  std::ifstream in(out);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["equilibria"].size(), 4u);
+  const int indices[4] = {0, 0, 1, 1};
+  for (int k = 0; k < 4; ++k) {
+    const auto& e = j["equilibria"][k];
+    EXPECT_EQ(e["status"], "converged");
+    EXPECT_EQ(e["rank"], k + 1);
+    EXPECT_EQ(e["stability"]["index"], indices[k]);
+    EXPECT_TRUE(e["energy"].is_number());
+    EXPECT_TRUE(std::filesystem::exists(dir / "profiles" / ("equilibrium_" + std::to_string(k + 1) + ".csv")));
+  }
+  EXPECT_EQ(j["stopped_because"], "max_equilibria reached");
+  // A bad --set is refused as input.
+  EXPECT_EQ(run("equilibria " + case_path("clamped_clamped.toml") + " --set nope=1", out), 2);
 }
 
 }  // namespace

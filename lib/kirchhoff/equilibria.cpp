@@ -463,8 +463,25 @@ class Search {
     return "";
   }
 
+  // The residual recomputed without the Jacobian can differ from the one Newton saw by the
+  // integrator's error control (an integration with sensitivities takes other steps): a root at
+  // the tolerance may read up to a few times above it. A few plain Newton steps settle it, kept
+  // only when they stay within the distinctness scale of the root (so they cannot move to another).
+  void polish(const ShootingProblem& problem, const DeflationOperator& deflation, Eigen::VectorXd& x) const {
+    Eigen::VectorXd F;
+    std::string failure;
+    if (!problem.evaluate(x, &F, nullptr, &failure) || max_abs_or_nan(F) <= deflated_.residual_tolerance) return;
+    NewtonOptions newton = definition_.options.newton;
+    newton.max_iterations = 4;
+    newton.fallback_search = false;
+    Eigen::VectorXd polished = x;
+    const NewtonSummary s = newton_solve(problem, polished, newton);
+    if (s.converged() && deflation.distance(polished, x) < options_.distinct_tolerance) x = polished;
+  }
+
   // A converged root: deflated from now on; reported if it is a new admissible equilibrium.
-  void consider(Family& f, const Eigen::VectorXd& x, const std::string& label) {
+  void consider(Family& f, Eigen::VectorXd x, const std::string& label) {
+    polish(*f.problem, f.deflation, x);
     f.deflation.add_root(x);
     ShootingResult result;
     result.x = x;
