@@ -30,6 +30,7 @@
 #include "kirchhoff/continuation.hpp"
 #include "kirchhoff/self_passage.hpp"
 #include "kirchhoff/discrete_seed.hpp"
+#include "kirchhoff/equilibria.hpp"
 #include "kirchhoff/invariants.hpp"
 #include "kirchhoff/shooting.hpp"
 #include "kirchhoff/solution.hpp"
@@ -142,6 +143,8 @@ struct PySolution {
   py::dict parameters, derived, invariants, profile;
   py::list contacts;  // as the CLI's JSON: report_contacts
   py::object stability = py::none();  // as the CLI's JSON "stability"; None when not converged
+  double energy = NAN;                // Case.equilibria(): total potential energy (NaN from solve())
+  std::string found_by;               // Case.equilibria(): which seed led to it
 };
 
 struct PyBranch {
@@ -599,6 +602,58 @@ py::dict py_plectonemes(const std::string& out, const std::vector<double>& slend
   return result;
 }
 
+// One equilibrium of Case.equilibria() as a Solution, with the fields solve() fills (the
+// stability without the discretised cross-check, as the CLI's `equilibria` JSON).
+PySolution equilibrium_solution(const Case& c, const Equilibrium& e) {
+  PySolution out;
+  const Solution& sol = e.solution;
+  out.status = to_string(sol.result.summary.status);
+  out.converged = sol.result.summary.converged();
+  out.residual = sol.result.summary.residual_norm;
+  out.message = e.found_by;
+  out.energy = e.energy;
+  out.found_by = e.found_by;
+  out.parameters = parameters_dict(sol.result.parameters);
+  for (const auto& name : c.derived) out.derived[py::str(name)] = sol.derived.at(name);
+  out.invariants = invariants_dict(sol.invariants);
+  out.profile = profile_dict(e.problem->equations(sol.result.parameters)->model(), sol.profile);
+  out.stability = stability_dict(e.stability, DiscreteStability{});
+  for (const auto& contact : report_contacts(*e.problem, sol)) {
+    py::dict d;
+    d["obstacle"] = contact.obstacle;
+    d["obstacle_name"] = contact.obstacle_name;
+    d["extended"] = contact.extended;
+    d["s"] = contact.s;
+    d["s_end"] = contact.s_end;
+    d["force"] = contact.force;
+    d["force_end"] = contact.force_end;
+    d["H_before"] = contact.H_before;
+    d["H_after"] = contact.H_after;
+    out.contacts.append(d);
+  }
+  return out;
+}
+
+// The CLI's `equilibria`: distinct equilibria at the case's parameters, by increasing energy.
+py::list py_equilibria(const PyCase& pc, int max, double max_seconds, const py::object& samples_arg) {
+  const Case& c = pc.c;
+  const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
+  if (samples < 2 || samples > 100000) throw py::value_error("samples must be in [2, 100000]");
+  if (max < 1) throw py::value_error("max must be >= 1");
+  if (!(max_seconds >= 0)) throw py::value_error("max_seconds must be >= 0");
+  EquilibriaOptions options;
+  options.max_equilibria = max;
+  options.max_seconds = max_seconds;
+  EquilibriaSearch search;
+  {
+    py::gil_scoped_release release;
+    search = find_equilibria(c.definition, c.start_guess, c.derived, samples, options);
+  }
+  py::list out;
+  for (const auto& e : search.equilibria) out.append(equilibrium_solution(c, e));
+  return out;
+}
+
 std::string repr_solution(const PySolution& s) {
   std::ostringstream o;
   o.precision(10);
@@ -665,6 +720,10 @@ Attributes:
       .def_readonly("stability", &PySolution::stability,
                     "Stability of the equilibrium (None when not converged): dict with index (None where not "
                     "defined, with reason), stable, zero_modes, conjugate_points, method, as the CLI's JSON.")
+      .def_readonly("energy", &PySolution::energy,
+                    "Total potential energy (Case.equilibria(): elastic energy plus the potential of the field\n"
+                    "and of the given end loads, docs/equilibria.md; NaN from solve())")
+      .def_readonly("found_by", &PySolution::found_by, "Case.equilibria(): which seed led to it ('' from solve())")
       .def("__bool__", [](const PySolution& s) { return s.converged; }, "True when converged.")
       .def("__repr__", &repr_solution);
 
@@ -766,6 +825,21 @@ Returns:
 
 Raises:
     CaseError (ValueError): unknown parameter or derived quantity, invalid options.)doc")
+      .def("equilibria", &py_equilibria, py::kw_only(), py::arg("max") = 16, py::arg("max_seconds") = 120.0,
+           py::arg("samples") = py::none(),
+           R"doc(The distinct equilibria at the case's parameters (the CLI's `equilibria`), by deflated Newton.
+
+Starts from the case's guess, its mirror images, the low modes of every equilibrium found and,
+for planar rods clamped at both ends, Ipopt's discretised minimisers (docs/equilibria.md).
+
+Args:
+    max (int): stop once this many distinct equilibria are found.
+    max_seconds (float): wall-clock limit of the search (0: none).
+    samples (int, optional): profile points; default the case's [output] samples.
+
+Returns:
+    list of Solution, by increasing energy: each converged and admissible, with the fields
+    solve() gives (derived, invariants, profile, contacts, stability) and energy, found_by.)doc")
       .def("vibrate", &py_vibrate, py::kw_only(), py::arg("modes") = 3, py::arg("rho_s") = 1.0,
            py::arg("samples") = 201,
            R"doc(Small-amplitude vibrations about the case's equilibrium (the CLI's `vibrate`, eqs. B.4).

@@ -495,5 +495,29 @@ class PlectonemesTest(unittest.TestCase):
             self.assertEqual(os.listdir(tmp), [])  # refused before anything ran
 
 
+class EquilibriaTest(unittest.TestCase):
+    def test_clamped_clamped_modes_by_energy(self):
+        c = kirchhoff.load_case(case_path("clamped_clamped.toml"))
+        eqs = c.equilibria(max=4)
+        self.assertEqual(len(eqs), 4)
+        # The symmetric mode and its mirror image (stable), then the S-shaped pair (index 1).
+        self.assertEqual([e.stability["index"] for e in eqs], [0, 0, 1, 1])
+        energies = [e.energy for e in eqs]
+        self.assertEqual(energies, sorted(energies))
+        for e in eqs:
+            self.assertTrue(e.converged)
+            self.assertLessEqual(e.residual, 1e-10)
+            self.assertTrue(e.found_by)
+            self.assertIn("y_max", e.derived)
+        # Mirror images: the same energy to the solver's accuracy (residuals 1e-10).
+        self.assertAlmostEqual(energies[0], energies[1], delta=1e-8 * energies[0])
+        self.assertNotAlmostEqual(eqs[0].profile["y"][100], eqs[1].profile["y"][100], places=3)
+
+    def test_bad_options_raise(self):
+        c = kirchhoff.load_case(case_path("clamped_clamped.toml"))
+        with self.assertRaises(ValueError):
+            c.equilibria(max=0)
+
+
 if __name__ == "__main__":
     unittest.main()
