@@ -17,11 +17,13 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/shooting.hpp"
+#include "kirchhoff/solution.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -861,6 +863,44 @@ TEST(ShippedCases, HeavyCantileverGuessHasTheSignsOfItsEquilibrium) {
   EXPECT_NEAR(start.n.y(), -w * L, 1e-9);
   EXPECT_LT(start.m.z(), 0.0);
   EXPECT_LT(tip.r.y(), 0.0);
+}
+
+// The profile CSV names the planar curvature kappa (= theta' = u2); spatial profiles keep u1, u2, u3.
+TEST(ShippedCases, PlanarProfileCsvHasKappaSpatialKeepsU) {
+  const fs::path dir = fs::temp_directory_path() / "kirchhoff_profile_csv_test";
+  fs::create_directories(dir);
+  // The header and the fields of the row at s = L/2 (written as solve --profile writes them).
+  auto written = [&](const std::string& name) {
+    const Case c = load_case(std::string(KIRCHHOFF_CASES_DIR) + "/" + name);
+    ShootingProblem problem(c.definition);
+    const ShootingResult r = solve(problem, problem.initial_unknowns(c.start_guess));
+    EXPECT_TRUE(r.summary.converged()) << name;
+    const double L = problem.length(r.parameters);
+    const auto profile = problem.sample(r.x, {0.0, L / 2, L});
+    const std::string path = (dir / (name + ".csv")).string();
+    write_profile_csv(path, problem.equations(r.parameters)->model(), profile, c.definition.kind);
+    std::ifstream in(path);
+    std::string header, row;
+    std::getline(in, header);
+    std::getline(in, row);
+    std::getline(in, row);
+    auto split = [](const std::string& line) {
+      std::vector<std::string> out;
+      std::stringstream ss(line);
+      for (std::string field; std::getline(ss, field, ',');) out.push_back(field);
+      return out;
+    };
+    return std::make_tuple(header, split(header), split(row), profile[1].u[1]);
+  };
+  const auto [planar, names, fields, u2] = written("simply_supported.toml");
+  EXPECT_THAT(planar, HasSubstr(",mz,kappa,H,"));
+  EXPECT_THAT(planar, Not(HasSubstr("u2")));
+  ASSERT_EQ(names.size(), fields.size());
+  const auto kappa = std::find(names.begin(), names.end(), "kappa") - names.begin();
+  EXPECT_EQ(std::stod(fields[static_cast<std::size_t>(kappa)]), u2);  // 17 digits: the double itself
+  EXPECT_LT(u2, -1.0);  // theta0 = 1, pinned: curved most at mid-span (kappa_M of eq. 54)
+  EXPECT_THAT(std::get<0>(written("twisted_clamped.toml")), HasSubstr(",mz,u1,u2,u3,H,"));
+  fs::remove_all(dir);
 }
 
 TEST(ShippedCases, TwistedClampedAcceptsTheAxialPhaseCondition) {

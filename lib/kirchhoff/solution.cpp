@@ -262,17 +262,22 @@ double explicit_s_derivative_of_energy(const RodModel& model, const RodPoint& p)
   return dV;
 }
 
-void write_profile_csv(const std::string& path, const RodModel& model, const std::vector<RodPoint>& profile) {
+void write_profile_csv(const std::string& path, const RodModel& model, const std::vector<RodPoint>& profile,
+                       RodKind kind) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write profile file '" + path + "'");
   out.precision(17);
-  out << "s,x,y,z,d1x,d1y,d1z,d2x,d2y,d2z,d3x,d3y,d3z,nx,ny,nz,mx,my,mz,u1,u2,u3,H,m3,n_dot_m,dH_ds_identity\n";
+  const bool planar = kind == RodKind::Planar;
+  out << "s,x,y,z,d1x,d1y,d1z,d2x,d2y,d2z,d3x,d3y,d3z,nx,ny,nz,mx,my,mz," << (planar ? "kappa" : "u1,u2,u3")
+      << ",H,m3,n_dot_m,dH_ds_identity\n";
   for (const auto& p : profile) {
     out << p.s << ',' << p.r.x() << ',' << p.r.y() << ',' << p.r.z();
     for (int c = 0; c < 3; ++c) out << ',' << p.R(0, c) << ',' << p.R(1, c) << ',' << p.R(2, c);
     out << ',' << p.n.x() << ',' << p.n.y() << ',' << p.n.z() << ',' << p.m.x() << ',' << p.m.y() << ',' << p.m.z();
-    out << ',' << p.u[0] << ',' << p.u[1] << ',' << p.u[2] << ',' << hamiltonian(model, p) << ','
-        << p.m.dot(p.R.col(2)) << ',' << p.n.dot(p.m) << ',' << -explicit_s_derivative_of_energy(model, p) << '\n';
+    if (planar) out << ',' << p.u[1];
+    else out << ',' << p.u[0] << ',' << p.u[1] << ',' << p.u[2];
+    out << ',' << hamiltonian(model, p) << ',' << p.m.dot(p.R.col(2)) << ',' << p.n.dot(p.m) << ','
+        << -explicit_s_derivative_of_energy(model, p) << '\n';
   }
 }
 

@@ -42,8 +42,11 @@ const std::map<std::string, std::string>& derived_catalogue();
 // tapered rod, H' = -1/2 EI'(s) theta'^2).
 double explicit_s_derivative_of_energy(const RodModel& model, const RodPoint& p);
 
-// Writes one row per profile point: s, r, d1, d2, d3, n, m, u, H, m3, n.m, dH/ds predicted by
-// the explicit-s identity. Throws std::runtime_error when the file cannot be written.
-void write_profile_csv(const std::string& path, const RodModel& model, const std::vector<RodPoint>& profile);
+// Writes one row per profile point: s, r, d1, d2, d3, n, m, the curvatures, H, m3, n.m, dH/ds
+// predicted by the explicit-s identity. The curvatures are u1, u2, u3 for a spatial rod and
+// kappa = theta' (= u2) for a planar one, whose u1 and u3 are not unknowns of its equations.
+// Throws std::runtime_error when the file cannot be written.
+void write_profile_csv(const std::string& path, const RodModel& model, const std::vector<RodPoint>& profile,
+                       RodKind kind = RodKind::Spatial);
 
 }  // namespace kirchhoff
