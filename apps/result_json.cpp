@@ -85,6 +85,20 @@ nlohmann::json solution_json(const Case& c, const ShootingProblem& problem, cons
                              {"force_end", c.force_end},
                              {"H_before", c.H_before},
                              {"H_after", c.H_after}});
+  // Where the case's stated contacts ([[guess.contacts]]) went: moved, released, or kept.
+  j["stated_contacts"] = nlohmann::json::array();
+  for (const auto& o : stated_contact_outcomes(c.definition.contacts, sol.contacts, problem.obstacles(sol.result.parameters),
+                                               problem.length(sol.result.parameters)))
+    j["stated_contacts"].push_back({{"obstacle", o.stated.obstacle},
+                                    {"extended", o.stated.extended},
+                                    {"stated_s", o.stated.s},
+                                    {"stated_s_end", o.stated.extended ? o.stated.s_end : o.stated.s},
+                                    {"released", o.released},
+                                    {"moved", o.moved},
+                                    {"s", o.released ? nlohmann::json() : nlohmann::json(o.solved.s)},
+                                    {"s_end", o.released ? nlohmann::json()
+                                                         : nlohmann::json(o.solved.extended ? o.solved.s_end : o.solved.s)},
+                                    {"message", o.message}});
   j["stability"] = stability_json(stability, discrete);
   if (sol.result.summary.used_fallback_search) j["note"] = "starting point from the NLopt fallback search";
   return j;

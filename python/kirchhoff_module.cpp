@@ -142,6 +142,7 @@ struct PySolution {
   std::vector<double> history;
   py::dict parameters, derived, invariants, profile;
   py::list contacts;  // as the CLI's JSON: report_contacts
+  py::list stated_contacts;  // as the CLI's JSON: stated_contact_outcomes
   py::object stability = py::none();  // as the CLI's JSON "stability"; None when not converged
   double energy = NAN;                // Case.equilibria(): total potential energy (NaN from solve())
   std::string found_by;               // Case.equilibria(): which seed led to it
@@ -333,6 +334,22 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
     d["H_before"] = contact.H_before;
     d["H_after"] = contact.H_after;
     out.contacts.append(d);
+  }
+  for (const auto& o : stated_contact_outcomes(c.definition.contacts, sol->contacts,
+                                               problem->obstacles(sol->result.parameters),
+                                               problem->length(sol->result.parameters))) {
+    py::dict d;
+    d["obstacle"] = o.stated.obstacle;
+    d["extended"] = o.stated.extended;
+    d["stated_s"] = o.stated.s;
+    d["stated_s_end"] = o.stated.extended ? o.stated.s_end : o.stated.s;
+    d["released"] = o.released;
+    d["moved"] = o.moved;
+    d["s"] = o.released ? py::object(py::none()) : py::object(py::float_(o.solved.s));
+    d["s_end"] = o.released ? py::object(py::none())
+                            : py::object(py::float_(o.solved.extended ? o.solved.s_end : o.solved.s));
+    d["message"] = o.message;
+    out.stated_contacts.append(d);
   }
   return out;
 }
@@ -712,6 +729,9 @@ Attributes:
       .def_readonly("used_fallback_search", &PySolution::used_fallback_search)
       .def_readonly("rhs_evaluations", &PySolution::rhs_evaluations)
       .def_readonly("contacts", &PySolution::contacts, "Contacts: list of {obstacle, obstacle_name, extended, s, s_end, force, force_end, H_before, H_after}")
+      .def_readonly("stated_contacts", &PySolution::stated_contacts,
+                    "Where the case's [[guess.contacts]] went: list of {obstacle, extended, stated_s, stated_s_end, "
+                    "released, moved, s, s_end, message} (message: 'stated at s = 0.5 converged at s = 0.557')")
       .def_readonly("history", &PySolution::history)
       .def_readonly("parameters", &PySolution::parameters)
       .def_readonly("derived", &PySolution::derived)

@@ -1,6 +1,8 @@
 // Frictionless point contact by complementarity in the shooting core (wall.toml), checked
 // against the elliptic-function solution and against the symmetric half-rod shooting.
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/contact.hpp"
@@ -173,6 +175,146 @@ TEST(ContactContinuation, PointContactFlattensIntoAnExtendedContact) {
   // everywhere: H = -P to the corrector's tolerance.
   EXPECT_NEAR(at.derived.at("H"), -at.derived.at("P"), 1e-9 * at.derived.at("P"));
   EXPECT_TRUE(at.H_flat);
+}
+
+// The active-set loop from the free arch at Delta = 0.032 adds a contact at mid-span, then a
+// second where the rod still penetrates, and settles on two point contacts with the rod straight
+// on the wall between them: the flat contact continuation reaches there by contact_flattens. It is
+// reported as that extended contact, with the continuation's load and interval.
+TEST(FlatContact, TwoPointContactsWithTheRodFlatBetweenThemAreOneExtendedContact) {
+  const ContactRun r = run({{"Delta", 0.032}});
+  ASSERT_TRUE(r.solve.result.summary.converged()) << r.solve.result.summary.brief_report();
+  ASSERT_TRUE(r.solve.complementarity) << r.solve.message;
+  ASSERT_EQ(r.solution.contacts.size(), 1u);
+  const PointContact& flat = r.solution.contacts[0];
+  EXPECT_TRUE(flat.extended);
+  EXPECT_TRUE(std::any_of(r.solve.log.begin(), r.solve.log.end(), [](const std::string& line) {
+    return line.find("between them: one extended contact over [") != std::string::npos;
+  }));
+  // Section 7.2: H = -P on a flat contact.
+  EXPECT_NEAR(r.solution.derived.at("H"), -r.solution.derived.at("P"), 1e-9 * r.solution.derived.at("P"));
+  // As continuation finds it (its corrector stops at 1e-10: P to ~1e-10 relative; the ends of a
+  // flat contact are contacts of higher order, located to ~1e-6 only, see above).
+  const Case c = load_case(testing::case_path("wall.toml"));
+  ContinuationOptions o;
+  o.parameter = "Delta";
+  o.target = 0.032;
+  o.max_step = 2.0;
+  o.max_points = 3000;
+  o.derived = {"P", "contact_s", "contact_length"};
+  const ContactContinuationResult branch = continue_with_contacts(c.definition, c.start_guess, o);
+  ASSERT_EQ(branch.result.reason, StopReason::ReachedTarget) << branch.result.message;
+  const auto& at = branch.result.points.back().derived;
+  EXPECT_NEAR(r.solution.derived.at("P") / at.at("P"), 1.0, 1e-8);
+  EXPECT_NEAR(flat.s, at.at("contact_s"), 1e-5);
+  EXPECT_NEAR(r.solution.derived.at("contact_length"), at.at("contact_length"), 1e-5);
+}
+
+// wall.toml at Delta = 0.04 with the flat contact stated at the answer (as continuation finds
+// it): the clamps' moment is 0 there (H = -P at a clamp parallel to the wall), a double root on
+// which Newton stalls at the integrator's round-off, just above the shipped tolerance 1e-12.
+std::string stated_flat_contact_case(const std::string& tolerance) {
+  const std::string path = ::testing::TempDir() + "/stated_flat_contact.toml";
+  std::ofstream out(path);
+  out << R"(model = "planar"
+[parameters]
+Delta = 0.04
+[rod]
+length = 1.0
+B = 1.0
+[start]
+type = "clamped"
+position = [0, 0]
+[end]
+type = "clamped"
+position = ["1 - Delta", 0]
+[[obstacles]]
+type = "plane"
+name = "wall"
+point = [0, 0.1]
+normal = [0, -1, 0]
+[solver]
+tolerance = )" << tolerance << R"(
+[guess]
+force = [-251.69080938464018, -67.8683322754695]
+moment = [0, 0, 0]
+[[guess.contacts]]
+obstacle = "wall"
+s = 0.39085166519642295
+s_end = 0.6091485362774002
+force = 67.8683322754695
+force_end = 67.86833227546919
+)";
+  return path;
+}
+
+TEST(FlatContact, StatedAtTheAnswerConvergesAtTheShippedTolerance) {
+  const Case c = load_case(stated_flat_contact_case("1e-12"));
+  const ContactSolveResult r = solve_with_contacts(c.definition, c.start_guess);
+  ASSERT_TRUE(r.result.summary.converged()) << r.result.summary.brief_report();
+  EXPECT_LE(r.result.summary.residual_norm, 10 * 1e-12);  // at round-off (kRoundOffFactor)
+  ASSERT_EQ(r.definition.contacts.size(), 1u);
+  EXPECT_TRUE(r.definition.contacts[0].extended);
+  // The load continuation gives there (to 1e-10, its corrector's tolerance).
+  EXPECT_NEAR(-r.result.x[3] / 251.69080938464018, 1.0, 1e-9);
+  // It did not move: nothing logged about the stated contact.
+  for (const auto& line : r.log) EXPECT_EQ(line.find("stated"), std::string::npos) << line;
+}
+
+TEST(FlatContact, StatedButBeyondRoundOffSaysWhy) {
+  // A tolerance a hundred times below the integrator's noise: no solve reaches it, and the
+  // message says why.
+  const Case c = load_case(stated_flat_contact_case("1e-14"));
+  const ContactSolveResult r = solve_with_contacts(c.definition, c.start_guess);
+  ASSERT_FALSE(r.result.summary.converged());
+  EXPECT_NE(r.message.find("double root"), std::string::npos) << r.message;
+  EXPECT_NE(r.result.summary.message.find("double root"), std::string::npos) << r.result.summary.message;
+}
+
+TEST(StatedContacts, OneThatMovesSaysWhereItWent) {
+  // indenter.toml states its contact at s = L/2; with the disc moved sideways the contact slides.
+  const Case c = load_case(testing::case_path("indenter.toml"), {{"half_span", 0.40}});
+  const ContactSolveResult r = solve_with_contacts(c.definition, c.start_guess);
+  ASSERT_TRUE(r.result.summary.converged()) << r.result.summary.brief_report();
+  ASSERT_FALSE(r.log.empty());
+  const std::string& line = r.log.back();
+  EXPECT_NE(line.find("stated at s = 0.5 converged at s = "), std::string::npos) << line;
+  const auto outcomes = stated_contact_outcomes(c.definition.contacts, r.definition.contacts, c.definition.obstacles, 1.0);
+  ASSERT_EQ(outcomes.size(), 1u);
+  EXPECT_TRUE(outcomes[0].moved);
+  EXPECT_FALSE(outcomes[0].released);
+  EXPECT_NE(outcomes[0].solved.s, 0.5);
+  EXPECT_EQ(line, outcomes[0].message);
+}
+
+TEST(StatedContacts, KeptMovedAndReleasedAreTold) {
+  const std::vector<Obstacle> walls{Obstacle::plane(Vec3(0, 0.1, 0), Vec3(0, -1, 0), "wall")};
+  const std::vector<PointContact> stated{{0, 0.2, 1.0}, {0, 0.5, 1.0}};
+  PointContact wrap{0, 0.3, 1.0};
+  wrap.extended = true;
+  wrap.s_end = 0.6;
+  // The contact at 0.5 stays (within 1e-6 L); the one at 0.2 finds nothing left: released.
+  auto o = stated_contact_outcomes(stated, {{0, 0.5 + 1e-8, 2.0}}, walls, 1.0);
+  ASSERT_EQ(o.size(), 2u);
+  EXPECT_TRUE(o[0].released);
+  EXPECT_NE(o[0].message.find("stated at s = 0.2 is not in the solution"), std::string::npos) << o[0].message;
+  EXPECT_FALSE(o[1].moved);
+  EXPECT_NE(o[1].message.find("('wall') stated at s = 0.5 stayed there"), std::string::npos) << o[1].message;
+  o = stated_contact_outcomes({stated[1]}, {wrap}, walls, 1.0);
+  EXPECT_TRUE(o[0].moved);
+  EXPECT_NE(o[0].message.find("stated at s = 0.5 converged over [0.3, 0.6]"), std::string::npos) << o[0].message;
+}
+
+TEST(FailedSolve, AfterTheNLoptSearchSaysWhatWasTried) {
+  // From the free arch at Delta = 0.04 the active-set loop reaches two point contacts that do not
+  // converge (the flat contact is reached by continuation; see the README).
+  const ContactRun r = run({{"Delta", 0.04}});
+  ASSERT_FALSE(r.solve.result.summary.converged());
+  const std::string& m = r.solve.result.summary.message;
+  EXPECT_NE(m.find("tried 2 starts: Newton from the guess"), std::string::npos) << m;
+  EXPECT_NE(m.find("NLopt least-squares search"), std::string::npos) << m;
+  EXPECT_NE(m.find("best residual"), std::string::npos) << m;
+  EXPECT_NE(m.find("2 contact(s)"), std::string::npos) << m;
 }
 
 // Further on, the flat part is a strut clamped by the wall at both ends under the compression P:

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 #include <sstream>
+#include <tuple>
 
 #include "kirchhoff/closest_approach.hpp"
 #include "kirchhoff/link.hpp"
@@ -29,7 +30,157 @@ Eigen::VectorXd carry_over(const ShootingProblem& old_problem, const Eigen::Vect
   return y;
 }
 
+// How far the rod may stand off a plane between two point contacts and still be lying on it. The
+// contacts themselves hold the gap to the residual tolerance (<= 1e-10); a hanging fold's blister
+// stands off by far more except within a relative 1e-6 of its onset, where the two are the same
+// configuration anyway.
+constexpr double kFlatBetweenTolerance = 1e-8;
+// Samples of the gap between two contacts (a blister is one smooth wave between them).
+constexpr int kFlatBetweenSamples = 16;
+
+// Whether the rod lies on `o` all the way over (a, b).
+bool lies_on(const ShootingProblem& problem, const Eigen::VectorXd& x, const Obstacle& o, double a, double b) {
+  std::vector<double> s;
+  for (int i = 1; i < kFlatBetweenSamples; ++i) s.push_back(a + (b - a) * i / kFlatBetweenSamples);
+  for (const RodPoint& p : problem.sample(x, s))
+    if (!(std::abs(o.gap(p.r)) <= kFlatBetweenTolerance)) return false;
+  return true;
+}
+
+// The solved active set with each pair of neighbouring point contacts on the same plane that has
+// the rod lying on it between them made one extended contact over [s1, s2] with the end forces
+// f1, f2 - what they are: the rod flat on the wall, free of moment and normal force in between
+// (the reverse of continuation's split into a hanging fold). The unknowns keep their layout
+// ([s1, f1], [s2, f2] become [s, force, s_end, force_end]), so x solves the merged problem too.
+// One line per merge in *log; the set unchanged when there is nothing to merge.
+std::vector<PointContact> merge_flat_pairs(const ShootingProblem& problem, const Eigen::VectorXd& x,
+                                           std::vector<PointContact> contacts, std::vector<std::string>* log) {
+  const Parameters parameters = problem.parameters_at(x);
+  const std::vector<Obstacle> obstacles = problem.obstacles(parameters);
+  const auto equations = problem.equations(parameters);
+  for (size_t k = 0; k + 1 < contacts.size(); ++k) {
+    const PointContact &a = contacts[k], &b = contacts[k + 1];
+    if (a.extended || b.extended || a.obstacle != b.obstacle || !(b.s > a.s)) continue;
+    const Obstacle& o = obstacles[a.obstacle];
+    if (!o.is_flat() || !extended_contact_unsupported(*equations, o).empty()) continue;
+    if (!lies_on(problem, x, o, a.s, b.s)) continue;
+    std::ostringstream line;
+    line << "the point contacts at s = " << a.s << " and " << b.s << " have the rod flat on obstacle " << a.obstacle
+         << " between them: one extended contact over [" << a.s << ", " << b.s << "]";
+    log->push_back(line.str());
+    PointContact flat = a;
+    flat.extended = true;
+    flat.s_end = b.s;
+    flat.force_end = b.force;
+    contacts[k] = flat;
+    contacts.erase(contacts.begin() + k + 1);
+  }
+  return contacts;
+}
+
+// Newton's tolerance on max |F| for a definition.
+double residual_tolerance(const ProblemDefinition& d) { return d.options.newton.residual_tolerance; }
+
+// Why a solve with an extended contact on a plane may stall just above the tolerance: with the
+// rod flat on the plane H = -P there, so wherever else it is parallel to the plane - at an end
+// clamped parallel to it - its curvature is zero too, as a double root (see run_legs): the
+// Jacobian is singular, Newton converges only linearly and stops at the integrator's round-off.
+std::string stalled_flat_contact_reason(const ProblemDefinition& d, const NewtonSummary& summary) {
+  const bool on_plane = std::any_of(d.contacts.begin(), d.contacts.end(),
+                                    [&](const auto& c) { return c.extended && d.obstacles[c.obstacle].is_flat(); });
+  // 1e3 x the tolerance: Newton's own bound for a step stalled at round-off (newton.hpp).
+  if (!on_plane || !(summary.residual_norm <= 1e3 * residual_tolerance(d))) return "";
+  std::ostringstream why;
+  why << "the residual stalled at " << summary.residual_norm << " against the tolerance " << residual_tolerance(d)
+      << ": with the rod flat on a plane, H = -P there, so at an end clamped parallel to the plane the curvature "
+         "is a double root and the Jacobian is singular; Newton converges only linearly and stops at the "
+         "integrator's round-off, which this tolerance leaves no room for (loosen [solver] tolerance by a decade, "
+         "or state a point contact and let the solver flatten it by continuation)";
+  return why.str();
+}
+
+// How far above the tolerance a stalled flat-contact solve may end and still be at round-off: the
+// integrator runs at 1e-12 relative, so residuals of ~1e-12 are its noise (the same configuration
+// gives 4.8e-13 with the variational equations integrated beside it and 1.09e-12 without, on
+// wall.toml at Delta = 0.04); ten times the tolerance is within that noise for tolerances near
+// it, and a real failure (a wrong active set, a bad guess) stalls orders of magnitude higher.
+constexpr double kRoundOffFactor = 10.0;
+
+// A solve that stalled on the singular Jacobian of a flat contact (stalled_flat_contact_reason)
+// is converged at round-off when Newton could decrease the residual no further and it is within
+// kRoundOffFactor x the tolerance. Newton accepts an iterate within 1e3 x the tolerance when its
+// step is at round-off (newton.hpp); here its full step runs along the null direction and is
+// not small, so Newton cannot see it. The summary then says "step at round-off" as Newton's does
+// (verification holds it to Newton's bound), and the caller logs why.
+bool converged_at_round_off(const ShootingProblem& problem, ShootingResult* r) {
+  const double tolerance = problem.definition().options.newton.residual_tolerance;
+  const SolverStatus status = r->summary.status;
+  if (status != SolverStatus::LineSearchFailed && status != SolverStatus::SingularJacobian) return false;
+  if (stalled_flat_contact_reason(problem.definition(), r->summary).empty()) return false;
+  if (!(r->summary.residual_norm <= kRoundOffFactor * tolerance)) return false;
+  r->summary.status = SolverStatus::Converged;
+  r->summary.message = "step at round-off";
+  return true;
+}
+
+// "s = 0.5" or "over [0.45, 0.55]".
+std::string where(const PointContact& c) {
+  std::ostringstream os;
+  if (c.extended)
+    os << "over [" << c.s << ", " << c.s_end << "]";
+  else
+    os << "at s = " << c.s;
+  return os.str();
+}
+
+// A contact moved when an end moved by more than this fraction of the rod's length: far above
+// the residual tolerance's effect on s, far below any change a reader would care about.
+constexpr double kMovedFraction = 1e-6;
+
 }  // namespace
+
+std::vector<StatedContactOutcome> stated_contact_outcomes(const std::vector<PointContact>& stated,
+                                                          const std::vector<PointContact>& solved,
+                                                          const std::vector<Obstacle>& obstacles, double length) {
+  // Pairs on the same obstacle, nearest first, each contact used once: a stated contact is
+  // matched with the solved one nearest to it unless another stated contact is nearer still.
+  std::vector<std::tuple<double, size_t, size_t>> pairs;
+  for (size_t i = 0; i < stated.size(); ++i)
+    for (size_t k = 0; k < solved.size(); ++k)
+      if (solved[k].obstacle == stated[i].obstacle) pairs.emplace_back(std::abs(solved[k].s - stated[i].s), i, k);
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<int> match(stated.size(), -1);
+  std::vector<bool> taken(solved.size(), false);
+  for (const auto& [distance, i, k] : pairs)
+    if (match[i] < 0 && !taken[k]) {
+      match[i] = static_cast<int>(k);
+      taken[k] = true;
+    }
+  std::vector<StatedContactOutcome> out;
+  for (size_t i = 0; i < stated.size(); ++i) {
+    const PointContact& c = stated[i];
+    StatedContactOutcome o;
+    o.stated = c;
+    std::ostringstream message;
+    message << "the contact with obstacle " << c.obstacle;
+    if (c.obstacle >= 0 && static_cast<size_t>(c.obstacle) < obstacles.size() && !obstacles[c.obstacle].name.empty())
+      message << " ('" << obstacles[c.obstacle].name << "')";
+    message << " stated " << where(c);
+    if (match[i] < 0) {
+      o.released = true;
+      message << " is not in the solution: the active-set loop released it (it would have pulled)";
+    } else {
+      o.solved = solved[match[i]];
+      const double end_stated = c.extended ? c.s_end : c.s, end_solved = o.solved.extended ? o.solved.s_end : o.solved.s;
+      o.moved = c.extended != o.solved.extended || std::abs(o.solved.s - c.s) > kMovedFraction * length ||
+                std::abs(end_solved - end_stated) > kMovedFraction * length;
+      message << (o.moved ? " converged " + where(o.solved) : " stayed there");
+    }
+    o.message = message.str();
+    out.push_back(o);
+  }
+  return out;
+}
 
 bool has_extended_contact(const std::vector<PointContact>& contacts) {
   return std::any_of(contacts.begin(), contacts.end(), [](const auto& c) { return c.extended; });
@@ -41,6 +192,53 @@ bool has_hanging_fold(const std::vector<PointContact>& contacts) {
       return true;
   return false;
 }
+
+namespace {
+
+// Appends `what` to a failed solve's message (once: the summary may already say it).
+void append_to_message(NewtonSummary* summary, const std::string& what) {
+  if (summary->message.find(what) != std::string::npos) return;
+  summary->message = summary->message.empty() ? what : summary->message + "; " + what;
+}
+
+// The log line of a solve accepted by converged_at_round_off.
+std::string round_off_note(const NewtonSummary& summary, const ProblemDefinition& d) {
+  std::ostringstream note;
+  note << "converged at round-off: the residual stalled at " << summary.residual_norm << " (tolerance "
+       << residual_tolerance(d) << ") on the singular Jacobian of a flat contact (an end clamped parallel to the "
+       << "plane has a double root in its curvature); within " << kRoundOffFactor
+       << " x the tolerance, the integrator's noise";
+  return note.str();
+}
+
+// After the loop has settled: pairs of point contacts with the rod flat on a plane between them
+// become the extended contact they are (merge_flat_pairs), re-solved as such so that the result
+// belongs to that active set. If the extended problem does not converge from the same
+// configuration (its Jacobian can be singular, see stalled_flat_contact_reason), the point
+// contacts are kept, and the log says so.
+void report_flat_pairs_as_extended(std::unique_ptr<ShootingProblem>* problem, ProblemDefinition* d,
+                                   ContactSolveResult* out) {
+  std::vector<std::string> merges;
+  ProblemDefinition merged = *d;
+  merged.contacts = merge_flat_pairs(**problem, out->result.x, d->contacts, &merges);
+  if (merges.empty()) return;
+  auto flat = std::make_unique<ShootingProblem>(merged);
+  ShootingResult r = solve(*flat, out->result.x);
+  if (!r.summary.converged() && converged_at_round_off(*flat, &r)) merges.push_back(round_off_note(r.summary, merged));
+  if (!r.summary.converged()) {
+    out->log.push_back("kept as point contacts: " + merges.front() + " does not converge as such (" +
+                       r.summary.brief_report() + ")");
+    return;
+  }
+  merged.contacts = flat->contacts_at(r.x);
+  for (const auto& line : merges) out->log.push_back(line);
+  *d = merged;
+  out->definition = merged;
+  out->result = std::move(r);
+  *problem = std::move(flat);
+}
+
+}  // namespace
 
 ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& guess, const ContactOptions& options) {
   ContactSolveResult out;
@@ -59,12 +257,18 @@ ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& gues
                                   o.name + "' (gap " + std::to_string(o.gap(r)) + ")");
     }
   }
+  const std::vector<PointContact> stated = d.contacts;
   Eigen::VectorXd x = problem->initial_unknowns(guess);
   for (int round = 0; round < options.max_rounds; ++round) {
     out.result = solve(*problem, x);
     out.definition = d;
+    if (!out.result.summary.converged() && converged_at_round_off(*problem, &out.result))
+      out.log.push_back(round_off_note(out.result.summary, d));
     if (!out.result.summary.converged()) {
       out.message = "solve with " + std::to_string(d.contacts.size()) + " contact(s) did not converge";
+      if (const std::string why = stalled_flat_contact_reason(d, out.result.summary); !why.empty()) out.message += ": " + why;
+      if (round > 0) out.message += " (round " + std::to_string(round + 1) + " of the active-set loop)";
+      append_to_message(&out.result.summary, out.message);
       return out;
     }
     const auto solved = problem->contacts_at(out.result.x);
@@ -83,6 +287,10 @@ ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& gues
       const ClosestApproach deepest = closest_approach(*problem, out.result.x, options.samples);
       if (!(deepest.gap < -options.penetration_tolerance)) {
         out.complementarity = true;
+        report_flat_pairs_as_extended(&problem, &d, &out);
+        const double length = problem->length(out.result.parameters);
+        for (const auto& o : stated_contact_outcomes(stated, out.definition.contacts, problem->obstacles(out.result.parameters), length))
+          if (o.released || o.moved) out.log.push_back(o.message);
         return out;
       }
       const int which = deepest.obstacle;

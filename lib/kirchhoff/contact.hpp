@@ -47,10 +47,28 @@ bool has_hanging_fold(const std::vector<PointContact>& contacts);
 
 // Solves from `guess` (the state at s = 0, completed by the start conditions) starting with the
 // definition's contacts as the active set. Non-convergence of a solve ends the loop with that
-// status; a loop that does not settle within max_rounds reports complementarity = false.
+// status (the summary's message says with how many contacts, and why when an extended contact on
+// a plane stalls at round-off); a loop that does not settle within max_rounds reports
+// complementarity = false. Once settled, two neighbouring point contacts on a plane with the rod
+// lying on it between them are reported as the extended contact they are (re-solved as such;
+// kept as point contacts, with a log line, where that does not converge), and the log says where
+// each stated contact that moved went, or that it was released (stated_contact_outcomes).
 // Throws InfeasibleContact when an imposed end position lies inside an obstacle.
 ContactSolveResult solve_with_contacts(ProblemDefinition definition, const RodPoint& guess,
                                        const ContactOptions& options = {});
+
+// A contact of a stated starting set (a case's [[guess.contacts]]) and where a solve left it: the
+// solved contact on the same obstacle nearest to it (each taken once), or none - released.
+struct StatedContactOutcome {
+  PointContact stated;
+  bool released = false;
+  PointContact solved;   // when not released
+  bool moved = false;    // an end moved by more than 1e-6 of the rod's length, or its kind changed
+  std::string message;   // "the contact with obstacle 0 ('wall') stated at s = 0.5 converged at s = 0.557"
+};
+std::vector<StatedContactOutcome> stated_contact_outcomes(const std::vector<PointContact>& stated,
+                                                          const std::vector<PointContact>& solved,
+                                                          const std::vector<Obstacle>& obstacles, double length);
 
 // Solves a definition from a guess: plain shooting, or the active-set loop when it has obstacles
 // (a loop that does not settle is reported as max_iterations with its message). `problem` is the

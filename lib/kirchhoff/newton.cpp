@@ -235,21 +235,37 @@ NewtonSummary solve_with_fallback(const NonlinearSystem& system, Eigen::VectorXd
   search.set_ftol_abs(0.5 * options.residual_tolerance * options.residual_tolerance);
   if (deadline.limited()) search.set_maxtime(deadline.remaining_seconds());
   std::vector<double> start(guess.data(), guess.data() + guess.size());
-  double value = 0.0;
+  double value = 0.0;  // NLopt's objective at its end (unused: the residual there is recomputed)
   try {
     search.optimize(start, value);
   } catch (const std::exception&) {
     // NLopt stops with roundoff_limited or similar: the point reached is still a candidate.
   }
   Eigen::VectorXd candidate = Eigen::Map<Eigen::VectorXd>(start.data(), start.size());
+  const Eigen::VectorXd searched = candidate;
   NewtonSummary second = newton_until(system, candidate, options, deadline);
   second.used_fallback_search = true;
   second.evaluations += summary.evaluations + ctx.evaluations;
-  if (second.converged() || second.residual_norm < summary.residual_norm) {
+  if (second.converged()) {
     x = candidate;
     return second;
   }
-  return summary;
+  // Neither start converged: the better one is returned, saying what both tried.
+  Eigen::VectorXd F_searched;
+  std::string failure;
+  const double reached = system.evaluate(searched, &F_searched, nullptr, &failure) ? max_abs_or_nan(F_searched) : NAN;
+  std::ostringstream tried;
+  tried << "tried 2 starts: Newton from the guess (" << to_string(summary.status) << " after " << summary.iterations
+        << " iterations, residual " << summary.residual_norm << "), then from the point an NLopt least-squares search "
+        << "reached in " << ctx.evaluations << " evaluations (residual " << reached << " there; Newton: "
+        << to_string(second.status) << " after " << second.iterations << " iterations, residual "
+        << second.residual_norm << "); best residual " << std::min(summary.residual_norm, second.residual_norm)
+        << " against the tolerance " << options.residual_tolerance;
+  NewtonSummary& best = second.residual_norm < summary.residual_norm ? second : summary;
+  if (&best == &second) x = candidate;
+  best.evaluations = second.evaluations;
+  best.message = best.message.empty() ? tried.str() : best.message + "; " + tried.str();
+  return best;
 }
 
 }  // namespace kirchhoff
