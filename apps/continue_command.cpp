@@ -262,6 +262,14 @@ int run_continue(const ContinueArguments& args) {
       c.definition.contacts = start->at.contacts;  // the active set the point's unknowns belong to
       start_point = start->at.point.x;
       print_start(*start, c, args.parameter);
+      // The point's unknowns are those of the case with its active set (and the phase condition
+      // of a branch switched onto at a double branch point).
+      ProblemDefinition d = c.definition;
+      if (start->at.phase_condition == "axial" && !d.parameters.contains("unfolding")) add_axial_phase_condition(d);
+      if (const auto n = ShootingProblem(d).size(); start_point.size() != n)
+        throw CaseError(args.start_from + ": its point has " + std::to_string(start_point.size()) +
+                        " unknowns, the case " + std::to_string(n) +
+                        " (set the parameters that fix the segments as in that run)");
     }
     if (args.seed.ipopt && !resuming) {
       // The first point from Ipopt's shape and contact set instead of the case's guess.
@@ -287,14 +295,12 @@ int run_continue(const ContinueArguments& args) {
     if (std::find(options.derived.begin(), options.derived.end(), e.quantity) == options.derived.end())
       options.derived.push_back(e.quantity);
 
-  if (!c.definition.obstacles.empty() && args.switch_at_bp > 0) {
-    std::cerr << "error: " << args.case_path << ": --switch-at-bp is not implemented for cases with obstacles yet\n";
-    return kExitBadInput;
-  }
   if (!args.profiles_dir.empty()) fs::create_directories(args.profiles_dir);
   Progress progress(args.parameter);
   RunState state;
   state.phase_condition = args.phase_condition.empty() ? "none" : args.phase_condition;
+  // A point on a branch followed with the axial phase condition goes on in that problem.
+  if (start && start->at.phase_condition == "axial") state.phase_condition = "axial";
   state.arguments = run_arguments(args);
   std::unique_ptr<BranchWriter> writer;
   const int kill_after = kill_after_row();
@@ -408,15 +414,16 @@ int run_continue(const ContinueArguments& args) {
       std::vector<PointContact> leg_contacts;         // the active set of the leg's points
       auto sink = [&](const ContinuationPoint& p) {
         ++state.row;
-        writer->write(state.row, p, 0);
+        writer->write(state.row, p, branch);
         if (state.row == kill_after) kill(getpid(), SIGKILL);
-        record_written(p, 0, state.phase_condition, leg_contacts);
-        progress.point(state.row, p, 0);
+        record_written(p, branch, state.phase_condition, leg_contacts);
+        progress.point(state.row, p, branch);
         if (leg_problem) write_profile(*leg_problem, p);
       };
       // The leg's state (its active set among it) after every point the run can resume from.
       auto save_leg = [&](const ContactMarchState& m) {
         set_contact_march_state(&state, m);
+        state.branch = branch;
         state.saved_row = state.row;
         save_state(state_path, state);
       };
@@ -428,12 +435,30 @@ int run_continue(const ContinueArguments& args) {
         d.contacts = contacts;
         leg_problem = std::make_unique<ShootingProblem>(d);
       };
+      // As without obstacles: branch 0 to its target or the K-th branch point (counted over its
+      // legs), branch 1 from there with no target.
+      ContinuationOptions first = branch == 1 ? bifurcating_branch_options(options) : options;
+      if (branch == 0) first.stop_at_branch_point = args.switch_at_bp;
       ContactContinuationResult r;
       r = resuming
-              ? resume_with_contacts(c.definition, contact_march_state(state), options, sink, {}, on_active_set, save_leg)
+              ? resume_with_contacts(c.definition, contact_march_state(state), first, sink, {}, on_active_set, save_leg)
           : start_point.size() > 0
-              ? continue_with_contacts_from(c.definition, start_point, options, sink, {}, on_active_set, save_leg)
-              : continue_with_contacts(c.definition, c.start_guess, options, sink, {}, on_active_set, save_leg);
+              ? continue_with_contacts_from(c.definition, start_point, first, sink, {}, on_active_set, save_leg)
+              : continue_with_contacts(c.definition, c.start_guess, first, sink, {}, on_active_set, save_leg);
+      if (branch == 0 && args.switch_at_bp > 0 && r.result.reason != StopReason::TimeLimit) {
+        progress.done();
+        for (const auto& line : r.changes) std::cerr << "contact: " << line << "\n";
+        if (r.result.reason != StopReason::BranchPointStop) {
+          std::cerr << "error: no branch point " << args.switch_at_bp << " before the run stopped ("
+                    << to_string(r.result.reason) << (r.result.message.empty() ? "" : ": " + r.result.message)
+                    << ")\n";
+          return kExitNotConverged;
+        }
+        const ContinuationPoint bp = r.result.points.back();
+        std::cerr << "switching branches at " << args.parameter << " = " << bp.parameter << "\n";
+        branch = 1;
+        r = switch_branch_with_contacts(r.definition, bp, args.switch_side, options, sink, {}, on_active_set, save_leg);
+      }
       progress.done();
       if (state.has_march) save_state(state_path, state);  // with the last row written
       for (const auto& line : r.changes) std::cerr << "contact: " << line << "\n";
@@ -452,12 +477,6 @@ int run_continue(const ContinueArguments& args) {
   options.on_resumable = save_march;
   try {
     auto problem = problem_for(state.phase_condition);
-    if (start_point.size() > 0 && start_point.size() != problem->size()) {
-      progress.done();
-      std::cerr << "error: " << args.start_from << ": its point has " << start_point.size() << " unknowns, the case "
-                << problem->size() << " (set the parameters that fix the segments as in that run)\n";
-      return kExitBadInput;
-    }
     // Each branch's march is run with the options the uninterrupted run gives it, a resumed one
     // too: branch 0 with the target, the self-passage guard and the stop at the K-th branch
     // point (the count of those passed is in the saved state), branch 1 with

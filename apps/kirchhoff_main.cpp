@@ -104,9 +104,10 @@ int main(int argc, char** argv) {
                          "run on multiple-shooting cases of hundreds of unknowns (plectonemes); folds are still found");
   continue_cmd
       ->add_option("--start-from", cont.start_from,
-                   "Start from the last saved point of another run (its CSV's .state.json), e.g. a ply\n"
-                   "followed in turns, continued now in slenderness; that run's parameter is set to the\n"
-                   "point's value (same --set otherwise, so that the unknowns match)")
+                   "Start from the last row another run wrote (its CSV's .state.json; the endpoint at --to\n"
+                   "included), e.g. a ply followed in turns, continued now in slenderness: that run's\n"
+                   "parameter at the point's value, its --set values kept (this command's --set wins), and\n"
+                   "its active contact set on cases with obstacles; the values are printed")
       ->check(CLI::ExistingFile);
   continue_cmd->add_option("--start-param", cont.start_param,
                            "The parameter of a --start-from state file that does not name it");
@@ -122,6 +123,9 @@ int main(int argc, char** argv) {
   continue_cmd->add_option("--samples", cont.samples, "Profile samples per point (invariants, derived quantities)")
       ->capture_default_str();
   continue_cmd->add_flag("--resume", cont.resume, "Resume the run whose CSV is --out from its last written point");
+  bool continue_deflate = false;
+  continue_cmd->add_flag("--deflate", continue_deflate,
+                         "Deflated continuation (every branch found at the start): not implemented; refused");
   continue_cmd
       ->add_option("--max-seconds", cont.max_seconds,
                    "Wall-clock limit of the run in seconds (0: none); it stops after the last point written, "
@@ -311,6 +315,11 @@ int main(int argc, char** argv) {
     if (*check_cmd) return run_check(check_path, check_overrides);
     if (*reproduce_cmd) return run_reproduce(out_dir, cases_dir, reproduce_full);
     if (*continue_cmd) {
+      if (continue_deflate) {
+        std::cerr << "error: continue --deflate (deflated continuation) is not implemented; `kirchhoff equilibria "
+                     "CASE --set ...` lists the equilibria at the start (docs/equilibria.md)\n";
+        return kExitBadInput;
+      }
       cont.seed.ipopt = continue_seed == "ipopt";
       return run_continue(cont);
     }

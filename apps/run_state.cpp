@@ -116,7 +116,8 @@ void save_state(const std::filesystem::path& path, const RunState& s) {
                         {"contact_bending_event", s.contact_bending_event},
                         {"leg_max_points", s.leg_max_points},
                         {"reported", s.reported},
-                        {"first_leg", s.first_leg}};
+                        {"first_leg", s.first_leg},
+                        {"branch_points_before", s.branch_points_before}};
     if (s.before) m["before"] = point_json(*s.before);
     j["march"] = m;
   }
@@ -177,6 +178,8 @@ RunState load_state(const std::filesystem::path& path) {
     s.leg_max_points = m.at("leg_max_points");
     s.reported = m.at("reported");
     s.first_leg = m.at("first_leg");
+    // (0 in older files: contact runs could not stop at a branch point then.)
+    s.branch_points_before = m.value("branch_points_before", 0);
   }
   if (j.contains("written")) s.written = written_from(j.at("written"));
   if (j.contains("set_parameters")) {
@@ -277,7 +280,8 @@ void set_march_state(RunState* s, const MarchState& m) {
 }
 
 ContactMarchState contact_march_state(const RunState& s) {
-  return {march_state(s), s.contacts, s.contact_bending_event, s.leg_max_points, s.reported, s.first_leg};
+  return {march_state(s), s.contacts, s.contact_bending_event, s.leg_max_points, s.reported, s.first_leg,
+          s.branch_points_before};
 }
 
 void set_contact_march_state(RunState* s, const ContactMarchState& m) {
@@ -287,6 +291,7 @@ void set_contact_march_state(RunState* s, const ContactMarchState& m) {
   s->leg_max_points = m.leg_max_points;
   s->reported = m.reported;
   s->first_leg = m.first_leg;
+  s->branch_points_before = m.branch_points_before;
 }
 
 // Keeps the header and the rows up to and including `last_index` (a row written after the

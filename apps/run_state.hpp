@@ -49,6 +49,7 @@ struct RunState {
   int leg_max_points = 0;
   int reported = 0;
   bool first_leg = true;
+  int branch_points_before = 0;
   // The last row written, which may be a point a resume does not start from (an endpoint at
   // --to, a fold, a branch point, an event): where --start-from starts. Absent in older files.
   std::optional<WrittenPoint> written;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <algorithm>
+#include <cstdlib>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 
@@ -418,6 +419,102 @@ TEST_F(ContinueCli, StartFromKeepsTheActiveContactSet) {
   EXPECT_NEAR(start_height[4], end_flat[4], 1e-6);
   EXPECT_GT(start_height[4], 0.09);  // the extended contact it ended with
   EXPECT_NE(rows_height.back().find(",endpoint,"), std::string::npos);
+}
+
+// No shipped case with obstacles has a branch point on the branches `continue` follows from it
+// (wall.toml and cavity.toml in Delta to 0.1, twisted_ribbon_pole.toml in phi): this one does.
+// The Euler column (pinned, sliding end under P) with a wall at y = a above it: the straight
+// column is clear of the wall, its branch point at P = pi^2 is where the buckled Elastica
+// bifurcates, and that branch reaches the wall where y_max = k L / K(k) = a (k = sin(theta0/2),
+// P = 4 K(k)^2 EI / L^2 on the way).
+const char* kColumnUnderWall = R"toml(title = "Euler column below a wall"
+model = "planar"
+[parameters]
+P = 1.0
+L = 1.0
+EI = 1.0
+a = 0.2
+[rod]
+length = "L"
+B = "EI"
+[start]
+type = "pinned"
+position = [0, 0]
+[end]
+type = "sliding"
+axis = [1, 0, 0]
+position = [0, 0]
+force = ["-P", 0]
+[guess]
+force = ["-P", 0]
+[[obstacles]]
+type = "plane"
+name = "wall"
+point = [0, "a"]
+normal = [0, -1, 0]
+[output]
+derived = ["theta0", "y_max", "contact_force", "contact_length"]
+)toml";
+
+// --switch-at-bp on a case with obstacles: the straight column to its branch point, then the
+// buckled branch through first contact (the closed form above) and the flattening of the
+// contact, with the active set changing on the switched branch. Killed on it (on the point
+// contact's leg and on the flat contact's) and resumed, it writes the same rows.
+TEST_F(ContinueCli, SwitchesAtABranchPointOfACaseWithObstacles) {
+  const fs::path case_path = dir_ / "column_wall.toml";
+  std::ofstream(case_path) << kColumnUnderWall;
+  auto args_for = [&](const fs::path& csv) {
+    return std::vector<std::string>{KIRCHHOFF_CLI, "continue", case_path.string(), "--param", "P", "--to", "12",
+                                    "--switch-at-bp", "1", "--event", "P=40", "--max-step", "0.5",
+                                    "--max-points", "400", "--out", csv.string()};
+  };
+  const fs::path full = dir_ / "full.csv";
+  ASSERT_EQ(run_to_end(args_for(full), dir_ / "full.log"), 0);
+  const auto log = lines_of(dir_ / "full.log");
+  EXPECT_TRUE(has_line_with(log, {"switching branches at P = 9.8696"}));
+  EXPECT_TRUE(has_line_with(log, {"a contact appears with obstacle 0 at s = 0.5"}));
+  EXPECT_TRUE(has_line_with(log, {"flattens into an extended contact"}));
+  const auto rows = lines_of(full);
+  int bp_row = -1, reached_row = -1, flat_row = -1;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    if (bp_row < 0 && rows[i].find(",branch_point,") != std::string::npos) bp_row = static_cast<int>(i);
+    if (rows[i].find("obstacle") != std::string::npos && rows[i].find(",event,") != std::string::npos)
+      reached_row = static_cast<int>(i);
+    if (rows[i].find("flattens") != std::string::npos) flat_row = static_cast<int>(i);
+  }
+  ASSERT_GT(bp_row, 0);
+  ASSERT_GT(reached_row, bp_row);
+  ASSERT_GT(flat_row, reached_row);
+  // Columns: index, branch, P, arclength, theta0, y_max, contact_force, contact_length.
+  EXPECT_NEAR(csv_field(rows[bp_row], 2), M_PI * M_PI, 1e-9);
+  EXPECT_EQ(csv_field(rows[bp_row], 1), 0.0);
+  EXPECT_EQ(csv_field(rows[bp_row + 1], 1), 1.0);  // the switched branch starts at the branch point
+  EXPECT_EQ(csv_field(rows[bp_row + 1], 2), csv_field(rows[bp_row], 2));
+  const double theta0 = csv_field(rows[reached_row], 4), k = std::sin(theta0 / 2), K = std::comp_ellint_1(k);
+  EXPECT_NEAR(csv_field(rows[reached_row], 5), 0.2, 1e-8);  // y_max = a
+  EXPECT_NEAR(k / K, 0.2, 1e-8);
+  EXPECT_NEAR(csv_field(rows[reached_row], 2), 4 * K * K, 1e-6);
+  EXPECT_EQ(csv_field(rows[reached_row], 1), 1.0);
+  EXPECT_GT(csv_field(rows.back(), 6), 0.0);  // pressing on the wall at P = 40
+  EXPECT_GT(csv_field(rows.back(), 7), 0.0);  // over an interval
+  EXPECT_NEAR(csv_field(rows.back(), 2), 40.0, 1e-9);
+
+  const fs::path csv = dir_ / "killed.csv";
+  // (Line i of the file is row i - 1.)
+  ASSERT_GT(rows.size(), static_cast<size_t>(flat_row + 10));
+  for (int row : {reached_row + 4, flat_row + 8}) {
+    SCOPED_TRACE("killed after row " + std::to_string(row));
+    fs::remove(csv);
+    fs::remove(csv.string() + ".state.json");
+    setenv("KIRCHHOFF_TEST_KILL_AFTER_ROW", std::to_string(row).c_str(), 1);
+    run_to_end(args_for(csv), dir_ / "killed.log");
+    unsetenv("KIRCHHOFF_TEST_KILL_AFTER_ROW");
+    ASSERT_EQ(lines_of(csv).size(), static_cast<size_t>(row + 2));
+    auto resume = args_for(csv);
+    resume.push_back("--resume");
+    ASSERT_EQ(run_to_end(resume, dir_ / "resume.log"), 0);
+    EXPECT_EQ(lines_of(csv), rows);
+  }
 }
 
 TEST_F(ContinueCli, ContinuingAnUnknownParameterIsRefused) {

@@ -454,13 +454,16 @@ std::string complementarity_violation(const ContinuationPoint& p, const ContactO
 ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const ContactMarchState* resume_from,
                                    ContinuationOptions options, const PointSink& sink, const ContactOptions& contact,
                                    const ActiveSetSink& active_set_sink, const ContactStateSink& state_sink,
-                                   ContactContinuationResult out) {
+                                   ContactContinuationResult out, const ContinuationPoint* switch_at = nullptr,
+                                   double side = 1.0) {
   const int max_points = options.max_points;
   bool first_leg = true;  // the first leg of this call (its start is not a point reported before)
   // The run's points reported so far and whether the leg is the run's first: with a resume they
   // continue those of the interrupted run, so that the legs' shares of max_points are the same.
   int reported = resume_from ? resume_from->reported : 0;
   bool run_first_leg = resume_from ? resume_from->first_leg : true;
+  // Branch points found by earlier legs: stop_at_branch_point counts the run's, not one leg's.
+  int branch_points_before = resume_from ? resume_from->branch_points_before : 0;
   // Set when a flat contact has just buckled: the next leg leaves the flat branch along the fold.
   std::optional<ContinuationPoint> fold_onset;
   size_t fold_contact = 0;  // the first of the fold's two contacts
@@ -471,6 +474,7 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     ContinuationOptions leg = options;
     // (A later leg's start is the last point of the previous one, counted there.)
     leg.max_points = resuming ? resume_from->leg_max_points : max_points - reported + (run_first_leg ? 0 : 1);
+    if (options.stop_at_branch_point > 0) leg.stop_at_branch_point = options.stop_at_branch_point - branch_points_before;
     // The gap event sits at -penetration_tolerance: an active contact touches with a gap of 0 up to
     // round-off, whose sign must not count as a crossing.
     leg.events.push_back({"min_gap", -contact.penetration_tolerance, true, "obstacle_reached"});
@@ -525,13 +529,20 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     leg.on_resumable = nullptr;
     if (state_sink)
       leg.on_resumable = [&, leg_max_points = leg.max_points, bending_event](const MarchState& m) {
-        if (violation.empty()) state_sink({m, d.contacts, bending_event, leg_max_points, reported, run_first_leg});
+        if (violation.empty()) state_sink({m, d.contacts, bending_event, leg_max_points, reported, run_first_leg,
+                                          branch_points_before});
       };
-    ContinuationResult r = resuming ? Continuation(problem, leg).resume(resume_from->march, leg_sink)
+    const bool switching = first_leg && switch_at && !resuming;
+    ContinuationResult r = resuming    ? Continuation(problem, leg).resume(resume_from->march, leg_sink)
+                           : switching ? Continuation(problem, leg).switch_branch(*switch_at, leg_sink, side)
                            : fold_onset ? leave_flat_branch(problem, leg, *fold_onset, fold_contact, leg_sink)
                                         : Continuation(problem, leg).run(x, leg_sink);
     fold_onset.reset();
     if (!first_leg && !r.points.empty()) r.points.erase(r.points.begin());
+    // (The switched leg's start is the branch point switched at, not one found on this branch.)
+    branch_points_before += static_cast<int>(
+        std::count_if(r.points.begin() + (switching && !r.points.empty() ? 1 : 0), r.points.end(),
+                      [](const ContinuationPoint& p) { return p.type == PointType::BranchPoint; }));
     if (!violation.empty()) {
       const auto bad = std::find_if(r.points.begin(), r.points.end(), [&](const ContinuationPoint& p) {
         return !complementarity_violation(p, contact).empty();
@@ -688,6 +699,19 @@ ContactContinuationResult continue_with_contacts_from(ProblemDefinition d, const
                                                       const ActiveSetSink& active_set_sink,
                                                       const ContactStateSink& state_sink) {
   return run_legs(std::move(d), x, nullptr, std::move(options), sink, contact, active_set_sink, state_sink, {});
+}
+
+ContactContinuationResult switch_branch_with_contacts(ProblemDefinition d, const ContinuationPoint& branch_point,
+                                                      double side, ContinuationOptions options, const PointSink& sink,
+                                                      const ContactOptions& contact,
+                                                      const ActiveSetSink& active_set_sink,
+                                                      const ContactStateSink& state_sink) {
+  if (branch_point.multiplicity == 2 && d.kind == RodKind::Spatial)
+    throw std::invalid_argument("a double branch point of a spatial rod with obstacles: switching there needs the "
+                                "axial phase condition, which is not implemented for contact runs");
+  d.parameters.set(options.parameter, branch_point.parameter);
+  return run_legs(std::move(d), branch_point.x, nullptr, bifurcating_branch_options(std::move(options)), sink,
+                  contact, active_set_sink, state_sink, {}, &branch_point, side);
 }
 
 ContactContinuationResult resume_with_contacts(ProblemDefinition d, const ContactMarchState& state,

@@ -119,6 +119,7 @@ struct ContactMarchState {
   int leg_max_points = 0;  // the leg's share of max_points (the legs share the run's budget)
   int reported = 0;        // points the run has handed to its sink so far, over all legs
   bool first_leg = true;   // the run's first leg (a later leg starts on the previous leg's event point)
+  int branch_points_before = 0;  // found by the run's earlier legs (stop_at_branch_point counts the run's)
 };
 // Called right after the point sink with every point such a run can resume from.
 using ContactStateSink = std::function<void(const ContactMarchState&)>;
@@ -133,6 +134,20 @@ ContactContinuationResult continue_with_contacts(ProblemDefinition definition, c
 // x is corrected at the definition's parameter values first; a start that breaks
 // complementarity ends the run as Inadmissible.
 ContactContinuationResult continue_with_contacts_from(ProblemDefinition definition, const Eigen::VectorXd& x,
+                                                      ContinuationOptions options, const PointSink& sink = {},
+                                                      const ContactOptions& contact = {},
+                                                      const ActiveSetSink& active_set_sink = {},
+                                                      const ContactStateSink& state_sink = {});
+// Follows the branch bifurcating at `branch_point`, a located simple branch point on a leg of such
+// a run whose active set is the definition's contacts (the run stops there with
+// options.stop_at_branch_point, which counts the branch points of all its legs), through the
+// changes of the active set as above. The first leg leaves along the null vector of
+// [F_x F_lambda] orthogonal to the old tangent (Continuation::switch_branch, `side` +1 or -1) and
+// reports the branch point again as its start; the options are bifurcating_branch_options'. A
+// double branch point of a spatial rod is refused (std::invalid_argument): its switch needs the
+// axial phase condition, not implemented with contacts.
+ContactContinuationResult switch_branch_with_contacts(ProblemDefinition definition,
+                                                      const ContinuationPoint& branch_point, double side,
                                                       ContinuationOptions options, const PointSink& sink = {},
                                                       const ContactOptions& contact = {},
                                                       const ActiveSetSink& active_set_sink = {},
