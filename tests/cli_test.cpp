@@ -492,6 +492,28 @@ TEST_F(CliTest, UnknownVariableInExpressionExitsTwo) {
   }
 }
 
+// A parameter computed from another ([parameters] EI = "pi*r^2"): the JSON shows it at its
+// computed value, the solution is the Elastica of that stiffness, and --set of it is refused.
+TEST_F(CliTest, ComputedParameterFollowsItsInputAndCannotBeSet) {
+  const std::string path = variant("simply_supported.toml", "EI = 1.0", "r = 0.5\nEI = \"pi*r^2\"");
+  const CliRun r = run("solve " + quoted(path) + " --json --set r=0.6");
+  ASSERT_EQ(r.status, 0) << r.err << r.out;
+  const json j = parse(r);
+  const double EI = M_PI * 0.36;
+  EXPECT_NEAR(j["parameters"]["EI"].get<double>(), EI, 1e-15 * EI);
+  EXPECT_EQ(j["parameters"]["r"].get<double>(), 0.6);
+  const kirchhoff::analytic::PinnedElastica love{1.0, EI, 1.0};
+  EXPECT_LT(relative(j["derived"]["P"].get<double>(), love.load()), 1e-9);  // Newton's 1e-10, as above
+
+  for (const char* command : {"solve", "check"}) {
+    SCOPED_TRACE(command);
+    const CliRun refused = run(std::string(command) + " " + quoted(path) + " --set EI=2");
+    EXPECT_EQ(refused.status, 2) << refused.err;
+    EXPECT_THAT(refused.err, HasSubstr(path + ": --set EI: EI is computed from r"));
+    EXPECT_THAT(refused.err, HasSubstr("set r instead"));
+  }
+}
+
 TEST_F(CliTest, MissingFileAndBadOptionsExitTwo) {
   const std::string missing = (dir_ / "missing.toml").string();
   const CliRun r = run("solve " + quoted(missing));
