@@ -512,6 +512,24 @@ TEST_F(CaseFileTest, ComputedParameterCannotBeSetOrSolvedFor) {
   EXPECT_EQ(dependent_parameter_refusal(chain, "r", "set"), "");
 }
 
+// Rules sharing inputs: each of 200 parameters the sum of the two above it. Loading, computing
+// and refusing a --set stay linear in the rules (a walk of the rules per path took 2^200 steps).
+TEST_F(CaseFileTest, LongChainsOfComputedParametersStayCheap) {
+  std::string chain = "p0 = 1.0\np1 = 1.0\n";
+  for (int k = 2; k < 200; ++k)
+    chain += "p" + std::to_string(k) + " = \"p" + std::to_string(k - 1) + " + p" + std::to_string(k - 2) + "\"\n";
+  const std::string path = write(replaced(kBase, "P = 12.0\n", "P = 12.0\n" + chain));
+  const Case c = load_case(path, {{"p1", 2.0}});
+  EXPECT_EQ(c.definition.parameters.get("p5"), 13.0);  // 1, 2, 3, 5, 8, 13
+  EXPECT_EQ(c.definition.dependent_parameters.size(), 198u);
+  try {
+    load_case(path, {{"p199", 1.0}});
+    ADD_FAILURE() << "--set of a computed parameter was accepted";
+  } catch (const CaseError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("p199 is computed from p0, p1 "));
+  }
+}
+
 // ---- --set overrides -----------------------------------------------------------------------
 
 TEST_F(CaseFileTest, OverrideOfUnknownParameter) {

@@ -597,16 +597,22 @@ bool is_identifier(const std::string& name) {
                      [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
 }
 
-// The parameters a dependent one is ultimately computed from (those a user can set).
+// The parameters a dependent one is ultimately computed from (those a user can set). Each
+// parameter is visited once: rules may share inputs (a chain using the two before it would
+// otherwise be walked 2^n times).
 std::set<std::string> free_roots(const std::vector<DependentParameter>& dependents, const std::string& name) {
-  const DependentParameter* d = find_dependent(dependents, name);
-  if (!d) return {name};
-  std::set<std::string> out;
-  for (const auto& used : d->uses) {
-    const auto roots = free_roots(dependents, used);
-    out.insert(roots.begin(), roots.end());
+  std::set<std::string> roots, seen{name};
+  std::vector<std::string> pending{name};
+  while (!pending.empty()) {
+    const std::string next = pending.back();
+    pending.pop_back();
+    const DependentParameter* d = find_dependent(dependents, next);
+    if (!d) roots.insert(next);
+    else
+      for (const auto& used : d->uses)
+        if (seen.insert(used).second) pending.push_back(used);
   }
-  return out;
+  return roots;
 }
 
 }  // namespace
@@ -734,7 +740,8 @@ Expression parameter_expression(const Reader& plain, const Value& v, const std::
                      std::to_string(entries[at].second->location().line()) +
                      "): a parameter may use only the parameters above it (so that none is computed in a cycle)");
   }
-  return *e;
+  // Bound to the names it uses only: it is evaluated wherever the problem takes its parameters.
+  return Expression(v.as_string().str, e->used_parameters(), false);
 }
 
 // Reads [parameters] into values and dependent parameters, with the overrides applied to the
