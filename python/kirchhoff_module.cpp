@@ -517,11 +517,16 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
     guard_self_passage(problem, &first);  // self-contact: no step through the rod itself
     Continuation run(problem, first);
     ContinuationResult result;
+    ProblemDefinition leg_definition;  // contact runs: the active set of the leg the run stopped on
     try {
       if (!d.obstacles.empty()) {
-        // Contact: the active set changes along the branch (no branch switching there yet).
-        if (switch_at_bp > 0) throw CaseError("switch_at_bp is not implemented for cases with obstacles yet");
-        result = continue_with_contacts(d, c.start_guess, options, check_signals).result;
+        // Contact: the active set changes along the branch; switch_at_bp counts the branch points
+        // of all its legs (as apps/continue_command.cpp).
+        ContinuationOptions contact_first = options;
+        contact_first.stop_at_branch_point = switch_at_bp;
+        ContactContinuationResult legs = continue_with_contacts(d, c.start_guess, contact_first, check_signals);
+        result = std::move(legs.result);
+        leg_definition = std::move(legs.definition);
       } else {
         result = run.run(problem.initial_unknowns(c.start_guess), check_signals);
       }
@@ -538,8 +543,11 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
       out.message = "no branch point " + std::to_string(switch_at_bp) + " before the run stopped (" +
                     to_string(result.reason) + (result.message.empty() ? "" : ": " + result.message) + ")";
     } else if (switch_at_bp > 0) {
-      result = follow_bifurcating_branch(run, result.points.back(), options, side,
-                                         [&](const ShootingProblem&, bool) { return PointSink(check_signals); });
+      result = d.obstacles.empty()
+                   ? follow_bifurcating_branch(run, result.points.back(), options, side,
+                                               [&](const ShootingProblem&, bool) { return PointSink(check_signals); })
+                   : switch_branch_with_contacts(leg_definition, result.points.back(), side, options, check_signals)
+                         .result;
       keep(result, 1);
       out.switched = true;
       out.reason = to_string(result.reason);

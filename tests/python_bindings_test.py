@@ -269,6 +269,28 @@ class ContactTest(unittest.TestCase):
         self.assertEqual(len(events), 1)
         self.assertIn("a contact appears", events[0])
 
+    def test_switch_at_a_branch_point_of_a_case_with_obstacles(self):
+        # The Euler column below a wall at y = 0.2 (as tests/continue_cli_test.cpp): the buckled
+        # branch leaves the straight one at P = pi^2 and reaches the wall on the way to P = 40.
+        with open(case_path("euler_column.toml")) as f:
+            text = f.read().replace("[output]", '[[obstacles]]\ntype = "plane"\npoint = [0, 0.2]\n'
+                                    'normal = [0, -1, 0]\n\n[output]')
+        with tempfile.TemporaryDirectory() as tmp:
+            path = pathlib.Path(tmp) / "column_wall.toml"
+            path.write_text(text)
+            case = kirchhoff.load_case(str(path), set={"P": 1.0, "theta_guess": 0.0})
+            b = case.continue_("P", to=12.0, switch_at_bp=1, events={"P": 40.0}, max_step=0.5)
+        self.assertTrue(b.switched, b.message)
+        self.assertEqual(b.reason, "event", b.message)
+        types, branches = b.points["type"], b.points["branch"]
+        first_bp = list(types).index("branch_point")
+        self.assertAlmostEqual(b.points["parameter"][first_bp], np.pi ** 2, places=9)
+        self.assertEqual(branches[first_bp + 1], 1)
+        contacts = [k for k, e in enumerate(b.points["event"]) if "a contact appears" in e]
+        self.assertEqual(len(contacts), 1)
+        self.assertEqual(branches[contacts[0]], 1)
+        self.assertAlmostEqual(b.points["y_max"][contacts[0]], 0.2, places=8)
+
 
 class ContinuationTest(unittest.TestCase):
     """The Euler column from P = 1 along the straight branch, switching at the first branch point
