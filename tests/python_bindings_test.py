@@ -217,6 +217,18 @@ class CheckedResultTest(unittest.TestCase):
         self.assertIn("soft wall", sol.message)
         self.assertEqual(sol.derived, {})
 
+    def test_stated_contact_that_moved_says_where(self):
+        # wrapped_indenter.toml states its wrap over [0.45, 0.55]; it converges over the closed
+        # form's interval, and the solution says where the stated contact went.
+        sol = kirchhoff.load_case(case_path("wrapped_indenter.toml")).solve()
+        self.assertTrue(sol.converged, sol.message)
+        [stated] = sol.stated_contacts
+        self.assertTrue(stated["moved"])
+        self.assertFalse(stated["released"])
+        self.assertEqual(stated["stated_s"], 0.45)
+        self.assertAlmostEqual(stated["s"], sol.contacts[0]["s"], places=12)
+        self.assertIn("stated over [0.45, 0.55] converged over [0.377472, 0.622528]", stated["message"])
+
     def test_whole_turns_away_is_check_failed(self):
         sol = kirchhoff.load_case(case_path("plectoneme.toml"), set={"turns": 2}).solve()
         self.assertEqual(sol.status, "check_failed")

@@ -7,6 +7,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -319,6 +323,63 @@ INSTANTIATE_TEST_SUITE_P(Cases, DefaultSolve, ::testing::ValuesIn(case_names()),
                          [](const ::testing::TestParamInfo<std::string>& info) {
                            return info.param.substr(0, info.param.size() - 5);  // without ".toml"
                          });
+
+// The CLI on a file (no --set: the default solve), its stdout and stderr.
+struct CliOutput {
+  int status = 0;
+  std::string out, err;
+};
+CliOutput run_cli(const std::string& args) {
+  const std::string out = ::testing::TempDir() + "/shipped_cli.out", err = ::testing::TempDir() + "/shipped_cli.err";
+  const int status = std::system((std::string(KIRCHHOFF_CLI) + " " + args + " > '" + out + "' 2> '" + err + "'").c_str());
+  const auto read = [](const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  return {status, read(out), read(err)};
+}
+
+// wall.toml at Delta = 0.032, written as the file's own value so that `solve` runs the active-set
+// loop from the free arch: it settles on two point contacts with the rod flat between them, which
+// solve reports as one extended contact, in JSON and in text, as `continue` does.
+TEST(SolveCli, FlatContactFoundAsTwoPointContactsIsReportedAsExtended) {
+  std::ifstream in(testing::case_path("wall.toml"));
+  std::string text(std::istreambuf_iterator<char>(in), {});
+  const std::string from = "Delta = 0.026";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(), "Delta = 0.032");
+  const std::string path = ::testing::TempDir() + "/wall_flat.toml";
+  std::ofstream(path) << text;
+  const CliOutput json = run_cli("solve '" + path + "' --json");
+  ASSERT_EQ(json.status, 0) << json.err;
+  const auto j = nlohmann::json::parse(json.out);
+  ASSERT_EQ(j["contacts"].size(), 1u) << json.out;
+  EXPECT_TRUE(j["contacts"][0]["extended"].get<bool>());
+  EXPECT_GT(j["contacts"][0]["s_end"].get<double>() - j["contacts"][0]["s"].get<double>(), 0.03);
+  EXPECT_NEAR(j["derived"]["contact_length"].get<double>(),
+              j["contacts"][0]["s_end"].get<double>() - j["contacts"][0]["s"].get<double>(), 1e-12);
+  const CliOutput text_run = run_cli("solve '" + path + "'");
+  ASSERT_EQ(text_run.status, 0) << text_run.err;
+  EXPECT_NE(text_run.out.find("(wall) over ["), std::string::npos) << text_run.out;
+  EXPECT_NE(text_run.err.find("one extended contact over ["), std::string::npos) << text_run.err;
+}
+
+// wrapped_indenter.toml states its wrap over [0.45, 0.55]; it converges over the closed form's
+// interval, and solve says so on stderr and in JSON.
+TEST(SolveCli, StatedContactThatMovedSaysWhere) {
+  const CliOutput json = run_cli("solve '" + testing::case_path("wrapped_indenter.toml") + "' --json");
+  ASSERT_EQ(json.status, 0) << json.err;
+  const auto stated = nlohmann::json::parse(json.out)["stated_contacts"];
+  ASSERT_EQ(stated.size(), 1u);
+  EXPECT_TRUE(stated[0]["moved"].get<bool>());
+  EXPECT_EQ(stated[0]["stated_s"].get<double>(), 0.45);
+  EXPECT_NEAR(stated[0]["s"].get<double>(),
+              analytic::three_point_bending_wrapped(1.0, 1.0, 0.5, kSupportSlope).contact_start, 1e-9);
+  const std::string expected = "stated over [0.45, 0.55] converged over [0.377472, 0.622528]";
+  EXPECT_NE(stated[0]["message"].get<std::string>().find(expected), std::string::npos) << stated[0]["message"];
+  const CliOutput text = run_cli("solve '" + testing::case_path("wrapped_indenter.toml") + "'");
+  EXPECT_NE(text.err.find(expected), std::string::npos) << text.err;
+}
 
 }  // namespace
 }  // namespace kirchhoff
