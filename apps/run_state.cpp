@@ -198,7 +198,9 @@ namespace {
 // and rod, with the active set after the change) the saved point is taken, with its active set.
 WrittenPoint start_point_of(const RunState& from) {
   if (from.written && from.written->row > from.saved_row) return *from.written;
-  return {from.saved_row, from.branch, from.phase_condition, from.last, from.contacts};
+  WrittenPoint saved{from.saved_row, from.branch, from.phase_condition, from.last, from.contacts};
+  if (from.written) saved.point.type = from.written->point.type;  // the row's type (an event), for the message
+  return saved;
 }
 
 bool names(const std::vector<std::pair<std::string, double>>& values, const std::string& name) {
