@@ -684,6 +684,14 @@ TEST(ParseSolverOverride, SplitsKeyAndValueText) {
             (std::pair<std::string, std::string>{"unknowns", "[\"P\", \"Q\"]"}));
   for (const char* bad : {"tolerance", "=1", "tolerance=", "solver.tolerance=1"})
     EXPECT_THROW(parse_solver_override(bad), std::invalid_argument) << bad;
+  EXPECT_EQ(parse_solver_overrides({"tolerance=1e-10", "stepper=rk78"}),
+            (SolverOverrides{{"tolerance", "1e-10"}, {"stepper", "rk78"}}));
+  try {
+    parse_solver_overrides({"tolerance=1e-10", "tolerance"});
+    ADD_FAILURE() << "accepted";
+  } catch (const CaseError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("--solver 'tolerance' is not KEY=VALUE"));
+  }
 }
 
 TEST(ParseOverride, AcceptsNameEqualsNumber) {

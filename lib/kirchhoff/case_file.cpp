@@ -705,6 +705,18 @@ std::pair<std::string, std::string> parse_solver_override(const std::string& tex
   return {key, text.substr(eq + 1)};
 }
 
+SolverOverrides parse_solver_overrides(const std::vector<std::string>& texts) {
+  SolverOverrides out;
+  for (const auto& t : texts) {
+    try {
+      out.push_back(parse_solver_override(t));
+    } catch (const std::invalid_argument& e) {
+      throw CaseError(std::string("--solver ") + e.what());
+    }
+  }
+  return out;
+}
+
 namespace {
 
 // [parameters] entries in the order of the file: toml11 keeps a table's keys unordered, and an

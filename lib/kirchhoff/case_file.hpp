@@ -102,6 +102,8 @@ std::string dependent_parameter_refusal(const std::vector<DependentParameter>& d
 // when there is no '=', no value or a key that is not a name. The key and value are checked
 // when the case is loaded.
 std::pair<std::string, std::string> parse_solver_override(const std::string& text);
+// Every --solver text parsed; throws CaseError naming the bad one ("--solver tolerance: ...").
+SolverOverrides parse_solver_overrides(const std::vector<std::string>& texts);
 
 // Parses "NAME=VALUE" (--set); throws std::invalid_argument with the reason: no '=', an empty
 // name or one that is not an identifier, a value that is not a finite number with |value| <= 1e100.
