@@ -290,7 +290,7 @@ ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& gues
         report_flat_pairs_as_extended(&problem, &d, &out);
         const double length = problem->length(out.result.parameters);
         for (const auto& o : stated_contact_outcomes(stated, out.definition.contacts, problem->obstacles(out.result.parameters), length))
-          if (o.released || o.moved) out.log.push_back(o.message);
+          if (o.released || o.moved) out.stated_moves.push_back(o.message);
         return out;
       }
       const int which = deepest.obstacle;
@@ -327,6 +327,7 @@ DefinitionSolve as_definition_solve(ContactSolveResult contact) {
   out.problem = std::make_unique<ShootingProblem>(contact.definition);
   out.result = std::move(contact.result);
   out.contact_log = std::move(contact.log);
+  out.contact_log.insert(out.contact_log.end(), contact.stated_moves.begin(), contact.stated_moves.end());
   if (out.result.summary.converged() && !contact.complementarity) {
     out.result.summary.status = SolverStatus::MaxIterations;
     out.result.summary.message = contact.message;

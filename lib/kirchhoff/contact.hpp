@@ -31,6 +31,9 @@ struct ContactSolveResult {
   ShootingResult result;
   ProblemDefinition definition;           // with the final active set
   std::vector<std::string> log;           // one line per change of the active set
+  // One line per contact of the starting set that moved or was released (stated_contact_outcomes);
+  // solve_definition's contact_log carries them after the log.
+  std::vector<std::string> stated_moves;
   bool complementarity = false;           // the final solution satisfies 0 <= g perp force >= 0
   std::string message;
 };
@@ -51,8 +54,8 @@ bool has_hanging_fold(const std::vector<PointContact>& contacts);
 // a plane stalls at round-off); a loop that does not settle within max_rounds reports
 // complementarity = false. Once settled, two neighbouring point contacts on a plane with the rod
 // lying on it between them are reported as the extended contact they are (re-solved as such;
-// kept as point contacts, with a log line, where that does not converge), and the log says where
-// each stated contact that moved went, or that it was released (stated_contact_outcomes).
+// kept as point contacts, with a log line, where that does not converge), and stated_moves says
+// where each stated contact that moved went, or that it was released (stated_contact_outcomes).
 // Throws InfeasibleContact when an imposed end position lies inside an obstacle.
 ContactSolveResult solve_with_contacts(ProblemDefinition definition, const RodPoint& guess,
                                        const ContactOptions& options = {});
