@@ -241,6 +241,32 @@ TEST(Equilibria, WallBeyondFlatteningHasAFlatContactBesideAsymmetricOnes) {
   EXPECT_FALSE(flat->stability.index);  // not defined for extended contacts (docs/stability.md)
 }
 
+TEST(Equilibria, TwistedRodListsEachCircleOfBuckledRodsOnce) {
+  // Below the Greenhill twist (M L / B = 8.9077 < 8.9868) the straight rod is stable and the
+  // subcritical buckled rod (index 1) coexists; the isotropic rod's buckled equilibria come in
+  // circles about e3 (a zero mode), which Newton reaches anywhere along: each circle listed once.
+  const EquilibriaSearch s =
+      search("twisted_clamped.toml", {{"phi", 11.58}, {"m_lateral", -1.7}, {"n_lateral", 3.4}});
+  ASSERT_GE(s.equilibria.size(), 2u);
+  const Equilibrium& straight = s.equilibria[0];
+  EXPECT_NEAR(straight.solution.derived.at("end_to_end"), 1.0, 1e-9);
+  ASSERT_TRUE(straight.stability.index);
+  EXPECT_EQ(*straight.stability.index, 0);
+  const Equilibrium& buckled = s.equilibria[1];
+  ASSERT_TRUE(buckled.stability.index);
+  EXPECT_EQ(*buckled.stability.index, 1);
+  EXPECT_EQ(buckled.stability.zero_modes, 1);
+  // The README's solve of this equilibrium with the axial phase condition: M = 8.78287684...,
+  // end_to_end = 0.97599525...
+  EXPECT_NEAR(buckled.solution.derived.at("M"), 8.78287684, 1e-8);
+  EXPECT_NEAR(buckled.solution.derived.at("end_to_end"), 0.97599525, 1e-8);
+  for (size_t i = 0; i < s.equilibria.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      EXPECT_GT(axial_orbit_distance(*s.equilibria[j].problem, s.equilibria[j].solution.result.x,
+                                     *s.equilibria[i].problem, s.equilibria[i].solution.result.x, 1.0),
+                1e-6);
+}
+
 int run(const std::string& arguments, const std::string& out) {
   const std::string command = std::string(KIRCHHOFF_CLI) + " " + arguments + " > " + out + " 2>/dev/null";
   return WEXITSTATUS(std::system(command.c_str()));

@@ -1,9 +1,11 @@
 #include "kirchhoff/equilibria.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -110,6 +112,37 @@ double profile_distance(const ShootingProblem& a, const Eigen::VectorXd& xa, con
     // The rotation angle between the frames: ||Ra - Rb||_F = 2 sqrt(2) sin(angle / 2).
     const double frame = 2.0 * std::asin(std::min(1.0, (pa[i].R - pb[i].R).norm() / (2.0 * std::sqrt(2.0))));
     worst = std::max({worst, (pa[i].r - pb[i].r).norm() / L, frame, (pa[i].n - pb[i].n).norm() / force_scale});
+  }
+  return worst;
+}
+
+double axial_orbit_distance(const ShootingProblem& a, const Eigen::VectorXd& xa, const ShootingProblem& b,
+                            const Eigen::VectorXd& xb, double force_scale, int samples) {
+  const double L = a.length(a.parameters_at(xa));
+  if (std::abs(L - b.length(b.parameters_at(xb))) > 1e-12 * L) return INFINITY;
+  std::vector<double> s(samples);
+  for (int i = 0; i < samples; ++i) s[i] = L * i / (samples - 1);
+  s.back() = L;
+  const auto pa = a.sample(xa, s), pb = b.sample(xb, s);
+  const Vec3 axis_point = pa.front().r;
+  // The scaled lab vectors whose (x, y) parts a rotation about e3 turns: r - r(0), d3, n, m.
+  const auto parts = [&](const RodPoint& p) {
+    return std::array<Vec3, 4>{(p.r - axis_point) / L, p.R.col(2), p.n / force_scale, p.m / (force_scale * L)};
+  };
+  // The angle that best turns b onto a (least squares over all samples and parts).
+  double dot = 0.0, cross = 0.0;
+  for (int i = 0; i < samples; ++i) {
+    const auto va = parts(pa[i]), vb = parts(pb[i]);
+    for (int k = 0; k < 4; ++k) {
+      dot += vb[k].x() * va[k].x() + vb[k].y() * va[k].y();
+      cross += vb[k].x() * va[k].y() - vb[k].y() * va[k].x();
+    }
+  }
+  const Mat3 Q = Eigen::AngleAxisd(std::atan2(cross, dot), Vec3::UnitZ()).toRotationMatrix();
+  double worst = 0.0;
+  for (int i = 0; i < samples; ++i) {
+    const auto va = parts(pa[i]), vb = parts(pb[i]);
+    for (int k = 0; k < 4; ++k) worst = std::max(worst, (Q * vb[k] - va[k]).norm());
   }
   return worst;
 }
@@ -250,6 +283,8 @@ class Search {
          int samples, const EquilibriaOptions& options)
       : definition_(definition), guess_(guess), derived_(derived), samples_(samples), options_(options) {
     deadline_ = deadline_after(options.max_seconds);
+    // Every solve of the search (the active-set loops, their fallback searches) ends by then too.
+    definition_.options.newton.deadline = std::min(definition_.options.newton.deadline, deadline_);
     deflated_ = options.deflation;
     deflated_.residual_tolerance = definition.options.newton.residual_tolerance;
     deflated_.deadline = std::min(deadline_, definition.options.newton.deadline);
@@ -505,15 +540,27 @@ class Search {
     Solution sol = make_solution(*f.problem, std::move(result), samples_, derived_);
     if (!sol.result.summary.converged())
       return reject(label, sol.result.summary.message, sol.result.summary.residual_norm);
+    // (Computed before the comparison only where it decides it: spatial rods.)
+    std::optional<StabilityReport> stability;
+    if (definition_.kind == RodKind::Spatial) stability = analyse_stability(*f.problem, x);
+    // A spatial equilibrium with a zero mode lies on a continuous family: for the isotropic rod
+    // with both ends on the e3 axis, rotating it about the axis (the cross-sections turned back)
+    // gives the same equilibrium again, which Newton lands on anywhere along the circle. Those
+    // are compared modulo that rotation, so a circle is listed once.
+    const bool on_orbit = stability && stability->zero_modes > 0;
     for (size_t i = 0; i < out_.equilibria.size(); ++i) {
       const Equilibrium& e = out_.equilibria[i];
-      if (profile_distance(*e.problem, e.solution.result.x, *f.problem, x, force_scale_, options_.compare_samples) <
-          options_.distinct_tolerance) {
+      const double d = profile_distance(*e.problem, e.solution.result.x, *f.problem, x, force_scale_,
+                                        options_.compare_samples);
+      const bool same = d < options_.distinct_tolerance ||
+                        (on_orbit && axial_orbit_distance(*e.problem, e.solution.result.x, *f.problem, x, force_scale_,
+                                                          options_.compare_samples) < options_.distinct_tolerance);
+      if (same) {
         out_.log.push_back(label + ": again equilibrium found by " + e.found_by);
         return;
       }
     }
-    accept(f, std::move(sol), label);
+    accept(f, std::move(sol), stability ? std::move(*stability) : analyse_stability(*f.problem, x), label);
   }
 
   void reject(const std::string& label, const std::string& reason, double residual) {
@@ -521,11 +568,11 @@ class Search {
     out_.log.push_back(label + ": rejected: " + reason);
   }
 
-  void accept(Family& f, Solution sol, const std::string& label) {
+  void accept(Family& f, Solution sol, StabilityReport stability, const std::string& label) {
     Equilibrium e;
     e.problem = f.problem;
     e.energy = total_potential_energy(*f.problem, sol.result.x);
-    e.stability = analyse_stability(*f.problem, sol.result.x);
+    e.stability = std::move(stability);
     e.found_by = label;
     e.solution = std::move(sol);
     const Eigen::VectorXd x = e.solution.result.x;

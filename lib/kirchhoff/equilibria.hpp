@@ -21,7 +21,9 @@
 // Distinctness is judged on the rod itself, scale-free: two equilibria are the same when their
 // profiles differ by less than distinct_tolerance in max_s (|dr| / L, the frame's rotation in
 // radians, |dn| / F0), F0 = max(B / L^2, |n(0)| of the case's guess) - never on raw shooting
-// unknowns, whose scales (and, with contacts, whose meaning) differ.
+// unknowns, whose scales (and, with contacts, whose meaning) differ. A spatial equilibrium with a
+// zero mode is compared modulo rotations about e3 as well (axial_orbit_distance): the isotropic
+// rod clamped on the axis has circles of equilibria, each listed once.
 //
 // Every reported equilibrium has passed: max |F| <= the case's Newton tolerance, the solution's
 // own checks (verification.hpp, link.hpp), and with obstacles 0 <= gap perp force >= 0 (gap >=
@@ -108,5 +110,11 @@ double total_potential_energy(const ShootingProblem& problem, const Eigen::Vecto
 // The scale-free distance between two solutions (see above) over `samples` points.
 double profile_distance(const ShootingProblem& a, const Eigen::VectorXd& xa, const ShootingProblem& b,
                         const Eigen::VectorXd& xb, double force_scale, int samples = 101);
+
+// The same modulo a rotation about the e3 axis through a's r(0) (the angle fitted by least squares):
+// the largest difference of (r - r(0)) / L, d3, n / F0 and m / (F0 L) along the rod. The director
+// d1 is left out, since the rotation of an isotropic rod's family turns its cross-sections back.
+double axial_orbit_distance(const ShootingProblem& a, const Eigen::VectorXd& xa, const ShootingProblem& b,
+                            const Eigen::VectorXd& xb, double force_scale, int samples = 101);
 
 }  // namespace kirchhoff
