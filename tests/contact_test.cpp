@@ -271,6 +271,27 @@ TEST(FlatContact, StatedButBeyondRoundOffSaysWhy) {
   EXPECT_NE(r.result.summary.message.find("double root"), std::string::npos) << r.result.summary.message;
 }
 
+// wrapped_indenter.toml with its wrap stated at the closed form's answer: converged at the case's
+// tolerance where it was stated (a wrap around a disc has no flat part: no singular Jacobian).
+TEST(StatedContacts, AWrapStatedAtTheAnswerConvergesThere) {
+  const auto exact = analytic::three_point_bending_wrapped(1.0, 1.0, 0.5, -35.0 * M_PI / 180.0);
+  Case c = load_case(testing::case_path("wrapped_indenter.toml"));
+  ASSERT_EQ(c.definition.contacts.size(), 1u);
+  PointContact& wrap = c.definition.contacts[0];
+  wrap.s = exact.contact_start;
+  wrap.s_end = 1.0 - exact.contact_start;
+  wrap.force = wrap.force_end = exact.edge_force;
+  c.start_guess.n = Vec3(0.0, exact.force / 2.0, 0.0);
+  // The case's guess turns the start by 0.6 rad; the answer leaves the pin at +35 degrees.
+  c.start_guess.R = Eigen::AngleAxisd(35.0 * M_PI / 180.0 - 0.6, Vec3::UnitZ()).toRotationMatrix() * c.start_guess.R;
+  const ContactSolveResult r = solve_with_contacts(c.definition, c.start_guess);
+  ASSERT_TRUE(r.result.summary.converged()) << r.result.summary.brief_report();
+  EXPECT_LE(r.result.summary.iterations, 2);  // started at the answer (to ~1e-11)
+  EXPECT_TRUE(r.log.empty());
+  EXPECT_TRUE(r.stated_moves.empty()) << r.stated_moves.front();
+  EXPECT_NEAR(r.definition.contacts[0].s, exact.contact_start, 1e-9);
+}
+
 TEST(StatedContacts, OneThatMovesSaysWhereItWent) {
   // indenter.toml states its contact at s = L/2; with the disc moved sideways the contact slides.
   const Case c = load_case(testing::case_path("indenter.toml"), {{"half_span", 0.40}});
