@@ -227,7 +227,8 @@ RunStart plan_start_from(const std::filesystem::path& state_path, const std::str
   if (!from.written)
     out.notes.push_back(file + " predates the record of a run's last row: starting from its last saved point (row " +
                         std::to_string(from.saved_row) +
-                        "), which is before the CSV's last row when that row is an endpoint, fold, branch point or event");
+                        "), which is before the CSV's last row when that row is an endpoint, fold, branch point "
+                        "or event");
 
   std::vector<std::pair<std::string, double>> kept = from.set_parameters;
   if (!from.has_set_parameters) {
