@@ -12,7 +12,7 @@
 namespace {
 
 // --seed, --seed-segments, --seed-amplitude (solve and continue).
-void add_seed_options(CLI::App* command, std::string* choice, kirchhoff::cli::StartSeed* seed) {
+void add_seed_options(CLI::App* command, std::string* choice, kirchhoff::StartSeed* seed) {
   command
       ->add_option("--seed", *choice,
                    "Where Newton starts: 'guess' (the case's [guess] and [[guess.contacts]]), or 'ipopt':\n"
@@ -56,7 +56,14 @@ int main(int argc, char** argv) {
   SolveArguments solve;
   auto* solve_cmd = app.add_subcommand("solve", "Solve one equilibrium and report derived quantities and invariants");
   solve_cmd->add_option("case", solve.case_path, "Case file (TOML)")->required()->check(CLI::ExistingFile);
-  solve_cmd->add_option("--set", solve.overrides, "Override a parameter: NAME=VALUE (repeatable)");
+  solve_cmd->add_option("--set", solve.overrides,
+                        "Override a parameter: NAME=VALUE (repeatable). The equilibrium at the new values is\n"
+                        "reached by continuation from the case's own (a homotopy in all changed parameters\n"
+                        "together), so it lies on the branch the case's guess starts; a fold on the way is\n"
+                        "reported (exit 1), never jumped");
+  solve_cmd->add_flag("--direct", solve.direct,
+                      "Newton from the case's guess at the --set values instead of the homotopy (whichever\n"
+                      "equilibrium attracts the guess)");
   solve_cmd->add_flag("--json", solve.json,
                       "Print one JSON object: status, iterations, residual, parameters, derived, invariants, ends");
   solve_cmd->add_option("--profile", solve.profile_path,

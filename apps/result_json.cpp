@@ -27,6 +27,31 @@ nlohmann::json parameters_json(const Parameters& p) {
   return out;
 }
 
+nlohmann::json path_json(const SolvePath& path) {
+  nlohmann::json j = {{"method", path.method}};
+  if (path.method == "ipopt_seed") j["seed"] = path.seed_summary;
+  if (path.method != "homotopy") return j;
+  const HomotopyResult& h = path.homotopy;
+  const auto values_at = [&](double t) {
+    nlohmann::json v = nlohmann::json::object();
+    for (const auto& c : path.changes) v[c.name] = c.at(t);
+    return v;
+  };
+  j["from"] = values_at(0.0);
+  j["to"] = values_at(1.0);
+  j["stop"] = h.stop;
+  j["fraction"] = h.fraction;
+  j["reached"] = values_at(h.fraction);
+  j["points"] = h.points;
+  j["branch_points_checked"] = h.branch_points_checked;
+  j["branch_points"] = nlohmann::json::array();
+  for (double t : h.branch_points) j["branch_points"].push_back(values_at(t));
+  j["contact_changes"] = h.contact_changes;
+  j["residual_evaluations"] = h.residual_evaluations;
+  j["jacobian_evaluations"] = h.jacobian_evaluations;
+  return j;
+}
+
 nlohmann::json stability_json(const StabilityReport& st, const DiscreteStability* discrete) {
   nlohmann::json j;
   j["index"] = st.index ? nlohmann::json(*st.index) : nlohmann::json();

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "kirchhoff/case_file.hpp"
+#include "kirchhoff/case_solve.hpp"
 #include "kirchhoff/solution.hpp"
 #include "kirchhoff/discrete_stability.hpp"
 #include "kirchhoff/stability.hpp"
@@ -19,5 +20,8 @@ nlohmann::json stability_json(const StabilityReport& stability, const DiscreteSt
 nlohmann::json failure_json(const Case& c, const std::string& status, int iterations, double residual,
                             const std::string& message);
 nlohmann::json parameters_json(const Parameters& p);
+// How a solve reached its equilibrium (case_solve.hpp): method, and for a homotopy the values it
+// went from and to, its points, the branch points it crossed and where it stopped.
+nlohmann::json path_json(const SolvePath& path);
 
 }  // namespace kirchhoff::cli

@@ -5,7 +5,6 @@
 
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/contact.hpp"
-#include "kirchhoff/discrete_seed.hpp"
 #include "kirchhoff/solution.hpp"
 #include "result_json.hpp"
 
@@ -40,6 +39,18 @@ void print_human(const Case& c, const Solution& sol, const StabilityReport& stab
     std::cout << "  warning: the discretised energy's check finds index " << *discrete.index << "\n";
 }
 
+// How the equilibrium was reached, when a homotopy took it there.
+void print_path(const SolvePath& path) {
+  if (path.method != "homotopy") return;
+  const HomotopyResult& h = path.homotopy;
+  std::cout << "  reached by homotopy from the case's " << describe_values(path.changes, 0.0) << " in " << h.points
+            << " continuation points\n";
+  for (double t : h.branch_points)
+    std::cout << "  crossed a branch point at " << describe_values(path.changes, t)
+              << " (another branch crosses there; the stability may change)\n";
+  if (!h.branch_points_checked) std::cout << "  (branch points were not looked for: too many unknowns)\n";
+}
+
 }  // namespace
 
 ParameterOverrides parse_overrides(const std::vector<std::string>& texts) {
@@ -54,21 +65,9 @@ ParameterOverrides parse_overrides(const std::vector<std::string>& texts) {
   return out;
 }
 
-namespace {
-
-// The seeded solve, shaped as solve_definition's result.
-DefinitionSolve solve_seeded(const Case& c, const StartSeed& options) {
-  DiscreteSeed seed;
-  ContactSolveResult contact = solve_from_discrete_seed(c.definition, options.segments, options.amplitude, &seed);
-  std::cerr << "seed: " << seed.summary << "\n";
-  return as_definition_solve(std::move(contact));
-}
-
-}  // namespace
-
 int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
                    const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed,
-                   double max_seconds) {
+                   double max_seconds, bool direct) {
   Case& c = out->c;
   try {
     c = load_case(case_path, parse_overrides(overrides), phase_condition);
@@ -80,14 +79,12 @@ int load_and_solve(const std::string& case_path, const std::vector<std::string>&
     std::cerr << "error: --max-seconds: " << e.what() << "\n";
     return kExitBadInput;
   }
-  std::unique_ptr<ShootingProblem>& problem = out->problem;
-  ShootingResult& result = out->result;
-  std::vector<std::string> contact_log;
+  CaseSolveOptions options;
+  options.seed = seed;
+  options.direct = direct;
+  CaseSolve solved;
   try {
-    DefinitionSolve solved = seed.ipopt ? solve_seeded(c, seed) : solve_definition(c.definition, c.start_guess);
-    problem = std::move(solved.problem);
-    result = std::move(solved.result);
-    contact_log = std::move(solved.contact_log);
+    solved = solve_case(c, options);
   } catch (const InfeasibleContact& e) {
     std::cerr << "error: " << c.path << ": infeasible: " << e.what() << "\n";
     if (json) std::cout << failure_json(c, "infeasible", 0, INFINITY, e.what()).dump(2) << "\n";
@@ -105,9 +102,23 @@ int load_and_solve(const std::string& case_path, const std::vector<std::string>&
     if (json) std::cout << failure_json(c, "seed_failed", 0, INFINITY, e.what()).dump(2) << "\n";
     return kExitNotConverged;
   }
+  out->path = std::move(solved.path);
+  if (!out->path.seed_summary.empty()) std::cerr << "seed: " << out->path.seed_summary << "\n";
+  if (!solved.failure.empty()) {
+    std::cerr << "error: " << c.path << ": " << solved.failure << ": " << solved.message << "\n";
+    if (json) {
+      const NewtonSummary& summary = solved.solved.result.summary;
+      nlohmann::json j = failure_json(c, solved.failure, summary.iterations, summary.residual_norm, solved.message);
+      j["path"] = path_json(out->path);
+      std::cout << j.dump(2) << "\n";
+    }
+    return kExitNotConverged;
+  }
+  out->problem = std::move(solved.solved.problem);
+  out->result = std::move(solved.solved.result);
   if (!json)
-    for (const auto& line : contact_log) std::cerr << "contact: " << line << "\n";
-  if (!result.summary.converged()) return report_not_converged(c, result.summary, json);
+    for (const auto& line : solved.solved.contact_log) std::cerr << "contact: " << line << "\n";
+  if (!out->result.summary.converged()) return report_not_converged(c, out->result.summary, json);
   return kExitOk;
 }
 
@@ -123,7 +134,7 @@ int report_not_converged(const Case& c, const NewtonSummary& summary, bool json)
 int run_solve(const SolveArguments& args) {
   SolvedCase solved;
   if (const int status = load_and_solve(args.case_path, args.overrides, args.phase_condition, args.json, &solved, args.seed,
-                                        args.max_seconds);
+                                        args.max_seconds, args.direct);
       status != kExitOk)
     return status;
   const Case& c = solved.c;
@@ -144,10 +155,14 @@ int run_solve(const SolveArguments& args) {
   // The independent check where it applies (planar rods without contacts): its lowest
   // eigenvalues, and whether its index agrees.
   const DiscreteStability discrete = discrete_stability(*problem, sol.result.x);
-  if (args.json)
-    std::cout << solution_json(c, *problem, sol, stability, &discrete).dump(2) << "\n";
-  else
+  if (args.json) {
+    nlohmann::json j = solution_json(c, *problem, sol, stability, &discrete);
+    j["path"] = path_json(solved.path);
+    std::cout << j.dump(2) << "\n";
+  } else {
     print_human(c, sol, stability, discrete);
+    print_path(solved.path);
+  }
   return kExitOk;
 }
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "kirchhoff/case_file.hpp"
+#include "kirchhoff/case_solve.hpp"
 
 namespace kirchhoff::cli {
 
@@ -13,14 +14,6 @@ namespace kirchhoff::cli {
 constexpr int kExitOk = 0;
 constexpr int kExitNotConverged = 1;  // the solver ran and reported a failure status
 constexpr int kExitBadInput = 2;      // the case file or the command line was refused
-
-// Where the solver starts: the case's [guess], or Ipopt on the discretised energy
-// (discrete_seed.hpp), which also gives the initial contact set.
-struct StartSeed {
-  bool ipopt = false;
-  int segments = 200;
-  double amplitude = 0.05;  // the first mode's amplitude Ipopt starts from (its sign: the side)
-};
 
 struct SolveArguments {
   std::string case_path;
@@ -30,6 +23,7 @@ struct SolveArguments {
   std::string profile_path;
   std::string phase_condition;  // empty: as in the case file
   double max_seconds = kDefaultSolveSeconds;  // wall-clock limit of the whole solve (0: none)
+  bool direct = false;  // Newton from the guess at the --set values instead of the homotopy
 };
 
 int run_solve(const SolveArguments& args);
@@ -37,17 +31,18 @@ int run_solve(const SolveArguments& args);
 // NAME=VALUE texts as overrides; throws CaseError naming the bad one.
 ParameterOverrides parse_overrides(const std::vector<std::string>& texts);
 
-// A case loaded and solved the way `solve` does it (active-set loop when it has obstacles).
+// A case loaded and solved the way `solve` does it (case_solve.hpp).
 struct SolvedCase {
   Case c;
   std::unique_ptr<ShootingProblem> problem;
   ShootingResult result;
+  SolvePath path;
 };
 // Loads and solves; on failure prints the reason (and, with json, a failure object on stdout)
 // and returns the exit status, else kExitOk.
 int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
                    const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed = {},
-                   double max_seconds = kDefaultSolveSeconds);
+                   double max_seconds = kDefaultSolveSeconds, bool direct = false);
 // Prints why a solve is not a trustworthy equilibrium (and, with json, the failure object) and
 // returns kExitNotConverged.
 int report_not_converged(const Case& c, const NewtonSummary& summary, bool json);

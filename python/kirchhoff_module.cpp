@@ -26,6 +26,7 @@
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/case_file.hpp"
+#include "kirchhoff/case_solve.hpp"
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/continuation.hpp"
 #include "kirchhoff/self_passage.hpp"
@@ -38,6 +39,7 @@
 #include "kirchhoff/stability.hpp"
 #include "kirchhoff/vibration.hpp"
 #include "plectonemes_command.hpp"  // apps/: the sweep behind `kirchhoff plectonemes`
+#include "result_json.hpp"          // apps/: the JSON blocks the CLI prints
 
 namespace py = pybind11;
 
@@ -146,6 +148,7 @@ struct PySolution {
   py::object stability = py::none();  // as the CLI's JSON "stability"; None when not converged
   double energy = NAN;                // Case.equilibria(): total potential energy (NaN from solve())
   std::string found_by;               // Case.equilibria(): which seed led to it
+  py::object path = py::none();       // as the CLI's JSON "path": how the equilibrium was reached
 };
 
 struct PyBranch {
@@ -243,7 +246,7 @@ py::dict stability_dict(const StabilityReport& st, const DiscreteStability& disc
 }
 
 PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::string& seed, int seed_segments,
-                    double max_seconds) {
+                    double max_seconds, bool direct) {
   Case c = pc.c;
   limit_wall_clock(c.definition.options, max_seconds);  // std::invalid_argument (ValueError) outside [0, 1e9]
   const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
@@ -258,17 +261,28 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   std::unique_ptr<Solution> sol;
   bool integration_failed = false;
   ShootingResult failed;
+  SolvePath path;
+  std::string path_failure;  // a homotopy that stopped short: its status word
   {
     py::gil_scoped_release release;
     ShootingResult solved_result;
     try {
-      // As the CLI: plain shooting, or the active-set loop when the case has obstacles, from the
-      // case's guess or from Ipopt's seed.
-      DefinitionSolve solved = seed == "ipopt"
-                                   ? as_definition_solve(solve_from_discrete_seed(c.definition, seed_segments))
-                                   : solve_definition(c.definition, c.start_guess);
-      problem = std::move(solved.problem);
-      solved_result = std::move(solved.result);
+      // The library's solve of a case, as the CLI's: homotopy from the file's values when
+      // parameters changed (or direct), the active-set loop with obstacles, Ipopt's seed.
+      CaseSolveOptions options;
+      options.direct = direct;
+      options.seed.ipopt = seed == "ipopt";
+      options.seed.segments = seed_segments;
+      CaseSolve solved = solve_case(c, options);
+      path = std::move(solved.path);
+      if (!solved.failure.empty()) {
+        path_failure = solved.failure;
+        integration_failed = true;
+        failed.summary = solved.solved.result.summary;  // the failed start solve's, or no residual
+        failed.summary.message = solved.message;
+      }
+      problem = std::move(solved.solved.problem);
+      solved_result = std::move(solved.solved.result);
     } catch (const InfeasibleContact& e) {
       integration_failed = true;
       failed.summary.status = SolverStatus::MaxIterations;
@@ -301,9 +315,11 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
       }
     }
   }
+  // As the CLI's JSON "path" (one builder for both).
+  out.path = py::module_::import("json").attr("loads")(cli::path_json(path).dump());
   if (!seed_refused.empty()) throw py::value_error(seed_refused);
   const ShootingResult& r = sol ? sol->result : failed;
-  out.status = to_string(r.summary.status);
+  out.status = path_failure.empty() ? to_string(r.summary.status) : path_failure;
   out.converged = r.summary.converged();
   out.iterations = r.summary.iterations;
   out.residual = r.summary.residual_norm;
@@ -745,6 +761,9 @@ Attributes:
       .def_readonly("derived", &PySolution::derived)
       .def_readonly("invariants", &PySolution::invariants)
       .def_readonly("profile", &PySolution::profile)
+      .def_readonly("path", &PySolution::path,
+                    "How the equilibrium was reached, as the CLI's JSON 'path': method ('direct', 'homotopy' or\n"
+                    "'ipopt_seed'); for a homotopy from/to/reached values, points, branch_points crossed, stop")
       .def_readonly("stability", &PySolution::stability,
                     "Stability of the equilibrium (None when not converged): dict with index (None where not "
                     "defined, with reason), stable, zero_modes, conjugate_points, method, as the CLI's JSON.")
@@ -809,8 +828,12 @@ Attributes:
       .def_property_readonly("samples", [](const PyCase& p) { return p.c.samples; })
       .def_readonly("phase_condition", &PyCase::phase_condition)
       .def("solve", &py_solve, py::arg("samples") = py::none(), py::kw_only(), py::arg("seed") = "guess",
-           py::arg("seed_segments") = 200, py::arg("max_seconds") = kDefaultSolveSeconds,
+           py::arg("seed_segments") = 200, py::arg("max_seconds") = kDefaultSolveSeconds, py::arg("direct") = false,
            R"doc(Solves the case by shooting.
+
+Parameters changed from the file's values (load(..., set=...)) are reached by continuation from
+the file's own values (a homotopy in all of them together), so the equilibrium lies on the branch
+the case's guess starts; a fold on the way gives status 'fold' with where it is in `message`.
 
 Args:
     samples (int, optional): profile points (>= 2); default the case's [output] samples.
@@ -820,6 +843,7 @@ Args:
     seed_segments (int): segments of that discretised rod.
     max_seconds (float): wall-clock limit of the solve (0: none); past it the result's status
         is 'time_limit'.
+    direct (bool): Newton from the case's guess at the requested values instead of the homotopy.
 
 Returns:
     Solution. Non-convergence is reported in Solution.status, not raised.)doc")

@@ -292,7 +292,8 @@ TEST_F(CliTest, UnwritableProfileIsRefused) {
 TEST_F(CliTest, NotConvergedExitsOneWithStatus) {
   const std::string path = variant("simply_supported.toml", "unknowns = [\"P\"]",
                                    "unknowns = [\"P\"]\nmax_iterations = 1\nfallback_search = false");
-  // Far from the guess P = 12: one Newton step cannot get there.
+  // One Newton step from the guess P = 12 cannot reach P = 11.22 at the file's theta0 = 1,
+  // where the homotopy to 2.5 starts (nor P = 26.6 at 2.5 directly).
   const std::string args = "solve " + quoted(path) + " --set theta0=2.5";
   const CliRun human = run(args);
   EXPECT_EQ(human.status, 1) << human.out << human.err;
@@ -364,7 +365,8 @@ TEST_F(CliTest, Dopri5StepperGivesTheElastica) {
 // its wall-clock limit with status time_limit, exit 1, the best residual reported.
 TEST_F(CliTest, MaxSecondsEndsASolveWithTimeLimit) {
   const auto start = std::chrono::steady_clock::now();
-  const CliRun r = run("solve " + quoted(case_path("simply_supported.toml")) + " --set theta0=1e6 --max-seconds 1 --json");
+  const CliRun r =
+      run("solve " + quoted(case_path("simply_supported.toml")) + " --set theta0=1e6 --max-seconds 1 --json --direct");
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_EQ(r.status, 1) << r.out << r.err;
   const json j = parse(r);
@@ -372,11 +374,22 @@ TEST_F(CliTest, MaxSecondsEndsASolveWithTimeLimit) {
   EXPECT_TRUE(j["residual"].is_number());
   EXPECT_LT(elapsed, 20.0);  // the limit plus one evaluation, with a wide margin for a loaded machine
   EXPECT_EQ(run("solve " + quoted(case_path("simply_supported.toml")) + " --max-seconds -1").status, 2);
+  // By homotopy the branch approaches the closed loop at theta0 = pi (P -> infinity) and the
+  // limit ends the path there: time_limit, where it got to, and no residual at 1e6 (none computed).
+  const CliRun path = run("solve " + quoted(case_path("simply_supported.toml")) + " --set theta0=1e6 --max-seconds 1 --json");
+  EXPECT_EQ(path.status, 1) << path.out << path.err;
+  const json k = parse(path);
+  EXPECT_EQ(k["status"], "time_limit") << path.out;
+  EXPECT_TRUE(k["residual"].is_null());
+  EXPECT_EQ(k["path"]["stop"], "time_limit");
+  EXPECT_LT(k["path"]["reached"]["theta0"].get<double>(), M_PI);
 }
 
 // The soft wall at a range 1e-20 once converged with the rod beyond the wall (gap < 0, exit 0).
 TEST_F(CliTest, RodBeyondItsSoftWallIsNotConverged) {
-  const CliRun r = run("solve " + quoted(case_path("soft_wall.toml")) + " --set log_b=-20 --json");
+  // Directly: Newton converges beyond the wall and the check refuses it. (By homotopy the path
+  // stalls as the wall stiffens, step_too_small, also exit 1.)
+  const CliRun r = run("solve " + quoted(case_path("soft_wall.toml")) + " --set log_b=-20 --json --direct");
   EXPECT_EQ(r.status, 1) << r.out << r.err;
   const json j = parse(r);
   EXPECT_EQ(j["status"], "check_failed") << r.out;
@@ -385,7 +398,7 @@ TEST_F(CliTest, RodBeyondItsSoftWallIsNotConverged) {
 
 TEST_F(CliTest, IpoptSeedSolvesWhatTheGuessCannot) {
   const std::string args = "solve " + quoted(case_path("cavity.toml")) + " --set Delta=0.05";
-  const CliRun plain = run(args);
+  const CliRun plain = run(args + " --direct");
   EXPECT_EQ(plain.status, 1) << plain.err;  // from the free arch: not converged
   const CliRun seeded = run(args + " --seed ipopt --json");
   EXPECT_EQ(seeded.status, 0) << seeded.err;

@@ -211,7 +211,9 @@ class CheckedResultTest(unittest.TestCase):
         self.assertTrue(all(np.isfinite(sol.profile["nx"])))
 
     def test_rod_beyond_its_soft_wall_is_check_failed(self):
-        sol = kirchhoff.load_case(case_path("soft_wall.toml"), set={"log_b": -20}).solve()
+        # Directly, Newton converges beyond the wall and the check refuses it (by homotopy the
+        # path stalls as the wall stiffens: step_too_small, not converged either).
+        sol = kirchhoff.load_case(case_path("soft_wall.toml"), set={"log_b": -20}).solve(direct=True)
         self.assertFalse(sol.converged)
         self.assertEqual(sol.status, "check_failed")
         self.assertIn("soft wall", sol.message)
@@ -230,7 +232,8 @@ class CheckedResultTest(unittest.TestCase):
         self.assertIn("stated over [0.45, 0.55] converged over [0.377472, 0.622528]", stated["message"])
 
     def test_whole_turns_away_is_check_failed(self):
-        sol = kirchhoff.load_case(case_path("plectoneme.toml"), set={"turns": 2}).solve()
+        # Directly from the untwisted guess: Newton converges two turns away and the check refuses it.
+        sol = kirchhoff.load_case(case_path("plectoneme.toml"), set={"turns": 2}).solve(direct=True)
         self.assertEqual(sol.status, "check_failed")
         self.assertIn("whole turns", sol.message)
 
@@ -257,7 +260,7 @@ class ContactTest(unittest.TestCase):
 
     def test_ipopt_seed_reaches_what_the_guess_cannot(self):
         case = kirchhoff.load_case(case_path("cavity.toml"), set={"Delta": 0.05})
-        self.assertFalse(case.solve().converged)  # from the free-arch guess
+        self.assertFalse(case.solve(direct=True).converged)  # Newton from the free-arch guess
         sol = case.solve(seed="ipopt")
         self.assertEqual(sol.status, "converged")
         self.assertEqual(len(sol.contacts), 1)
@@ -269,9 +272,17 @@ class ContactTest(unittest.TestCase):
             kirchhoff.load_case(case_path("indenter.toml")).solve(seed="ipopt")
 
     def test_infeasible_wall_is_a_status(self):
-        sol = kirchhoff.load_case(case_path("wall.toml"), set={"a": -0.01}).solve()
+        case = kirchhoff.load_case(case_path("wall.toml"), set={"a": -0.01})
+        sol = case.solve(direct=True)
         self.assertFalse(sol.converged)
         self.assertIn("infeasible", sol.message)
+        # By homotopy the wall comes down onto the arch until the branch turns back (a fold):
+        # no admissible equilibrium is reached, and the path says where it stopped.
+        sol = case.solve()
+        self.assertFalse(sol.converged)
+        self.assertEqual(sol.status, "fold")
+        self.assertEqual(sol.path["method"], "homotopy")
+        self.assertGreater(sol.path["reached"]["a"], 0.0)
 
     def test_continuation_records_the_first_contact(self):
         branch = kirchhoff.load_case(case_path("wall.toml"), set={"Delta": 0.005, "m_guess": 0.9}).continue_(

@@ -163,8 +163,12 @@ class Reader {
       fail(v, key, error.what());
     }
     if (!e->depends_on_s()) (void)value(*e, v, key);
+    note_uses(*e, key);
     return *e;
   }
+
+  // The parameters the problem itself (not its [guess]) depends on, as far as read so far.
+  const std::set<std::string>& problem_uses() const { return problem_uses_; }
 
   // e at the case's parameter values and arclength s: finite and within kMaxMagnitude.
   double value(const Expression& e, const Value& v, const std::string& key, double s = 0.0) const {
@@ -188,10 +192,17 @@ class Reader {
       names.push_back(axis);
     }
     try {
-      return Expression(v.as_string().str, names, false);
+      Expression e(v.as_string().str, names, false);
+      note_uses(e, key);
+      return e;
     } catch (const std::invalid_argument& e) {
       fail(v, key, e.what());
     }
+  }
+
+  void note_uses(const Expression& e, const std::string& key) const {
+    if (key.rfind("guess", 0) == 0) return;
+    problem_uses_.insert(e.used_parameters().begin(), e.used_parameters().end());
   }
 
   std::array<Expression, 3> vector(const Value& v, const std::string& key, bool uses_s = false) const {
@@ -221,6 +232,7 @@ class Reader {
   std::string path_;
   std::vector<std::string> parameter_names_;
   Parameters parameters_;
+  mutable std::set<std::string> problem_uses_;  // see uses()
 };
 
 VectorTarget vector_target(const std::array<Expression, 3>& e) {
@@ -1187,6 +1199,11 @@ Case load_case_text(const std::string& text, const std::string& path, const Para
     if (v) reader.fail(*v, table, what);
     reader.fail(table, what);
   }
+  // A computed parameter the problem uses makes the problem use what it is computed from (later
+  // rules may use earlier ones: walked backwards).
+  c.problem_parameters = reader.problem_uses();
+  for (auto rule = d.dependent_parameters.rbegin(); rule != d.dependent_parameters.rend(); ++rule)
+    if (c.problem_parameters.count(rule->name)) c.problem_parameters.insert(rule->uses.begin(), rule->uses.end());
   return c;
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -35,6 +36,8 @@ struct Case {
   // include: a solve at the overridden values may reach them from the file's (homotopy.hpp).
   Parameters file_parameters;
   ParameterOverrides overrides;
+  // The parameters the rod, its ends or its obstacles use: the others only shape the [guess].
+  std::set<std::string> problem_parameters;
   std::string text;             // the file's text and the options it was read with (reload_case)
   std::string phase_condition;
   SolverOverrides solver_overrides;

@@ -1,0 +1,131 @@
+// Solving at --set values by homotopy from the case's own (case_solve.hpp, homotopy.hpp): the
+// equilibrium reached is the one on the branch the case's guess starts, checked against closed
+// forms; a fold on the way is reported with where it is, and parameters that only shape the guess
+// stay guesses.
+#include <cmath>
+
+#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/case_solve.hpp"
+#include "kirchhoff/continuation.hpp"
+#include "test_support.hpp"
+
+namespace kirchhoff {
+namespace {
+
+// Newton polishes the path's end at exactly the requested values to |F| <= 1e-10 with RK78 at
+// 1e-12 per step, as the direct solves of elastica_test: P to ~1e-11 relative. 1e-9 leaves room
+// for the conditioning of P in theta0 near pi (dP/dtheta0 ~ 3e3 at 3.1).
+constexpr double kLoadTolerance = 1e-9;
+
+CaseSolve solve_at(const std::string& name, const ParameterOverrides& overrides, bool direct = false) {
+  const Case c = load_case(testing::case_path(name), overrides);
+  CaseSolveOptions options;
+  options.direct = direct;
+  return solve_case(c, options);
+}
+
+double solved_load(const CaseSolve& s) { return s.solved.result.parameters["P"]; }
+
+class SimplySupportedHomotopy : public ::testing::TestWithParam<double> {};
+
+// Fig. 3's branch up to theta0 = 3.1, past the branch point where the supports meet (2.2814),
+// against P = 4 K(k)^2 EI / L^2: Newton from the case's guess lands elsewhere from 2.5 on.
+TEST_P(SimplySupportedHomotopy, ReachesFig3sElasticaWhereNewtonFromTheGuessDoesNot) {
+  const double theta0 = GetParam();
+  const double exact = analytic::PinnedElastica{1.0, 1.0, theta0}.load();
+  const CaseSolve s = solve_at("simply_supported.toml", {{"theta0", theta0}});
+  ASSERT_TRUE(s.failure.empty()) << s.failure << ": " << s.message;
+  ASSERT_TRUE(s.solved.result.summary.converged()) << s.solved.result.summary.brief_report();
+  EXPECT_EQ(s.path.method, "homotopy");
+  EXPECT_EQ(s.path.homotopy.stop, "reached");
+  EXPECT_NEAR(solved_load(s) / exact, 1.0, kLoadTolerance);
+  // The solution is at exactly the requested value (polished there, not at the path's t ~ 1).
+  EXPECT_EQ(s.solved.result.parameters["theta0"], theta0);
+  // The supports meet at theta0 = 2.2814 (end_to_end = 0): the path crosses that branch point.
+  ASSERT_EQ(s.path.homotopy.branch_points.size(), 1u);
+  const double at = s.path.changes[0].at(s.path.homotopy.branch_points[0]);
+  // Located by the determinant's sign change to the continuation's tolerance (~1e-4 here).
+  EXPECT_NEAR(at, 2.2814, 2e-3);
+  // The direct solve from the same guess reaches another equilibrium (what the homotopy avoids).
+  const CaseSolve direct = solve_at("simply_supported.toml", {{"theta0", theta0}}, true);
+  EXPECT_EQ(direct.path.method, "direct");
+  if (direct.solved.result.summary.converged())
+    EXPECT_GT(std::abs(solved_load(direct) / exact - 1.0), 1e-3) << "theta0 = " << theta0;
+}
+
+INSTANTIATE_TEST_SUITE_P(Fig3, SimplySupportedHomotopy, ::testing::Values(2.5, 2.95, 3.1));
+
+// Two parameters at once: theta0 and L together, P = 4 K^2 EI / L^2 at the new length.
+TEST(Homotopy, MovesEveryChangedParameterTogether) {
+  const CaseSolve s = solve_at("simply_supported.toml", {{"theta0", 2.0}, {"L", 2.0}, {"EI", 3.0}});
+  ASSERT_TRUE(s.failure.empty()) << s.message;
+  ASSERT_TRUE(s.solved.result.summary.converged());
+  ASSERT_EQ(s.path.changes.size(), 3u);
+  const analytic::PinnedElastica exact{2.0, 3.0, 2.0};  // L, EI, theta0
+  EXPECT_NEAR(solved_load(s) / exact.load(), 1.0, kLoadTolerance);
+}
+
+// The shallow arch under its weight snaps through at a fold: asked for a weight beyond it, the
+// homotopy stops there and says where, instead of returning an equilibrium of another branch.
+TEST(Homotopy, StopsAtAFoldAndSaysWhere) {
+  const CaseSolve s = solve_at("shallow_arch.toml", {{"w", 150.0}});
+  EXPECT_EQ(s.failure, "fold");
+  EXPECT_EQ(s.solved.problem, nullptr);
+  EXPECT_NE(s.message.find("fold at w = "), std::string::npos) << s.message;
+  const double w_fold = s.path.changes[0].at(s.path.homotopy.fraction);
+  // The same fold located independently, by continuation in w itself (another parametrisation
+  // of the same branch, so other steps and another located point): both locate dw/dsigma = 0
+  // by the secant method to ~1e-8 of the step; 1e-6 relative is far below the fold's value.
+  const Case c = load_case(testing::case_path("shallow_arch.toml"));
+  ContinuationOptions o;
+  o.parameter = "w";
+  o.target = 150.0;
+  o.stop_at_fold = true;
+  ShootingProblem problem(c.definition);
+  const ContinuationResult run = Continuation(problem, o).run(problem.initial_unknowns(c.start_guess));
+  ASSERT_EQ(run.reason, StopReason::FoldStop);
+  EXPECT_NEAR(w_fold / run.points.back().parameter, 1.0, 1e-6);
+  // Below the fold the same request is reached.
+  const CaseSolve below = solve_at("shallow_arch.toml", {{"w", 0.9 * w_fold}});
+  EXPECT_TRUE(below.failure.empty()) << below.message;
+}
+
+// theta_guess shapes only the [guess]: setting it picks the start (the straight column), and the
+// load's change is then followed along the straight column, through the Euler load pi^2.
+TEST(Homotopy, ParametersOfTheGuessAloneStayGuesses) {
+  const Case c = load_case(testing::case_path("euler_column.toml"), {{"theta_guess", 0.0}, {"P", 5.0}});
+  EXPECT_FALSE(c.problem_parameters.count("theta_guess"));
+  EXPECT_TRUE(c.problem_parameters.count("P"));
+  const auto changes = homotopy_changes(c);
+  ASSERT_EQ(changes.size(), 1u);
+  EXPECT_EQ(changes[0].name, "P");
+  const CaseSolve s = solve_case(c);
+  ASSERT_TRUE(s.failure.empty()) << s.message;
+  const Solution sol = make_solution(*s.solved.problem, s.solved.result, 101, c.derived);
+  EXPECT_NEAR(sol.derived.at("theta0"), 0.0, 1e-9);
+  ASSERT_EQ(s.path.homotopy.branch_points.size(), 1u);
+  EXPECT_NEAR(s.path.changes[0].at(s.path.homotopy.branch_points[0]) / (M_PI * M_PI), 1.0, 1e-3);
+}
+
+// Only guesses changed (the unknown load's): nothing to follow, Newton from the guess.
+TEST(Homotopy, OnlyGuessesChangedSolvesDirectly) {
+  const CaseSolve s = solve_at("simply_supported.toml", {{"P", 11.0}});
+  EXPECT_EQ(s.path.method, "direct");
+  EXPECT_TRUE(s.solved.result.summary.converged());
+}
+
+// With obstacles the path goes through changes of the contact set: a smaller end shortening
+// lowers the arch below the wall, and its contact lifts off on the way.
+TEST(Homotopy, FollowsContactSetChanges) {
+  const CaseSolve s = solve_at("wall.toml", {{"Delta", 0.02}});
+  ASSERT_TRUE(s.failure.empty()) << s.message;
+  ASSERT_TRUE(s.solved.result.summary.converged());
+  ASSERT_FALSE(s.path.homotopy.contact_changes.empty());
+  EXPECT_NE(s.path.homotopy.contact_changes[0].find("Delta = "), std::string::npos)
+      << s.path.homotopy.contact_changes[0];
+  EXPECT_NE(s.path.homotopy.contact_changes[0].find("lifts off"), std::string::npos);
+  EXPECT_TRUE(s.solved.problem->definition().contacts.empty());
+}
+
+}  // namespace
+}  // namespace kirchhoff
