@@ -1,5 +1,7 @@
 #include "equilibria_command.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
@@ -38,7 +40,11 @@ std::string contacts_text(const Solution& sol) {
 void print_table(const Case& c, const EquilibriaSearch& search) {
   std::cout << (c.title.empty() ? c.path : c.title) << "\n";
   std::cout << "  " << search.equilibria.size() << " distinct equilibria (" << search.stopped_because << ", "
-            << search.newton_runs << " Newton runs), by increasing energy:\n";
+            << search.newton_runs << " Newton runs), "
+            << (std::any_of(search.equilibria.begin(), search.equilibria.end(),
+                            [](const Equilibrium& e) { return std::isnan(e.energy); })
+                    ? "energy not defined for some (see docs/equilibria.md), those in the order found:\n"
+                    : "by increasing energy:\n");
   std::cout << "  " << std::setw(3) << "#" << std::setw(16) << "energy" << std::setw(12) << "index" << std::setw(11)
             << "residual" << std::setw(11) << "H spread";
   for (const auto& name : c.derived) std::cout << std::setw(15) << name;
@@ -92,7 +98,8 @@ void write_profiles(const std::string& dir, const EquilibriaSearch& search) {
   for (size_t i = 0; i < search.equilibria.size(); ++i) {
     const Equilibrium& e = search.equilibria[i];
     const std::string path = (std::filesystem::path(dir) / ("equilibrium_" + std::to_string(i + 1) + ".csv")).string();
-    write_profile_csv(path, e.problem->equations(e.solution.result.parameters)->model(), e.solution.profile);
+    write_profile_csv(path, e.problem->equations(e.solution.result.parameters)->model(), e.solution.profile,
+                      e.problem->definition().kind);
   }
 }
 
@@ -102,7 +109,7 @@ int run_equilibria(const EquilibriaArguments& args) {
   Case c;
   EquilibriaOptions options;
   try {
-    c = load_case(args.case_path, parse_overrides(args.overrides));
+    c = load_case(args.case_path, parse_overrides(args.overrides), "", parse_solver_overrides(args.solver));
     if (args.max_equilibria < 1) throw CaseError("--max: at least 1");
     if (!(args.max_seconds >= 0)) throw CaseError("--max-seconds: not negative");
     options.max_equilibria = args.max_equilibria;

@@ -73,6 +73,9 @@ double end_load_work(const EndCondition& end, const RodEquations& eq, const Para
 }  // namespace
 
 double total_potential_energy(const ShootingProblem& problem, const Eigen::VectorXd& x) {
+  const ProblemDefinition& definition = problem.definition();
+  for (const auto& name : definition.unknown_parameters)
+    if (definition.model_parameters.count(name) || definition.obstacle_parameters.count(name)) return NAN;
   const Parameters params = problem.parameters_at(x);
   const auto eq = problem.equations(params);
   const RodModel& model = eq->model();
@@ -91,8 +94,8 @@ double total_potential_energy(const ShootingProblem& problem, const Eigen::Vecto
     energy += simpson(problem, x, model, i == 0 ? a : a + inset, i + 2 == breaks.size() ? b : b - inset, n);
   }
   const auto ends = problem.sample(x, {0.0, L});
-  const ProblemDefinition& d = problem.definition();
-  return energy - end_load_work(d.start, *eq, params, ends.front()) - end_load_work(d.end, *eq, params, ends.back());
+  return energy - end_load_work(definition.start, *eq, params, ends.front()) -
+         end_load_work(definition.end, *eq, params, ends.back());
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -104,7 +104,9 @@ EquilibriaSearch find_equilibria(const ProblemDefinition& definition, const RodP
 // moment). Contact forces do no work (the rod is on the rigid obstacle where they act). The
 // integral is composite Simpson between the contacts' arclengths (the density is smooth there:
 // error ~ h^4, ~1e-13 of the energy with 2000 intervals); NaN where the energy is not a potential:
-// a dead couple on a spatial end free to rotate.
+// a dead couple on a spatial end free to rotate, or an unknown parameter that changes the rod or
+// an obstacle (a sleeve's sliding length: the work the sleeve's load does as the rod slides is not
+// part of this energy, so comparing such equilibria by it would mislead).
 double total_potential_energy(const ShootingProblem& problem, const Eigen::VectorXd& x);
 
 // The scale-free distance between two solutions (see above) over `samples` points.
