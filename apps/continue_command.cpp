@@ -231,10 +231,14 @@ int run_continue(const ContinueArguments& args) {
       overrides = start->parameters;
       refuse_foreign_parameters(*start, args);
     }
-    c = load_case(args.case_path, overrides, args.phase_condition);
+    c = load_case(args.case_path, overrides, args.phase_condition, parse_solver_overrides(args.solver));
     options.parameter = args.parameter;
     if (!c.definition.parameters.contains(args.parameter))
       throw CaseError(args.case_path + ": --param " + args.parameter + ": not a parameter of the case");
+    if (const std::string why = dependent_parameter_refusal(c.definition.dependent_parameters, args.parameter,
+                                                            "continue in");
+        !why.empty())
+      throw CaseError(args.case_path + ": --param " + args.parameter + ": " + why);
     if (args.has_to) options.target = args.to;
     options.initial_step = args.step;
     options.min_step = args.min_step;
@@ -354,7 +358,7 @@ int run_continue(const ContinueArguments& args) {
     std::ostringstream name;
     name << "point_" << std::setw(5) << std::setfill('0') << state.row << ".csv";
     write_profile_csv((fs::path(args.profiles_dir) / name.str()).string(), copy.equations(r.parameters)->model(),
-                      s.profile);
+                      s.profile, copy.definition().kind);
   };
 
   // The state is saved after every point a run can resume from (options.on_resumable, called

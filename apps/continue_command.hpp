@@ -12,6 +12,7 @@ namespace kirchhoff::cli {
 struct ContinueArguments {
   std::string case_path;
   std::vector<std::string> overrides;
+  std::vector<std::string> solver;     // --solver KEY=VALUE: [solver] keys
   std::string phase_condition;
   std::string parameter;
   double to = 0.0;

@@ -9,6 +9,7 @@ namespace kirchhoff::cli {
 struct EquilibriaArguments {
   std::string case_path;
   std::vector<std::string> overrides;  // NAME=VALUE
+  std::vector<std::string> solver;     // --solver KEY=VALUE: [solver] keys
   int max_equilibria = 16;
   bool json = false;           // print the JSON on stdout instead of the table
   std::string profiles_dir;    // one profile CSV per equilibrium; empty: none

@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
   SolveArguments solve;
   auto* solve_cmd = app.add_subcommand("solve", "Solve one equilibrium and report derived quantities and invariants");
   solve_cmd->add_option("case", solve.case_path, "Case file (TOML)")->required()->check(CLI::ExistingFile);
+  solve_cmd->add_option("--solver", solve.solver, "Override a [solver] key: KEY=VALUE, e.g. tolerance=1e-10, stepper=dopri5 (repeatable; checked as in the file)");
   solve_cmd->add_option("--set", solve.overrides,
                         "Override a parameter: NAME=VALUE (repeatable). The equilibrium at the new values is\n"
                         "reached by continuation from the case's own (a homotopy in all changed parameters\n"
@@ -87,6 +88,8 @@ int main(int argc, char** argv) {
   auto* check_cmd = app.add_subcommand("check", "Validate a case file without solving");
   check_cmd->add_option("case", check_path, "Case file (TOML)")->required()->check(CLI::ExistingFile);
   check_cmd->add_option("--set", check_overrides, "Override a parameter: NAME=VALUE (repeatable)");
+  std::vector<std::string> check_solver;
+  check_cmd->add_option("--solver", check_solver, "Override a [solver] key: KEY=VALUE, e.g. tolerance=1e-10, stepper=dopri5 (repeatable; checked as in the file)");
 
   ContinueArguments cont;
   auto* continue_cmd = app.add_subcommand(
@@ -139,6 +142,7 @@ int main(int argc, char** argv) {
                    "with time_limit and exit 1, and --resume goes on")
       ->capture_default_str();
   continue_cmd->add_option("--set", cont.overrides, "Override a parameter: NAME=VALUE (repeatable)");
+  continue_cmd->add_option("--solver", cont.solver, "Override a [solver] key: KEY=VALUE, e.g. tolerance=1e-10, stepper=dopri5 (repeatable; checked as in the file)");
   continue_cmd->add_option("--phase-condition", cont.phase_condition, "As for solve")
       ->check(CLI::IsMember({"none", "axial"}));
 
@@ -160,6 +164,7 @@ int main(int argc, char** argv) {
       "  kirchhoff equilibria cases/wall.toml --set Delta=0.033 --max 6 --json --profiles wall_eq/");
   equilibria_cmd->add_option("case", eq.case_path, "Case file (TOML)")->required()->check(CLI::ExistingFile);
   equilibria_cmd->add_option("--set", eq.overrides, "Override a parameter: NAME=VALUE (repeatable)");
+  equilibria_cmd->add_option("--solver", eq.solver, "Override a [solver] key: KEY=VALUE, e.g. tolerance=1e-10, stepper=dopri5 (repeatable; checked as in the file)");
   equilibria_cmd->add_option("--max", eq.max_equilibria, "Stop once this many distinct equilibria are found")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -199,6 +204,7 @@ int main(int argc, char** argv) {
       "  kirchhoff vibrate cases/heavy_cantilever.toml --set w=0 --rho-s 2 --json");
   vibrate_cmd->add_option("case", vib.case_path, "Case file (TOML) of a planar rod")->required()->check(CLI::ExistingFile);
   vibrate_cmd->add_option("--set", vib.overrides, "Override a parameter: NAME=VALUE (repeatable)");
+  vibrate_cmd->add_option("--solver", vib.solver, "Override a [solver] key: KEY=VALUE, e.g. tolerance=1e-10, stepper=dopri5 (repeatable; checked as in the file)");
   vibrate_cmd->add_option("--modes", vib.modes, "Number of lowest frequencies to find")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -319,7 +325,7 @@ int main(int argc, char** argv) {
       solve.seed.ipopt = solve_seed == "ipopt";
       return run_solve(solve);
     }
-    if (*check_cmd) return run_check(check_path, check_overrides);
+    if (*check_cmd) return run_check(check_path, check_overrides, check_solver);
     if (*reproduce_cmd) return run_reproduce(out_dir, cases_dir, reproduce_full);
     if (*continue_cmd) {
       if (continue_deflate) {

@@ -67,10 +67,10 @@ ParameterOverrides parse_overrides(const std::vector<std::string>& texts) {
 
 int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
                    const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed,
-                   double max_seconds, bool direct) {
+                   double max_seconds, bool direct, const std::vector<std::string>& solver) {
   Case& c = out->c;
   try {
-    c = load_case(case_path, parse_overrides(overrides), phase_condition);
+    c = load_case(case_path, parse_overrides(overrides), phase_condition, parse_solver_overrides(solver));
     limit_wall_clock(c.definition.options, max_seconds);
   } catch (const CaseError& e) {
     std::cerr << "error: " << e.what() << "\n";
@@ -134,7 +134,7 @@ int report_not_converged(const Case& c, const NewtonSummary& summary, bool json)
 int run_solve(const SolveArguments& args) {
   SolvedCase solved;
   if (const int status = load_and_solve(args.case_path, args.overrides, args.phase_condition, args.json, &solved, args.seed,
-                                        args.max_seconds, args.direct);
+                                        args.max_seconds, args.direct, args.solver);
       status != kExitOk)
     return status;
   const Case& c = solved.c;
@@ -145,7 +145,8 @@ int run_solve(const SolveArguments& args) {
   if (!sol.result.summary.converged()) return report_not_converged(c, sol.result.summary, args.json);
   if (!args.profile_path.empty()) {
     try {
-      write_profile_csv(args.profile_path, problem->equations(sol.result.parameters)->model(), sol.profile);
+      write_profile_csv(args.profile_path, problem->equations(sol.result.parameters)->model(), sol.profile,
+                        problem->definition().kind);
     } catch (const std::runtime_error& e) {
       std::cerr << "error: " << e.what() << "\n";
       return kExitBadInput;
@@ -166,9 +167,10 @@ int run_solve(const SolveArguments& args) {
   return kExitOk;
 }
 
-int run_check(const std::string& case_path, const std::vector<std::string>& overrides) {
+int run_check(const std::string& case_path, const std::vector<std::string>& overrides,
+              const std::vector<std::string>& solver) {
   try {
-    const Case c = load_case(case_path, parse_overrides(overrides));
+    const Case c = load_case(case_path, parse_overrides(overrides), "", parse_solver_overrides(solver));
     const ShootingProblem problem(c.definition);
     std::cout << case_path << ": ok (" << (c.definition.kind == RodKind::Planar ? "planar" : "spatial") << ", "
               << problem.size() << " unknowns, " << c.definition.options.segments << " segment(s))\n";

@@ -19,6 +19,7 @@ struct SolveArguments {
   std::string case_path;
   StartSeed seed;
   std::vector<std::string> overrides;  // NAME=VALUE
+  std::vector<std::string> solver;     // --solver KEY=VALUE: [solver] keys
   bool json = false;
   std::string profile_path;
   std::string phase_condition;  // empty: as in the case file
@@ -42,10 +43,12 @@ struct SolvedCase {
 // and returns the exit status, else kExitOk.
 int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
                    const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed = {},
-                   double max_seconds = kDefaultSolveSeconds, bool direct = false);
+                   double max_seconds = kDefaultSolveSeconds, bool direct = false,
+                   const std::vector<std::string>& solver = {});
 // Prints why a solve is not a trustworthy equilibrium (and, with json, the failure object) and
 // returns kExitNotConverged.
 int report_not_converged(const Case& c, const NewtonSummary& summary, bool json);
-int run_check(const std::string& case_path, const std::vector<std::string>& overrides);
+int run_check(const std::string& case_path, const std::vector<std::string>& overrides,
+              const std::vector<std::string>& solver = {});
 
 }  // namespace kirchhoff::cli

@@ -100,7 +100,8 @@ void print_table(const Case& c, const VibrationAnalysis& analysis) {
 
 int run_vibrate(const VibrateArguments& args) {
   SolvedCase solved;
-  if (const int status = load_and_solve(args.case_path, args.overrides, "", args.json, &solved); status != kExitOk)
+  if (const int status = load_and_solve(args.case_path, args.overrides, "", args.json, &solved, {}, kDefaultSolveSeconds, false,
+                                        args.solver); status != kExitOk)
     return status;
   if (solved.c.definition.kind != RodKind::Planar) {
     std::cerr << "error: " << args.case_path

@@ -9,6 +9,7 @@ namespace kirchhoff::cli {
 struct VibrateArguments {
   std::string case_path;
   std::vector<std::string> overrides;  // NAME=VALUE
+  std::vector<std::string> solver;     // --solver KEY=VALUE: [solver] keys
   int modes = 3;
   double rho_s = 1.0;
   std::string out_path;      // JSON file; empty: none

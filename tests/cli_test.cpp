@@ -568,4 +568,42 @@ TEST_F(CliTest, CheckRefusesBadFile) {
   EXPECT_THAT(r.out, Not(HasSubstr("ok")));
 }
 
+// --solver KEY=VALUE overrides [solver] keys for every command that loads a case, checked as the
+// file's value is, the message naming the option.
+TEST_F(CliTest, SolverSettingsFromTheCommandLine) {
+  const std::string ss = quoted(case_path("simply_supported.toml"));
+  const CliRun r = run("solve " + ss + " --json --solver tolerance=1e-11 --solver stepper=dopri5");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_LT(parse(r)["residual"].get<double>(), 1e-11);
+  const std::string out = " --out " + quoted((dir_ / "b.csv").string());
+  for (const std::string command : {"solve " + ss, "check " + ss, "continue " + ss + " --param theta0 --to 1.1" + out,
+                                    "vibrate " + ss, "equilibria " + ss}) {
+    SCOPED_TRACE(command);
+    const CliRun bad = run(command + " --solver tolerance=1");
+    EXPECT_EQ(bad.status, 2) << bad.err;
+    EXPECT_THAT(bad.err, HasSubstr("--solver tolerance=1: key 'solver.tolerance': must be in (0, 0.01]"));
+  }
+  const CliRun typo = run("check " + ss + " --solver tolernace=1e-9");
+  EXPECT_EQ(typo.status, 2);
+  EXPECT_THAT(typo.err, HasSubstr("key 'solver.tolernace': unknown key"));
+  EXPECT_EQ(run("check " + ss + " --solver tolerance").status, 2);
+}
+
+// continue in a computed parameter: exit 2 naming the one to continue in.
+TEST_F(CliTest, ContinueInAComputedParameterIsRefused) {
+  const std::string path = variant("simply_supported.toml", "EI = 1.0", "r = 0.5\nEI = \"pi*r^2\"");
+  const CliRun r = run("continue " + quoted(path) + " --param EI --to 2 --out " + quoted((dir_ / "b.csv").string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("--param EI: EI is computed from r"));
+  EXPECT_THAT(r.err, HasSubstr("continue in r instead"));
+}
+
+// solve --profile: a planar rod's curvature column is kappa.
+TEST_F(CliTest, PlanarProfileHasKappa) {
+  const fs::path csv = dir_ / "p.csv";
+  ASSERT_EQ(run("solve " + quoted(case_path("euler_column.toml")) + " --profile " + quoted(csv.string())).status, 0);
+  const Csv c = read_csv(csv);
+  EXPECT_THAT(c.first_line, HasSubstr(",mz,kappa,H,"));
+}
+
 }  // namespace
