@@ -174,6 +174,20 @@ TEST(Equilibria, ClampedClampedModesAgreeWithTheirSolvesFromTheCaseGuess) {
   }
 }
 
+TEST(Equilibria, EnergyOfAHeavyCantileverIsElasticPlusFieldPotential) {
+  // A cantilever under its own weight, the far end free: no end load does work, so the total
+  // potential energy is the elastic energy plus the weight's potential, which solution.cpp
+  // integrates on its own (elastic_energy, E_wall: Simpson on 4000 intervals, ~1e-12).
+  const auto solved = testing::solve_case("heavy_cantilever.toml");
+  const Solution parts = make_solution(*solved.problem, solved.solution.result, 101, {"elastic_energy", "E_wall"});
+  const double E = total_potential_energy(*solved.problem, solved.solution.result.x);
+  const double expected = parts.derived.at("elastic_energy") + parts.derived.at("E_wall");
+  EXPECT_NEAR(E, expected, 1e-10 * (std::abs(parts.derived.at("elastic_energy")) + std::abs(parts.derived.at("E_wall"))));
+  // It sags: the weight's potential is negative and larger than the bending it costs (a minimum).
+  EXPECT_LT(parts.derived.at("E_wall"), 0.0);
+  EXPECT_LT(E, 0.0);
+}
+
 // Complementarity of every listed equilibrium with obstacles.
 void expect_admissible(const Equilibrium& e) {
   EXPECT_GE(e.solution.derived.at("min_gap"), -1e-9);
