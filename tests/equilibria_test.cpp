@@ -253,6 +253,10 @@ TEST(Equilibria, WallBeyondFlatteningHasAFlatContactBesideAsymmetricOnes) {
   EXPECT_NEAR(c.s + c.s_end, 1.0, 1e-7);
   EXPECT_NEAR(flat->solution.derived.at("H"), -flat->solution.derived.at("P"), 1e-7 * flat->solution.derived.at("P"));
   EXPECT_FALSE(flat->stability.index);  // not defined for extended contacts (docs/stability.md)
+  // Deflated roots that penetrate the wall (converged shooting solutions, not equilibria) were
+  // met on the way: rejected with the reason, and none of them listed (expect_admissible above).
+  ASSERT_FALSE(s.rejected.empty());
+  for (const auto& r : s.rejected) EXPECT_NE(r.reason.find("penetrates"), std::string::npos) << r.reason;
 }
 
 TEST(Equilibria, TwistedRodListsEachCircleOfBuckledRodsOnce) {
