@@ -231,6 +231,22 @@ class CheckedResultTest(unittest.TestCase):
         self.assertAlmostEqual(stated["s"], sol.contacts[0]["s"], places=12)
         self.assertIn("stated over [0.45, 0.55] converged over [0.377472, 0.622528]", stated["message"])
 
+    def test_flat_contact_found_as_two_point_contacts_is_extended(self):
+        # wall.toml at Delta = 0.032 as the file's own value: the active-set loop from the free arch
+        # settles on two point contacts with the rod flat on the wall between them, which the
+        # solution reports as the one extended contact it is (H = -P on it, section 7.2).
+        text = pathlib.Path(case_path("wall.toml")).read_text().replace("Delta = 0.026", "Delta = 0.032")
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "wall_flat.toml")
+            pathlib.Path(path).write_text(text)
+            sol = kirchhoff.load_case(path).solve()
+        self.assertTrue(sol.converged, sol.message)
+        [flat] = sol.contacts
+        self.assertTrue(flat["extended"])
+        self.assertAlmostEqual(sol.derived["contact_length"], flat["s_end"] - flat["s"], places=12)
+        self.assertGreater(sol.derived["contact_length"], 0.03)
+        self.assertAlmostEqual(sol.derived["H"] / -sol.derived["P"], 1.0, places=9)
+
     def test_whole_turns_away_is_check_failed(self):
         # Directly from the untwisted guess: Newton converges two turns away and the check refuses it.
         sol = kirchhoff.load_case(case_path("plectoneme.toml"), set={"turns": 2}).solve(direct=True)
