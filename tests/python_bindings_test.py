@@ -37,6 +37,32 @@ class AnalyticTest(unittest.TestCase):
             kirchhoff.analytic_pinned_load(1.0, 1.0, 4.0)
 
 
+class HomotopyTest(unittest.TestCase):
+    def test_set_values_are_reached_along_the_cases_branch(self):
+        # Fig. 3 at theta0 = 3.1: P = 4 K(k)^2 EI / L^2; Newton from the guess lands elsewhere.
+        case = kirchhoff.load_case(case_path("simply_supported.toml"), set={"theta0": 3.1})
+        sol = case.solve()
+        self.assertEqual(sol.status, "converged")
+        exact = kirchhoff.analytic_pinned_load(1.0, 1.0, 3.1)
+        self.assertLess(abs(sol.parameters["P"] / exact - 1.0), 1e-9)  # as tests/homotopy_test.cpp
+        self.assertEqual(sol.path["method"], "homotopy")
+        self.assertEqual(sol.path["from"], {"theta0": 1.0})
+        self.assertEqual(sol.path["stop"], "reached")
+        self.assertEqual(len(sol.path["branch_points"]), 1)  # where the supports meet
+        self.assertAlmostEqual(sol.path["branch_points"][0]["theta0"], 2.2814, delta=2e-3)
+        direct = case.solve(direct=True)
+        self.assertEqual(direct.path["method"], "direct")
+        self.assertGreater(abs(direct.parameters["P"] / exact - 1.0), 1e-3)
+
+    def test_a_fold_on_the_way_is_a_status_with_where(self):
+        sol = kirchhoff.load_case(case_path("shallow_arch.toml"), set={"w": 150.0}).solve()
+        self.assertFalse(sol.converged)
+        self.assertEqual(sol.status, "fold")
+        self.assertIn("fold at w = ", sol.message)
+        self.assertLess(sol.path["reached"]["w"], 150.0)
+        self.assertEqual(sol.derived, {})
+
+
 class LoadCaseTest(unittest.TestCase):
     def test_case_attributes(self):
         case = kirchhoff.load_case(case_path("simply_supported.toml"), set={"theta0": 2.0})

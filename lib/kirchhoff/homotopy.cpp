@@ -43,9 +43,18 @@ ProblemDefinition homotopy_definition(ProblemDefinition d, const std::vector<Par
   return d;
 }
 
-ContinuationOptions path_options(const ShootingProblem& problem, const std::string& t, const HomotopyOptions& options) {
+ContinuationOptions path_options(const ShootingProblem& problem, const std::string& t, const Eigen::VectorXd& x_start,
+                                 const HomotopyOptions& options) {
   ContinuationOptions o;
   o.parameter = t;
+  // The arclength measures (dx, dt) together, and t spans only [0, 1] while the unknowns move by
+  // amounts of their own size: longer steps where they are large (plectoneme.toml to its fold
+  // at 1.77 turns: 120 s -> 27 s). Only by the square root of that size: steps in proportion
+  // to it located the supports' meeting on Fig. 3's branch 1e-2 off (its correctors fail
+  // on long steps near the branch point), at the square root to 1e-5 as with unit steps.
+  const double scale = std::sqrt(1.0 + x_start.norm());
+  o.initial_step *= scale;
+  o.max_step *= scale;
   o.target = 1.0;
   o.max_points = options.max_points;
   o.deadline = options.deadline;
@@ -139,7 +148,7 @@ HomotopyResult follow_homotopy(const ProblemDefinition& start, const Eigen::Vect
   const std::string t = fresh_name(start.parameters);
   const ProblemDefinition path = homotopy_definition(start, changes, t);
   const ShootingProblem problem(path);
-  const ContinuationOptions o = path_options(problem, t, options);
+  const ContinuationOptions o = path_options(problem, t, x_start, options);
   HomotopyResult h;
   h.branch_points_checked = o.detect_branch_points;
   ContinuationResult run;
