@@ -17,6 +17,7 @@
 
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/contact.hpp"
+#include "kirchhoff/deflated_continuation.hpp"
 #include "kirchhoff/continuation.hpp"
 #include "kirchhoff/self_passage.hpp"
 #include "kirchhoff/discrete_seed.hpp"
@@ -192,6 +193,45 @@ void print_start(const RunStart& start, const Case& c, const std::string& parame
   for (const auto& note : start.notes) std::cerr << "note: " << note << "\n";
 }
 
+// --deflate: the equilibria at the start, then the branch through each, written as branches
+// 0, 1, ... of the CSV (no state file: such a run is not resumable).
+int continue_deflated(const ContinueArguments& args, const Case& c, const ContinuationOptions& options,
+                      BranchWriter& writer, Progress& progress) {
+  EquilibriaOptions search;
+  search.max_equilibria = args.deflate_max;
+  search.max_seconds = args.max_seconds;
+  int row = -1;
+  const auto sink_for = [&](int rank, const Equilibrium& start) -> PointSink {
+    progress.done();
+    std::cerr << "branch " << rank << ": from the equilibrium of energy " << start.energy << " ("
+              << describe(start.stability) << ", found by " << start.found_by << ")\n";
+    return [&, rank](const ContinuationPoint& p) {
+      writer.write(++row, p, rank);
+      progress.point(row, p, rank);
+    };
+  };
+  EveryBranch all;
+  try {
+    all = continue_every_branch(c.definition, c.start_guess, c.derived, c.samples, options, search, sink_for);
+  } catch (const std::exception& e) {
+    progress.done();
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitNotConverged;
+  }
+  progress.done();
+  std::cerr << all.search.equilibria.size() << " equilibria at the start (" << all.search.stopped_because << ")\n";
+  bool ok = !all.branches.empty();
+  for (const auto& b : all.branches) {
+    std::cerr << "branch " << b.rank << " stopped: " << to_string(b.result.reason)
+              << (b.result.message.empty() ? "" : " (" + b.result.message + ")") << "\n";
+    for (const auto& line : b.contact_changes) std::cerr << "  contact: " << line << "\n";
+    ok = ok && b.result.reason != StopReason::StartFailed && b.result.reason != StopReason::StepTooSmall &&
+         b.result.reason != StopReason::Inadmissible && b.result.reason != StopReason::TimeLimit;
+  }
+  std::cerr << row + 1 << " points on " << all.branches.size() << " branches in " << args.out_path << "\n";
+  return ok ? kExitOk : kExitNotConverged;
+}
+
 }  // namespace
 
 int run_continue(const ContinueArguments& args) {
@@ -203,6 +243,11 @@ int run_continue(const ContinueArguments& args) {
   // start's row, which it had not finished: resuming it is starting it again, which rewrites the
   // CSV with the same rows. More rows and no state means the state was removed or the rows are
   // another run's: nothing records where that march stood, so it is refused.
+  if (args.deflate && (args.resume || !args.start_from.empty() || args.switch_at_bp > 0 || args.seed.ipopt)) {
+    std::cerr << "error: --deflate starts every branch from the equilibria it finds: it does not combine with "
+                 "--resume, --start-from, --switch-at-bp or --seed (a --deflate run is not resumable)\n";
+    return kExitBadInput;
+  }
   bool resuming = args.resume;
   if (args.resume && !fs::exists(state_path)) {
     if (const int rows = data_rows(csv); rows > 1) {
@@ -337,6 +382,7 @@ int run_continue(const ContinueArguments& args) {
     return kExitBadInput;
   }
   if (kill_after == -1) kill(getpid(), SIGKILL);
+  if (args.deflate) return continue_deflated(args, c, options, *writer, progress);
 
   // The problem of the current branch (the switched branch of a symmetric rod has the phase
   // condition added).

@@ -38,6 +38,10 @@ struct ContinueArguments {
   std::string start_from;
   std::string start_param;
   double max_seconds = 0.0;   // wall-clock limit of the run (0: none); it stops resumable, time_limit
+  // --deflate: every branch through the equilibria found at the start (deflated_continuation.hpp),
+  // at most deflate_max of them; branch k of the CSV starts at the k-th by energy.
+  bool deflate = false;
+  int deflate_max = 16;
 };
 
 int run_continue(const ContinueArguments& args);

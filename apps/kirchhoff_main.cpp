@@ -133,9 +133,13 @@ int main(int argc, char** argv) {
   continue_cmd->add_option("--samples", cont.samples, "Profile samples per point (invariants, derived quantities)")
       ->capture_default_str();
   continue_cmd->add_flag("--resume", cont.resume, "Resume the run whose CSV is --out from its last written point");
-  bool continue_deflate = false;
-  continue_cmd->add_flag("--deflate", continue_deflate,
-                         "Deflated continuation (every branch found at the start): not implemented; refused");
+  continue_cmd->add_flag("--deflate", cont.deflate,
+                         "Follow every branch through the equilibria found at the start by deflation (as\n"
+                         "`equilibria` lists them); branch K of the CSV starts at the K-th by energy. Not with\n"
+                         "--resume, --start-from, --switch-at-bp or --seed");
+  continue_cmd->add_option("--deflate-max", cont.deflate_max, "At most this many equilibria (and branches) with --deflate")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
   continue_cmd
       ->add_option("--max-seconds", cont.max_seconds,
                    "Wall-clock limit of the run in seconds (0: none); it stops after the last point written, "
@@ -328,11 +332,6 @@ int main(int argc, char** argv) {
     if (*check_cmd) return run_check(check_path, check_overrides, check_solver);
     if (*reproduce_cmd) return run_reproduce(out_dir, cases_dir, reproduce_full);
     if (*continue_cmd) {
-      if (continue_deflate) {
-        std::cerr << "error: continue --deflate (deflated continuation) is not implemented; `kirchhoff equilibria "
-                     "CASE --set ...` lists the equilibria at the start (docs/equilibria.md)\n";
-        return kExitBadInput;
-      }
       cont.seed.ipopt = continue_seed == "ipopt";
       return run_continue(cont);
     }

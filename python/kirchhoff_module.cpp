@@ -29,6 +29,7 @@
 #include "kirchhoff/case_solve.hpp"
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/continuation.hpp"
+#include "kirchhoff/deflated_continuation.hpp"
 #include "kirchhoff/self_passage.hpp"
 #include "kirchhoff/discrete_seed.hpp"
 #include "kirchhoff/equilibria.hpp"
@@ -475,7 +476,7 @@ py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
 PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::object& to, double step,
                      double min_step, double max_step, int max_points, const py::object& events,
                      const py::object& record, int switch_at_bp, double side, int samples, double direction,
-                     bool branch_points, bool stability) {
+                     bool branch_points, bool stability, bool deflate, int deflate_max) {
   const Case& c = pc.c;
   ContinuationOptions options;
   options.parameter = parameter;
@@ -519,6 +520,35 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
       points.back().point.jacobian.reset();
     }
   };
+  if (deflate) {
+    if (switch_at_bp > 0) throw CaseError("deflate=True follows every branch from the start: not with switch_at_bp");
+    if (deflate_max < 1) throw CaseError("deflate_max must be >= 1");
+    // As the CLI's --deflate: branch k starts at the k-th equilibrium found at the start.
+    EquilibriaOptions search;
+    search.max_equilibria = deflate_max;
+    EveryBranch all;
+    {
+      py::gil_scoped_release release;
+      all = continue_every_branch(c.definition, c.start_guess, c.derived, c.samples, options, search,
+                                  [&](int, const Equilibrium&) { return PointSink(check_signals); });
+    }
+    std::ostringstream message;
+    out.reason = all.branches.empty() ? "no_equilibrium" : to_string(StopReason::ReachedTarget);
+    message << all.search.equilibria.size() << " equilibria at the start (" << all.search.stopped_because << ")";
+    for (const auto& b : all.branches) {
+      keep(b.result, b.rank);
+      message << "; branch " << b.rank << ": " << to_string(b.result.reason);
+      // The run's reason: the first branch that did not end normally, else the first's.
+      if (b.rank == 0 || (out.reason == to_string(all.branches[0].result.reason) &&
+                          (b.result.reason == StopReason::StartFailed || b.result.reason == StopReason::StepTooSmall ||
+                           b.result.reason == StopReason::Inadmissible)))
+        out.reason = to_string(b.result.reason);
+    }
+    out.message = message.str();
+    out.size = points.size();
+    out.points = branch_points_dict(points, options.derived);
+    return out;
+  }
   {
     py::gil_scoped_release release;
     // As apps/continue_command.cpp: branch 0 up to the switch_at_bp-th branch point, then the
@@ -852,6 +882,7 @@ Returns:
            py::arg("max_points") = 500, py::arg("events") = py::none(), py::arg("record") = py::none(),
            py::arg("switch_at_bp") = 0, py::arg("side") = 1.0, py::arg("samples") = 101,
            py::arg("direction") = 1.0, py::arg("branch_points") = true, py::arg("stability") = true,
+           py::arg("deflate") = false, py::arg("deflate_max") = 16,
            R"doc(Pseudo-arclength continuation in one parameter (the CLI's `continue`).
 
 Args:
@@ -871,9 +902,11 @@ Args:
         found either way.
     stability (bool): the stability index of every point (column stability_index: NaN where
         it is not defined; zero_modes beside it), as the CLI's CSV.
+    deflate (bool): follow every branch through the equilibria found at the start by deflation
+        (as equilibria() lists them, at most deflate_max): branch k starts at the k-th by energy.
 
 Returns:
-    Branch (points of both branches concatenated, with a `branch` column).
+    Branch (points of all branches concatenated, with a `branch` column).
 
 Raises:
     CaseError (ValueError): unknown parameter or derived quantity, invalid options.)doc")

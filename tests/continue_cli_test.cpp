@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_run_support.hpp"
+#include "kirchhoff/analytic.hpp"
 
 namespace {
 
@@ -525,6 +526,68 @@ TEST_F(ContinueCli, ContinuingAnUnknownParameterIsRefused) {
   const auto log = lines_of(dir_ / "x.log");
   ASSERT_FALSE(log.empty());
   EXPECT_NE(log.front().find("Q"), std::string::npos);
+}
+
+}  // namespace
+
+namespace {
+
+// --deflate: the five equilibria of the Euler column at P = 50 (straight, mode 1 and mode 2 up and
+// down), each followed to P = 60 as its own branch; at P = 60 the buckled ends lie on the elliptic
+// closed form P = (2 n K(k))^2 EI / L^2, k = sin(theta0 / 2), n = 1 or 2 (CSV values to 15
+// digits; the endpoint located at P = 60 to ~1e-10, so 1e-8 relative).
+TEST_F(ContinueCli, DeflateFollowsEveryBranchFromTheStart) {
+  const fs::path csv = dir_ / "d.csv";
+  const std::vector<std::string> args = {KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/euler_column.toml",
+                                         "--set", "P=50", "--param", "P", "--to", "60", "--deflate", "--deflate-max", "5",
+                                         "--no-stability", "--out", csv.string()};
+  ASSERT_EQ(run_to_end(args, dir_ / "d.log"), 0);
+  const auto lines = lines_of(csv);
+  ASSERT_GT(lines.size(), 10u);
+  std::vector<std::string> header;
+  std::stringstream h(lines[0]);
+  for (std::string cell; std::getline(h, cell, ',');) header.push_back(cell);
+  const auto column = [&](const std::string& name) {
+    return static_cast<size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  const size_t branch_col = column("branch"), P_col = column("P"), theta_col = column("theta0"), type_col = column("type");
+  std::vector<double> theta_at_60;
+  std::vector<int> branches;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    std::vector<std::string> f;
+    std::stringstream row(lines[i]);
+    for (std::string cell; std::getline(row, cell, ',');) f.push_back(cell);
+    const int branch = std::stoi(f[branch_col]);
+    if (std::find(branches.begin(), branches.end(), branch) == branches.end()) {
+      branches.push_back(branch);
+      EXPECT_EQ(std::stod(f[P_col]), 50.0) << lines[i];  // every branch starts at the start
+    }
+    if (f[type_col] == "endpoint") {
+      EXPECT_NEAR(std::stod(f[P_col]), 60.0, 1e-9);
+      theta_at_60.push_back(std::stod(f[theta_col]));
+    }
+  }
+  EXPECT_EQ(branches, (std::vector<int>{0, 1, 2, 3, 4}));
+  ASSERT_EQ(theta_at_60.size(), 5u);
+  int straight = 0, mode1 = 0, mode2 = 0;
+  for (double angle : theta_at_60) {
+    // The mirror image of a mode-1 rod may carry its angle 2 pi on (3.309 for -2.974): the same rod.
+    const double theta0 = std::remainder(angle, 2.0 * M_PI);
+    if (std::abs(theta0) < 1e-9) {
+      ++straight;
+      continue;
+    }
+    const double first_mode_load = kirchhoff::analytic::PinnedElastica{1.0, 1.0, std::abs(theta0)}.load();
+    if (std::abs(first_mode_load / 60.0 - 1.0) < 1e-8) ++mode1;
+    if (std::abs(4.0 * first_mode_load / 60.0 - 1.0) < 1e-8) ++mode2;  // two half-waves: 4 K^2 times 4
+  }
+  EXPECT_EQ(straight, 1);
+  EXPECT_EQ(mode1, 2);
+  EXPECT_EQ(mode2, 2);
+  // Not resumable: refused with the options that need a saved state.
+  auto resumed = args;
+  resumed.push_back("--resume");
+  EXPECT_EQ(run_to_end(resumed, dir_ / "r.log"), 2);
 }
 
 }  // namespace

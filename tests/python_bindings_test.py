@@ -605,6 +605,21 @@ class EquilibriaTest(unittest.TestCase):
         with self.assertRaises(ValueError):
             c.equilibria(max=0)
 
+    def test_continue_deflate_follows_every_branch_from_the_start(self):
+        # The Euler column's five equilibria at P = 50, each followed to P = 60 (as the CLI's
+        # --deflate; tests/continue_cli_test.cpp checks the ends against the closed form).
+        b = kirchhoff.load_case(case_path("euler_column.toml"), set={"P": 50}).continue_(
+            "P", to=60, deflate=True, deflate_max=5, stability=False)
+        self.assertEqual(b.reason, "reached_target")
+        branch = np.asarray(b.points["branch"])
+        self.assertEqual(sorted(set(branch.tolist())), [0, 1, 2, 3, 4])
+        P = np.asarray(b.points["parameter"])
+        for k in range(5):
+            self.assertEqual(P[branch == k][0], 50.0)
+            self.assertAlmostEqual(P[branch == k][-1], 60.0, delta=1e-9)
+        with self.assertRaises(ValueError):
+            kirchhoff.load_case(case_path("euler_column.toml")).continue_("P", to=60, deflate=True, switch_at_bp=1)
+
 
 if __name__ == "__main__":
     unittest.main()
