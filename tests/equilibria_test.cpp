@@ -314,8 +314,8 @@ TEST(EquilibriaCli, JsonListsTheModesWithEnergyIndexAndProfiles) {
   EXPECT_EQ(j["stopped_because"], "max_equilibria reached");
   // A bad --set is refused as input.
   EXPECT_EQ(run("equilibria " + case_path("clamped_clamped.toml") + " --set nope=1", out), 2);
-  // Deflated continuation is refused as not implemented, not silently ignored.
-  EXPECT_EQ(run("continue " + case_path("euler_column.toml") + " --param P --to 20 --deflate", out), 2);
+  // Deflated continuation with a resume is refused (such a run is not resumable), not ignored.
+  EXPECT_EQ(run("continue " + case_path("euler_column.toml") + " --param P --to 20 --deflate --resume", out), 2);
 }
 
 }  // namespace
