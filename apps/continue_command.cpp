@@ -56,6 +56,7 @@ std::string run_arguments(const ContinueArguments& a) {
   o << std::setprecision(17) << "case=" << (ec ? fs::path(a.case_path) : canonical).string() << " case_hash=" << std::hex
     << hash << std::dec << " param=" << a.parameter;
   for (const auto& s : a.overrides) o << " set=" << s;
+  for (const auto& s : a.solver) o << " solver=" << s;  // none: the line older state files hold
   o << " phase=" << a.phase_condition << " to=";
   if (a.has_to)
     o << a.to;

@@ -107,7 +107,7 @@ py::array_t<T> column(size_t n, F&& f) {
   return a;
 }
 
-py::dict profile_dict(const RodModel& model, const std::vector<RodPoint>& profile) {
+py::dict profile_dict(const RodModel& model, const std::vector<RodPoint>& profile, RodKind kind) {
   const size_t n = profile.size();
   py::dict d;
   auto add = [&](const char* name, auto&& f) {
@@ -127,6 +127,8 @@ py::dict profile_dict(const RodModel& model, const std::vector<RodPoint>& profil
   add("u1", [](const RodPoint& p) { return p.u[0]; });
   add("u2", [](const RodPoint& p) { return p.u[1]; });
   add("u3", [](const RodPoint& p) { return p.u[2]; });
+  // A planar rod's curvature by its name, as the CLI's profile CSV has it (u2 stays for old scripts).
+  if (kind == RodKind::Planar) add("kappa", [](const RodPoint& p) { return p.u[1]; });
   add("H", [&](const RodPoint& p) { return hamiltonian(model, p); });
   add("m3", [](const RodPoint& p) { return p.m.dot(p.R.col(2)); });
   return d;
@@ -336,7 +338,8 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   out.parameters = parameters_dict(sol->result.parameters);
   for (const auto& name : c.derived) out.derived[py::str(name)] = sol->derived.at(name);
   out.invariants = invariants_dict(sol->invariants);
-  out.profile = profile_dict(problem->equations(sol->result.parameters)->model(), sol->profile);
+  out.profile = profile_dict(problem->equations(sol->result.parameters)->model(), sol->profile,
+                             problem->definition().kind);
   out.stability = stability_dict(analyse_stability(*problem, sol->result.x),
                                  discrete_stability(*problem, sol->result.x));
   for (const auto& contact : report_contacts(*problem, *sol)) {
@@ -687,7 +690,8 @@ PySolution equilibrium_solution(const Case& c, const Equilibrium& e) {
   out.parameters = parameters_dict(sol.result.parameters);
   for (const auto& name : c.derived) out.derived[py::str(name)] = sol.derived.at(name);
   out.invariants = invariants_dict(sol.invariants);
-  out.profile = profile_dict(e.problem->equations(sol.result.parameters)->model(), sol.profile);
+  out.profile = profile_dict(e.problem->equations(sol.result.parameters)->model(), sol.profile,
+                             e.problem->definition().kind);
   out.stability = stability_dict(e.stability, DiscreteStability{});
   for (const auto& contact : report_contacts(*e.problem, sol)) {
     py::dict d;

@@ -47,6 +47,7 @@ class HomotopyTest(unittest.TestCase):
         self.assertLess(abs(sol.parameters["P"] / exact - 1.0), 1e-9)  # as tests/homotopy_test.cpp
         self.assertEqual(sol.path["method"], "homotopy")
         self.assertEqual(sol.path["from"], {"theta0": 1.0})
+        np.testing.assert_array_equal(sol.profile["kappa"], sol.profile["u2"])  # planar: kappa named
         self.assertEqual(sol.path["stop"], "reached")
         self.assertEqual(len(sol.path["branch_points"]), 1)  # where the supports meet
         self.assertAlmostEqual(sol.path["branch_points"][0]["theta0"], 2.2814, delta=2e-3)
