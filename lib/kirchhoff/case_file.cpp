@@ -793,7 +793,10 @@ void read_parameters(const Reader& plain, const Value& root, const ParameterOver
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const auto& [name, v] = entries[i];
     const std::string key = "parameters." + name;
-    const auto given = std::find_if(overrides.begin(), overrides.end(), [&](const auto& o) { return o.first == name; });
+    // (Clang refuses a lambda capturing a structured binding in C++17: the name by its own reference.)
+    const std::string& entry_name = name;
+    const auto given =
+        std::find_if(overrides.begin(), overrides.end(), [&](const auto& o) { return o.first == entry_name; });
     if (!v->is_string()) {
       values->set(name, plain.number(*v, key));  // finite, within kMaxMagnitude
     } else {
