@@ -89,6 +89,25 @@ py::dict vector_stats_dict(const VectorInvariantStats& s) {
 }
 
 // The same keys as the CLI's JSON "invariants" object.
+// The CLI's JSON "contacts" (report_contacts) as a list of dicts.
+py::list contacts_list(const ShootingProblem& problem, const Solution& sol) {
+  py::list out;
+  for (const auto& contact : report_contacts(problem, sol)) {
+    py::dict d;
+    d["obstacle"] = contact.obstacle;
+    d["obstacle_name"] = contact.obstacle_name;
+    d["extended"] = contact.extended;
+    d["s"] = contact.s;
+    d["s_end"] = contact.s_end;
+    d["force"] = contact.force;
+    d["force_end"] = contact.force_end;
+    d["H_before"] = contact.H_before;
+    d["H_after"] = contact.H_after;
+    out.append(d);
+  }
+  return out;
+}
+
 py::dict invariants_dict(const InvariantReport& r) {
   py::dict d;
   d["H"] = stats_dict(r.H);
@@ -342,19 +361,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
                              problem->definition().kind);
   out.stability = stability_dict(analyse_stability(*problem, sol->result.x),
                                  discrete_stability(*problem, sol->result.x));
-  for (const auto& contact : report_contacts(*problem, *sol)) {
-    py::dict d;
-    d["obstacle"] = contact.obstacle;
-    d["obstacle_name"] = contact.obstacle_name;
-    d["extended"] = contact.extended;
-    d["s"] = contact.s;
-    d["s_end"] = contact.s_end;
-    d["force"] = contact.force;
-    d["force_end"] = contact.force_end;
-    d["H_before"] = contact.H_before;
-    d["H_after"] = contact.H_after;
-    out.contacts.append(d);
-  }
+  out.contacts = contacts_list(*problem, *sol);
   for (const auto& o : stated_contact_outcomes(c.definition.contacts, sol->contacts,
                                                problem->obstacles(sol->result.parameters),
                                                problem->length(sol->result.parameters))) {
@@ -536,17 +543,21 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
                                   [&](int, const Equilibrium&) { return PointSink(check_signals); });
     }
     std::ostringstream message;
-    out.reason = all.branches.empty() ? "no_equilibrium" : to_string(StopReason::ReachedTarget);
     message << all.search.equilibria.size() << " equilibria at the start (" << all.search.stopped_because << ")";
     for (const auto& b : all.branches) {
       keep(b.result, b.rank);
       message << "; branch " << b.rank << ": " << to_string(b.result.reason);
-      // The run's reason: the first branch that did not end normally, else the first's.
-      if (b.rank == 0 || (out.reason == to_string(all.branches[0].result.reason) &&
-                          (b.result.reason == StopReason::StartFailed || b.result.reason == StopReason::StepTooSmall ||
-                           b.result.reason == StopReason::Inadmissible)))
-        out.reason = to_string(b.result.reason);
     }
+    // The run's reason: the first branch that did not end normally (as PyBranch::ok judges), else
+    // the first branch's.
+    const auto abnormal = [](const BranchFromEquilibrium& b) {
+      return b.result.reason == StopReason::StartFailed || b.result.reason == StopReason::StepTooSmall ||
+             b.result.reason == StopReason::Inadmissible;
+    };
+    const auto first_abnormal = std::find_if(all.branches.begin(), all.branches.end(), abnormal);
+    out.reason = all.branches.empty()                    ? "no_equilibrium"
+                 : first_abnormal != all.branches.end() ? to_string(first_abnormal->result.reason)
+                                                        : to_string(all.branches.front().result.reason);
     out.message = message.str();
     out.size = points.size();
     out.points = branch_points_dict(points, options.derived);
@@ -693,19 +704,7 @@ PySolution equilibrium_solution(const Case& c, const Equilibrium& e) {
   out.profile = profile_dict(e.problem->equations(sol.result.parameters)->model(), sol.profile,
                              e.problem->definition().kind);
   out.stability = stability_dict(e.stability, DiscreteStability{});
-  for (const auto& contact : report_contacts(*e.problem, sol)) {
-    py::dict d;
-    d["obstacle"] = contact.obstacle;
-    d["obstacle_name"] = contact.obstacle_name;
-    d["extended"] = contact.extended;
-    d["s"] = contact.s;
-    d["s_end"] = contact.s_end;
-    d["force"] = contact.force;
-    d["force_end"] = contact.force_end;
-    d["H_before"] = contact.H_before;
-    d["H_after"] = contact.H_after;
-    out.contacts.append(d);
-  }
+  out.contacts = contacts_list(*e.problem, sol);
   return out;
 }
 

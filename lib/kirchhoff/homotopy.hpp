@@ -36,8 +36,9 @@ struct HomotopyOptions {
   int max_points = 5000;
   // No continuation step starts after this (a command's wall-clock limit).
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
-  // Branch points cost an SVD of the bordered matrix per point: on problems with more unknowns
-  // than this (long multiple-shooting rods) they are not looked for, and the path says so.
+  // Problems with more unknowns than this (long multiple-shooting rods) are followed as the
+  // plectoneme sweeps follow theirs: branch points are not looked for (an SVD of the bordered
+  // matrix per point; the path says so), and the corrector keeps its matrix (modified Newton).
   int branch_point_unknown_limit = 400;
 };
 
