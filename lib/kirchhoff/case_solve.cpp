@@ -72,7 +72,10 @@ CaseSolve by_homotopy(const Case& c, std::vector<ParameterChange> changes, Homot
 
 std::vector<ParameterChange> homotopy_changes(const Case& c) {
   std::vector<ParameterChange> changes;
-  for (const auto& [name, value] : c.overrides) {
+  for (const auto& override_pair : c.overrides) {
+    // Named copies: clang's C++17 (the fuzzer build) refuses a lambda capturing a structured binding.
+    const std::string& name = override_pair.first;
+    const double value = override_pair.second;
     if (only_a_guess(c, name) || !c.file_parameters.contains(name)) continue;
     const double from = c.file_parameters.get(name);
     if (from == value) continue;
