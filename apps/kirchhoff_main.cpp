@@ -8,6 +8,7 @@
 #include "solve_command.hpp"
 #include "vibrate_command.hpp"
 #include "equilibria_command.hpp"
+#include "sweep_command.hpp"
 
 namespace {
 
@@ -318,6 +319,27 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
 
+  SweepArguments sweep;
+  auto* sweep_cmd = app.add_subcommand(
+      "sweep",
+      "Run the jobs of a sweep file (solve or equilibria over a grid or list of parameter values):\n"
+      "DIR/jobs/<id>/ per job (result.json, profiles), DIR/index.csv (one row per job, in job order)\n"
+      "and DIR/times.csv (wall times). Under mpirun/srun the jobs are shared out over the ranks\n"
+      "(a manager hands them out, largest first) with the same files; see docs/sweeps.md");
+  sweep_cmd->footer(
+      "Exit status: 0 every job has its result (failed jobs are rows with their status), 2 refused.\n\n"
+      "Examples:\n"
+      "  kirchhoff sweep sweeps/wall_phase_diagram.toml --out wall_phase\n"
+      "  mpirun -n 8 kirchhoff sweep sweeps/wall_phase_diagram.toml --out wall_phase --resume");
+  sweep_cmd->add_option("spec", sweep.spec_path, "Sweep file (TOML)")->required()->check(CLI::ExistingFile);
+  sweep_cmd->add_option("--out", sweep.out_dir, "Output folder (created)")->capture_default_str();
+  sweep_cmd->add_flag("--resume", sweep.resume,
+                      "Go on with the sweep in --out: finished jobs are kept, the others run (a sweep killed\n"
+                      "and resumed leaves the same files as one never interrupted)");
+  sweep_cmd->add_flag("--manager-only", sweep.manager_only,
+                      "Under MPI: rank 0 only hands out jobs (by default it runs jobs too, on a thread)");
+  sweep_cmd->add_flag("--quiet", sweep.quiet, "No progress line per job on stderr");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -338,6 +360,7 @@ int main(int argc, char** argv) {
     if (*vibrate_cmd) return run_vibrate(vib);
     if (*equilibria_cmd) return run_equilibria(eq);
     if (*plectonemes_cmd) return run_plectonemes(plect);
+    if (*sweep_cmd) return run_sweep(sweep);
   } catch (const std::exception& e) {
     // The commands report the errors they expect; anything else still ends with a message
     // rather than an abort.

@@ -1,0 +1,445 @@
+#include "kirchhoff/sweep.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <toml.hpp>
+
+#include "kirchhoff/toml_nesting.hpp"
+
+namespace kirchhoff {
+
+const char* to_string(SweepJobKind kind) {
+  switch (kind) {
+    case SweepJobKind::Solve: return "solve";
+    case SweepJobKind::Equilibria: return "equilibria";
+    case SweepJobKind::Continue: return "continue";
+    case SweepJobKind::Plectonemes: return "plectonemes";
+  }
+  return "?";
+}
+
+namespace {
+
+using Value = toml::value;
+
+// Ranges hold at most this many points: a larger count is a typo (a 1e6-job sweep is kMaxJobs).
+constexpr long kMaxRangeCount = 1000000;
+// Default relative costs by kind (a `cost` key replaces them): a solve is about a second, an
+// equilibria search a few to tens of solves, a branch hundreds of points, a plectoneme branch
+// minutes to hours. Only their order matters: the MPI manager hands out larger jobs first.
+double default_cost(SweepJobKind kind) {
+  switch (kind) {
+    case SweepJobKind::Solve: return 1.0;
+    case SweepJobKind::Equilibria: return 10.0;
+    case SweepJobKind::Continue: return 100.0;
+    case SweepJobKind::Plectonemes: return 10000.0;
+  }
+  return 1.0;
+}
+
+std::string shown(double v) {
+  std::ostringstream os;
+  os.precision(17);  // round-trip: the fingerprint tells values apart
+  os << v;
+  return os.str();
+}
+
+std::string type_name(const Value& v) {
+  switch (v.type()) {
+    case toml::value_t::boolean: return "a boolean";
+    case toml::value_t::integer: return "an integer";
+    case toml::value_t::floating: return "a float";
+    case toml::value_t::string: return "a string";
+    case toml::value_t::array: return "an array";
+    case toml::value_t::table: return "a table";
+    default: return "a date or time";
+  }
+}
+
+// Entries of a table in the order of the file (toml11 keeps a table's keys unordered): the
+// grid's first key varies slowest, as in a nested loop written in that order.
+std::vector<std::pair<std::string, const Value*>> in_file_order(const toml::table& table) {
+  std::vector<std::pair<std::string, const Value*>> entries;
+  for (const auto& entry : table) entries.emplace_back(entry.first, &entry.second);
+  std::sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+    const auto &la = a.second->location(), &lb = b.second->location();
+    return std::pair(la.line(), la.column()) < std::pair(lb.line(), lb.column());
+  });
+  return entries;
+}
+
+// Turns every problem into a SweepError naming the file, the line, the key and the reason.
+class Reader {
+ public:
+  explicit Reader(std::string path) : path_(std::move(path)) {}
+
+  [[noreturn]] void fail(const Value& v, const std::string& key, const std::string& reason) const {
+    std::ostringstream os;
+    os << path_;
+    if (const auto line = v.location().line(); line > 0) os << ":" << line;
+    os << ": key '" << key << "': " << reason;
+    throw SweepError(os.str());
+  }
+  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
+    throw SweepError(path_ + ": key '" + key + "': " + reason);
+  }
+
+  void allow_keys(const Value& table, const std::string& name, const std::set<std::string>& allowed) const {
+    if (!table.is_table()) fail(table, name, "must be a table, got " + type_name(table));
+    for (const auto& entry : table.as_table())
+      if (!allowed.count(entry.first)) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        fail(entry.second, qualified(name, entry.first), "unknown key (expected one of: " + list + ")");
+      }
+  }
+
+  static std::string qualified(const std::string& table, const std::string& key) {
+    return table.empty() ? key : table + "." + key;
+  }
+  static const Value* find(const Value& table, const std::string& key) {
+    const auto& t = table.as_table();
+    const auto it = t.find(key);
+    return it == t.end() ? nullptr : &it->second;
+  }
+
+  double number(const Value& v, const std::string& key) const {
+    double x = 0.0;
+    if (v.is_floating()) x = v.as_floating();
+    else if (v.is_integer()) x = static_cast<double>(v.as_integer());
+    else fail(v, key, "must be a number, got " + type_name(v));
+    if (!std::isfinite(x) || std::abs(x) > case_limits::kMaxMagnitude)
+      fail(v, key, "must be a finite number with magnitude <= 1e+100, got " + shown(x));
+    return x;
+  }
+  long integer(const Value& v, const std::string& key, long low, long high) const {
+    if (!v.is_integer()) fail(v, key, "must be an integer, got " + type_name(v));
+    const auto x = v.as_integer();
+    if (x < low || x > high)
+      fail(v, key, "must be in [" + std::to_string(low) + ", " + std::to_string(high) + "], got " + std::to_string(x));
+    return static_cast<long>(x);
+  }
+  bool boolean(const Value& v, const std::string& key) const {
+    if (!v.is_boolean()) fail(v, key, "must be true or false, got " + type_name(v));
+    return v.as_boolean();
+  }
+  std::string string(const Value& v, const std::string& key) const {
+    if (!v.is_string()) fail(v, key, "must be a string, got " + type_name(v));
+    return v.as_string().str;
+  }
+
+  // A parameter's values: a number, an array of numbers, or a range
+  // { from, to, count [, log = true] } (count points, both ends included; log: evenly spaced in
+  // log10, from and to > 0).
+  std::vector<double> values(const Value& v, const std::string& key) const {
+    if (v.is_array()) {
+      const auto& a = v.as_array();
+      if (a.empty()) fail(v, key, "an empty array: no values to sweep");
+      if (a.size() > sweep_limits::kMaxJobs)
+        fail(v, key, "more than " + std::to_string(sweep_limits::kMaxJobs) + " values");
+      std::vector<double> out;
+      for (std::size_t i = 0; i < a.size(); ++i) out.push_back(number(a[i], key + "[" + std::to_string(i) + "]"));
+      return out;
+    }
+    if (v.is_table()) {
+      allow_keys(v, key, {"from", "to", "count", "log"});
+      for (const char* required : {"from", "to", "count"})
+        if (!find(v, required))
+          fail(v, key, std::string("a range needs from, to and count (") + required + " is missing)");
+      const double from = number(*find(v, "from"), key + ".from");
+      const double to = number(*find(v, "to"), key + ".to");
+      const long count = integer(*find(v, "count"), key + ".count", 1, kMaxRangeCount);
+      const bool log = find(v, "log") && boolean(*find(v, "log"), key + ".log");
+      if (log && !(from > 0 && to > 0)) fail(v, key, "a log range needs from > 0 and to > 0");
+      if (count == 1 && from != to) fail(v, key, "count = 1 needs from = to");
+      std::vector<double> out;
+      for (long k = 0; k < count; ++k) {
+        // The ends exactly as written; interior points from the ends, not by accumulated steps.
+        if (k == 0) out.push_back(from);
+        else if (k == count - 1) out.push_back(to);
+        else if (log)
+          out.push_back(std::pow(10.0, std::log10(from) + (std::log10(to) - std::log10(from)) * static_cast<double>(k) /
+                                                              static_cast<double>(count - 1)));
+        else
+          out.push_back(from + (to - from) * static_cast<double>(k) / static_cast<double>(count - 1));
+      }
+      return out;
+    }
+    return {number(v, key)};
+  }
+
+  // NAME = number overrides (a table).
+  ParameterOverrides overrides(const Value& v, const std::string& key) const {
+    if (!v.is_table()) fail(v, key, "must be a table of NAME = number, got " + type_name(v));
+    ParameterOverrides out;
+    for (const auto& [name, value] : in_file_order(v.as_table())) out.emplace_back(name, number(*value, key + "." + name));
+    return out;
+  }
+
+  // [solver] keys as the case loader's --solver texts.
+  SolverOverrides solver(const Value& v, const std::string& key) const {
+    if (!v.is_table()) fail(v, key, "must be a table of [solver] keys, got " + type_name(v));
+    SolverOverrides out;
+    for (const auto& [name, value] : in_file_order(v.as_table())) {
+      if (value->is_string()) out.emplace_back(name, value->as_string().str);
+      else if (value->is_boolean()) out.emplace_back(name, value->as_boolean() ? "true" : "false");
+      else out.emplace_back(name, shown(number(*value, key + "." + name)));
+    }
+    return out;
+  }
+
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+SweepJobKind parse_kind(const Reader& r, const Value& v, const std::string& key) {
+  const std::string s = r.string(v, key);
+  if (s == "solve") return SweepJobKind::Solve;
+  if (s == "equilibria") return SweepJobKind::Equilibria;
+  if (s == "continue" || s == "plectonemes")
+    r.fail(v, key,
+           "job kind '" + s + "' is not implemented yet in sweeps: its run is not a library entry point yet (run `kirchhoff " +
+               s + "` per branch meanwhile)");
+  r.fail(v, key, "unknown job kind '" + s + "' (expected one of: solve, equilibria, continue, plectonemes)");
+}
+
+bool valid_name(const std::string& s) {
+  if (s.empty() || s.size() > 64) return false;
+  return std::all_of(s.begin(), s.end(), [](char ch) {
+    return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' || ch == '-';
+  });
+}
+
+std::string padded(std::size_t k, std::size_t count) {
+  std::string s = std::to_string(k);
+  const std::size_t width = std::max<std::size_t>(3, std::to_string(count).size());
+  return std::string(width > s.size() ? width - s.size() : 0, '0') + s;
+}
+
+// The points of one [[jobs]] table: a grid's Cartesian product (first key slowest), or the list.
+// `where` gets each swept name's value in the file (for messages).
+std::vector<ParameterOverrides> points(const Reader& r, const Value& group, const std::string& key,
+                                       std::map<std::string, std::pair<const Value*, std::string>>* where) {
+  const Value* grid = Reader::find(group, "grid");
+  const Value* list = Reader::find(group, "list");
+  if (grid && list) r.fail(*list, key + ".list", "give either grid or list, not both");
+  std::vector<ParameterOverrides> out;
+  if (grid) {
+    if (!grid->is_table()) r.fail(*grid, key + ".grid", "must be a table NAME = values, got " + type_name(*grid));
+    out.push_back({});
+    for (const auto& [name, value] : in_file_order(grid->as_table())) {
+      const std::vector<double> values = r.values(*value, key + ".grid." + name);
+      where->emplace(name, std::pair(value, key + ".grid." + name));
+      if (out.size() * values.size() > sweep_limits::kMaxJobs)
+        r.fail(*value, key + ".grid." + name, "the grid has more than " + std::to_string(sweep_limits::kMaxJobs) + " points");
+      std::vector<ParameterOverrides> next;
+      for (const auto& p : out)
+        for (double x : values) {
+          next.push_back(p);
+          next.back().emplace_back(name, x);
+        }
+      out = std::move(next);
+    }
+    return out;
+  }
+  if (list) {
+    if (!list->is_array() || list->as_array().empty())
+      r.fail(*list, key + ".list", "must be a non-empty array of tables { NAME = number, ... }");
+    const auto& a = list->as_array();
+    if (a.size() > sweep_limits::kMaxJobs) r.fail(*list, key + ".list", "too many entries");
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const std::string entry = key + ".list[" + std::to_string(i) + "]";
+      out.push_back(r.overrides(a[i], entry));
+      if (a[i].is_table())
+        for (const auto& [name, value] : a[i].as_table()) where->emplace(name, std::pair(&value, entry + "." + name));
+    }
+    return out;
+  }
+  return {ParameterOverrides{}};  // one job at the case's values (and the overrides)
+}
+
+std::string resolve(const std::string& sweep_path, const std::string& case_path) {
+  const std::filesystem::path p(case_path);
+  if (p.is_absolute()) return case_path;
+  const std::filesystem::path folder = std::filesystem::path(sweep_path).parent_path();
+  return (folder / p).lexically_normal().string();
+}
+
+}  // namespace
+
+std::string SweepJob::fingerprint() const {
+  std::ostringstream os;
+  os << to_string(kind) << " case=" << case_name;
+  for (const auto& [name, value] : values) os << " " << name << "=" << shown(value);
+  os << " set:";
+  for (const auto& [name, value] : set) os << " " << name << "=" << shown(value);
+  os << " solver:";
+  for (const auto& [name, value] : solver) os << " " << name << "=" << value;
+  os << " direct=" << direct << " max_seconds=" << shown(max_seconds) << " max_equilibria=" << max_equilibria
+     << " profiles=" << profiles;
+  return os.str();
+}
+
+ParameterOverrides SweepJob::overrides() const {
+  ParameterOverrides out;
+  for (const auto& entry : set) {
+    const std::string& name = entry.first;
+    if (std::none_of(values.begin(), values.end(), [&name](const auto& v) { return v.first == name; }))
+      out.push_back(entry);
+  }
+  for (const auto& entry : values) out.push_back(entry);
+  return out;
+}
+
+SweepSpec load_sweep(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SweepError(path + ": cannot open the file (" + std::strerror(errno) + ")");
+  std::string text(sweep_limits::kMaxFileBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad()) throw SweepError(path + ": cannot read the file (" + std::strerror(errno) + ")");
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  return load_sweep_text(text, path);
+}
+
+SweepSpec load_sweep_text(const std::string& text, const std::string& path) {
+  if (text.size() > sweep_limits::kMaxFileBytes) throw SweepError(path + ": larger than 1 MiB: not a sweep file");
+  if (const int line = toml_line_beyond_nesting(text, case_limits::kMaxNesting))
+    throw SweepError(path + ":" + std::to_string(line) + ": arrays and tables nest too deeply");
+  if (const std::size_t at = toml_invalid_utf8_at(text); at < text.size())
+    throw SweepError(path + ": not valid UTF-8 (byte " + std::to_string(at) + ")");
+  Value root;
+  try {
+    std::istringstream stream(text);
+    root = toml::parse(stream, path);
+  } catch (const std::exception& e) {
+    throw SweepError(path + ": TOML syntax error: " + e.what());
+  }
+  const Reader r(path);
+  r.allow_keys(root, "", {"title", "case", "set", "solver", "jobs"});
+  SweepSpec spec;
+  spec.path = path;
+  if (const Value* v = Reader::find(root, "title")) spec.title = r.string(*v, "title");
+  std::string top_case;
+  if (const Value* v = Reader::find(root, "case")) top_case = r.string(*v, "case");
+  ParameterOverrides top_set;
+  if (const Value* v = Reader::find(root, "set")) top_set = r.overrides(*v, "set");
+  SolverOverrides top_solver;
+  if (const Value* v = Reader::find(root, "solver")) top_solver = r.solver(*v, "solver");
+  const Value* jobs = Reader::find(root, "jobs");
+  if (!jobs) r.fail("jobs", "no [[jobs]] tables: nothing to run");
+  if (!jobs->is_array() || jobs->as_array().empty())
+    r.fail(*jobs, "jobs", "must be [[jobs]] tables (an array of tables), got " + type_name(*jobs));
+
+  std::set<std::string> names;
+  const auto& groups = jobs->as_array();
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const Value& group = groups[g];
+    const std::string key = "jobs[" + std::to_string(g + 1) + "]";
+    r.allow_keys(group, key, {"name", "kind", "case", "set", "solver", "grid", "list", "cost", "direct", "max_seconds",
+                              "max_equilibria", "profiles"});
+    SweepJob prototype;
+    const Value* kind = Reader::find(group, "kind");
+    if (!kind) r.fail(group, key + ".kind", "missing (solve, equilibria, continue or plectonemes)");
+    prototype.kind = parse_kind(r, *kind, key + ".kind");
+    std::string name = to_string(prototype.kind);
+    if (const Value* v = Reader::find(group, "name")) {
+      name = r.string(*v, key + ".name");
+      if (!valid_name(name)) r.fail(*v, key + ".name", "'" + name + "' is not 1-64 letters, digits, '_' or '-' (it names folders)");
+    }
+    if (!names.insert(name).second)
+      r.fail(Reader::find(group, "name") ? *Reader::find(group, "name") : group, key + ".name",
+             "'" + name + "' names another [[jobs]] table too: give each its own name (it prefixes the job ids)");
+    std::string case_text = top_case;
+    const Value* case_value = Reader::find(group, "case");
+    if (case_value) case_text = r.string(*case_value, key + ".case");
+    if (case_text.empty()) r.fail(group, key + ".case", "no case: give `case` at the top or in the [[jobs]] table");
+    prototype.case_path = resolve(path, case_text);
+    prototype.case_name = case_text;
+    prototype.set = top_set;
+    if (const Value* v = Reader::find(group, "set"))
+      for (auto& [n, x] : r.overrides(*v, key + ".set")) {
+        const std::string nn = n;
+        auto it = std::find_if(prototype.set.begin(), prototype.set.end(), [&nn](const auto& e) { return e.first == nn; });
+        if (it != prototype.set.end()) it->second = x;
+        else prototype.set.emplace_back(n, x);
+      }
+    prototype.solver = top_solver;
+    if (const Value* v = Reader::find(group, "solver"))
+      for (auto& entry : r.solver(*v, key + ".solver")) prototype.solver.push_back(entry);
+    prototype.cost = default_cost(prototype.kind);
+    if (const Value* v = Reader::find(group, "cost")) {
+      prototype.cost = r.number(*v, key + ".cost");
+      if (!(prototype.cost > 0)) r.fail(*v, key + ".cost", "must be > 0");
+    }
+    if (const Value* v = Reader::find(group, "direct")) {
+      if (prototype.kind != SweepJobKind::Solve) r.fail(*v, key + ".direct", "only solve jobs take it");
+      prototype.direct = r.boolean(*v, key + ".direct");
+    }
+    if (const Value* v = Reader::find(group, "max_seconds")) {
+      prototype.max_seconds = r.number(*v, key + ".max_seconds");
+      if (prototype.max_seconds < 0) r.fail(*v, key + ".max_seconds", "must be >= 0 (0: no limit)");
+    }
+    if (const Value* v = Reader::find(group, "max_equilibria")) {
+      if (prototype.kind != SweepJobKind::Equilibria) r.fail(*v, key + ".max_equilibria", "only equilibria jobs take it");
+      prototype.max_equilibria = static_cast<int>(r.integer(*v, key + ".max_equilibria", 1, 1000));
+    }
+    if (const Value* v = Reader::find(group, "profiles")) prototype.profiles = r.boolean(*v, key + ".profiles");
+
+    std::map<std::string, std::pair<const Value*, std::string>> where;
+    const std::vector<ParameterOverrides> group_points = points(r, group, key, &where);
+    // The case, loaded once with the group's overrides, then with its first point: a case that
+    // does not load, unknown or computed parameters and refused values are reported before any
+    // job runs, at the key that names them.
+    Case c;
+    try {
+      c = load_case(prototype.case_path, prototype.set, "", prototype.solver);
+    } catch (const CaseError& e) {
+      const Value* at = Reader::find(group, "set") ? Reader::find(group, "set") : case_value;
+      r.fail(at ? *at : group, key + (at == case_value ? ".case" : ".set"), e.what());
+    }
+    for (const auto& d : c.derived)
+      if (std::find(spec.derived_columns.begin(), spec.derived_columns.end(), d) == spec.derived_columns.end())
+        spec.derived_columns.push_back(d);
+    for (const auto& [pname, at] : where) {
+      if (!c.file_parameters.contains(pname)) {
+        std::string have;
+        for (const auto& n : c.file_parameters.names()) have += (have.empty() ? "" : ", ") + n;
+        r.fail(*at.first, at.second, "no parameter '" + pname + "' in " + prototype.case_path + " (have: " + have + ")");
+      }
+      if (const std::string refusal = dependent_parameter_refusal(c.definition.dependent_parameters, pname, "sweep"); !refusal.empty())
+        r.fail(*at.first, at.second, refusal);
+    }
+    try {
+      SweepJob first = prototype;
+      first.values = group_points.front();
+      load_case(prototype.case_path, first.overrides(), "", prototype.solver);
+    } catch (const CaseError& e) {
+      r.fail(group, key, std::string("at its first point: ") + e.what());
+    }
+    if (spec.jobs.size() + group_points.size() > sweep_limits::kMaxJobs)
+      r.fail(group, key, "the sweep has more than " + std::to_string(sweep_limits::kMaxJobs) + " jobs");
+    for (std::size_t k = 0; k < group_points.size(); ++k) {
+      SweepJob job = prototype;
+      job.id = group_points.size() == 1 ? name : name + "-" + padded(k + 1, group_points.size());
+      job.order = static_cast<int>(spec.jobs.size());
+      job.values = group_points[k];
+      for (const auto& entry : job.values)
+        if (std::find(spec.parameter_columns.begin(), spec.parameter_columns.end(), entry.first) ==
+            spec.parameter_columns.end())
+          spec.parameter_columns.push_back(entry.first);
+      spec.jobs.push_back(std::move(job));
+    }
+  }
+  return spec;
+}
+
+}  // namespace kirchhoff
