@@ -7,8 +7,7 @@
 #include <sstream>
 
 #include "kirchhoff/jacobian_lu.hpp"
-#include "kirchhoff/solution.hpp"
-#include "kirchhoff/stability.hpp"
+#include "kirchhoff/point_record.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -28,8 +27,6 @@ constexpr double kChordContraction = 0.3;
 // factor (it converges linearly at that rate, still cheaper than a new matrix when one costs
 // tens of residuals).
 constexpr double kModifiedNewtonContraction = 0.5;
-// H is flagged as not flat above this fraction of its scale (the standard).
-constexpr double kFlatH = 1e-9;
 
 double sign_of(double v) { return v < 0 ? -1.0 : 1.0; }
 
@@ -98,6 +95,9 @@ Continuation::Continuation(const ShootingProblem& problem, ContinuationOptions o
   for (const auto& e : options_.events)
     if (std::find(options_.derived.begin(), options_.derived.end(), e.quantity) == options_.derived.end())
       options_.derived.push_back(e.quantity);
+  // The engine knows no rod: what a point records comes from the recorder, by default the rod
+  // layer's (it reads the derived list completed with the events' quantities above).
+  if (!options_.recorder) options_.recorder = rod_point_recorder(options_);
   n_ = problem_.size();
 }
 
@@ -247,11 +247,10 @@ ContinuationPoint Continuation::make_point(const Eigen::VectorXd& z, const Eigen
     for (int i = 0; i <= n_; ++i) p.small_count += sv[i] / sv[0] < options_.branch_point_tolerance ? 1 : 0;
   }
   p.jacobian = std::move(A);
-  describe(&p);
   return p;
 }
 
-std::optional<ContinuationPoint> Continuation::restore(const ContinuationPoint& saved) {
+std::optional<ContinuationPoint> Continuation::restore(const ContinuationPoint& saved, bool with_description) {
   if (saved.x.size() != n_ || saved.tangent.size() != n_ + 1) return std::nullopt;
   const Eigen::VectorXd z = join(saved.x, saved.parameter);
   Eigen::VectorXd F;
@@ -263,32 +262,20 @@ std::optional<ContinuationPoint> Continuation::restore(const ContinuationPoint& 
   ContinuationPoint p = make_point(z, saved.tangent, std::make_shared<const Eigen::MatrixXd>(std::move(A)), false,
                                    saved.type, saved.index, saved.arclength, saved.newton_iterations);
   p.step = saved.step;
+  if (with_description) describe(&p);
   return p;
 }
 
 void Continuation::describe(ContinuationPoint* point) {
-  ContinuationPoint& p = *point;
-  if (options_.compute_invariants || !options_.derived.empty()) {
-    problem_.set_parameter(options_.parameter, p.parameter);
-    ShootingResult r;
-    r.x = p.x;
-    r.summary.status = SolverStatus::Converged;
-    r.parameters = problem_.parameters_at(p.x);
-    const Parameters at = r.parameters;
-    const Solution s = make_solution(problem_, std::move(r), options_.samples, options_.derived);
-    if (!s.result.summary.converged()) p.check_failure = s.result.summary.message;
-    p.derived = s.derived;
-    // Parameters solved for belong on the branch too (e.g. the load of a displacement-controlled run).
-    for (const auto& name : problem_.definition().unknown_parameters) p.derived[name] = at.get(name);
-    p.invariants = s.invariants;
-    p.H_flat = !s.invariants.H.applies || s.invariants.H.spread <= kFlatH * std::max(1.0, s.invariants.H.scale);
-  }
-  if (options_.compute_stability) {
-    problem_.set_parameter(options_.parameter, p.parameter);
-    const StabilityReport stability = analyse_stability(problem_, p.x);
-    p.stability_index = stability.index;
-    p.zero_modes = stability.zero_modes;
-  }
+  if (!options_.recorder->describe) return;
+  problem_.set_parameter(options_.parameter, point->parameter);
+  options_.recorder->describe(problem_, point);
+}
+
+void Continuation::record(ContinuationPoint* point) {
+  if (!options_.recorder->record) return;
+  problem_.set_parameter(options_.parameter, point->parameter);
+  options_.recorder->record(problem_, point);
 }
 
 std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint& from, double h, PointType type) {
@@ -306,6 +293,7 @@ std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint
       by_chord && iterations <= options_.reuse_jacobian_iterations && from.jacobian && from.jacobian->rows() == n_;
   auto point = point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations,
                         reuse ? from.jacobian : nullptr);
+  if (point) describe(&*point);
   // A corrected point that is not an admissible solution is a failed step, as a corrector that
   // did not converge is: the step shrinks, and the run ends saying why at the smallest step.
   if (point && !point->check_failure.empty()) {
@@ -380,6 +368,7 @@ ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink&
   const double direction = std::isnan(options_.target) ? sign_of(options_.direction) : sign_of(options_.target - lambda0);
   std::optional<ContinuationPoint> start;
   if (correct(z, z, e, &iterations)) start = point_at(z, direction * e, PointType::Start, 0, 0.0, iterations);
+  if (start) describe(&*start);
   if (!start || !start->check_failure.empty()) {
     result.reason = StopReason::StartFailed;
     result.message = "the starting point does not converge at " + options_.parameter + " = " + std::to_string(lambda0) +
@@ -396,7 +385,7 @@ ContinuationResult Continuation::resume(const MarchState& saved, const PointSink
   ContinuationResult failed;
   failed.reason = StopReason::StartFailed;
   MarchState state = saved;
-  auto current = restore(saved.current);
+  auto current = restore(saved.current, true);
   if (!current) {
     failed.message = "cannot resume: the saved point cannot be evaluated (or does not fit this problem)";
     return failed;
@@ -404,7 +393,7 @@ ContinuationResult Continuation::resume(const MarchState& saved, const PointSink
   state.current = std::move(*current);
   // The point before is only looked at for minima of the smallest singular value.
   if (saved.before && options_.detect_branch_points) {
-    auto before = restore(*saved.before);
+    auto before = restore(*saved.before, false);
     if (!before) {
       failed.message = "cannot resume: the point before the saved one cannot be evaluated";
       return failed;
@@ -459,11 +448,13 @@ ContinuationResult Continuation::run_along(const Eigen::VectorXd& x, double lamb
   std::optional<ContinuationPoint> first;
   if (correct(z, z_pred, d, &iterations))
     first = point_at(z, d, PointType::Regular, 1, (z - z_bp).norm(), iterations);
+  if (first) describe(&*first);
   if (!first) {
     result.reason = StopReason::StartFailed;
     result.message = "no solution along the switching direction";
     return result;
   }
+  record(&origin);
   if (sink) sink(origin);
   first->step = options_.initial_step;
   MarchState state;
@@ -514,6 +505,7 @@ ContinuationResult Continuation::march(MarchState state, const PointSink& sink, 
     options_.on_resumable(now);
   };
 
+  if (report_start) record(&current);
   result.points.push_back(current);
   if (current.type != PointType::BranchPoint) result.points.back().jacobian.reset();
   if (report_start) {
@@ -530,6 +522,7 @@ ContinuationResult Continuation::march(MarchState state, const PointSink& sink, 
     p.step = ds;
     newest_matrix = std::move(p.jacobian);
     p.jacobian = p.type == PointType::BranchPoint ? newest_matrix : nullptr;
+    record(&p);
     result.points.push_back(std::move(p));
     if (sink) sink(result.points.back());
   };
@@ -543,6 +536,8 @@ ContinuationResult Continuation::march(MarchState state, const PointSink& sink, 
                           current.arclength, current.newton_iterations);
     if (!fresh) return false;
     fresh->step = current.step;
+    // Same unknowns and parameter: the same description, not computed again.
+    static_cast<PointRecord&>(*fresh) = static_cast<const PointRecord&>(current);
     current = std::move(*fresh);
     return true;
   };

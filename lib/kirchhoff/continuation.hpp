@@ -41,6 +41,21 @@ struct ContinuationEvent {
 struct ContinuationPoint;
 struct MarchState;
 
+// What a run records of a point besides its unknowns, parameter, tangent and counts, supplied by
+// the layer that knows what the unknowns mean (BifurcationKit's record_from_solution is the
+// model; point_record.hpp is the rod layer's). The engine sets the problem's continued parameter
+// to the point's before each call and interprets only `derived` (events read their quantities
+// there) and `check_failure` (non-empty: the corrected point is not a solution, the step is
+// refused) of what the hooks fill.
+struct PointRecorder {
+  // At most once per corrected point, before the engine tests it (events, admissibility); a
+  // point whose matrix is re-evaluated keeps what it was given. Empty: nothing is described.
+  std::function<void(const ShootingProblem& problem, ContinuationPoint* point)> describe;
+  // Once per point put on the branch (the start, regular and special points reported), after
+  // `describe`: what only the branch's points need (e.g. their stability). Empty: nothing.
+  std::function<void(const ShootingProblem& problem, ContinuationPoint* point)> record;
+};
+
 struct ContinuationOptions {
   std::string parameter;                                      // the continued parameter
   double target = std::numeric_limits<double>::quiet_NaN();   // stop on reaching it (NaN: no target)
@@ -100,6 +115,9 @@ struct ContinuationOptions {
   // same steps as the uninterrupted run (see MarchState). Contact continuations report through
   // their own ContactStateSink instead (it adds the leg's state) and replace this one.
   std::function<void(const MarchState&)> on_resumable;
+  // What is recorded at each point; nullopt: the rod layer's default from compute_invariants,
+  // samples, derived and compute_stability above (rod_point_recorder, point_record.hpp).
+  std::optional<PointRecorder> recorder;
 
   std::string validate() const;
 };
@@ -107,7 +125,21 @@ struct ContinuationOptions {
 enum class PointType { Start, Regular, Fold, BranchPoint, Event, Endpoint };
 const char* to_string(PointType type);
 
-struct ContinuationPoint {
+// What the recorder (PointRecorder) fills; the engine computes none of it. The rod layer's
+// default fills every field (rod_point_recorder).
+struct PointRecord {
+  std::map<std::string, double> derived;  // named quantities (events read theirs here)
+  InvariantReport invariants;
+  bool H_flat = true;       // false flags a point whose H spread exceeds 1e-9 of its scale
+  // With compute_stability: the index (empty where it is not defined) and the zero modes.
+  std::optional<int> stability_index;
+  int zero_modes = 0;
+  // Why the point failed the checks of a solution (verification.hpp: a profile with NaN, a rod
+  // beyond its soft wall), "" when it passed. Such a point is never put on a branch.
+  std::string check_failure;
+};
+
+struct ContinuationPoint : PointRecord {
   int index = 0;
   double parameter = 0.0;
   double arclength = 0.0;
@@ -118,15 +150,6 @@ struct ContinuationPoint {
   int newton_iterations = 0;
   bool jacobian_reused = false;  // its matrix is the previous point's (reuse_jacobian_iterations)
   std::string event;        // events: the quantity that crossed
-  std::map<std::string, double> derived;
-  InvariantReport invariants;
-  bool H_flat = true;       // false flags a point whose H spread exceeds 1e-9 of its scale
-  // With compute_stability: the index (empty where it is not defined) and the zero modes.
-  std::optional<int> stability_index;
-  int zero_modes = 0;
-  // Why the point failed the checks of a solution (verification.hpp: a profile with NaN, a rod
-  // beyond its soft wall), "" when it passed. Such a point is never put on a branch.
-  std::string check_failure;
   double step = 0.0;        // step size after this point
   // Test functions: det [F_x F_lambda; t^T], and the smallest singular value of that matrix
   // over its largest, with the count of singular values below branch_point_tolerance (both left
@@ -228,16 +251,15 @@ class Continuation {
   // iterations stop contracting.
   bool correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
                int* iterations, const Eigen::MatrixXd* chord = nullptr, bool* by_chord = nullptr);
-  // Tangent at z oriented by `previous`, with the test functions, as a point (derived
-  // quantities and invariants included).
+  // Tangent at z oriented by `previous`, with the test functions, as a point (not described).
   // With `reused`, that matrix stands for [F_x F_lambda] at z (no evaluation).
   std::optional<ContinuationPoint> point_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous, PointType type,
                                             int index, double arclength, int iterations,
                                             std::shared_ptr<const Eigen::MatrixXd> reused = nullptr);
-  // The matrix, test functions and derived quantities of a saved point, its tangent kept.
-  std::optional<ContinuationPoint> restore(const ContinuationPoint& saved);
-  // The point at z with tangent t and matrix A = [F_x F_lambda] there: the test functions and
-  // derived quantities.
+  // The matrix and test functions of a saved point, its tangent kept, and its description when
+  // asked for.
+  std::optional<ContinuationPoint> restore(const ContinuationPoint& saved, bool with_description);
+  // The point at z with tangent t and matrix A = [F_x F_lambda] there: the test functions.
   ContinuationPoint make_point(const Eigen::VectorXd& z, const Eigen::VectorXd& t,
                                std::shared_ptr<const Eigen::MatrixXd> A, bool reused, PointType type, int index,
                                double arclength, int iterations);
@@ -248,8 +270,10 @@ class Continuation {
   std::optional<ContinuationPoint> locate(const ContinuationPoint& from, double h_max,
                                           const std::function<double(const ContinuationPoint&)>& monitor,
                                           bool minimise, PointType type);
-  // Derived quantities and invariants of a point (its x and parameter set).
+  // The recorder's description of a corrected point (its x and parameter set), and what it
+  // records of a point put on the branch.
   void describe(ContinuationPoint* point);
+  void record(ContinuationPoint* point);
   std::optional<ContinuationPoint> step_from(const ContinuationPoint& from, double h, PointType type);
   Eigen::VectorXd join(const Eigen::VectorXd& x, double lambda) const;
 
