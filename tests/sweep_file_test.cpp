@@ -1,0 +1,79 @@
+// Sweep files (sweep.hpp): expansion of grids, lists, ranges and log ranges into jobs with
+// deterministic ids, and errors that name the file, the line, the key and the reason.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "kirchhoff/sweep.hpp"
+
+namespace kirchhoff {
+namespace {
+
+const std::string kCases = KIRCHHOFF_CASES_DIR;
+
+std::string error_of(const std::string& text) {
+  try {
+    load_sweep_text(text, "bad.toml");
+  } catch (const SweepError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string head() { return "case = \"" + kCases + "/simply_supported.toml\"\n"; }
+
+TEST(SweepFile, GridExpandsFirstKeySlowestWithRangesAndLogRanges) {
+  const SweepSpec spec = load_sweep_text(head() +
+                                             "[[jobs]]\nname = \"g\"\nkind = \"solve\"\n"
+                                             "grid = { theta0 = [1, 2], P = { from = 1, to = 100, count = 3, log = true } }\n"
+                                             "[[jobs]]\nkind = \"equilibria\"\nlist = [{ theta0 = 0.5 }, { theta0 = 0.25 }]\n",
+                                         "sweep.toml");
+  ASSERT_EQ(spec.jobs.size(), 8u);
+  EXPECT_EQ(spec.jobs[0].id, "g-001");
+  EXPECT_EQ(spec.jobs[5].id, "g-006");
+  EXPECT_EQ(spec.jobs[6].id, "equilibria-001");
+  EXPECT_EQ(spec.jobs[6].kind, SweepJobKind::Equilibria);
+  EXPECT_EQ(spec.parameter_columns, (std::vector<std::string>{"theta0", "P"}));
+  // theta0 slowest; P = 1, 10, 100 (log: the ends exactly, 10 to rounding).
+  EXPECT_EQ(spec.jobs[2].values[0].second, 1.0);
+  EXPECT_EQ(spec.jobs[3].values[0].second, 2.0);
+  EXPECT_EQ(spec.jobs[0].values[1].second, 1.0);
+  EXPECT_NEAR(spec.jobs[1].values[1].second, 10.0, 1e-13);
+  EXPECT_EQ(spec.jobs[2].values[1].second, 100.0);
+  EXPECT_GT(spec.jobs[6].cost, spec.jobs[0].cost);  // searches are handed out before solves
+  EXPECT_EQ(spec.jobs[7].values[0].second, 0.25);
+}
+
+TEST(SweepFile, ErrorsNameFileLineKeyAndReason) {
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\ngrid = { theta0 = [1, 2], thetaX = 3 }\n"),
+            "bad.toml:4: key 'jobs[1].grid.thetaX': no parameter 'thetaX' in " + kCases +
+                "/simply_supported.toml (have: theta0, L, EI, P)");
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\nfoo = 1\n").rfind("bad.toml:4: key 'jobs[1].foo': unknown key", 0),
+            0u);
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\ngrid = { theta0 = { from = 1, to = 2 } }\n"),
+            "bad.toml:4: key 'jobs[1].grid.theta0': a range needs from, to and count (count is missing)");
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\ngrid = { theta0 = { from = 0, to = 2, count = 3, log = true } }\n"),
+            "bad.toml:4: key 'jobs[1].grid.theta0': a log range needs from > 0 and to > 0");
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\ngrid = { theta0 = \"1\" }\n"),
+            "bad.toml:4: key 'jobs[1].grid.theta0': must be a number, got a string");
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\n[[jobs]]\nkind = \"solve\"\n")
+                .find("'solve' names another [[jobs]] table too"),
+            error_of(head() + "[[jobs]]\nkind = \"solve\"\n[[jobs]]\nkind = \"solve\"\n").find("'solve' names"));
+  EXPECT_NE(error_of(head() + "[[jobs]]\nkind = \"solve\"\n[[jobs]]\nkind = \"solve\"\n").find("bad.toml:4: key 'jobs[2].name'"),
+            std::string::npos);
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solv\"\n"),
+            "bad.toml:3: key 'jobs[1].kind': unknown job kind 'solv' (expected one of: solve, equilibria, continue, "
+            "plectonemes)");
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\nmax_equilibria = 3\n"),
+            "bad.toml:4: key 'jobs[1].max_equilibria': only equilibria jobs take it");
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\nset = { nope = 1 }\n").rfind("bad.toml:4: key 'jobs[1].set': ", 0),
+            0u);
+  EXPECT_EQ(error_of("[[jobs]]\nkind = \"solve\"\n"),
+            "bad.toml:1: key 'jobs[1].case': no case: give `case` at the top or in the [[jobs]] table");
+  EXPECT_EQ(error_of(head()), "bad.toml: key 'jobs': no [[jobs]] tables: nothing to run");
+  EXPECT_EQ(error_of("case = [\n").rfind("bad.toml: TOML syntax error: ", 0), 0u);
+}
+
+}  // namespace
+}  // namespace kirchhoff
