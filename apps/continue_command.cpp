@@ -3,26 +3,20 @@
 #include <signal.h>
 #include <unistd.h>
 
-#include <cmath>
-#include <cstdio>
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 
+#include "kirchhoff/case_continue.hpp"
 #include "kirchhoff/case_file.hpp"
-#include "kirchhoff/contact.hpp"
-#include "kirchhoff/deflated_continuation.hpp"
-#include "kirchhoff/continuation.hpp"
-#include "kirchhoff/self_passage.hpp"
-#include "kirchhoff/discrete_seed.hpp"
-#include "kirchhoff/solution.hpp"
-#include "run_state.hpp"
+#include "kirchhoff/continue_outputs.hpp"
+#include "kirchhoff/run_state.hpp"
 #include "solve_command.hpp"
 
 namespace kirchhoff::cli {
@@ -42,8 +36,8 @@ int data_rows(const fs::path& path) {
 }
 
 // The arguments that decide a run's points, in one line: a state file records them, and a
-// resume with other ones is refused (it would not continue the same run). The output paths and
-// --resume itself are not among them.
+// resume with other ones is refused (it would not continue the same run). The output paths,
+// --checkpoint and --resume itself are not among them.
 // The case is named by its canonical path and its content's FNV-1a hash (an edited case file is
 // another run too).
 std::string run_arguments(const ContinueArguments& a) {
@@ -76,9 +70,10 @@ std::string run_arguments(const ContinueArguments& a) {
 
 // For tests and tests/resume_soak.sh: KIRCHHOFF_TEST_KILL_AFTER_ROW=K makes the run kill itself
 // with SIGKILL right after row K is written and flushed, before the state is saved for it (the
-// narrowest window a real kill can hit: the row is on disk, the state is the previous point's);
-// -1 kills it once the CSV header is written, before any point. Nothing is cleaned up, as with a
-// real kill. Unset (or not a number), runs are not affected.
+// narrowest window a real kill can hit: the row is on disk, the state is the previous point's,
+// or an older one between checkpoints); -1 kills it once the CSV header is written, before any
+// point. Nothing is cleaned up, as with a real kill. Unset (or not a number), runs are not
+// affected.
 int kill_after_row() {
   const char* value = std::getenv("KIRCHHOFF_TEST_KILL_AFTER_ROW");
   if (!value || !*value) return -2;
@@ -87,73 +82,54 @@ int kill_after_row() {
   return *end == '\0' && k >= -1 ? static_cast<int>(k) : -2;
 }
 
-class BranchWriter {
+// The terminal: one line updated in place on a terminal, plain lines (every 10th point and every
+// special point) otherwise; the run's notes on lines of their own; the kill hook. Comes after the
+// CSV in the sinks, so that a killed run has its row written.
+class TerminalSink : public ContinueSink {
  public:
-  BranchWriter(const fs::path& path, const std::string& parameter, std::vector<std::string> derived, bool append)
-      : derived_(std::move(derived)) {
-    out_.open(path, append ? std::ios::app : std::ios::trunc);
-    if (!out_) throw std::runtime_error("cannot write " + path.string());
-    out_ << std::setprecision(15);
-    if (!append) {
-      out_ << "index,branch," << parameter << ",arclength";
-      for (const auto& d : derived_) out_ << ',' << d;
-      out_ << ",H_spread,m3_spread,n_dot_m_spread,H_flat,type,multiplicity,event,newton_iterations,stability_index,"
-              "zero_modes\n";
-      out_.flush();
-    }
+  explicit TerminalSink(std::string parameter)
+      : parameter_(std::move(parameter)), tty_(isatty(STDERR_FILENO)), kill_after_(kill_after_row()) {}
+  void begin(const std::string&, const std::vector<std::string>&, int) override {
+    if (kill_after_ == -1) kill(getpid(), SIGKILL);
   }
-  void write(int row, const ContinuationPoint& p, int branch) {
-    out_ << row << ',' << branch << ',' << p.parameter << ',' << p.arclength;
-    for (const auto& d : derived_) out_ << ',' << (p.derived.count(d) ? p.derived.at(d) : NAN);
-    const auto& inv = p.invariants;
-    // + 0.0 prints a zero spread as 0, not -0.
-    out_ << ',' << inv.H.relative_spread() + 0.0 << ',' << inv.m3.relative_spread() + 0.0 << ','
-         << inv.n_dot_m.relative_spread() + 0.0
-         << ',' << (p.H_flat ? 1 : 0) << ',' << to_string(p.type) << ',' << p.multiplicity << ',' << p.event << ','
-         << p.newton_iterations << ',';
-    // Empty where the index is not defined (or not computed): never a guessed number.
-    if (p.stability_index) out_ << *p.stability_index;
-    out_ << ',' << p.zero_modes << '\n';
-    out_.flush();
-  }
-
- private:
-  std::ofstream out_;
-  std::vector<std::string> derived_;
-};
-
-// One line updated in place on a terminal, plain lines (every 10th point and every special
-// point) otherwise.
-class Progress {
- public:
-  explicit Progress(std::string parameter) : parameter_(std::move(parameter)), tty_(isatty(STDERR_FILENO)) {}
-  void point(int row, const ContinuationPoint& p, int branch) {
+  void point(const RunPoint& rp) override {
+    if (rp.row == kill_after_) kill(getpid(), SIGKILL);
+    const ContinuationPoint& p = *rp.point;
     std::ostringstream line;
-    line << "branch " << branch << "  point " << row << "  " << parameter_ << " = " << std::setprecision(10)
+    line << "branch " << rp.branch << "  point " << rp.row << "  " << parameter_ << " = " << std::setprecision(10)
          << p.parameter << "  step " << std::setprecision(3) << p.step;
     if (p.type != PointType::Regular && p.type != PointType::Start) line << "  [" << to_string(p.type) << "]";
     if (!p.H_flat) line << "  [H not flat]";
     if (p.stability_index) line << (*p.stability_index == 0 ? "  stable" : "  index " + std::to_string(*p.stability_index));
     if (tty_) {
       std::cerr << "\r" << line.str() << "\033[K" << std::flush;
-    } else if (row % 10 == 0 || p.type != PointType::Regular || !p.H_flat) {
+      open_line_ = true;
+    } else if (rp.row % 10 == 0 || p.type != PointType::Regular || !p.H_flat) {
       std::cerr << line.str() << "\n";
     }
   }
+  void note(const std::string& line) override {
+    done();
+    std::cerr << line << "\n";
+  }
+  void finish(const RunState*) override { done(); }
+  // Ends the line updated in place.
   void done() {
-    if (tty_) std::cerr << "\n";
+    if (open_line_) std::cerr << "\n";
+    open_line_ = false;
   }
 
  private:
   std::string parameter_;
   bool tty_;
+  bool open_line_ = false;
+  int kill_after_;
 };
 
 std::vector<ContinuationEvent> parse_events(const std::vector<std::string>& texts, bool stop) {
   std::vector<ContinuationEvent> out;
   for (const auto& t : texts) {
     const auto [name, value] = parse_override(t);
-    if (!derived_catalogue().count(name)) throw CaseError("--event/--record: '" + name + "' is not a derived quantity");
     out.push_back({name, value, stop, ""});
   }
   return out;
@@ -194,61 +170,51 @@ void print_start(const RunStart& start, const Case& c, const std::string& parame
   for (const auto& note : start.notes) std::cerr << "note: " << note << "\n";
 }
 
-// --deflate: the equilibria at the start, then the branch through each, written as branches
-// 0, 1, ... of the CSV (no state file: such a run is not resumable).
-int continue_deflated(const ContinueArguments& args, const Case& c, const ContinuationOptions& options,
-                      BranchWriter& writer, Progress& progress) {
-  EquilibriaOptions search;
-  search.max_equilibria = args.deflate_max;
-  search.max_seconds = args.max_seconds;
-  int row = -1;
-  const auto sink_for = [&](int rank, const Equilibrium& start) -> PointSink {
-    progress.done();
-    std::cerr << "branch " << rank << ": from the equilibrium of energy " << start.energy << " ("
-              << describe(start.stability) << ", found by " << start.found_by << ")\n";
-    return [&, rank](const ContinuationPoint& p) {
-      writer.write(++row, p, rank);
-      progress.point(row, p, rank);
-    };
-  };
-  EveryBranch all;
-  try {
-    all = continue_every_branch(c.definition, c.start_guess, c.derived, c.samples, options, search, sink_for);
-  } catch (const std::exception& e) {
-    progress.done();
-    std::cerr << "error: " << e.what() << "\n";
+// What the run's end says on the terminal, and the exit status.
+int report_end(const ContinueArguments& args, const ContinueRunResult& r) {
+  if (args.deflate) {
+    std::cerr << r.equilibria << " equilibria at the start (" << r.search_stopped_because << ")\n";
+    for (const auto& b : r.branches) {
+      std::cerr << "branch " << b.rank << " stopped: " << to_string(b.reason)
+                << (b.message.empty() ? "" : " (" + b.message + ")") << "\n";
+      for (const auto& line : b.contact_changes) std::cerr << "  contact: " << line << "\n";
+    }
+    std::cerr << r.points << " points on " << r.branches.size() << " branches in " << args.out_path << "\n";
+    return r.ok ? kExitOk : kExitNotConverged;
+  }
+  for (const auto& line : r.contact_changes) std::cerr << "contact: " << line << "\n";
+  if (r.switch_requested && !r.switched && r.reason != StopReason::TimeLimit) {
+    std::cerr << "error: " << r.message << "\n";
     return kExitNotConverged;
   }
-  progress.done();
-  std::cerr << all.search.equilibria.size() << " equilibria at the start (" << all.search.stopped_because << ")\n";
-  bool ok = !all.branches.empty();
-  for (const auto& b : all.branches) {
-    std::cerr << "branch " << b.rank << " stopped: " << to_string(b.result.reason)
-              << (b.result.message.empty() ? "" : " (" + b.result.message + ")") << "\n";
-    for (const auto& line : b.contact_changes) std::cerr << "  contact: " << line << "\n";
-    ok = ok && b.result.reason != StopReason::StartFailed && b.result.reason != StopReason::StepTooSmall &&
-         b.result.reason != StopReason::Inadmissible && b.result.reason != StopReason::TimeLimit;
+  std::cerr << "stopped: " << r.status << (r.message.empty() ? "" : " (" + r.message + ")") << "; " << r.points
+            << " points";
+  if (!r.with_contacts) std::cerr << " (last on branch " << r.last_branch << ")";
+  std::cerr << " in " << args.out_path << "\n";
+  if (!r.with_contacts) {
+    if (r.refused_steps > 0) std::cerr << r.refused_steps << " steps refused and retried shorter\n";
+    if (r.reason == StopReason::TimeLimit) std::cerr << "the run can go on with --resume\n";
   }
-  std::cerr << row + 1 << " points on " << all.branches.size() << " branches in " << args.out_path << "\n";
-  return ok ? kExitOk : kExitNotConverged;
+  return r.ok ? kExitOk : kExitNotConverged;
 }
 
 }  // namespace
 
 int run_continue(const ContinueArguments& args) {
-  Case c;
-  ContinuationOptions options;
-  Eigen::VectorXd start_point;  // --start-from: the unknowns to start from
   const fs::path csv(args.out_path), state_path(args.out_path + ".state.json");
-  // A run killed before it saved its first point (its start) has no state file, and at most the
-  // start's row, which it had not finished: resuming it is starting it again, which rewrites the
-  // CSV with the same rows. More rows and no state means the state was removed or the rows are
-  // another run's: nothing records where that march stood, so it is refused.
   if (args.deflate && (args.resume || !args.start_from.empty() || args.switch_at_bp > 0 || args.seed.ipopt)) {
     std::cerr << "error: --deflate starts every branch from the equilibria it finds: it does not combine with "
                  "--resume, --start-from, --switch-at-bp or --seed (a --deflate run is not resumable)\n";
     return kExitBadInput;
   }
+  if (!(args.checkpoint_seconds >= 0 && args.checkpoint_seconds <= 1e6)) {
+    std::cerr << "error: --checkpoint must be in [0, 1e6] seconds\n";
+    return kExitBadInput;
+  }
+  // A run killed before it saved its first point (its start) has no state file, and at most the
+  // start's row, which it had not finished: resuming it is starting it again, which rewrites the
+  // CSV with the same rows. More rows and no state means the state was removed or the rows are
+  // another run's: nothing records where that march stood, so it is refused.
   bool resuming = args.resume;
   if (args.resume && !fs::exists(state_path)) {
     if (const int rows = data_rows(csv); rows > 1) {
@@ -261,312 +227,86 @@ int run_continue(const ContinueArguments& args) {
               << ": the run was stopped before its first point was saved, so it starts from the beginning\n";
     resuming = false;
   }
-  std::optional<RunState> saved;  // --resume: the interrupted run's state
+
+  ContinueRequest request;
+  request.parameter = args.parameter;
+  if (args.has_to) request.target = args.to;
+  request.initial_step = args.step;
+  request.min_step = args.min_step;
+  request.max_step = args.max_step;
+  request.max_points = args.max_points;
+  request.samples = args.samples;
+  request.detect_branch_points = !args.no_branch_points;
+  request.compute_stability = !args.no_stability;
+  request.switch_at_bp = args.switch_at_bp;
+  request.switch_side = args.switch_side;
+  request.max_seconds = args.max_seconds;
+  request.phase_condition = args.phase_condition;
+  request.deflate = args.deflate;
+  request.deflate_max = args.deflate_max;
+  request.seed = args.seed;
+  request.identity = run_arguments(args);
+  Case c;
   std::optional<RunStart> start;  // --start-from: where and with which parameters the run starts
-  ParameterOverrides overrides;   // the run's parameter values beyond the case file's
   try {
+    ParameterOverrides overrides;  // the run's parameter values beyond the case file's
     for (const auto& t : args.overrides) overrides.push_back(parse_override(t));
     if (resuming) {
-      saved = load_state(state_path);
+      request.resume = resumable_state(state_path.string(), request.identity);
       // A run started from another one keeps the values it started with (the other run's, which
       // its arguments line does not hold).
-      if (saved->has_set_parameters) overrides = saved->set_parameters;
+      if (request.resume->has_set_parameters) overrides = request.resume->set_parameters;
     } else if (!args.start_from.empty()) {
       if (args.seed.ipopt) throw CaseError("--start-from does not combine with --seed");
       start = plan_start_from(args.start_from, args.start_param, overrides);
       overrides = start->parameters;
       refuse_foreign_parameters(*start, args);
+      request.start = start->at;
+      request.start_name = args.start_from;
     }
     c = load_case(args.case_path, overrides, args.phase_condition, parse_solver_overrides(args.solver));
-    options.parameter = args.parameter;
-    if (!c.definition.parameters.contains(args.parameter))
-      throw CaseError(args.case_path + ": --param " + args.parameter + ": not a parameter of the case");
-    if (const std::string why = dependent_parameter_refusal(c.definition.dependent_parameters, args.parameter,
-                                                            "continue in");
-        !why.empty())
-      throw CaseError(args.case_path + ": --param " + args.parameter + ": " + why);
-    if (args.has_to) options.target = args.to;
-    options.initial_step = args.step;
-    options.min_step = args.min_step;
-    options.max_step = args.max_step;
-    options.max_points = args.max_points;
-    options.samples = args.samples;
-    if (!(args.max_seconds >= 0 && args.max_seconds <= 1e9)) throw CaseError("--max-seconds must be in [0, 1e9]");
-    if (args.max_seconds > 0) {
-      // One deadline for the whole run: the first solve, every branch and every contact leg.
-      limit_wall_clock(c.definition.options, args.max_seconds);
-      options.deadline = c.definition.options.newton.deadline;
-    }
-    options.detect_branch_points = !args.no_branch_points;
-    options.compute_stability = !args.no_stability;
-    if (args.no_branch_points && args.switch_at_bp > 0)
-      throw CaseError("--switch-at-bp needs branch points: drop --no-branch-points");
-    options.derived = c.derived;
-    options.events = parse_events(args.stop_events, true);
-    for (auto& e : parse_events(args.record_events, false)) options.events.push_back(e);
-    if (std::string e = options.validate(); !e.empty()) throw CaseError(e);
-    if (start) {
-      if (!start->at.contacts.empty() && c.definition.obstacles.empty())
-        throw CaseError(args.start_from + ": its point has active contacts, and " + args.case_path +
-                        " has no obstacles");
-      c.definition.contacts = start->at.contacts;  // the active set the point's unknowns belong to
-      start_point = start->at.point.x;
-      print_start(*start, c, args.parameter);
-      // The point's unknowns are those of the case with its active set (and the phase condition
-      // of a branch switched onto at a double branch point).
-      ProblemDefinition d = c.definition;
-      if (start->at.phase_condition == "axial" && !d.parameters.contains("unfolding")) add_axial_phase_condition(d);
-      if (const auto n = ShootingProblem(d).size(); start_point.size() != n)
-        throw CaseError(args.start_from + ": its point has " + std::to_string(start_point.size()) +
-                        " unknowns, the case " + std::to_string(n) +
-                        " (set the parameters that fix the segments as in that run)");
-    }
-    if (args.seed.ipopt && !resuming) {
-      // The first point from Ipopt's shape and contact set instead of the case's guess.
-      const DiscreteSeed seed = seed_from_discrete_energy(c.definition, args.seed.segments, args.seed.amplitude);
-      std::cerr << "seed: " << seed.summary << "\n";
-      c.definition.contacts = seed.contacts;
-      c.start_guess = seed.start;
-    }
+    request.set_parameters = overrides;
+    request.events = parse_events(args.stop_events, true);
+    for (auto& e : parse_events(args.record_events, false)) request.events.push_back(e);
+    if (std::string why = request.validate(c); !why.empty()) throw CaseError(why);
+    if (start) print_start(*start, c, args.parameter);
+  } catch (const std::invalid_argument& e) {  // CaseError, a bad NAME=VALUE, a state file refused
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
   } catch (const CaseError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;
-  } catch (const nlohmann::json::exception& e) {  // a state file that is not one
-    std::cerr << "error: " << state_path.string() << ": not a state file of this command: " << e.what() << "\n";
-    return kExitBadInput;
-  } catch (const std::invalid_argument& e) {
+  } catch (const std::runtime_error& e) {  // no state file to resume from
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;
-  } catch (const std::runtime_error& e) {  // the seed's Ipopt did not converge
-    std::cerr << "error: " << e.what() << "\n";
-    return kExitNotConverged;
   }
-  for (const auto& e : options.events)
-    if (std::find(options.derived.begin(), options.derived.end(), e.quantity) == options.derived.end())
-      options.derived.push_back(e.quantity);
 
-  if (!args.profiles_dir.empty()) fs::create_directories(args.profiles_dir);
-  Progress progress(args.parameter);
-  RunState state;
-  state.phase_condition = args.phase_condition.empty() ? "none" : args.phase_condition;
-  // A point on a branch followed with the axial phase condition goes on in that problem.
-  if (start && start->at.phase_condition == "axial") state.phase_condition = "axial";
-  state.arguments = run_arguments(args);
-  std::unique_ptr<BranchWriter> writer;
-  const int kill_after = kill_after_row();
-
+  BranchCsvSink branch_csv(csv);
+  TerminalSink terminal(args.parameter);
+  StateFileSink state_file(state_path, std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                           std::chrono::duration<double>(args.checkpoint_seconds)));
+  std::vector<ContinueSink*> sinks = {&branch_csv, &terminal};
+  if (!args.deflate) sinks.push_back(&state_file);  // a deflated run is not resumable
+  std::optional<ProfileSink> profiles;
   try {
-    if (resuming) {
-      // Without the march's whole state (files written before 2026-12-02) or with other
-      // arguments, the resumed run would not be the interrupted one continued: refused, not
-      // approximated.
-      if (!saved->has_march)
-        throw CaseError("cannot resume from " + state_path.string() +
-                        ": it was written by an older kirchhoff that did not save the march's whole state, so a "
-                        "resumed run would not repeat the uninterrupted one; run again without --resume");
-      if (saved->arguments != state.arguments)
-        throw CaseError("cannot resume from " + state_path.string() + ": it belongs to a run with other arguments\n  saved: " +
-                        saved->arguments + "\n  now:   " + state.arguments);
-      state = std::move(*saved);
-      truncate_csv(csv, state.row);
-      // The rows after the saved point are gone: the last one is the saved point's.
-      state.written = WrittenPoint{state.saved_row, state.branch, state.phase_condition, state.last, state.contacts};
-    }
-    state.parameter_name = args.parameter;
-    state.has_set_parameters = true;
-    state.set_parameters = overrides;
-    std::vector<std::string> columns = c.definition.unknown_parameters;  // solved-for parameters first
-    columns.insert(columns.end(), options.derived.begin(), options.derived.end());
-    writer = std::make_unique<BranchWriter>(csv, args.parameter, columns, resuming);
+    if (!args.profiles_dir.empty()) sinks.push_back(&profiles.emplace(c, args.parameter, args.profiles_dir, args.samples));
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;
   }
-  if (kill_after == -1) kill(getpid(), SIGKILL);
-  if (args.deflate) return continue_deflated(args, c, options, *writer, progress);
-
-  // The problem of the current branch (the switched branch of a symmetric rod has the phase
-  // condition added).
-  auto problem_for = [&](const std::string& phase) {
-    ProblemDefinition d = c.definition;
-    if (phase == "axial" && !d.parameters.contains("unfolding")) add_axial_phase_condition(d);
-    return std::make_unique<ShootingProblem>(d);
-  };
-
-  // DIR/point_NNNNN.csv for --profiles: the point's solution along the rod, in its problem.
-  auto write_profile = [&](const ShootingProblem& problem, const ContinuationPoint& p) {
-    if (args.profiles_dir.empty()) return;
-    ShootingProblem copy = problem;
-    copy.set_parameter(args.parameter, p.parameter);
-    ShootingResult r;
-    r.x = p.x;
-    r.parameters = copy.parameters_at(p.x);
-    const Solution s = make_solution(copy, r, args.samples, {});
-    std::ostringstream name;
-    name << "point_" << std::setw(5) << std::setfill('0') << state.row << ".csv";
-    write_profile_csv((fs::path(args.profiles_dir) / name.str()).string(), copy.equations(r.parameters)->model(),
-                      s.profile, copy.definition().kind);
-  };
-
-  // The state is saved after every point a run can resume from (options.on_resumable, called
-  // right after the point's row is written): a run killed after a special point (fold, branch
-  // point, event) redoes the step that found it from the point before, and its row is rewritten.
-  auto save_march = [&](const MarchState& m) {
-    set_march_state(&state, m);
-    state.saved_row = state.row;
-    save_state(state_path, state);
-  };
-  // The row just written, where a run started from this one starts (--start-from): saved now
-  // unless the point is resumable (then the march's state is saved right after it).
-  auto record_written = [&](const ContinuationPoint& p, int branch, const std::string& phase,
-                            const std::vector<PointContact>& contacts) {
-    state.written = WrittenPoint{state.row, branch, phase, p, contacts};
-    state.written->point.jacobian.reset();
-    if (!resumable(p) && state.has_march) save_state(state_path, state);
-  };
-  auto sink_for = [&](const ShootingProblem& problem, int branch, const std::string& phase) {
-    return [&, branch, phase](const ContinuationPoint& p) {
-      ++state.row;
-      writer->write(state.row, p, branch);
-      if (state.row == kill_after) kill(getpid(), SIGKILL);
-      record_written(p, branch, phase, {});
-      if (resumable(p)) {
-        state.branch = branch;
-        state.phase_condition = phase;
-      }
-      progress.point(state.row, p, branch);
-      write_profile(problem, p);
-    };
-  };
-
-  // Branch 0 runs until its target (or, with --switch-at-bp K, its K-th branch point); branch 1
-  // starts on the bifurcating branch there. A resumed run picks up whichever it was on.
-  ContinuationResult result;
-  int branch = state.branch;
-  auto switch_branches = [&](Continuation& run, const ContinuationPoint& bp) {
-    branch = 1;
-    return follow_bifurcating_branch(run, bp, options, args.switch_side,
-                                     [&](const ShootingProblem& problem, bool with_phase_condition) {
-                                       std::cerr << (isatty(STDERR_FILENO) ? "\n" : "");
-                                       if (with_phase_condition)
-                                         std::cerr << "double branch point at " << args.parameter << " = "
-                                                   << bp.parameter << ": switching with the axial phase condition\n";
-                                       else
-                                         std::cerr << "switching branches at " << args.parameter << " = "
-                                                   << bp.parameter << "\n";
-                                       return sink_for(problem, 1,
-                                                       with_phase_condition ? "axial" : state.phase_condition);
-                                     });
-  };
-  if (!c.definition.obstacles.empty()) {
-    // Contact: the active set changes along the branch (each change is an event row).
-    try {
-      std::unique_ptr<ShootingProblem> leg_problem;  // for --profiles
-      std::vector<PointContact> leg_contacts;         // the active set of the leg's points
-      auto sink = [&](const ContinuationPoint& p) {
-        ++state.row;
-        writer->write(state.row, p, branch);
-        if (state.row == kill_after) kill(getpid(), SIGKILL);
-        record_written(p, branch, state.phase_condition, leg_contacts);
-        progress.point(state.row, p, branch);
-        if (leg_problem) write_profile(*leg_problem, p);
-      };
-      // The leg's state (its active set among it) after every point the run can resume from.
-      auto save_leg = [&](const ContactMarchState& m) {
-        set_contact_march_state(&state, m);
-        state.branch = branch;
-        state.saved_row = state.row;
-        save_state(state_path, state);
-      };
-      auto on_active_set = [&](const std::vector<PointContact>& contacts) {
-        leg_contacts = contacts;
-        if (args.profiles_dir.empty()) return;
-        // The points that follow belong to this leg's problem (its active set).
-        ProblemDefinition d = c.definition;
-        d.contacts = contacts;
-        leg_problem = std::make_unique<ShootingProblem>(d);
-      };
-      // As without obstacles: branch 0 to its target or the K-th branch point (counted over its
-      // legs), branch 1 from there with no target.
-      ContinuationOptions first = branch == 1 ? bifurcating_branch_options(options) : options;
-      if (branch == 0) first.stop_at_branch_point = args.switch_at_bp;
-      ContactContinuationResult r;
-      r = resuming
-              ? resume_with_contacts(c.definition, contact_march_state(state), first, sink, {}, on_active_set, save_leg)
-          : start_point.size() > 0
-              ? continue_with_contacts_from(c.definition, start_point, first, sink, {}, on_active_set, save_leg)
-              : continue_with_contacts(c.definition, c.start_guess, first, sink, {}, on_active_set, save_leg);
-      if (branch == 0 && args.switch_at_bp > 0 && r.result.reason != StopReason::TimeLimit) {
-        progress.done();
-        for (const auto& line : r.changes) std::cerr << "contact: " << line << "\n";
-        if (r.result.reason != StopReason::BranchPointStop) {
-          std::cerr << "error: no branch point " << args.switch_at_bp << " before the run stopped ("
-                    << to_string(r.result.reason) << (r.result.message.empty() ? "" : ": " + r.result.message)
-                    << ")\n";
-          return kExitNotConverged;
-        }
-        const ContinuationPoint bp = r.result.points.back();
-        std::cerr << "switching branches at " << args.parameter << " = " << bp.parameter << "\n";
-        branch = 1;
-        r = switch_branch_with_contacts(r.definition, bp, args.switch_side, options, sink, {}, on_active_set, save_leg);
-      }
-      progress.done();
-      if (state.has_march) save_state(state_path, state);  // with the last row written
-      for (const auto& line : r.changes) std::cerr << "contact: " << line << "\n";
-      std::cerr << "stopped: " << to_string(r.result.reason)
-                << (r.result.message.empty() ? "" : " (" + r.result.message + ")") << "; " << state.row + 1
-                << " points in " << args.out_path << "\n";
-      const bool failed = r.result.reason == StopReason::StartFailed || r.result.reason == StopReason::StepTooSmall ||
-                          r.result.reason == StopReason::Inadmissible || r.result.reason == StopReason::TimeLimit;
-      return failed ? kExitNotConverged : kExitOk;
-    } catch (const std::exception& e) {
-      progress.done();
-      std::cerr << "error: " << e.what() << "\n";
-      return kExitNotConverged;
-    }
-  }
-  options.on_resumable = save_march;
+  ContinueRunResult result;
   try {
-    auto problem = problem_for(state.phase_condition);
-    // Each branch's march is run with the options the uninterrupted run gives it, a resumed one
-    // too: branch 0 with the target, the self-passage guard and the stop at the K-th branch
-    // point (the count of those passed is in the saved state), branch 1 with
-    // bifurcating_branch_options (no target: `--to` applied there stopped resumed runs at it).
-    ContinuationOptions first = options;
-    // A rod with self-contact: steps that would carry it through itself are refused.
-    if (branch == 0 && guard_self_passage(*problem, &first))
-      std::cerr << "self-contact: steps through the rod itself are refused\n";
-    if (branch == 0 && args.switch_at_bp > 0) first.stop_at_branch_point = args.switch_at_bp;
-    if (branch == 1) first = bifurcating_branch_options(options);
-    if (resuming) problem->set_parameter(args.parameter, state.last.parameter);
-    Continuation run(*problem, first);
-    // (A resume never starts on a branch point: only points the march goes on from are saved.)
-    result = resuming ? run.resume(march_state(state), sink_for(*problem, branch, state.phase_condition))
-                      : run.run(start_point.size() > 0 ? start_point : problem->initial_unknowns(c.start_guess),
-                                sink_for(*problem, 0, state.phase_condition));
-    if (branch == 0 && args.switch_at_bp > 0 && result.reason != StopReason::TimeLimit) {
-      if (result.reason != StopReason::BranchPointStop) {
-        progress.done();
-        std::cerr << "error: no branch point " << args.switch_at_bp << " before the run stopped ("
-                  << to_string(result.reason) << ")\n";
-        return kExitNotConverged;
-      }
-      result = switch_branches(run, result.points.back());
-    }
-  } catch (const std::exception& e) {
-    progress.done();
+    result = continue_case(c, request, sinks);
+  } catch (const CaseError& e) {  // a start point of another problem, outputs that cannot be written
+    terminal.done();
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const std::exception& e) {  // the seed's Ipopt did not converge, a march that threw
+    terminal.done();
     std::cerr << "error: " << e.what() << "\n";
     return kExitNotConverged;
   }
-  progress.done();
-  if (state.has_march) save_state(state_path, state);  // with the last row written
-  std::cerr << "stopped: " << to_string(result.reason) << (result.message.empty() ? "" : " (" + result.message + ")")
-            << "; " << state.row + 1 << " points (last on branch " << branch << ") in " << args.out_path << "\n";
-  if (result.refused_steps > 0) std::cerr << result.refused_steps << " steps refused and retried shorter\n";
-  if (result.reason == StopReason::TimeLimit) std::cerr << "the run can go on with --resume\n";
-  const bool ok = result.reason != StopReason::StartFailed && result.reason != StopReason::StepTooSmall &&
-                  result.reason != StopReason::Inadmissible && result.reason != StopReason::TimeLimit;
-  return ok ? kExitOk : kExitNotConverged;
+  return report_end(args, result);
 }
 
 }  // namespace kirchhoff::cli

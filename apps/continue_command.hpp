@@ -1,5 +1,6 @@
 // `kirchhoff continue`: pseudo-arclength continuation of a case in one parameter, written to a
-// CSV point by point, resumable after being killed.
+// CSV point by point, resumable after being killed. The arguments are mapped onto
+// kirchhoff::continue_case (case_continue.hpp), which does the run.
 #pragma once
 
 #include <string>
@@ -38,6 +39,9 @@ struct ContinueArguments {
   std::string start_from;
   std::string start_param;
   double max_seconds = 0.0;   // wall-clock limit of the run (0: none); it stops resumable, time_limit
+  // The state file is saved after the first point, then at most once per this many seconds (0:
+  // after every point), and at the end; a resume recomputes the rows after the last save.
+  double checkpoint_seconds = 1.0;
   // --deflate: every branch through the equilibria found at the start (deflated_continuation.hpp),
   // at most deflate_max of them; branch k of the CSV starts at the k-th by energy.
   bool deflate = false;

@@ -146,6 +146,11 @@ int main(int argc, char** argv) {
                    "Wall-clock limit of the run in seconds (0: none); it stops after the last point written, "
                    "with time_limit and exit 1, and --resume goes on")
       ->capture_default_str();
+  continue_cmd
+      ->add_option("--checkpoint", cont.checkpoint_seconds,
+                   "Save the state file (for --resume) at most once per this many seconds (0: after every\n"
+                   "point); a resumed run recomputes the rows after the last save, the same rows")
+      ->capture_default_str();
   continue_cmd->add_option("--set", cont.overrides, "Override a parameter: NAME=VALUE (repeatable)");
   continue_cmd->add_option("--solver", cont.solver, "Override a [solver] key: KEY=VALUE, e.g. tolerance=1e-10, stepper=dopri5 (repeatable; checked as in the file)");
   continue_cmd->add_option("--phase-condition", cont.phase_condition, "As for solve")

@@ -19,7 +19,7 @@
 #include "kirchhoff/plectoneme.hpp"
 #include "kirchhoff/self_passage.hpp"
 #include "kirchhoff/solution.hpp"
-#include "run_state.hpp"
+#include "kirchhoff/run_state.hpp"
 
 namespace kirchhoff::cli {
 namespace {

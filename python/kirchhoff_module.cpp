@@ -26,6 +26,7 @@
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/case_file.hpp"
+#include "kirchhoff/case_continue.hpp"
 #include "kirchhoff/case_solve.hpp"
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/continuation.hpp"
@@ -177,15 +178,11 @@ struct PyBranch {
   std::string parameter;
   std::string reason;
   std::string message;
-  bool switch_requested = false;
   bool switched = false;
+  bool ok = false;  // what the CLI turns into exit status 0 (ContinueRunResult::ok)
+  std::vector<std::string> contact_changes;  // as the CLI's "contact:" lines
   py::dict points;
   size_t size = 0;
-  // What the CLI turns into exit status 0.
-  bool ok() const {
-    return reason != to_string(StopReason::StartFailed) && reason != to_string(StopReason::StepTooSmall) &&
-           reason != to_string(StopReason::Inadmissible) && (!switch_requested || switched);
-  }
 };
 
 struct PyCase {
@@ -383,10 +380,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
 
 std::vector<ContinuationEvent> events_from(const py::object& obj, bool stop) {
   std::vector<ContinuationEvent> out;
-  for (const auto& [name, value] : named_values(obj)) {
-    if (!derived_catalogue().count(name)) throw CaseError("--event/--record: '" + name + "' is not a derived quantity");
-    out.push_back({name, value, stop, ""});
-  }
+  for (const auto& [name, value] : named_values(obj)) out.push_back({name, value, stop, ""});
   return out;
 }
 
@@ -483,142 +477,58 @@ py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
   return out;
 }
 
+// The points of a run, for Branch.points; Ctrl-C stops a long run between points (the exception
+// unwinds the continuation).
+class CollectingSink : public ContinueSink {
+ public:
+  std::vector<BranchPoint> points;
+  void point(const RunPoint& p) override {
+    points.push_back({*p.point, p.branch});
+    points.back().point.jacobian.reset();
+    py::gil_scoped_acquire acquire;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  }
+};
+
+// The CLI's `continue` (continue_case: the same statuses and messages), its points in memory.
 PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::object& to, double step,
                      double min_step, double max_step, int max_points, const py::object& events,
                      const py::object& record, int switch_at_bp, double side, int samples, double direction,
                      bool branch_points, bool stability, bool deflate, int deflate_max) {
-  const Case& c = pc.c;
-  ContinuationOptions options;
-  options.parameter = parameter;
-  if (!c.definition.parameters.contains(parameter))
-    throw CaseError(c.path + ": --param " + parameter + ": not a parameter of the case");
-  if (const std::string why = dependent_parameter_refusal(c.definition.dependent_parameters, parameter, "continue in");
-      !why.empty())
-    throw CaseError(c.path + ": --param " + parameter + ": " + why);
-  if (!to.is_none()) options.target = to.cast<double>();
-  options.direction = direction;
-  options.initial_step = step;
-  options.min_step = min_step;
-  options.max_step = max_step;
-  options.max_points = max_points;
-  options.samples = samples;
-  options.detect_branch_points = branch_points;
-  options.compute_stability = stability;
-  options.derived = c.derived;
-  options.events = events_from(events, true);
-  for (auto& e : events_from(record, false)) options.events.push_back(e);
-  if (std::string e = options.validate(); !e.empty()) throw CaseError(e);
-  if (switch_at_bp < 0) throw CaseError("switch_at_bp must be >= 0");
-  if (switch_at_bp > 0 && !branch_points) throw CaseError("switch_at_bp needs branch_points=True");
-  for (const auto& e : options.events)
-    if (std::find(options.derived.begin(), options.derived.end(), e.quantity) == options.derived.end())
-      options.derived.push_back(e.quantity);
-
-  PyBranch out;
-  out.parameter = parameter;
-  out.switch_requested = switch_at_bp > 0;
-  std::vector<BranchPoint> points;
-
-  // Lets Ctrl-C stop a long run between points (the exception unwinds the continuation).
-  const PointSink check_signals = [](const ContinuationPoint&) {
-    py::gil_scoped_acquire acquire;
-    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-  };
-  auto keep = [&](const ContinuationResult& r, int branch) {
-    for (const auto& p : r.points) {
-      points.push_back({p, branch});
-      points.back().point.jacobian.reset();
-    }
-  };
-  if (deflate) {
-    if (switch_at_bp > 0) throw CaseError("deflate=True follows every branch from the start: not with switch_at_bp");
-    if (deflate_max < 1) throw CaseError("deflate_max must be >= 1");
-    // As the CLI's --deflate: branch k starts at the k-th equilibrium found at the start.
-    EquilibriaOptions search;
-    search.max_equilibria = deflate_max;
-    EveryBranch all;
-    {
-      py::gil_scoped_release release;
-      all = continue_every_branch(c.definition, c.start_guess, c.derived, c.samples, options, search,
-                                  [&](int, const Equilibrium&) { return PointSink(check_signals); });
-    }
-    std::ostringstream message;
-    message << all.search.equilibria.size() << " equilibria at the start (" << all.search.stopped_because << ")";
-    for (const auto& b : all.branches) {
-      keep(b.result, b.rank);
-      message << "; branch " << b.rank << ": " << to_string(b.result.reason);
-    }
-    // The run's reason: the first branch that did not end normally (as PyBranch::ok judges), else
-    // the first branch's.
-    const auto abnormal = [](const BranchFromEquilibrium& b) {
-      return b.result.reason == StopReason::StartFailed || b.result.reason == StopReason::StepTooSmall ||
-             b.result.reason == StopReason::Inadmissible;
-    };
-    const auto first_abnormal = std::find_if(all.branches.begin(), all.branches.end(), abnormal);
-    out.reason = all.branches.empty()                    ? "no_equilibrium"
-                 : first_abnormal != all.branches.end() ? to_string(first_abnormal->result.reason)
-                                                        : to_string(all.branches.front().result.reason);
-    out.message = message.str();
-    out.size = points.size();
-    out.points = branch_points_dict(points, options.derived);
-    return out;
-  }
+  ContinueRequest request;
+  request.parameter = parameter;
+  if (!to.is_none()) request.target = to.cast<double>();
+  request.direction = direction;
+  request.initial_step = step;
+  request.min_step = min_step;
+  request.max_step = max_step;
+  request.max_points = max_points;
+  request.samples = samples;
+  request.detect_branch_points = branch_points;
+  request.compute_stability = stability;
+  request.events = events_from(events, true);
+  for (auto& e : events_from(record, false)) request.events.push_back(e);
+  request.switch_at_bp = switch_at_bp;
+  request.switch_side = side;
+  request.phase_condition = pc.phase_condition;
+  request.deflate = deflate;
+  request.deflate_max = deflate_max;
+  if (std::string why = request.validate(pc.c); !why.empty()) throw CaseError(why);
+  CollectingSink collect;
+  ContinueRunResult result;
   {
     py::gil_scoped_release release;
-    // As apps/continue_command.cpp: branch 0 up to the switch_at_bp-th branch point, then the
-    // bifurcating branch (with the axial phase condition at the double branch point of a
-    // spatial rod).
-    const std::string phase = pc.phase_condition.empty() ? "none" : pc.phase_condition;
-    ProblemDefinition d = c.definition;
-    if (phase == "axial" && !d.parameters.contains("unfolding")) add_axial_phase_condition(d);
-    const ShootingProblem problem(d);
-    ContinuationOptions first = options;
-    first.stop_at_branch_point = switch_at_bp;
-    guard_self_passage(problem, &first);  // self-contact: no step through the rod itself
-    Continuation run(problem, first);
-    ContinuationResult result;
-    ProblemDefinition leg_definition;  // contact runs: the active set of the leg the run stopped on
-    try {
-      if (!d.obstacles.empty()) {
-        // Contact: the active set changes along the branch; switch_at_bp counts the branch points
-        // of all its legs (as apps/continue_command.cpp).
-        ContinuationOptions contact_first = options;
-        contact_first.stop_at_branch_point = switch_at_bp;
-        ContactContinuationResult legs = continue_with_contacts(d, c.start_guess, contact_first, check_signals);
-        result = std::move(legs.result);
-        leg_definition = std::move(legs.definition);
-      } else {
-        result = run.run(problem.initial_unknowns(c.start_guess), check_signals);
-      }
-    } catch (const IntegrationError& e) {
-      result.reason = StopReason::StartFailed;
-      result.message = std::string("the initial guess cannot be integrated: ") + e.what();
-    } catch (const InfeasibleContact& e) {
-      result.reason = StopReason::StartFailed;
-      result.message = std::string("infeasible: ") + e.what();
-    }
-    keep(result, 0);
-    if (switch_at_bp > 0 && result.reason != StopReason::BranchPointStop) {
-      out.reason = to_string(result.reason);
-      out.message = "no branch point " + std::to_string(switch_at_bp) + " before the run stopped (" +
-                    to_string(result.reason) + (result.message.empty() ? "" : ": " + result.message) + ")";
-    } else if (switch_at_bp > 0) {
-      result = d.obstacles.empty()
-                   ? follow_bifurcating_branch(run, result.points.back(), options, side,
-                                               [&](const ShootingProblem&, bool) { return PointSink(check_signals); })
-                   : switch_branch_with_contacts(leg_definition, result.points.back(), side, options, check_signals)
-                         .result;
-      keep(result, 1);
-      out.switched = true;
-      out.reason = to_string(result.reason);
-      out.message = result.message;
-    } else {
-      out.reason = to_string(result.reason);
-      out.message = result.message;
-    }
+    result = continue_case(pc.c, request, {&collect});
   }
-  out.size = points.size();
-  out.points = branch_points_dict(points, options.derived);
+  PyBranch out;
+  out.parameter = parameter;
+  out.reason = result.status;
+  out.message = result.message;
+  out.switched = result.switched;
+  out.ok = result.ok;
+  out.contact_changes = result.contact_changes;
+  out.size = collect.points.size();
+  out.points = branch_points_dict(collect.points, result.derived);
   return out;
 }
 
@@ -812,12 +722,18 @@ Attributes:
 Attributes:
     parameter (str): the continued parameter.
     reason (str): why the (last) run stopped: "reached_target", "max_points",
-        "parameter_bounds", "step_too_small", "event", "branch_point" or "start_failed".
+        "parameter_bounds", "step_too_small", "event", "branch_point", "start_failed",
+        "inadmissible", "time_limit" (deflate=True: "no_equilibrium" too), the CLI's word.
     message (str): details (the event, why the start failed, or "no branch point K before the
         run stopped (...)" when switch_at_bp found too few branch points).
     switched (bool): the bifurcating branch was followed (switch_at_bp > 0 and found).
-    ok (bool): what the CLI reports with exit status 0: not start_failed/step_too_small, and the
-        requested branch switch happened.
+    contact_changes (list of str): cases with obstacles: each change of the active set, where and
+        what ("Delta = 0.0250667: a contact appears with obstacle 0 at s = 0.5"), as the CLI's
+        "contact:" lines; the point's `event` holds the event's name (obstacle_reached,
+        contact_lifts_off, contact_flattens, ...) as the CLI's CSV does.
+    ok (bool): what the CLI reports with exit status 0 (kirchhoff::ended_normally): not
+        start_failed, step_too_small, inadmissible or time_limit, and the requested branch switch
+        happened.
     points (dict): one entry per point, in order; numpy arrays unless said otherwise:
         index, branch (0 = starting branch, 1 = after the switch), parameter, arclength, each
         derived quantity (the case's [output] derived plus event quantities; NaN where
@@ -831,7 +747,8 @@ Attributes:
       .def_readonly("reason", &PyBranch::reason)
       .def_readonly("message", &PyBranch::message)
       .def_readonly("switched", &PyBranch::switched)
-      .def_property_readonly("ok", &PyBranch::ok)
+      .def_readonly("ok", &PyBranch::ok)
+      .def_readonly("contact_changes", &PyBranch::contact_changes)
       .def_readonly("points", &PyBranch::points)
       .def("__len__", [](const PyBranch& b) { return b.size; })
       .def("__repr__", [](const PyBranch& b) {

@@ -333,7 +333,10 @@ class ContactTest(unittest.TestCase):
         self.assertEqual(branch.reason, "reached_target")
         events = [e for e in branch.points["event"] if e]
         self.assertEqual(len(events), 1)
-        self.assertIn("a contact appears", events[0])
+        # The event's name, as the CLI's CSV has it; what changed, as the CLI's "contact:" lines.
+        self.assertEqual(events[0], "obstacle_reached")
+        self.assertEqual(len(branch.contact_changes), 1)
+        self.assertIn("a contact appears", branch.contact_changes[0])
 
     def test_switch_at_a_branch_point_of_a_case_with_obstacles(self):
         # The Euler column below a wall at y = 0.2 (as tests/continue_cli_test.cpp): the buckled
@@ -352,7 +355,8 @@ class ContactTest(unittest.TestCase):
         first_bp = list(types).index("branch_point")
         self.assertAlmostEqual(b.points["parameter"][first_bp], np.pi ** 2, places=9)
         self.assertEqual(branches[first_bp + 1], 1)
-        contacts = [k for k, e in enumerate(b.points["event"]) if "a contact appears" in e]
+        contacts = [k for k, e in enumerate(b.points["event"]) if e == "obstacle_reached"]
+        self.assertIn("a contact appears", " ".join(b.contact_changes))
         self.assertEqual(len(contacts), 1)
         self.assertEqual(branches[contacts[0]], 1)
         self.assertAlmostEqual(b.points["y_max"][contacts[0]], 0.2, places=8)

@@ -1,7 +1,9 @@
-// The state file of a long continuation run: its last resumable point, kept beside the branch
-// CSV (branch.csv.state.json) and replaced atomically after every such point, so that a killed
-// run resumes from it without losing or duplicating a row. Shared by `continue` and
-// `plectonemes`.
+// The state file of a long continuation run: a resumable point with the march's whole state
+// there, kept beside the branch CSV (branch.csv.state.json) and replaced atomically (by `continue`
+// at most once a second, continue_outputs.hpp's StateFileSink; by the plectoneme sweep after
+// every such point), so that a killed run resumes from it: the CSV is cut back to the saved
+// point's row and the march repeats the rows after it, none lost or duplicated. The JSON format
+// is the one earlier versions wrote; their files still load.
 #pragma once
 
 #include <filesystem>
@@ -12,7 +14,7 @@
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/continuation.hpp"
 
-namespace kirchhoff::cli {
+namespace kirchhoff {
 
 // A row a run wrote, with what a run started from it (--start-from) needs beside the point: the
 // active set its unknowns belong to, the phase condition of its problem and its branch.
@@ -92,7 +94,8 @@ struct RunStart {
 RunStart plan_start_from(const std::filesystem::path& state_path, const std::string& start_param,
                          const std::vector<std::pair<std::string, double>>& command_line);
 
-// Keeps the header and the rows whose first column (the row index) is at most `last_index`.
+// Keeps the header and the rows of a branch CSV up to and including the one whose index (first
+// column) is `last_index`; the rows after it, and a row cut short by a kill, are dropped.
 void truncate_csv(const std::filesystem::path& path, int last_index);
 
-}  // namespace kirchhoff::cli
+}  // namespace kirchhoff

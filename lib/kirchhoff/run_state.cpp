@@ -1,4 +1,4 @@
-#include "run_state.hpp"
+#include "kirchhoff/run_state.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 
 #include "kirchhoff/case_file.hpp"
 
-namespace kirchhoff::cli {
+namespace kirchhoff {
 namespace {
 
 namespace fs = std::filesystem;
@@ -297,8 +297,10 @@ void set_contact_march_state(RunState* s, const ContactMarchState& m) {
   s->branch_points_before = m.branch_points_before;
 }
 
-// Keeps the header and the rows up to and including `last_index` (a row written after the
-// state was last saved is dropped, so no point is duplicated on resume).
+// Keeps the header and the rows up to and including `last_index` (rows written after the state
+// was last saved are dropped and computed again, so no point is duplicated on resume). Rows are
+// in order of their index: reading stops after row last_index, so a line a kill cut short after
+// it is dropped whatever its first characters read as.
 void truncate_csv(const std::filesystem::path& path, int last_index) {
   std::ifstream in(path);
   std::string header, line, kept;
@@ -308,10 +310,11 @@ void truncate_csv(const std::filesystem::path& path, int last_index) {
     const int index = std::stoi(line.substr(0, line.find(',')));
     if (index > last_index) break;
     kept += line + "\n";
+    if (index == last_index) break;
   }
   in.close();
   std::ofstream out(path, std::ios::trunc);
   out << header << "\n" << kept;
 }
 
-}  // namespace kirchhoff::cli
+}  // namespace kirchhoff
