@@ -6,6 +6,7 @@
 #include <optional>
 #include <sstream>
 
+#include "kirchhoff/continuation_detectors.hpp"
 #include "kirchhoff/jacobian_lu.hpp"
 #include "kirchhoff/point_record.hpp"
 
@@ -16,8 +17,6 @@ namespace {
 constexpr double kLambdaStep = 1e-6;
 // Step growth and shrink factors: the usual choices for predictor-corrector continuation.
 constexpr double kGrow = 1.5, kShrink = 0.5;
-// The located end point of a run with a target is accepted this close to it (relative).
-constexpr double kTargetTolerance = 1e-9;
 // Secant/Brent location stops when the step interval is this small relative to the step.
 constexpr double kLocateTolerance = 1e-12;
 constexpr int kLocateIterations = 60;
@@ -476,229 +475,203 @@ ContinuationResult Continuation::switch_branch(const ContinuationPoint& bp, cons
   return run_along(bp.x, bp.parameter, d, PointType::BranchPoint, sink);
 }
 
-ContinuationResult Continuation::march(MarchState state, const PointSink& sink, bool report_start) {
-  ContinuationResult result;
-  ContinuationPoint current = std::move(state.current);
-  std::optional<ContinuationPoint> before_current = std::move(state.before);  // the point before `current`, for minima
-  double previous_h = state.previous_step;
-  int branch_points_found = state.branch_points_found;
-  bool just_reported_branch_point = state.just_reported_branch_point;
-  result.refused_steps = state.refused_steps;
-  // Points of this march made before `current` (by the run that a resumed one continues): they
-  // count against max_points as if it had not been interrupted.
-  const int points_before = state.points - 1;
-  const bool has_target = !std::isnan(options_.target);
-  double ds = current.step > 0 ? current.step : options_.initial_step;
-
-  // The march's state right after `current` was accepted, for a run to resume from.
-  auto report_state = [&]() {
-    if (!options_.on_resumable || !resumable_type(current.type)) return;
-    MarchState now;
-    now.current = result.points.back();
-    now.before = before_current;
-    if (now.before) now.before->jacobian.reset();
-    now.previous_step = previous_h;
-    now.just_reported_branch_point = just_reported_branch_point;
-    now.branch_points_found = branch_points_found;
-    now.points = points_before + static_cast<int>(result.points.size());
-    now.refused_steps = result.refused_steps;
-    options_.on_resumable(now);
-  };
-
-  if (report_start) record(&current);
-  result.points.push_back(current);
-  if (current.type != PointType::BranchPoint) result.points.back().jacobian.reset();
-  if (report_start) {
-    if (sink) sink(current);
-    report_state();
+// The march's working state: MarchState's fields, the result so far and the step size. One step
+// is a candidate point (next_candidate), the detectors' special points inside it (detect), those
+// put on the branch with their actions (take_special), then the candidate itself (advance).
+struct Continuation::Marcher {
+  Marcher(Continuation& engine, const PointSink& point_sink, MarchState state)
+      : c(engine),
+        o(engine.options_),
+        sink(point_sink),
+        current(std::move(state.current)),
+        before(std::move(state.before)),
+        previous_h(state.previous_step),
+        just_reported_branch_point(state.just_reported_branch_point),
+        points_before(state.points - 1),
+        ds(current.step > 0 ? current.step : engine.options_.initial_step) {
+    counters.branch_points_found = state.branch_points_found;
+    result.refused_steps = state.refused_steps;
   }
 
+  Continuation& c;
+  const ContinuationOptions& o;
+  const PointSink& sink;
+  ContinuationResult result;
+  ContinuationPoint current;
+  std::optional<ContinuationPoint> before;  // the point before `current`, for minima
+  double previous_h;
+  bool just_reported_branch_point;
+  detail::MarchCounters counters;
+  // Points of this march made before `current` (by the run that a resumed one continues): they
+  // count against max_points as if it had not been interrupted.
+  int points_before;
+  double ds;
   // Only branch points keep their matrix in the branch (for switching); the newest point's moves
   // on to `current`, for the next corrector's chord. A long branch keeping every one would hold
   // n^2 doubles per point.
   std::shared_ptr<const Eigen::MatrixXd> newest_matrix;
-  auto accept = [&](ContinuationPoint p) {
+
+  bool has_room() const { return points_before + static_cast<int>(result.points.size()) < o.max_points; }
+
+  ContinuationResult stop(StopReason reason, std::string message = {}) {
+    result.reason = reason;
+    result.message = std::move(message);
+    return std::move(result);
+  }
+
+  // The march's state right after `current` was accepted, for a run to resume from.
+  void report_state() {
+    if (!o.on_resumable || !resumable_type(current.type)) return;
+    MarchState now;
+    now.current = result.points.back();
+    now.before = before;
+    if (now.before) now.before->jacobian.reset();
+    now.previous_step = previous_h;
+    now.just_reported_branch_point = just_reported_branch_point;
+    now.branch_points_found = counters.branch_points_found;
+    now.points = points_before + static_cast<int>(result.points.size());
+    now.refused_steps = result.refused_steps;
+    o.on_resumable(now);
+  }
+
+  void start(bool report) {
+    if (report) c.record(&current);
+    result.points.push_back(current);
+    if (current.type != PointType::BranchPoint) result.points.back().jacobian.reset();
+    if (!report) return;
+    if (sink) sink(current);
+    report_state();
+  }
+
+  // Puts p on the branch: recorded, then reported.
+  void accept(ContinuationPoint p) {
     p.index = result.points.back().index + 1;
     p.step = ds;
     newest_matrix = std::move(p.jacobian);
     p.jacobian = p.type == PointType::BranchPoint ? newest_matrix : nullptr;
-    record(&p);
+    c.record(&p);
     result.points.push_back(std::move(p));
     if (sink) sink(result.points.back());
-  };
+  }
 
   // A point that kept an older matrix (reuse_jacobian_iterations) gets its own before the step
   // is shrunk: the stale matrix, not the step, may be what failed the corrector or turned the
   // tangent, and shrinking alone then crawls (seen at L/2R = 500: steps of 1e-6 for 1,400 points).
-  auto refresh_current = [&]() {
+  bool refresh_current() {
     if (!current.jacobian_reused) return false;
-    auto fresh = point_at(join(current.x, current.parameter), current.tangent, current.type, current.index,
-                          current.arclength, current.newton_iterations);
+    auto fresh = c.point_at(c.join(current.x, current.parameter), current.tangent, current.type, current.index,
+                            current.arclength, current.newton_iterations);
     if (!fresh) return false;
     fresh->step = current.step;
     // Same unknowns and parameter: the same description, not computed again.
     static_cast<PointRecord&>(*fresh) = static_cast<const PointRecord&>(current);
     current = std::move(*fresh);
     return true;
-  };
+  }
 
-  while (points_before + static_cast<int>(result.points.size()) < options_.max_points) {
-    if (std::chrono::steady_clock::now() >= options_.deadline) {
-      result.reason = StopReason::TimeLimit;
-      result.message = "the wall-clock limit was reached";
-      return result;
-    }
-    auto candidate = step_from(current, ds, PointType::Regular);
+  // The corrected point a step ds ahead, if it is taken: a corrector failure, a turn of the
+  // tangent beyond max_tangent_angle or a refusal of step_check shortens the step instead (none),
+  // down to the minimum step, where the run stops (*stop).
+  std::optional<ContinuationPoint> next_candidate(std::optional<detail::Stop>* stop) {
+    auto candidate = c.step_from(current, ds, PointType::Regular);
     if (!candidate) {
-      if (refresh_current()) continue;
+      if (refresh_current()) return std::nullopt;
       ds *= kShrink;
-      if (ds < options_.min_step) {
-        result.reason = StopReason::StepTooSmall;
-        result.message = "the corrector failed down to the minimum step (last failure: " + last_corrector_failure_ + ")";
-        return result;
-      }
-      continue;
+      if (ds < o.min_step)
+        *stop = {StopReason::StepTooSmall,
+                 "the corrector failed down to the minimum step (last failure: " + c.last_corrector_failure_ + ")"};
+      return std::nullopt;
     }
     const double angle = std::acos(std::clamp(current.tangent.dot(candidate->tangent), -1.0, 1.0));
-    if (angle > options_.max_tangent_angle && ds > options_.min_step) {
-      if (refresh_current()) continue;
-      ds = std::max(ds * kShrink, options_.min_step);
-      continue;
+    if (angle > o.max_tangent_angle && ds > o.min_step) {
+      if (!refresh_current()) ds = std::max(ds * kShrink, o.min_step);
+      return std::nullopt;
     }
-    if (options_.step_check) {
-      const std::string refusal = options_.step_check(current, *candidate);
-      if (!refusal.empty()) {
-        ++result.refused_steps;
-        if (ds * kShrink < options_.min_step) {
-          result.reason = StopReason::Inadmissible;
-          result.message = refusal + " (refused down to the minimum step)";
-          return result;
-        }
-        ds *= kShrink;
-        continue;
-      }
-    }
+    const std::string refusal = o.step_check ? o.step_check(current, *candidate) : std::string();
+    if (refusal.empty()) return candidate;
+    ++result.refused_steps;
+    if (ds * kShrink < o.min_step)
+      *stop = {StopReason::Inadmissible, refusal + " (refused down to the minimum step)"};
+    else
+      ds *= kShrink;
+    return std::nullopt;
+  }
 
-    // Special points inside this step, each with its position h along it.
-    std::vector<std::pair<double, ContinuationPoint>> special;
-    bool stop = false;
-    StopReason stop_reason = StopReason::MaxPoints;
-    auto crossed = [](double a, double b) { return (a < 0) != (b < 0) && a != 0.0; };
-    if (has_target && crossed(current.parameter - options_.target, candidate->parameter - options_.target)) {
-      auto p = locate(current, ds, [&](const ContinuationPoint& q) { return q.parameter - options_.target; }, false,
-                      PointType::Endpoint);
-      // A corrector that failed inside the step leaves locate with a point short of the target (or
-      // the whole step's, beyond it): retry with a shorter step rather than stop off the target.
-      if (p && std::abs(p->parameter - options_.target) > kTargetTolerance * std::max(1.0, std::abs(options_.target)) &&
-          ds * kShrink >= options_.min_step) {
-        ds *= kShrink;
-        continue;
-      }
-      if (p) {
-        special.push_back({(p->arclength - current.arclength), *p});
-        stop = true;
-        stop_reason = StopReason::ReachedTarget;
-      }
-    }
-    for (double bound : {options_.parameter_min, options_.parameter_max}) {
-      if (std::isfinite(bound) && crossed(current.parameter - bound, candidate->parameter - bound)) {
-        auto p = locate(current, ds, [&](const ContinuationPoint& q) { return q.parameter - bound; }, false,
-                        PointType::Endpoint);
-        if (p) {
-          special.push_back({p->arclength - current.arclength, *p});
-          stop = true;
-          stop_reason = StopReason::ParameterBounds;
-        }
-      }
-    }
-    if (options_.detect_folds && crossed(current.tangent[n_], candidate->tangent[n_])) {
-      auto p = locate(current, ds, [&](const ContinuationPoint& q) { return q.tangent[n_]; }, false, PointType::Fold);
-      if (p) special.push_back({p->arclength - current.arclength, *p});
-    }
-    bool simple_bp = false;
-    if (options_.detect_branch_points && crossed(current.determinant, candidate->determinant)) {
-      auto p = locate(current, ds, [](const ContinuationPoint& q) { return q.determinant; }, false,
-                      PointType::BranchPoint);
-      if (p) {
-        p->multiplicity = std::max(1, p->small_count);
-        special.push_back({p->arclength - current.arclength, *p});
-        simple_bp = true;
-      }
-    }
-    // Branch points that keep the determinant's sign (even multiplicity): a local minimum of
-    // the smallest singular value over the last two steps that is, once located, tiny.
-    // (Skipped right after a branch point was reported: the minimum is that point again.)
-    if (options_.detect_branch_points && !simple_bp && before_current && !just_reported_branch_point &&
-        current.smallest_singular < before_current->smallest_singular &&
-        current.smallest_singular < candidate->smallest_singular) {
-      auto p = locate(*before_current, previous_h + ds, [](const ContinuationPoint& q) { return q.smallest_singular; },
-                      true, PointType::BranchPoint);
-      if (p && p->smallest_singular < options_.branch_point_tolerance) {
-        p->multiplicity = std::max(1, p->small_count);
-        // It may lie just behind `current` (already recorded): points are in detection order.
-        special.push_back({p->arclength - current.arclength, *p});
-      }
-    }
-    for (const auto& e : options_.events) {
-      const double a = current.derived.count(e.quantity) ? current.derived.at(e.quantity) - e.value : NAN;
-      const double b = candidate->derived.count(e.quantity) ? candidate->derived.at(e.quantity) - e.value : NAN;
-      if (std::isfinite(a) && std::isfinite(b) && crossed(a, b)) {
-        auto p = locate(current, ds, [&](const ContinuationPoint& q) { return q.derived.at(e.quantity) - e.value; },
-                        false, PointType::Event);
-        if (p) {
-          p->event = e.label.empty() ? e.quantity + "=" + std::to_string(e.value) : e.label;
-          special.push_back({p->arclength - current.arclength, *p});
-          if (e.stop) {
-            stop = true;
-            stop_reason = StopReason::EventStop;
-          }
-        }
-      }
-    }
-    std::sort(special.begin(), special.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    just_reported_branch_point = false;
-    for (const auto& sp : special) just_reported_branch_point |= sp.second.type == PointType::BranchPoint;
-    for (auto& [h, p] : special) {
-      accept(p);
-      if (p.type == PointType::BranchPoint) ++branch_points_found;
-      if (p.type == PointType::Fold && options_.stop_at_fold) {
-        result.reason = StopReason::FoldStop;
-        result.message = "fold at " + options_.parameter + " = " + std::to_string(p.parameter);
-        return result;
-      }
-      if (p.type == PointType::BranchPoint && options_.stop_at_branch_point > 0 &&
-          branch_points_found >= options_.stop_at_branch_point) {
-        result.reason = StopReason::BranchPointStop;
-        result.message = "branch point " + std::to_string(branch_points_found);
-        return result;
-      }
-      if (stop && (p.type == PointType::Endpoint || p.type == PointType::Event)) {
-        if (p.type == PointType::Event && stop_reason == StopReason::EventStop) {
-          result.reason = stop_reason;
-          result.message = "event " + p.event;
-          return result;
-        }
-        if (p.type == PointType::Endpoint) {
-          result.reason = stop_reason;
-          return result;
-        }
-      }
-    }
+  // Every detector on the step current -> candidate, in order; false: one asks for the step
+  // again, shorter.
+  bool detect(const std::vector<std::unique_ptr<detail::Detector>>& detectors, const ContinuationPoint& candidate,
+              std::vector<detail::Detection>* found) {
+    const detail::StepView step{current, candidate, before ? &*before : nullptr, ds, previous_h,
+                                just_reported_branch_point, ds * kShrink >= o.min_step,
+                                [this](const ContinuationPoint& from, double h_max, const detail::TestFunction& test,
+                                       bool minimise, PointType type) {
+                                  return c.locate(from, h_max, test, minimise, type);
+                                }};
+    for (const auto& d : detectors)
+      if (d->detect(step, found) == detail::Verdict::RetryShorter) return false;
+    return true;
+  }
 
-    const int iterations = candidate->newton_iterations;
-    before_current = std::move(current);
+  // The special points of a step on the branch, in order along it, each acted on by its detector.
+  // A step in which a stopping detector found its point ends the run at its first end point, or
+  // with a stopping event at its first event point (the reason of the last such detection).
+  std::optional<detail::Stop> take_special(std::vector<detail::Detection> found) {
+    std::optional<StopReason> step_stop;
+    for (const auto& d : found)
+      if (d.stop) step_stop = d.stop;
+    const double s0 = current.arclength;
+    std::sort(found.begin(), found.end(), [s0](const detail::Detection& a, const detail::Detection& b) {
+      return a.point.arclength - s0 < b.point.arclength - s0;
+    });
+    just_reported_branch_point = std::any_of(found.begin(), found.end(), [](const detail::Detection& d) {
+      return d.point.type == PointType::BranchPoint;
+    });
+    for (auto& d : found) {
+      accept(d.point);
+      const ContinuationPoint& p = result.points.back();
+      if (auto s = d.detector->act(p, &counters)) return s;
+      if (step_stop && p.type == PointType::Endpoint) return detail::Stop{*step_stop, ""};
+      if (step_stop == StopReason::EventStop && p.type == PointType::Event)
+        return detail::Stop{StopReason::EventStop, "event " + p.event};
+    }
+    return std::nullopt;
+  }
+
+  // The candidate on the branch as the new current point. The next step is decided before the
+  // point is reported, so that a run resumed from it takes the same step as the uninterrupted one.
+  void advance(ContinuationPoint candidate) {
+    const int iterations = candidate.newton_iterations;
+    before = std::move(current);
     previous_h = ds;
-    // The next step is decided before the point is reported, so that a run resumed from it takes
-    // the same step as the uninterrupted one.
-    if (iterations <= options_.grow_iterations) ds = std::min(ds * kGrow, options_.max_step);
-    if (iterations >= options_.shrink_iterations) ds = std::max(ds * kShrink, options_.min_step);
-    accept(std::move(*candidate));
+    if (iterations <= o.grow_iterations) ds = std::min(ds * kGrow, o.max_step);
+    if (iterations >= o.shrink_iterations) ds = std::max(ds * kShrink, o.min_step);
+    accept(std::move(candidate));
     current = result.points.back();
     current.jacobian = std::move(newest_matrix);
     report_state();
   }
-  result.reason = StopReason::MaxPoints;
-  return result;
+};
+
+ContinuationResult Continuation::march(MarchState state, const PointSink& sink, bool report_start) {
+  Marcher m(*this, sink, std::move(state));
+  m.start(report_start);
+  const auto detectors = detail::make_detectors(options_, n_);
+  while (m.has_room()) {
+    if (std::chrono::steady_clock::now() >= options_.deadline)
+      return m.stop(StopReason::TimeLimit, "the wall-clock limit was reached");
+    std::optional<detail::Stop> stop;
+    auto candidate = m.next_candidate(&stop);
+    if (stop) return m.stop(stop->first, stop->second);
+    if (!candidate) continue;
+    std::vector<detail::Detection> found;
+    if (!m.detect(detectors, *candidate, &found)) {
+      m.ds *= kShrink;
+      continue;
+    }
+    if (auto s = m.take_special(std::move(found))) return m.stop(s->first, s->second);
+    m.advance(std::move(*candidate));
+  }
+  return m.stop(StopReason::MaxPoints);
 }
 
 SymmetricBranchStart axial_symmetry_branch(Continuation& straight, const ContinuationPoint& bp, double sign) {

@@ -150,6 +150,7 @@ struct ContinuationPoint : PointRecord {
   int newton_iterations = 0;
   bool jacobian_reused = false;  // its matrix is the previous point's (reuse_jacobian_iterations)
   std::string event;        // events: the quantity that crossed
+  int event_index = -1;     // events: which of the options' events crossed (its index there)
   double step = 0.0;        // step size after this point
   // Test functions: det [F_x F_lambda; t^T], and the smallest singular value of that matrix
   // over its largest, with the count of singular values below branch_point_tolerance (both left
@@ -263,8 +264,10 @@ class Continuation {
   ContinuationPoint make_point(const Eigen::VectorXd& z, const Eigen::VectorXd& t,
                                std::shared_ptr<const Eigen::MatrixXd> A, bool reused, PointType type, int index,
                                double arclength, int iterations);
-  // Marches on from `state` (its `current` reported to the sink first when report_start).
+  // Marches on from `state` (its `current` reported to the sink first when report_start): the
+  // steps, and the special points the detectors (continuation_detectors.hpp) find inside them.
   ContinuationResult march(MarchState state, const PointSink& sink, bool report_start = true);
+  struct Marcher;  // the march's working state and its parts (continuation.cpp)
   // Locates where `monitor` (of the point reached from `from` by a step h) vanishes or is
   // minimal, by the secant method or Brent on h in (0, h_max].
   std::optional<ContinuationPoint> locate(const ContinuationPoint& from, double h_max,
