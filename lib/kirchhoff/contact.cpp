@@ -451,6 +451,202 @@ std::string complementarity_violation(const ContinuationPoint& p, const ContactO
   return what.str();
 }
 
+// The changes of the active set a contact leg stops at (contact.hpp says what each does), each a
+// stopping event of the leg on a derived quantity.
+enum class ContactChange {
+  ObstacleReached,
+  ContactLiftsOff,
+  FlatContactBuckles,
+  ContactShrinksToAPoint,
+  ContactFlattens,
+  WrapTensionVanishes,
+};
+
+// What the handler of a change works on, the leg's event point, and what it leaves for the next leg.
+struct ChangeAt {
+  const ShootingProblem& here;                // the leg's problem at the event's parameter
+  const ContinuationPoint& at;
+  const std::vector<PointContact>& contacts;  // the leg's active set, solved at `at`
+  const ContactOptions& contact;
+  std::ostringstream& change;                 // what changed, for the log
+  std::vector<PointContact> next = {};        // the next leg's active set
+  std::optional<ContinuationPoint> fold_onset = {};  // the next leg leaves the flat branch here...
+  size_t fold_contact = 0;                           // ...along the fold after this contact
+  std::optional<size_t> unwound_contact = {};        // a contact that has just shrunk to a point
+};
+// A change after which the run ends instead of starting a leg: why, and whether the point is
+// inadmissible (a change that is not modelled) rather than a plain stop.
+struct RunEnd {
+  std::string message;
+  bool inadmissible = true;
+};
+using ChangeHandler = std::optional<RunEnd> (*)(ChangeAt&);
+
+std::optional<RunEnd> wrap_tension_vanishes(ChangeAt&) {
+  return RunEnd{"the tension of a wrapped part vanishes: beyond, it would pull on the disc and lift off inside the "
+                "wrap, which is not modelled"};
+}
+
+// The reverse of contact_flattens: the extended contact becomes a point contact carrying both edge
+// forces (at zero length they act at the same point, along the same normal).
+std::optional<RunEnd> contact_shrinks_to_a_point(ChangeAt& c) {
+  c.next = c.contacts;
+  const auto shortest = std::min_element(c.next.begin(), c.next.end(), [](const auto& a, const auto& b) {
+    return (a.extended ? a.s_end - a.s : INFINITY) < (b.extended ? b.s_end - b.s : INFINITY);
+  });
+  c.change << "the extended contact at s = " << shortest->s << " shrinks to a point contact";
+  shortest->extended = false;
+  shortest->force += shortest->force_end;
+  shortest->s_end = shortest->s;
+  shortest->force_end = 0.0;
+  c.unwound_contact = static_cast<size_t>(shortest - c.next.begin());
+  return std::nullopt;
+}
+
+// Beyond, the flat branch is unstable: the flat part buckles away from the obstacle into a hanging
+// fold, two point contacts with a blister between them.
+std::optional<RunEnd> flat_contact_buckles(ChangeAt& c) {
+  const size_t which = buckling_flat_contact(c.here, c.at.x, c.contacts);
+  c.change << "the flat contact over [" << c.contacts[which].s << ", " << c.contacts[which].s_end
+           << "] buckles away from the obstacle: a hanging fold";
+  c.next = split_into_fold(c.contacts, which);
+  c.fold_onset = c.at;
+  c.fold_contact = which;
+  return std::nullopt;
+}
+
+// The point contact whose curvature away from the obstacle vanished becomes an extended contact of
+// zero length there; it grows along the obstacle from the next leg on.
+std::optional<RunEnd> contact_flattens(ChangeAt& c) {
+  const ShootingProblem& here = c.here;
+  const ContinuationPoint& at = c.at;
+  c.next = c.contacts;
+  double smallest = INFINITY;
+  size_t which = 0;
+  for (size_t k = 0; k < c.contacts.size(); ++k) {
+    if (c.contacts[k].extended) continue;
+    const double g2 = here.contact_bending(at.x, c.contacts[k]);
+    if (g2 < smallest) {
+      smallest = g2;
+      which = k;
+    }
+  }
+  PointContact& p = c.next[which];
+  const Obstacle o = here.obstacles(here.parameters_at(at.x))[p.obstacle];
+  // The rod's curvature has reached the obstacle's: beyond, it would lie on it over an interval.
+  if (const std::string e = extended_contact_unsupported(*here.equations(here.parameters_at(at.x)), o); !e.empty())
+    return RunEnd{"the contact at s = " + std::to_string(p.s) + " starts to wrap around " + o.describe() + ": " + e};
+  if (!here.equations(here.parameters_at(at.x))->is_planar())
+    return RunEnd{"the contact at s = " + std::to_string(p.s) + " starts to wrap around " + o.describe() +
+                  ": a spatial rod lying on a cylinder is solved by multiple shooting (rod_on_cylinder.hpp), "
+                  "and contact continuation is single shooting - following the wrap here is not implemented"};
+  if (!o.is_flat()) {
+    // A wrap presses on the disc with its tension / radius: in compression the rod cannot lie
+    // on the disc, it would touch it at two points either side instead.
+    const RodPoint r = here.sample(at.x, {p.s}).front();
+    const double tension = r.n.dot(r.R.col(2));
+    if (tension < -c.contact.force_tolerance)
+      return RunEnd{"the contact at s = " + std::to_string(p.s) + " reaches the curvature of " + o.describe() +
+                    " in compression (n.t = " + std::to_string(tension) +
+                    "): it would touch the disc at two points either side, which is not implemented"};
+  }
+  p.extended = true;
+  p.s_end = p.s;
+  p.force_end = 0.5 * p.force;
+  p.force *= 0.5;
+  c.change << "the contact at s = " << p.s
+           << (o.is_flat() ? " flattens into an extended contact" : " starts to wrap around the obstacle");
+  return std::nullopt;
+}
+
+std::optional<RunEnd> contact_lifts_off(ChangeAt& c) {
+  const auto weakest = std::min_element(c.contacts.begin(), c.contacts.end(),
+                                        [](const auto& a, const auto& b) { return a.force < b.force; });
+  c.change << "the contact at s = " << weakest->s << " lifts off";
+  c.next = c.contacts;
+  c.next.erase(c.next.begin() + (weakest - c.contacts.begin()));
+  return std::nullopt;
+}
+
+// Where the rod reaches an obstacle: the smallest gap, refined between samples.
+std::optional<RunEnd> obstacle_reached(ChangeAt& c) {
+  const ClosestApproach reached = sampled_closest_approach(c.here, c.at.x, c.contact.samples);
+  const int which = reached.obstacle;
+  const double margin = 2.0 * reached.spacing;
+  for (const auto& a : c.contacts)
+    if (a.obstacle == which && reached.s > a.s - margin && reached.s < (a.extended ? a.s_end : a.s) + margin)
+      return RunEnd{"the rod penetrates the obstacle next to an active contact at s = " + std::to_string(reached.s) +
+                        " (a curved obstacle or a lift-off pattern not modelled): the run stops here",
+                    false};
+  const double where = closest_approach(c.here, c.at.x, c.contact.samples).s;
+  c.change << "a contact appears with obstacle " << which << " at s = " << where;
+  c.next = c.contacts;
+  c.next.push_back({which, where, 0.0});
+  std::sort(c.next.begin(), c.next.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
+  return std::nullopt;
+}
+
+// The table of changes, in the order of ContactChange: the derived quantity each one's event
+// watches, the event's label (the point's `event` until the change is logged) and its handler.
+struct ContactChangeKind {
+  ContactChange change;
+  const char* quantity;
+  const char* label;
+  ChangeHandler handle;
+};
+const ContactChangeKind kContactChanges[] = {
+    {ContactChange::ObstacleReached, "min_gap", "obstacle_reached", obstacle_reached},
+    {ContactChange::ContactLiftsOff, "min_contact_force", "contact_lifts_off", contact_lifts_off},
+    {ContactChange::FlatContactBuckles, "flat_contact_margin", "flat_contact_buckles", flat_contact_buckles},
+    {ContactChange::ContactShrinksToAPoint, "min_contact_length", "contact_shrinks_to_a_point",
+     contact_shrinks_to_a_point},
+    {ContactChange::ContactFlattens, "contact_bending", "contact_flattens", contact_flattens},
+    {ContactChange::WrapTensionVanishes, "min_wrap_tension", "wrap_tension_vanishes", wrap_tension_vanishes},
+};
+const ContactChangeKind& kind_of(ContactChange change) { return kContactChanges[static_cast<int>(change)]; }
+
+// A leg's options: the run's, with a stopping event for each change its active set d can undergo
+// after the caller's events (`changes` says which change each of those is, in order), and its
+// share of the run's max_points and branch points. bending_event: where contact_flattens is armed.
+ContinuationOptions leg_options(const ContinuationOptions& options, const ProblemDefinition& d,
+                                const ContactOptions& contact, double bending_event,
+                                std::vector<ContactChange>* changes) {
+  ContinuationOptions leg = options;
+  changes->clear();
+  const auto add = [&](ContactChange change, double value) {
+    leg.events.push_back({kind_of(change).quantity, value, true, kind_of(change).label});
+    changes->push_back(change);
+  };
+  // The gap event sits at -penetration_tolerance: an active contact touches with a gap of 0 up to
+  // round-off, whose sign must not count as a crossing.
+  add(ContactChange::ObstacleReached, -contact.penetration_tolerance);
+  leg.samples = std::max(leg.samples, contact.samples);
+  if (!d.contacts.empty()) add(ContactChange::ContactLiftsOff, 0.0);
+  const bool has_point = std::any_of(d.contacts.begin(), d.contacts.end(), [](const auto& c) { return !c.extended; });
+  // With an extended contact the Jacobian is singular all along the branch (smallest singular
+  // value ~1e-9 of the largest on wall.toml), so the bordered determinant's sign is noise.
+  // Cause: H is invariant and equals -P on the flat part (theta = 0, kappa = 0), so wherever
+  // else the rod is parallel to the obstacle - at an end clamped parallel to it - the curvature
+  // vanishes too. That end's moment m0 is then a double root (H = EI kappa0^2 / 2 - P = -P),
+  // and to first order the arc between the clamp and the flat part can slide along itself
+  // (m0 and s change together, the tangency rows do not see it): the null vector of F_x is
+  // (dm0, ds) = (1, 1 / n_y). The solution is isolated only at second order. Branch points
+  // are not looked for rather than reported falsely; removing the degeneracy would need the
+  // double root replaced by its square root (kappa0 = 0 imposed at such an end).
+  if (has_extended_contact(d.contacts)) {
+    leg.detect_branch_points = false;
+    add(ContactChange::FlatContactBuckles, 0.0);
+    add(ContactChange::ContactShrinksToAPoint, 0.0);
+  }
+  // After a contact shrank to a point its g'' starts at ~0 (to the event's location, not
+  // exactly): the event is armed at that start value, so the start is not a crossing.
+  if (has_point && d.kind == RodKind::Planar) add(ContactChange::ContactFlattens, bending_event);
+  // A wrapped part presses on its disc with tension / radius: where the tension would turn to
+  // compression the rod leaves the disc inside the wrap.
+  if (has_wrap(d)) add(ContactChange::WrapTensionVanishes, 0.0);
+  return leg;
+}
+
 // The legs of a contact continuation, from unknowns x (a new run) or from a saved state (a resume).
 ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const ContactMarchState* resume_from,
                                    ContinuationOptions options, const PointSink& sink, const ContactOptions& contact,
@@ -472,40 +668,14 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
   std::optional<size_t> unwound_contact;  // which one, set at the event
   while (true) {
     const bool resuming = first_leg && resume_from;
-    ContinuationOptions leg = options;
+    // After a contact shrank to a point, contact_flattens is armed at its g'' there.
+    const double bending_event = resuming ? resume_from->contact_bending_event : unwound_bending.value_or(0.0);
+    unwound_bending.reset();
+    std::vector<ContactChange> changes;  // of the leg's events after the caller's
+    ContinuationOptions leg = leg_options(options, d, contact, bending_event, &changes);
     // (A later leg's start is the last point of the previous one, counted there.)
     leg.max_points = resuming ? resume_from->leg_max_points : max_points - reported + (run_first_leg ? 0 : 1);
     if (options.stop_at_branch_point > 0) leg.stop_at_branch_point = options.stop_at_branch_point - branch_points_before;
-    // The gap event sits at -penetration_tolerance: an active contact touches with a gap of 0 up to
-    // round-off, whose sign must not count as a crossing.
-    leg.events.push_back({"min_gap", -contact.penetration_tolerance, true, "obstacle_reached"});
-    leg.samples = std::max(leg.samples, contact.samples);
-    if (!d.contacts.empty()) leg.events.push_back({"min_contact_force", 0.0, true, "contact_lifts_off"});
-    const bool has_point = std::any_of(d.contacts.begin(), d.contacts.end(), [](const auto& c) { return !c.extended; });
-    // With an extended contact the Jacobian is singular all along the branch (smallest singular
-    // value ~1e-9 of the largest on wall.toml), so the bordered determinant's sign is noise.
-    // Cause: H is invariant and equals -P on the flat part (theta = 0, kappa = 0), so wherever
-    // else the rod is parallel to the obstacle - at an end clamped parallel to it - the curvature
-    // vanishes too. That end's moment m0 is then a double root (H = EI kappa0^2 / 2 - P = -P),
-    // and to first order the arc between the clamp and the flat part can slide along itself
-    // (m0 and s change together, the tangency rows do not see it): the null vector of F_x is
-    // (dm0, ds) = (1, 1 / n_y). The solution is isolated only at second order. Branch points
-    // are not looked for rather than reported falsely; removing the degeneracy would need the
-    // double root replaced by its square root (kappa0 = 0 imposed at such an end).
-    if (has_extended_contact(d.contacts)) {
-      leg.detect_branch_points = false;
-      leg.events.push_back({"flat_contact_margin", 0.0, true, "flat_contact_buckles"});
-      leg.events.push_back({"min_contact_length", 0.0, true, "contact_shrinks_to_a_point"});
-    }
-    // After a contact shrank to a point its g'' starts at ~0 (to the event's location, not
-    // exactly): the event is armed at that start value, so the start is not a crossing.
-    const double bending_event = resuming ? resume_from->contact_bending_event : unwound_bending.value_or(0.0);
-    if (has_point && d.kind == RodKind::Planar)
-      leg.events.push_back({"contact_bending", bending_event, true, "contact_flattens"});
-    unwound_bending.reset();
-    // A wrapped part presses on its disc with tension / radius: where the tension would turn to
-    // compression the rod leaves the disc inside the wrap.
-    if (has_wrap(d)) leg.events.push_back({"min_wrap_tension", 0.0, true, "wrap_tension_vanishes"});
     const ShootingProblem problem(d);
     if (active_set_sink) active_set_sink(d.contacts);
     // A leg starts on the previous leg's last point, which is already reported. A point that
@@ -567,101 +737,20 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
     std::ostringstream change;
     change << options.parameter << " = " << at.parameter << ": ";
     const auto contacts = here.contacts_at(at.x);
-    // Ends the run at this event, for a change of the active set that is not modelled.
-    const auto stop_here = [&](const std::string& why) {
-      out.result.reason = StopReason::Inadmissible;
-      out.result.message = why + "; the run stops here";
+    // A stopping event of the caller's ends the run there; the leg's own change the active set.
+    const int own = at.event_index - static_cast<int>(options.events.size());
+    if (own < 0) return out;
+    ChangeAt c{here, at, contacts, contact, change};
+    if (const auto end = kind_of(changes[own]).handle(c)) {
+      if (end->inadmissible) out.result.reason = StopReason::Inadmissible;
+      out.result.message = end->inadmissible ? end->message + "; the run stops here" : end->message;
       out.changes.push_back(change.str() + out.result.message);
       return out;
-    };
-    if (at.event == "wrap_tension_vanishes")
-      return stop_here("the tension of a wrapped part vanishes: beyond, it would pull on the disc and lift off inside "
-                       "the wrap, which is not modelled");
-    if (at.event == "contact_shrinks_to_a_point") {
-      // The reverse of contact_flattens: the extended contact becomes a point contact carrying both
-      // edge forces (at zero length they act at the same point, along the same normal).
-      d.contacts = contacts;
-      const auto shortest = std::min_element(d.contacts.begin(), d.contacts.end(), [](const auto& a, const auto& b) {
-        return (a.extended ? a.s_end - a.s : INFINITY) < (b.extended ? b.s_end - b.s : INFINITY);
-      });
-      change << "the extended contact at s = " << shortest->s << " shrinks to a point contact";
-      shortest->extended = false;
-      shortest->force += shortest->force_end;
-      shortest->s_end = shortest->s;
-      shortest->force_end = 0.0;
-      unwound_contact = static_cast<size_t>(shortest - d.contacts.begin());
-    } else if (at.event == "flat_contact_buckles") {
-      // Beyond, the flat branch is unstable: the flat part buckles away from the obstacle into a
-      // hanging fold, two point contacts with a blister between them.
-      const size_t which = buckling_flat_contact(here, at.x, contacts);
-      change << "the flat contact over [" << contacts[which].s << ", " << contacts[which].s_end
-             << "] buckles away from the obstacle: a hanging fold";
-      d.contacts = split_into_fold(contacts, which);
-      fold_onset = at;
-      fold_contact = which;
-    } else if (at.event == "contact_flattens") {
-      // The point contact whose curvature away from the obstacle vanished becomes an extended
-      // contact of zero length there; it grows along the obstacle from the next leg on.
-      d.contacts = contacts;
-      double smallest = INFINITY;
-      size_t which = 0;
-      for (size_t k = 0; k < contacts.size(); ++k) {
-        if (contacts[k].extended) continue;
-        const double g2 = here.contact_bending(at.x, contacts[k]);
-        if (g2 < smallest) {
-          smallest = g2;
-          which = k;
-        }
-      }
-      PointContact& c = d.contacts[which];
-      const Obstacle o = here.obstacles(here.parameters_at(at.x))[c.obstacle];
-      // The rod's curvature has reached the obstacle's: beyond, it would lie on it over an interval.
-      if (const std::string e = extended_contact_unsupported(*here.equations(here.parameters_at(at.x)), o); !e.empty())
-        return stop_here("the contact at s = " + std::to_string(c.s) + " starts to wrap around " + o.describe() + ": " + e);
-      if (!here.equations(here.parameters_at(at.x))->is_planar())
-        return stop_here("the contact at s = " + std::to_string(c.s) + " starts to wrap around " + o.describe() +
-                         ": a spatial rod lying on a cylinder is solved by multiple shooting (rod_on_cylinder.hpp), "
-                         "and contact continuation is single shooting - following the wrap here is not implemented");
-      if (!o.is_flat()) {
-        // A wrap presses on the disc with its tension / radius: in compression the rod cannot lie
-        // on the disc, it would touch it at two points either side instead.
-        const RodPoint p = here.sample(at.x, {c.s}).front();
-        const double tension = p.n.dot(p.R.col(2));
-        if (tension < -contact.force_tolerance)
-          return stop_here("the contact at s = " + std::to_string(c.s) + " reaches the curvature of " + o.describe() +
-                           " in compression (n.t = " + std::to_string(tension) +
-                           "): it would touch the disc at two points either side, which is not implemented");
-      }
-      c.extended = true;
-      c.s_end = c.s;
-      c.force_end = 0.5 * c.force;
-      c.force *= 0.5;
-      change << "the contact at s = " << c.s << (o.is_flat() ? " flattens into an extended contact" : " starts to wrap around the obstacle");
-    } else if (at.event == "contact_lifts_off") {
-      auto weakest = std::min_element(contacts.begin(), contacts.end(),
-                                      [](const auto& a, const auto& b) { return a.force < b.force; });
-      change << "the contact at s = " << weakest->s << " lifts off";
-      d.contacts = contacts;
-      d.contacts.erase(d.contacts.begin() + (weakest - contacts.begin()));
-    } else {
-      // Where the rod reaches an obstacle: the smallest gap, refined between samples.
-      const ClosestApproach reached = sampled_closest_approach(here, at.x, contact.samples);
-      const int which = reached.obstacle;
-      const double margin = 2.0 * reached.spacing;
-      for (const auto& c : contacts)
-        if (c.obstacle == which && reached.s > c.s - margin && reached.s < (c.extended ? c.s_end : c.s) + margin) {
-          out.result.message = "the rod penetrates the obstacle next to an active contact at s = " +
-                               std::to_string(reached.s) +
-                               " (a curved obstacle or a lift-off pattern not modelled): the run stops here";
-          out.changes.push_back(change.str() + out.result.message);
-          return out;
-        }
-      const double where = closest_approach(here, at.x, contact.samples).s;
-      change << "a contact appears with obstacle " << which << " at s = " << where;
-      d.contacts = contacts;
-      d.contacts.push_back({which, where, 0.0});
-      std::sort(d.contacts.begin(), d.contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
     }
+    d.contacts = std::move(c.next);
+    if (c.fold_onset) fold_onset = std::move(c.fold_onset);
+    fold_contact = c.fold_contact;
+    unwound_contact = c.unwound_contact;
     out.changes.push_back(change.str());
     out.result.points.back().event = change.str();
     // The next leg starts from the same configuration with the new set.
