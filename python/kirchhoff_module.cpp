@@ -39,6 +39,7 @@
 #include "kirchhoff/solution.hpp"
 #include "kirchhoff/discrete_stability.hpp"
 #include "kirchhoff/stability.hpp"
+#include "kirchhoff/sweep_run.hpp"
 #include "kirchhoff/vibration.hpp"
 #include "plectonemes_command.hpp"  // apps/: the sweep behind `kirchhoff plectonemes`
 #include "result_json.hpp"          // apps/: the JSON blocks the CLI prints
@@ -548,6 +549,33 @@ py::dict csv_columns(const std::string& path) {
 }
 
 // The Fig. 11 sweep (the CLI's `plectonemes`): each slenderness's branches, as the CSVs it wrote.
+// kirchhoff.sweep(spec, out): the serial sweep (sweep_run.hpp), its index as columns: numbers
+// (NaN where empty) in the numeric columns, text in the others.
+py::dict py_sweep(const std::string& spec_path, const std::string& out, bool resume) {
+  SweepSummary summary;
+  try {
+    const SweepSpec spec = load_sweep(spec_path);
+    SweepRunOptions options;
+    options.out_dir = out;
+    options.resume = resume;
+    py::gil_scoped_release release;
+    summary = kirchhoff::run_sweep(spec, options);
+  } catch (const SweepError& e) {
+    throw CaseError(e.what());
+  }
+  py::dict columns;
+  const SweepIndex& index = summary.index;
+  for (std::size_t k = 0; k < index.columns.size(); ++k) {
+    py::list column;
+    for (const auto& row : index.rows) {
+      if (!index.numeric[k]) column.append(row[k]);
+      else column.append(row[k].empty() ? std::numeric_limits<double>::quiet_NaN() : std::stod(row[k]));
+    }
+    columns[py::str(index.columns[k])] = column;
+  }
+  return columns;
+}
+
 py::dict py_plectonemes(const std::string& out, const std::vector<double>& slenderness,
                         const std::vector<double>& turns, const py::object& case_path,
                         const std::vector<double>& from_ply, double turns_min, double hard_from, bool resume,
@@ -890,6 +918,21 @@ Returns:
 
 Raises:
     CaseError (ValueError): the file cannot be used; the message names the key and the reason.)doc");
+
+  m.def("sweep", &py_sweep, py::arg("spec"), py::arg("out"), py::kw_only(), py::arg("resume") = false,
+        R"doc(Runs a sweep file serially (the CLI's `kirchhoff sweep SPEC --out OUT`, the same files:
+OUT/jobs/<id>/, OUT/index.csv, OUT/times.csv; docs/sweeps.md) and returns the index as columns:
+{"job": [...], "kind": [...], <each swept parameter>: [float], "status", "reason",
+"contact_state", "stable_states": [str], "stability_index", "equilibria", "energy", <derived>:
+[float, NaN where not defined]}. A failing job is a row with its status, not an exception.
+
+Args:
+    spec (str): the sweep file.
+    out (str): output folder (created); one holding results is refused unless resume.
+    resume (bool): keep the finished jobs in `out`, run the others.
+
+Raises:
+    CaseError (ValueError): the sweep file or the folder is refused (file, line, key, reason).)doc");
 
   m.def("plectonemes", &py_plectonemes, py::arg("out"), py::arg("slenderness") = std::vector<double>{100},
         py::arg("turns") = std::vector<double>{10}, py::kw_only(), py::arg("case") = py::none(),

@@ -587,6 +587,34 @@ class PlectonemesTest(unittest.TestCase):
             self.assertEqual(os.listdir(tmp), [])  # refused before anything ran
 
 
+class SweepTest(unittest.TestCase):
+    def test_serial_sweep_returns_the_index_as_columns(self):
+        with tempfile.TemporaryDirectory() as d:
+            spec = pathlib.Path(d) / "sweep.toml"
+            spec.write_text(f'case = "{pathlib.Path(case_path("simply_supported.toml")).resolve()}"\n'
+                            '[[jobs]]\nkind = "solve"\ngrid = { theta0 = [0.5, 1.0, 2.0] }\n')
+            out = str(pathlib.Path(d) / "out")
+            index = kirchhoff.sweep(str(spec), out)
+            self.assertEqual(index["job"], ["solve-001", "solve-002", "solve-003"])
+            self.assertEqual(index["theta0"], [0.5, 1.0, 2.0])
+            self.assertEqual(index["status"], ["ok"] * 3)
+            self.assertEqual(index["contact_state"], ["none"] * 3)
+            self.assertEqual(index["stability_index"], [0.0] * 3)
+            self.assertAlmostEqual(index["P"][2], 17.4295934848, places=8)  # Fig. 3, README
+            self.assertTrue((pathlib.Path(out) / "jobs" / "solve-002" / "profile.csv").exists())
+            with self.assertRaises(kirchhoff.CaseError):  # results there already, no resume
+                kirchhoff.sweep(str(spec), out)
+            self.assertEqual(kirchhoff.sweep(str(spec), out, resume=True), index)
+
+    def test_bad_sweep_file_raises_case_error_with_line_and_key(self):
+        with tempfile.TemporaryDirectory() as d:
+            spec = pathlib.Path(d) / "bad.toml"
+            spec.write_text(f'case = "{pathlib.Path(case_path("simply_supported.toml")).resolve()}"\n[[jobs]]\nkind = "solve"\n'
+                            'grid = { nope = [1, 2] }\n')
+            with self.assertRaisesRegex(kirchhoff.CaseError, r"bad.toml:4: key 'jobs\[1\].grid.nope': no parameter"):
+                kirchhoff.sweep(str(spec), str(pathlib.Path(d) / "out"))
+
+
 class EquilibriaTest(unittest.TestCase):
     def test_clamped_clamped_modes_by_energy(self):
         c = kirchhoff.load_case(case_path("clamped_clamped.toml"))

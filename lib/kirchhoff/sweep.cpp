@@ -329,7 +329,8 @@ SweepSpec load_sweep_text(const std::string& text, const std::string& path) {
   spec.path = path;
   if (const Value* v = Reader::find(root, "title")) spec.title = r.string(*v, "title");
   std::string top_case;
-  if (const Value* v = Reader::find(root, "case")) top_case = r.string(*v, "case");
+  const Value* top_case_value = Reader::find(root, "case");
+  if (top_case_value) top_case = r.string(*top_case_value, "case");
   ParameterOverrides top_set;
   if (const Value* v = Reader::find(root, "set")) top_set = r.overrides(*v, "set");
   SolverOverrides top_solver;
@@ -361,6 +362,8 @@ SweepSpec load_sweep_text(const std::string& text, const std::string& path) {
     std::string case_text = top_case;
     const Value* case_value = Reader::find(group, "case");
     if (case_value) case_text = r.string(*case_value, key + ".case");
+    const std::string case_key = case_value ? key + ".case" : "case";
+    if (!case_value) case_value = top_case_value;
     if (case_text.empty()) r.fail(group, key + ".case", "no case: give `case` at the top or in the [[jobs]] table");
     prototype.case_path = resolve(path, case_text);
     prototype.case_name = case_text;
@@ -404,7 +407,7 @@ SweepSpec load_sweep_text(const std::string& text, const std::string& path) {
       c = load_case(prototype.case_path, prototype.set, "", prototype.solver);
     } catch (const CaseError& e) {
       const Value* at = Reader::find(group, "set") ? Reader::find(group, "set") : case_value;
-      r.fail(at ? *at : group, key + (at == case_value ? ".case" : ".set"), e.what());
+      r.fail(at ? *at : group, at == case_value ? case_key : key + ".set", e.what());
     }
     for (const auto& d : c.derived)
       if (std::find(spec.derived_columns.begin(), spec.derived_columns.end(), d) == spec.derived_columns.end())
