@@ -11,7 +11,7 @@
 
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/equilibria.hpp"
-#include "result_json.hpp"
+#include "kirchhoff/result_json.hpp"
 #include "solve_command.hpp"
 
 namespace kirchhoff::cli {

@@ -6,7 +6,7 @@
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/solution.hpp"
-#include "result_json.hpp"
+#include "kirchhoff/result_json.hpp"
 
 namespace kirchhoff::cli {
 namespace {

@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "kirchhoff/vibration.hpp"
-#include "result_json.hpp"
+#include "kirchhoff/result_json.hpp"
 #include "solve_command.hpp"
 
 namespace kirchhoff::cli {

@@ -28,6 +28,8 @@
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/case_continue.hpp"
 #include "kirchhoff/case_solve.hpp"
+#include "kirchhoff/plectoneme_sweep.hpp"
+#include "kirchhoff/result_json.hpp"
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/continuation.hpp"
 #include "kirchhoff/deflated_continuation.hpp"
@@ -41,8 +43,6 @@
 #include "kirchhoff/stability.hpp"
 #include "kirchhoff/sweep_run.hpp"
 #include "kirchhoff/vibration.hpp"
-#include "plectonemes_command.hpp"  // apps/: the sweep behind `kirchhoff plectonemes`
-#include "result_json.hpp"          // apps/: the JSON blocks the CLI prints
 
 namespace py = pybind11;
 
@@ -336,7 +336,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
     }
   }
   // As the CLI's JSON "path" (one builder for both).
-  out.path = py::module_::import("json").attr("loads")(cli::path_json(path).dump());
+  out.path = py::module_::import("json").attr("loads")(path_json(path).dump());
   if (!seed_refused.empty()) throw py::value_error(seed_refused);
   const ShootingResult& r = sol ? sol->result : failed;
   out.status = path_failure.empty() ? to_string(r.summary.status) : path_failure;
@@ -580,7 +580,7 @@ py::dict py_plectonemes(const std::string& out, const std::vector<double>& slend
                         const std::vector<double>& turns, const py::object& case_path,
                         const std::vector<double>& from_ply, double turns_min, double hard_from, bool resume,
                         double sensitivity_tol) {
-  cli::PlectonemesArguments args;
+  PlectonemesArguments args;
   args.case_path = case_path.is_none() ? std::string(KIRCHHOFF_CASES_DIR) + "/plectoneme.toml"
                                        : case_path.cast<std::string>();
   args.out_dir = out;
@@ -597,14 +597,14 @@ py::dict py_plectonemes(const std::string& out, const std::vector<double>& slend
   // GIL is back); resume=True then continues it.
   args.after_point = [] {
     py::gil_scoped_acquire acquire;
-    if (PyErr_CheckSignals() != 0) throw cli::SweepStopped{};
+    if (PyErr_CheckSignals() != 0) throw SweepStopped{};
   };
-  cli::PlectonemeSweep sweep;
+  PlectonemeSweep sweep;
   try {
     py::gil_scoped_release release;
     (void)load_case(args.case_path, {});  // a case file that cannot be used is a CaseError
-    sweep = cli::sweep_plectonemes(args, std::cout);  // so are arguments it refuses
-  } catch (const cli::SweepStopped&) {
+    sweep = sweep_plectonemes(args, std::cout);  // so are arguments it refuses
+  } catch (const SweepStopped&) {
     throw py::error_already_set();
   }
   py::dict branches;
@@ -937,7 +937,7 @@ Raises:
   m.def("plectonemes", &py_plectonemes, py::arg("out"), py::arg("slenderness") = std::vector<double>{100},
         py::arg("turns") = std::vector<double>{10}, py::kw_only(), py::arg("case") = py::none(),
         py::arg("from_ply") = std::vector<double>{}, py::arg("turns_min") = 4.0, py::arg("hard_from") = 0.0,
-        py::arg("resume") = false, py::arg("sensitivity_tol") = cli::kPlectonemeSensitivityTol,
+        py::arg("resume") = false, py::arg("sensitivity_tol") = kPlectonemeSensitivityTol,
         R"doc(The Fig. 11 sweep of cases/plectoneme.toml (the CLI's `kirchhoff plectonemes`, the same
 files into `out`; progress on stderr, a line per slenderness on stdout).
 

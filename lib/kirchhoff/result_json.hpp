@@ -1,4 +1,6 @@
-// JSON views of solver results for the CLI (nlohmann::json).
+// JSON views of solver results (nlohmann::json, header-only: a user of this header needs its
+// headers): the blocks `kirchhoff solve --json`, `equilibria` and `vibrate` print, and Python's
+// Solution.path.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -10,7 +12,7 @@
 #include "kirchhoff/discrete_stability.hpp"
 #include "kirchhoff/stability.hpp"
 
-namespace kirchhoff::cli {
+namespace kirchhoff {
 
 nlohmann::json solution_json(const Case& c, const ShootingProblem& problem, const Solution& sol,
                              const StabilityReport& stability, const DiscreteStability* discrete = nullptr);
@@ -24,4 +26,4 @@ nlohmann::json parameters_json(const Parameters& p);
 // went from and to, its points, the branch points it crossed and where it stopped.
 nlohmann::json path_json(const SolvePath& path);
 
-}  // namespace kirchhoff::cli
+}  // namespace kirchhoff

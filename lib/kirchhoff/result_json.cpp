@@ -1,8 +1,8 @@
-#include "result_json.hpp"
+#include "kirchhoff/result_json.hpp"
 
 #include <cmath>
 
-namespace kirchhoff::cli {
+namespace kirchhoff {
 namespace {
 
 nlohmann::json vec(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
@@ -136,4 +136,4 @@ nlohmann::json failure_json(const Case& c, const std::string& status, int iterat
           {"parameters", parameters_json(c.definition.parameters)}};
 }
 
-}  // namespace kirchhoff::cli
+}  // namespace kirchhoff
