@@ -5,6 +5,7 @@
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/continuation.hpp"
+#include "kirchhoff/point_record.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {
@@ -357,6 +358,54 @@ TEST(TaperedColumn, BranchPointsAndTheTaperedIdentityAlongTheBuckledBranch) {
     const double dH = (hamiltonian(model, pts[2]) - hamiltonian(model, pts[0])) / (2 * h);
     const double eq57 = -0.5 * model.B[1].derivative(s) * pts[1].u[1] * pts[1].u[1];
     EXPECT_NEAR(dH, eq57, 1e-7 * std::max(1.0, p.invariants.H.scale)) << "P = " << p.parameter;
+  }
+}
+
+// The record hook: each point on the branch is described once and recorded once (the buckled
+// branch through its branch point and a stopping event, so located points are among them), and
+// an empty recorder leaves the points with nothing but what the engine computes.
+TEST(Recorder, DescribesEachPointOnceAndRecordsEveryPointOnTheBranch) {
+  ContinuationOptions o = euler_options();
+  o.target = 12.0;
+  o.stop_at_branch_point = 1;
+  const BranchRun run = continue_case("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, o);
+  ASSERT_EQ(run.result.reason, StopReason::BranchPointStop);
+  ContinuationOptions b = bifurcating_branch_options(euler_options());
+  b.max_step = 1.0;
+  b.events = {{"theta0", 1.0, true, ""}};
+  const PointRecorder rod = rod_point_recorder(b);
+  int described = 0, recorded = 0;
+  PointRecorder counting;
+  counting.describe = [&](const ShootingProblem& problem, ContinuationPoint* p) {
+    ++described;
+    rod.describe(problem, p);
+    p->derived["describe_calls"] += 1.0;
+  };
+  counting.record = [&](const ShootingProblem&, ContinuationPoint* p) {
+    ++recorded;
+    p->derived["record_calls"] += 1.0;
+  };
+  b.recorder = counting;
+  Continuation branch(*run.problem, b);
+  const ContinuationResult r = branch.switch_branch(run.result.points.back());
+  ASSERT_EQ(r.reason, StopReason::EventStop);
+  EXPECT_EQ(recorded, static_cast<int>(r.points.size()));
+  EXPECT_GE(described, recorded);  // trial points of the event's location are described too
+  for (const auto& p : r.points) {
+    EXPECT_EQ(p.derived.at("describe_calls"), 1.0) << "point " << p.index;
+    EXPECT_EQ(p.derived.at("record_calls"), 1.0) << "point " << p.index;
+  }
+  EXPECT_NEAR(r.points.back().derived.at("theta0"), 1.0, 1e-9);
+
+  b.recorder = PointRecorder{};
+  b.events.clear();
+  b.max_points = 10;
+  Continuation bare(*run.problem, b);
+  const ContinuationResult plain = bare.switch_branch(run.result.points.back());
+  ASSERT_GE(plain.points.size(), 10u);
+  for (const auto& p : plain.points) {
+    EXPECT_TRUE(p.derived.empty());
+    EXPECT_FALSE(p.invariants.H.applies);
   }
 }
 
