@@ -69,6 +69,15 @@ TEST(SweepFile, ErrorsNameFileLineKeyAndReason) {
             "bad.toml:4: key 'jobs[1].max_equilibria': only equilibria jobs take it");
   EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\nset = { nope = 1 }\n").rfind("bad.toml:4: key 'jobs[1].set': ", 0),
             0u);
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"continue\"\n"),
+            "bad.toml:2: key 'jobs[1].param': missing: the parameter a continue job follows its branch in");
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"continue\"\nparam = \"Q\"\n"),
+            "bad.toml:4: key 'jobs[1].param': no parameter 'Q' in " + kCases + "/simply_supported.toml");
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\nparam = \"P\"\n"),
+            "bad.toml:4: key 'jobs[1].param': only continue jobs take it");
+  EXPECT_NE(error_of(head() + "[[jobs]]\nkind = \"plectonemes\"\n").find("key 'jobs[1].kind': job kind 'plectonemes' is not "
+                                                                          "implemented yet in sweeps"),
+            std::string::npos);
   EXPECT_EQ(error_of("[[jobs]]\nkind = \"solve\"\n"),
             "bad.toml:1: key 'jobs[1].case': no case: give `case` at the top or in the [[jobs]] table");
   EXPECT_EQ(error_of(head()), "bad.toml: key 'jobs': no [[jobs]] tables: nothing to run");

@@ -36,9 +36,8 @@ std::map<std::string, std::string> files_of(const fs::path& dir) {
 
 class SweepRunTest : public ScratchFolderTest {
  protected:
-  // 14 jobs: solves of Fig. 3 by homotopy (one beyond its branch point), one refused at load
-  // (theta0 past the guess's reach is still a solve; P is solved for, so an override of it is a
-  // guess), and equilibria of the column.
+  // 15 jobs: solves of Fig. 3 by homotopy (the last ones beyond its branch point), equilibria of
+  // the column, and the straight column continued in P from 5 through its branch point to 12.
   fs::path write_spec() {
     const fs::path spec = dir_ / "sweep.toml";
     std::ofstream(spec) << "title = \"test sweep\"\n"
@@ -46,7 +45,10 @@ class SweepRunTest : public ScratchFolderTest {
                            "[[jobs]]\nname = \"fig3\"\nkind = \"solve\"\n"
                            "grid = { theta0 = { from = 0.25, to = 3.0, count = 12 } }\n"
                            "[[jobs]]\nname = \"column\"\nkind = \"equilibria\"\ncase = \"" << kCases
-                        << "/euler_column.toml\"\nmax_equilibria = 3\nlist = [{ P = 5 }, { P = 12 }]\n";
+                        << "/euler_column.toml\"\nmax_equilibria = 3\nlist = [{ P = 5 }, { P = 12 }]\n"
+                        << "[[jobs]]\nname = \"branch\"\nkind = \"continue\"\ncase = \"" << kCases
+                        << "/euler_column.toml\"\nset = { theta_guess = 0 }\nparam = \"P\"\nto = 12\nmax_points = 100\n"
+                           "list = [{ P = 5 }]\n";
     return spec;
   }
   std::vector<std::string> sweep(const fs::path& spec, const fs::path& out) {
@@ -58,7 +60,7 @@ TEST_F(SweepRunTest, IndexHasOneRowPerJobInJobOrder) {
   const fs::path spec = write_spec();
   ASSERT_EQ(testing::run_to_end(sweep(spec, dir_ / "a"), dir_ / "a.log"), 0);
   const auto rows = testing::lines_of(dir_ / "a" / "index.csv");
-  ASSERT_EQ(rows.size(), 15u);
+  ASSERT_EQ(rows.size(), 16u);
   EXPECT_EQ(rows[0].rfind("job,kind,theta0,P,status,reason,contact_state,stable_states,stability_index,equilibria,"
                           "energy,derived_P,y_max,kappa_max,end_to_end,derived_theta0",
                           0),
@@ -68,7 +70,9 @@ TEST_F(SweepRunTest, IndexHasOneRowPerJobInJobOrder) {
   EXPECT_EQ(rows[13].rfind("column-001,equilibria,,5.0,ok,,none,none,0,3,", 0), 0u) << rows[13];
   EXPECT_TRUE(fs::exists(dir_ / "a" / "jobs" / "fig3-012" / "profile.csv"));
   EXPECT_TRUE(fs::exists(dir_ / "a" / "jobs" / "column-002" / "equilibrium_3.csv"));
-  EXPECT_EQ(testing::lines_of(dir_ / "a" / "times.csv").size(), 15u);
+  EXPECT_EQ(rows[15].rfind("branch,continue,,5.0,ok,", 0), 0u) << rows[15];
+  EXPECT_TRUE(fs::exists(dir_ / "a" / "jobs" / "branch" / "branch.csv"));
+  EXPECT_EQ(testing::lines_of(dir_ / "a" / "times.csv").size(), 16u);
   // Again into the same folder without --resume: refused, nothing touched.
   EXPECT_EQ(testing::run_to_end(sweep(spec, dir_ / "a"), dir_ / "b.log"), 2);
 }
@@ -84,7 +88,7 @@ TEST_F(SweepRunTest, SerialAndTwoRanksGiveTheSameFiles) {
   ASSERT_EQ(testing::run_to_end(sweep(spec, dir_ / "serial"), dir_ / "serial.log"), 0);
   ASSERT_EQ(testing::run_to_end(under_mpi(sweep(spec, dir_ / "mpi")), dir_ / "mpi.log"), 0);
   const auto serial = files_of(dir_ / "serial");
-  EXPECT_EQ(serial.size(), 1u + 12 * 2 + 2 * 4);
+  EXPECT_EQ(serial.size(), 1u + 12 * 2 + 2 * 4 + 2);
   EXPECT_EQ(files_of(dir_ / "mpi"), serial);
   // Both ranks ran jobs (the manager too, on its thread).
   const auto times = testing::lines_of(dir_ / "mpi" / "times.csv");

@@ -205,7 +205,8 @@ SweepJobKind parse_kind(const Reader& r, const Value& v, const std::string& key)
   const std::string s = r.string(v, key);
   if (s == "solve") return SweepJobKind::Solve;
   if (s == "equilibria") return SweepJobKind::Equilibria;
-  if (s == "continue" || s == "plectonemes")
+  if (s == "continue") return SweepJobKind::Continue;
+  if (s == "plectonemes")
     r.fail(v, key,
            "job kind '" + s + "' is not implemented yet in sweeps: its run is not a library entry point yet (run `kirchhoff " +
                s + "` per branch meanwhile)");
@@ -286,6 +287,10 @@ std::string SweepJob::fingerprint() const {
   for (const auto& [name, value] : solver) os << " " << name << "=" << value;
   os << " direct=" << direct << " max_seconds=" << shown(max_seconds) << " max_equilibria=" << max_equilibria
      << " profiles=" << profiles;
+  if (kind == SweepJobKind::Continue)
+    os << " param=" << param << " to=" << shown(to) << " max_points=" << max_points << " step=" << shown(step)
+       << " min_step=" << shown(min_step) << " max_step=" << shown(max_step) << " branch_points=" << branch_points
+       << " stability=" << stability;
   return os.str();
 }
 
@@ -346,7 +351,8 @@ SweepSpec load_sweep_text(const std::string& text, const std::string& path) {
     const Value& group = groups[g];
     const std::string key = "jobs[" + std::to_string(g + 1) + "]";
     r.allow_keys(group, key, {"name", "kind", "case", "set", "solver", "grid", "list", "cost", "direct", "max_seconds",
-                              "max_equilibria", "profiles"});
+                              "max_equilibria", "profiles", "param", "to", "max_points", "step", "min_step",
+                              "max_step", "branch_points", "stability"});
     SweepJob prototype;
     const Value* kind = Reader::find(group, "kind");
     if (!kind) r.fail(group, key + ".kind", "missing (solve, equilibria, continue or plectonemes)");
@@ -396,6 +402,26 @@ SweepSpec load_sweep_text(const std::string& text, const std::string& path) {
       prototype.max_equilibria = static_cast<int>(r.integer(*v, key + ".max_equilibria", 1, 1000));
     }
     if (const Value* v = Reader::find(group, "profiles")) prototype.profiles = r.boolean(*v, key + ".profiles");
+    // continue's keys, only there.
+    for (const char* k : {"param", "to", "max_points", "step", "min_step", "max_step", "branch_points", "stability"})
+      if (const Value* v = Reader::find(group, k); v && prototype.kind != SweepJobKind::Continue)
+        r.fail(*v, key + "." + k, "only continue jobs take it");
+    const Value* param_value = Reader::find(group, "param");
+    if (prototype.kind == SweepJobKind::Continue) {
+      if (!param_value) r.fail(group, key + ".param", "missing: the parameter a continue job follows its branch in");
+      prototype.param = r.string(*param_value, key + ".param");
+      if (const Value* v = Reader::find(group, "to")) prototype.to = r.number(*v, key + ".to");
+      if (const Value* v = Reader::find(group, "max_points"))
+        prototype.max_points = static_cast<int>(r.integer(*v, key + ".max_points", 1, 1000000));
+      for (auto [k, field] : {std::pair<const char*, double*>{"step", &prototype.step}, {"min_step", &prototype.min_step},
+                              {"max_step", &prototype.max_step}})
+        if (const Value* v = Reader::find(group, k)) {
+          *field = r.number(*v, key + "." + k);
+          if (!(*field > 0)) r.fail(*v, key + "." + k, "must be > 0");
+        }
+      if (const Value* v = Reader::find(group, "branch_points")) prototype.branch_points = r.boolean(*v, key + ".branch_points");
+      if (const Value* v = Reader::find(group, "stability")) prototype.stability = r.boolean(*v, key + ".stability");
+    }
 
     std::map<std::string, std::pair<const Value*, std::string>> where;
     const std::vector<ParameterOverrides> group_points = points(r, group, key, &where);
@@ -412,6 +438,14 @@ SweepSpec load_sweep_text(const std::string& text, const std::string& path) {
     for (const auto& d : c.derived)
       if (std::find(spec.derived_columns.begin(), spec.derived_columns.end(), d) == spec.derived_columns.end())
         spec.derived_columns.push_back(d);
+    if (param_value) {
+      if (!c.file_parameters.contains(prototype.param))
+        r.fail(*param_value, key + ".param", "no parameter '" + prototype.param + "' in " + prototype.case_path);
+      if (const std::string refusal =
+              dependent_parameter_refusal(c.definition.dependent_parameters, prototype.param, "continue in");
+          !refusal.empty())
+        r.fail(*param_value, key + ".param", refusal);
+    }
     for (const auto& [pname, at] : where) {
       if (!c.file_parameters.contains(pname)) {
         std::string have;

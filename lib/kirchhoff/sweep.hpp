@@ -7,7 +7,7 @@
 //   set = { m_guess = 0.9 }            # overrides of every job (optional)
 //   [[jobs]]
 //   name = "phase"                     # job ids: phase-001, phase-002, ... (default: the kind)
-//   kind = "solve"                     # solve | equilibria | continue | plectonemes
+//   kind = "solve"                     # solve | equilibria | continue (plectonemes: not yet)
 //   grid = { a = [0.05, 0.1], Delta = { from = 0.005, to = 0.06, count = 12 } }
 //   # or list = [{ a = 0.1, Delta = 0.02 }, ...]; values, ranges and log ranges
 //   # ({ from = 1e-4, to = 1e-1, count = 4, log = true })
@@ -16,6 +16,7 @@
 // reason, as case files do (case_file.hpp).
 #pragma once
 
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -48,6 +49,14 @@ struct SweepJob {
   double max_seconds = 120.0;  // wall-clock limit of the job's solve or search (0: none)
   int max_equilibria = 16;     // equilibria
   bool profiles = true;        // write the profile CSV(s)
+  // continue: a branch in `param` (case_continue.hpp), to `to` (NaN: no target) within
+  // max_points, with these pseudo-arclength steps; branch points and stability as `continue`.
+  std::string param;
+  double to = std::numeric_limits<double>::quiet_NaN();
+  int max_points = 500;
+  double step = 0.05, min_step = 1e-7, max_step = 0.5;
+  bool branch_points = true;
+  bool stability = true;
   // What the job is, as one line of text: a finished job's result records it, and --resume
   // refuses a folder whose results were computed for other jobs under the same ids.
   std::string fingerprint() const;

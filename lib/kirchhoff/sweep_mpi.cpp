@@ -128,14 +128,11 @@ SweepSummary manager(const SweepSpec& spec, const SweepMpiOptions& options, std:
       busy = true;
     }
     if (workers_running > 0) {
+      // Probed and slept on rather than blocked on: a blocking MPI_Probe spins (OpenMPI polls at
+      // full speed), taking a core from the jobs when ranks share cores.
       int flag = 0;
       MPI_Status status;
-      if (local) {
-        MPI_Iprobe(MPI_ANY_SOURCE, kTagReady, MPI_COMM_WORLD, &flag, &status);
-      } else {
-        MPI_Probe(MPI_ANY_SOURCE, kTagReady, MPI_COMM_WORLD, &status);  // nothing else to do: block
-        flag = 1;
-      }
+      MPI_Iprobe(MPI_ANY_SOURCE, kTagReady, MPI_COMM_WORLD, &flag, &status);
       if (flag) {
         int count = 0;
         MPI_Get_count(&status, MPI_CHAR, &count);

@@ -11,7 +11,9 @@
 #include <set>
 #include <sstream>
 
+#include "kirchhoff/case_continue.hpp"
 #include "kirchhoff/case_solve.hpp"
+#include "kirchhoff/continue_outputs.hpp"
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/equilibria.hpp"
 #include "kirchhoff/integrator.hpp"
@@ -176,6 +178,36 @@ void run_equilibria(const SweepJob& job, const Case& c, const fs::path& folder, 
   if (job.profiles) (*result)["files"] = std::move(files);
 }
 
+// A continue job: continue_case as `kirchhoff continue` does, the branch into branch.csv. The row
+// says how the run ended (ok: normally, at its target, a bound, its point budget...).
+void run_continue(const SweepJob& job, const Case& c, const fs::path& folder, json* result) {
+  ContinueRequest request;
+  request.parameter = job.param;
+  request.target = job.to;
+  request.max_points = job.max_points;
+  request.initial_step = job.step;
+  request.min_step = job.min_step;
+  request.max_step = job.max_step;
+  request.detect_branch_points = job.branch_points;
+  request.compute_stability = job.stability;
+  request.max_seconds = job.max_seconds;
+  request.set_parameters = job.overrides();
+  if (const std::string why = request.validate(c); !why.empty()) {
+    (*result)["status"] = "bad_input";
+    (*result)["reason"] = why;
+    return;
+  }
+  BranchCsvSink csv(folder / "branch.csv");
+  const ContinueRunResult run = continue_case(c, request, {&csv});
+  (*result)["status"] = run.ok ? "ok" : run.status;
+  (*result)["reason"] = run.ok ? "" : run.message;
+  (*result)["stopped_because"] = run.status;
+  (*result)["message"] = run.message;
+  (*result)["points"] = run.points;
+  (*result)["contact_changes"] = run.contact_changes;
+  (*result)["files"] = json::array({"branch.csv"});
+}
+
 // CSV cell: quoted when it holds a comma, a quote or a line break.
 std::string csv_cell(const std::string& s) {
   if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
@@ -227,6 +259,7 @@ JobOutcome run_sweep_job(const SweepJob& job, const std::string& dir) {
     switch (job.kind) {
       case SweepJobKind::Solve: run_solve(job, c, partial, &result); break;
       case SweepJobKind::Equilibria: run_equilibria(job, c, partial, &result); break;
+      case SweepJobKind::Continue: run_continue(job, c, partial, &result); break;
       default:
         result["status"] = "not_implemented";
         result["reason"] = std::string("job kind '") + to_string(job.kind) + "' is not implemented yet";
