@@ -21,6 +21,7 @@
 #include "kirchhoff/discrete_elastica.hpp"
 #include "kirchhoff/solution.hpp"
 #include "kirchhoff/stability.hpp"
+#include "kirchhoff/sweep_run.hpp"
 #include "kirchhoff/vibration.hpp"
 #include "plectonemes_command.hpp"
 #include "solve_command.hpp"
@@ -849,6 +850,14 @@ int run_reproduce(const std::string& out_dir, const std::string& cases_dir, bool
     progress(full ? "Section 7.6 / Fig. 11: the ply with exact self-contact at L/2R = 100, 200 and 500 (about 7 minutes)"
                   : "Section 7.6 / Fig. 11: the ply with exact self-contact at L/2R = 100 and 200 (about a minute)");
     exact_plies((cases / "plectoneme.toml").string(), out / "profiles" / "exact", full, &rows);
+    if (full) {
+      // The hard-wall phase diagram (docs/sweeps.md) into DIR/wall_phase, drawn by make_figures.py.
+      progress("Hard-wall Elastica: contact states over (a, Delta), sweeps/wall_phase_diagram.toml (about 5 minutes)");
+      SweepRunOptions sweep;
+      sweep.out_dir = (out / "wall_phase").string();
+      fs::remove_all(sweep.out_dir);
+      run_sweep(load_sweep((cases / ".." / "sweeps" / "wall_phase_diagram.toml").lexically_normal().string()), sweep);
+    }
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitNotConverged;

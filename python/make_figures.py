@@ -6,6 +6,7 @@ Usage: /usr/bin/python3 python/make_figures.py OUT_DIR   (reads OUT_DIR/profiles
 Only plotting happens here: every number comes from the C++ toolkit (numeric and analytic
 columns side by side in the CSV files), so no physics is re-implemented in Python.
 """
+import csv
 import pathlib
 import sys
 
@@ -278,11 +279,40 @@ def fig11(profiles, figures):
     plt.close(fig)
 
 
+def wall_phase(profiles, figures):
+    """The hard-wall phase diagram (reproduce --full: OUT/wall_phase/index.csv, docs/sweeps.md)."""
+    path = profiles.parent / "wall_phase" / "index.csv"
+    if not path.exists():
+        return
+    with open(path, newline="") as f:  # quoted reasons hold commas: the csv module, not genfromtxt
+        rows = [r for r in csv.DictReader(f) if r["job"].startswith("arch")]
+    colours = {"none": "tab:blue", "point": "tab:orange", "flat": "tab:green", "fold": "tab:red",
+               "several": "tab:purple"}
+    fig, ax = plt.subplots(figsize=(8, 4.4))
+    for state, colour in colours.items():
+        for stable, fill in ((True, colour), (False, "none")):
+            pick = [r for r in rows if r["status"] == "ok" and r["contact_state"] == state
+                    and (r["stability_index"] == "0") == stable]
+            if pick:
+                ax.scatter([float(r["Delta"]) for r in pick], [float(r["a"]) for r in pick], s=60, facecolors=fill,
+                           edgecolors=colour, label=f"{state}, {'stable' if stable else 'unstable or undefined'}")
+    failed = [r for r in rows if r["status"] != "ok"]
+    ax.scatter([float(r["Delta"]) for r in failed], [float(r["a"]) for r in failed], marker="x", color="gray",
+               label="not reached (fold, ...)")
+    ax.set_xlabel("$\\Delta$ (end shortening)")
+    ax.set_ylabel("a (wall height)")
+    ax.set_title("Hard-wall Elastica: contact state of the arch")
+    ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1))
+    fig.tight_layout()
+    fig.savefig(figures / "wall_phase_diagram.png", dpi=120)
+    plt.close(fig)
+
+
 def main(out):
     out = pathlib.Path(out)
     profiles, figures = out / "profiles", out / "figures"
     figures.mkdir(parents=True, exist_ok=True)
-    for make in (fig3, fig9, fig12, euler_branch, sleeves, vibrations, fig5, fig11):
+    for make in (fig3, fig9, fig12, euler_branch, sleeves, vibrations, fig5, fig11, wall_phase):
         make(profiles, figures)
         print(f"  {make.__name__}: written", file=sys.stderr)
 
