@@ -63,6 +63,25 @@ INSTANTIATE_TEST_SUITE_P(
       return name;
     });
 
+// The planar variational equations written out (planar_equations.cpp) for an extensible,
+// shearable rod without a field, with stiffnesses and natural strains that vary along it: every
+// term of their linearisation (the internal force's components in the frame, the s-dependence).
+TEST(VariationalJacobian, ExtensiblePlanarRodWithoutField) {
+  Case c = load_case(testing::case_path("simply_supported.toml"), {{"theta0", 1.5}});
+  c.definition.model = [inner = c.definition.model](const Parameters& p) {
+    RodModel m = inner(p);
+    m.extensible = true;
+    m.A[0] = Profile([](double s) { return 30.0 + 10.0 * s; });
+    m.A[2] = Profile([](double s) { return 50.0 - 20.0 * s; });
+    m.v_hat[0] = Profile(0.02);
+    m.u_hat[1] = Profile([](double s) { return 0.3 * s; });
+    m.B[1] = Profile([](double s) { return 1.0 + 0.5 * s; });
+    return m;
+  };
+  const ShootingProblem problem(c.definition);
+  expect_jacobians_agree(problem, perturbed_guess(problem, c, 0.05));
+}
+
 TEST(FiniteDifferenceFallback, ConvergesToTheSameSolution) {
   Case c = load_case(testing::case_path("simply_supported.toml"), {{"theta0", 2.0}});
   const ShootingProblem exact(c.definition);
