@@ -736,20 +736,8 @@ PlectonemeSweep sweep_plectonemes(const PlectonemesArguments& args, std::ostream
                 << args.turns[k] << " and down to " << args.turns_min << "\n";
     else
       std::cerr << "L/2R = " << sl << ": turns 0 -> " << args.turns[k] << "\n";
-    PlectonemeRunOptions options;
-    options.progress_every = args.progress_every;
-    options.max_step = args.max_step;
-    options.reuse_jacobian = args.reuse_jacobian;
-    options.modified_newton = args.modified_newton;
-    options.resume = args.resume;
-    options.ply_log_softness = args.ply_log_softness;
-    options.hard_contact_every = args.hard_contact_every;
-    options.hard_spacing = args.hard_spacing;
-    options.hard_from = args.hard_from;
+    PlectonemeRunOptions options = args;  // every branch's options are the sweep's
     options.hard_turns_min = args.turns_min;
-    options.ply_max_step = args.ply_max_step;
-    options.sensitivity_tol = args.sensitivity_tol;
-    options.after_point = args.after_point;
     PlectonemeSweepBranch branch;
     branch.slenderness = sl;
     try {

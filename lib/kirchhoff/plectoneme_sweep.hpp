@@ -121,28 +121,19 @@ PlectonemeBranchSummary follow_hard_from_ply(const std::string& case_path, const
                                              double turns_max, const std::string& hard_csv,
                                              const PlectonemeRunOptions& options);
 
-struct PlectonemesArguments {
+// The sweep: the options of every branch (PlectonemeRunOptions, given to each as they are, with
+// progress lines every 50 points) and which branches to follow.
+struct PlectonemesArguments : PlectonemeRunOptions {
+  PlectonemesArguments() { progress_every = 50; }
   std::string case_path;
   std::vector<double> slenderness{100, 200, 500, 1000};
   std::vector<double> turns{10, 20, 20, 50};
   // Slendernesses reached from the ply of the one before them in the list (follow_from_ply).
   std::vector<double> from_ply{1000};
-  double turns_min = 4.0;  // where branches reached from a ply end on the way down
-  double ply_log_softness = -5.0;
+  // Where branches reached from a ply end on the way down, and the exact ply's legs
+  // (PlectonemeRunOptions::hard_turns_min, which the sweep sets to it).
+  double turns_min = 4.0;
   std::string out_dir = "plectonemes";
-  double max_step = kPlectonemeMaxStep;
-  int reuse_jacobian = kPlectonemeReuseJacobian;
-  bool modified_newton = true;
-  bool resume = false;
-  double hard_contact_every = 0.0;
-  double hard_spacing = 0.25;
-  double hard_from = 0.0;
-  double ply_max_step = kPlyMaxStep;
-  // IntegratorOptions::sensitivity_tol of the barrier branches and of the exact ply's legs (0: the
-  // case's); the exact ply's first solve from its seed keeps the case's.
-  double sensitivity_tol = kPlectonemeSensitivityTol;
-  std::function<void()> after_point;  // PlectonemeRunOptions::after_point
-  int progress_every = 50;            // PlectonemeRunOptions::progress_every
 };
 
 // What a sweep computed for one slenderness: the CSV of its barrier branch (empty for one reached
