@@ -75,9 +75,11 @@ TEST(SweepFile, ErrorsNameFileLineKeyAndReason) {
             "bad.toml:4: key 'jobs[1].param': no parameter 'Q' in " + kCases + "/simply_supported.toml");
   EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\nparam = \"P\"\n"),
             "bad.toml:4: key 'jobs[1].param': only continue jobs take it");
-  EXPECT_NE(error_of(head() + "[[jobs]]\nkind = \"plectonemes\"\n").find("key 'jobs[1].kind': job kind 'plectonemes' is not "
-                                                                          "implemented yet in sweeps"),
-            std::string::npos);
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"plectonemes\"\nlist = [{ P = 1 }]\n"),
+            "bad.toml:2: key 'jobs[1]': a plectonemes job needs 'slenderness' in its grid or list (the branch's L/2R "
+            "and its largest turns)");
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\nfrom_ply = 500\n"),
+            "bad.toml:4: key 'jobs[1].from_ply': only plectonemes jobs take it");
   EXPECT_EQ(error_of("[[jobs]]\nkind = \"solve\"\n"),
             "bad.toml:1: key 'jobs[1].case': no case: give `case` at the top or in the [[jobs]] table");
   EXPECT_EQ(error_of(head()), "bad.toml: key 'jobs': no [[jobs]] tables: nothing to run");

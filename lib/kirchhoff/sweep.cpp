@@ -206,10 +206,7 @@ SweepJobKind parse_kind(const Reader& r, const Value& v, const std::string& key)
   if (s == "solve") return SweepJobKind::Solve;
   if (s == "equilibria") return SweepJobKind::Equilibria;
   if (s == "continue") return SweepJobKind::Continue;
-  if (s == "plectonemes")
-    r.fail(v, key,
-           "job kind '" + s + "' is not implemented yet in sweeps: its run is not a library entry point yet (run `kirchhoff " +
-               s + "` per branch meanwhile)");
+  if (s == "plectonemes") return SweepJobKind::Plectonemes;
   r.fail(v, key, "unknown job kind '" + s + "' (expected one of: solve, equilibria, continue, plectonemes)");
 }
 
@@ -291,6 +288,8 @@ std::string SweepJob::fingerprint() const {
     os << " param=" << param << " to=" << shown(to) << " max_points=" << max_points << " step=" << shown(step)
        << " min_step=" << shown(min_step) << " max_step=" << shown(max_step) << " branch_points=" << branch_points
        << " stability=" << stability;
+  if (kind == SweepJobKind::Plectonemes)
+    os << " from_ply=" << shown(from_ply) << " from_ply_turns=" << shown(from_ply_turns) << " hard_from=" << shown(hard_from);
   return os.str();
 }
 
@@ -352,7 +351,7 @@ SweepSpec load_sweep_text(const std::string& text, const std::string& path) {
     const std::string key = "jobs[" + std::to_string(g + 1) + "]";
     r.allow_keys(group, key, {"name", "kind", "case", "set", "solver", "grid", "list", "cost", "direct", "max_seconds",
                               "max_equilibria", "profiles", "param", "to", "max_points", "step", "min_step",
-                              "max_step", "branch_points", "stability"});
+                              "max_step", "branch_points", "stability", "from_ply", "from_ply_turns", "hard_from"});
     SweepJob prototype;
     const Value* kind = Reader::find(group, "kind");
     if (!kind) r.fail(group, key + ".kind", "missing (solve, equilibria, continue or plectonemes)");
@@ -406,6 +405,19 @@ SweepSpec load_sweep_text(const std::string& text, const std::string& path) {
     for (const char* k : {"param", "to", "max_points", "step", "min_step", "max_step", "branch_points", "stability"})
       if (const Value* v = Reader::find(group, k); v && prototype.kind != SweepJobKind::Continue)
         r.fail(*v, key + "." + k, "only continue jobs take it");
+    for (const char* k : {"from_ply", "from_ply_turns", "hard_from"})
+      if (const Value* v = Reader::find(group, k)) {
+        if (prototype.kind != SweepJobKind::Plectonemes) r.fail(*v, key + "." + k, "only plectonemes jobs take it");
+        const double x = r.number(*v, key + "." + k);
+        if (!(x >= 0)) r.fail(*v, key + "." + k, "must be >= 0");
+        (std::string(k) == "from_ply" ? prototype.from_ply : std::string(k) == "hard_from" ? prototype.hard_from
+                                                                                          : prototype.from_ply_turns) = x;
+      }
+    if (prototype.kind == SweepJobKind::Plectonemes) {
+      if (const Value* v = Reader::find(group, "set"))
+        r.fail(*v, key + ".set", "plectonemes jobs run their case file as it is (slenderness and turns from the grid or list)");
+      if (const Value* v = Reader::find(group, "solver")) r.fail(*v, key + ".solver", "plectonemes jobs take the case's [solver]");
+    }
     const Value* param_value = Reader::find(group, "param");
     if (prototype.kind == SweepJobKind::Continue) {
       if (!param_value) r.fail(group, key + ".param", "missing: the parameter a continue job follows its branch in");
@@ -462,6 +474,12 @@ SweepSpec load_sweep_text(const std::string& text, const std::string& path) {
     } catch (const CaseError& e) {
       r.fail(group, key, std::string("at its first point: ") + e.what());
     }
+    if (prototype.kind == SweepJobKind::Plectonemes)
+      for (const char* needed : {"slenderness", "turns"})
+        for (const auto& point : group_points)
+          if (std::none_of(point.begin(), point.end(), [needed](const auto& e) { return e.first == needed; }))
+            r.fail(group, key, std::string("a plectonemes job needs '") + needed +
+                                   "' in its grid or list (the branch's L/2R and its largest turns)");
     if (spec.jobs.size() + group_points.size() > sweep_limits::kMaxJobs)
       r.fail(group, key, "the sweep has more than " + std::to_string(sweep_limits::kMaxJobs) + " jobs");
     for (std::size_t k = 0; k < group_points.size(); ++k) {

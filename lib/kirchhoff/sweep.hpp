@@ -7,7 +7,7 @@
 //   set = { m_guess = 0.9 }            # overrides of every job (optional)
 //   [[jobs]]
 //   name = "phase"                     # job ids: phase-001, phase-002, ... (default: the kind)
-//   kind = "solve"                     # solve | equilibria | continue (plectonemes: not yet)
+//   kind = "solve"                     # solve | equilibria | continue | plectonemes
 //   grid = { a = [0.05, 0.1], Delta = { from = 0.005, to = 0.06, count = 12 } }
 //   # or list = [{ a = 0.1, Delta = 0.02 }, ...]; values, ranges and log ranges
 //   # ({ from = 1e-4, to = 1e-1, count = 4, log = true })
@@ -57,6 +57,13 @@ struct SweepJob {
   double step = 0.05, min_step = 1e-7, max_step = 0.5;
   bool branch_points = true;
   bool stability = true;
+  // plectonemes: a branch of the case (plectoneme.toml) at the job's values of `slenderness` and
+  // `turns` (its largest turns), from the untwisted rod (plectoneme_sweep.hpp), or with from_ply
+  // > 0 from the ply of that thicker slenderness followed first, in the job, up to from_ply_turns;
+  // hard_from > 0: the ply with exact contact from that many turns (`plectonemes --hard-from`).
+  double from_ply = 0.0;
+  double from_ply_turns = 20.0;
+  double hard_from = 0.0;
   // What the job is, as one line of text: a finished job's result records it, and --resume
   // refuses a folder whose results were computed for other jobs under the same ids.
   std::string fingerprint() const;

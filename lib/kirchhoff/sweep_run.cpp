@@ -16,6 +16,7 @@
 #include "kirchhoff/continue_outputs.hpp"
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/equilibria.hpp"
+#include "kirchhoff/plectoneme_sweep.hpp"
 #include "kirchhoff/integrator.hpp"
 #include "kirchhoff/solution.hpp"
 #include "kirchhoff/stability.hpp"
@@ -208,6 +209,57 @@ void run_continue(const SweepJob& job, const Case& c, const fs::path& folder, js
   (*result)["files"] = json::array({"branch.csv"});
 }
 
+// A plectonemes job: sweep_plectonemes (`kirchhoff plectonemes`) for the job's slenderness, the
+// thicker one first with from_ply; its CSVs into the job's folder.
+void run_plectonemes(const SweepJob& job, const fs::path& folder, json* result) {
+  auto value = [&job](const std::string& name) {
+    for (const auto& [n, x] : job.values)
+      if (n == name) return x;
+    return 0.0;  // load_sweep requires both
+  };
+  PlectonemesArguments args;
+  args.case_path = job.case_path;
+  args.out_dir = folder.string();
+  args.progress_every = 0;
+  args.hard_from = job.hard_from;
+  args.slenderness = {value("slenderness")};
+  args.turns = {value("turns")};
+  args.from_ply = {};
+  if (job.from_ply > 0) {
+    args.slenderness.insert(args.slenderness.begin(), job.from_ply);
+    args.turns.insert(args.turns.begin(), job.from_ply_turns);
+    args.from_ply = {value("slenderness")};
+  }
+  std::ostringstream report;
+  PlectonemeSweep sweep;
+  try {
+    sweep = sweep_plectonemes(args, report);
+  } catch (const CaseError& e) {
+    (*result)["status"] = "bad_input";
+    (*result)["reason"] = e.what();
+    return;
+  } catch (const std::runtime_error& e) {
+    (*result)["status"] = "branch_failed";
+    (*result)["reason"] = e.what();
+    return;
+  }
+  json branches = json::array();
+  json files = json::array();
+  for (const auto& b : sweep.branches) {
+    json last = json::object();
+    for (const auto& [name, x] : b.summary.last) last[name] = number(x);
+    branches.push_back({{"slenderness", b.slenderness}, {"stop", b.summary.stop}, {"last_ply_point", last},
+                        {"hard_ply_stop", b.summary.hard_ply_stop}});
+    for (const auto& f : {b.barrier_csv, b.ply_csv})
+      if (!f.empty()) files.push_back(fs::path(f).filename().string());
+  }
+  (*result)["status"] = "ok";
+  (*result)["reason"] = "";
+  (*result)["points"] = sweep.points;
+  (*result)["branches"] = std::move(branches);
+  (*result)["files"] = std::move(files);
+}
+
 // CSV cell: quoted when it holds a comma, a quote or a line break.
 std::string csv_cell(const std::string& s) {
   if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
@@ -254,15 +306,14 @@ JobOutcome run_sweep_job(const SweepJob& job, const std::string& dir) {
   result["set"] = overrides_json(job.set);
   result["fingerprint"] = job.fingerprint();
   try {
-    Case c = load_case(job.case_path, job.overrides(), "", job.solver);
-    if (job.kind == SweepJobKind::Solve) limit_wall_clock(c.definition.options, job.max_seconds);
-    switch (job.kind) {
-      case SweepJobKind::Solve: run_solve(job, c, partial, &result); break;
-      case SweepJobKind::Equilibria: run_equilibria(job, c, partial, &result); break;
-      case SweepJobKind::Continue: run_continue(job, c, partial, &result); break;
-      default:
-        result["status"] = "not_implemented";
-        result["reason"] = std::string("job kind '") + to_string(job.kind) + "' is not implemented yet";
+    if (job.kind == SweepJobKind::Plectonemes) {
+      run_plectonemes(job, partial, &result);  // the sweep loads the case itself
+    } else {
+      Case c = load_case(job.case_path, job.overrides(), "", job.solver);
+      if (job.kind == SweepJobKind::Solve) limit_wall_clock(c.definition.options, job.max_seconds);
+      if (job.kind == SweepJobKind::Solve) run_solve(job, c, partial, &result);
+      else if (job.kind == SweepJobKind::Equilibria) run_equilibria(job, c, partial, &result);
+      else run_continue(job, c, partial, &result);
     }
   } catch (const CaseError& e) {
     result["status"] = "bad_input";
