@@ -2,7 +2,9 @@
 //   DIR/jobs/<id>/result.json   the job's result (status, reason, parameters, contact state,
 //                               stability index, derived quantities, contacts; per equilibrium
 //                               for equilibria jobs), written once the job has finished
-//   DIR/jobs/<id>/*.csv         profiles (solve: profile.csv; equilibria: equilibrium_K.csv)
+//   DIR/jobs/<id>/*.csv         profiles (solve: profile.csv; equilibria: equilibrium_K.csv), the
+//                               branch (continue: branch.csv) or branches (plectonemes:
+//                               plectoneme_<L/2R>.csv and their state files)
 //   DIR/index.csv               one row per job in job order, rebuilt from the result files
 //   DIR/times.csv               job, wall seconds, rank: one line per job run, as they finish
 // A job's folder is written as DIR/jobs/.<id>.partial and renamed when complete, so a job either
