@@ -286,7 +286,7 @@ def wall_phase(profiles, figures):
         return
     with open(path, newline="") as f:  # quoted reasons hold commas: the csv module, not genfromtxt
         rows = [r for r in csv.DictReader(f) if r["job"].startswith("arch")]
-    colours = {"none": "tab:blue", "point": "tab:orange", "flat": "tab:green", "fold": "tab:red",
+    colours = {"none": "tab:blue", "point": "tab:orange", "flat": "tab:green", "hanging_fold": "tab:red",
                "several": "tab:purple"}
     fig, ax = plt.subplots(figsize=(8, 4.4))
     for state, colour in colours.items():

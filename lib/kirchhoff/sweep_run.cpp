@@ -287,7 +287,7 @@ std::string contact_state(const std::vector<Obstacle>& obstacles, const std::vec
   }
   if (contacts.size() == 2 && !contacts[0].extended && !contacts[1].extended &&
       contacts[0].obstacle == contacts[1].obstacle)
-    return "fold";
+    return "hanging_fold";
   return "several";
 }
 

@@ -24,8 +24,8 @@
 namespace kirchhoff {
 
 // A job's contact state from its active contacts: "none", "point" (one point contact), "flat"
-// (one extended contact on a plane), "wrap" (one extended contact on a curved obstacle), "fold"
-// (two point contacts on one obstacle: the hanging fold of a rod on a wall) or "several".
+// (one extended contact on a plane), "wrap" (one extended contact on a curved obstacle), "hanging_fold"
+// (two point contacts on one obstacle: the hanging fold of a rod on a wall; not the status `fold`) or "several".
 std::string contact_state(const std::vector<Obstacle>& obstacles, const std::vector<PointContact>& contacts);
 
 struct JobOutcome {
