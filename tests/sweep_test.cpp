@@ -36,8 +36,9 @@ std::map<std::string, std::string> files_of(const fs::path& dir) {
 
 class SweepRunTest : public ScratchFolderTest {
  protected:
-  // 15 jobs: solves of Fig. 3 by homotopy (the last ones beyond its branch point), equilibria of
-  // the column, and the straight column continued in P from 5 through its branch point to 12.
+  // 16 jobs: solves of Fig. 3 by homotopy (the last ones beyond its branch point), equilibria of
+  // the column, the straight column continued in P from 5 through its branch point to 12, and the
+  // plectoneme case's branch from the untwisted rod to a quarter turn.
   fs::path write_spec() {
     const fs::path spec = dir_ / "sweep.toml";
     std::ofstream(spec) << "title = \"test sweep\"\n"
@@ -48,7 +49,9 @@ class SweepRunTest : public ScratchFolderTest {
                         << "/euler_column.toml\"\nmax_equilibria = 3\nlist = [{ P = 5 }, { P = 12 }]\n"
                         << "[[jobs]]\nname = \"branch\"\nkind = \"continue\"\ncase = \"" << kCases
                         << "/euler_column.toml\"\nset = { theta_guess = 0 }\nparam = \"P\"\nto = 12\nmax_points = 100\n"
-                           "list = [{ P = 5 }]\n";
+                           "list = [{ P = 5 }]\n"
+                           "[[jobs]]\nname = \"ply\"\nkind = \"plectonemes\"\ncase = \"" << kCases
+                        << "/plectoneme.toml\"\nlist = [{ slenderness = 100, turns = 0.25 }]\n";
     return spec;
   }
   std::vector<std::string> sweep(const fs::path& spec, const fs::path& out) {
@@ -60,19 +63,21 @@ TEST_F(SweepRunTest, IndexHasOneRowPerJobInJobOrder) {
   const fs::path spec = write_spec();
   ASSERT_EQ(testing::run_to_end(sweep(spec, dir_ / "a"), dir_ / "a.log"), 0);
   const auto rows = testing::lines_of(dir_ / "a" / "index.csv");
-  ASSERT_EQ(rows.size(), 16u);
-  EXPECT_EQ(rows[0].rfind("job,kind,theta0,P,status,reason,contact_state,stable_states,stability_index,equilibria,"
+  ASSERT_EQ(rows.size(), 17u);
+  EXPECT_EQ(rows[0].rfind("job,kind,theta0,P,slenderness,turns,status,reason,contact_state,stable_states,stability_index,equilibria,"
                           "energy,derived_P,y_max,kappa_max,end_to_end,derived_theta0",
                           0),
             0u)
       << rows[0];
-  EXPECT_EQ(rows[1].rfind("fig3-001,solve,0.25,,ok,,none,none,0,1,", 0), 0u) << rows[1];
-  EXPECT_EQ(rows[13].rfind("column-001,equilibria,,5.0,ok,,none,none,0,3,", 0), 0u) << rows[13];
+  EXPECT_EQ(rows[1].rfind("fig3-001,solve,0.25,,,,ok,,none,none,0,1,", 0), 0u) << rows[1];
+  EXPECT_EQ(rows[13].rfind("column-001,equilibria,,5.0,,,ok,,none,none,0,3,", 0), 0u) << rows[13];
   EXPECT_TRUE(fs::exists(dir_ / "a" / "jobs" / "fig3-012" / "profile.csv"));
   EXPECT_TRUE(fs::exists(dir_ / "a" / "jobs" / "column-002" / "equilibrium_3.csv"));
-  EXPECT_EQ(rows[15].rfind("branch,continue,,5.0,ok,", 0), 0u) << rows[15];
+  EXPECT_EQ(rows[15].rfind("branch,continue,,5.0,,,ok,", 0), 0u) << rows[15];
   EXPECT_TRUE(fs::exists(dir_ / "a" / "jobs" / "branch" / "branch.csv"));
-  EXPECT_EQ(testing::lines_of(dir_ / "a" / "times.csv").size(), 16u);
+  EXPECT_EQ(rows[16].rfind("ply,plectonemes,,,100.0,0.25,ok,", 0), 0u) << rows[16];
+  EXPECT_TRUE(fs::exists(dir_ / "a" / "jobs" / "ply" / "plectoneme_100.csv"));
+  EXPECT_EQ(testing::lines_of(dir_ / "a" / "times.csv").size(), 17u);
   // Again into the same folder without --resume: refused, nothing touched.
   EXPECT_EQ(testing::run_to_end(sweep(spec, dir_ / "a"), dir_ / "b.log"), 2);
 }
@@ -88,7 +93,7 @@ TEST_F(SweepRunTest, SerialAndTwoRanksGiveTheSameFiles) {
   ASSERT_EQ(testing::run_to_end(sweep(spec, dir_ / "serial"), dir_ / "serial.log"), 0);
   ASSERT_EQ(testing::run_to_end(under_mpi(sweep(spec, dir_ / "mpi")), dir_ / "mpi.log"), 0);
   const auto serial = files_of(dir_ / "serial");
-  EXPECT_EQ(serial.size(), 1u + 12 * 2 + 2 * 4 + 2);
+  EXPECT_EQ(serial.size(), 1u + 12 * 2 + 2 * 4 + 2 + 3);
   EXPECT_EQ(files_of(dir_ / "mpi"), serial);
   // Both ranks ran jobs (the manager too, on its thread).
   const auto times = testing::lines_of(dir_ / "mpi" / "times.csv");
