@@ -855,6 +855,7 @@ int run_reproduce(const std::string& out_dir, const std::string& cases_dir, bool
       progress("Hard-wall Elastica: contact states over (a, Delta), sweeps/wall_phase_diagram.toml (about 5 minutes)");
       SweepRunOptions sweep;
       sweep.out_dir = (out / "wall_phase").string();
+      sweep.progress = [](const std::string& line) { progress("  " + line); };
       fs::remove_all(sweep.out_dir);
       run_sweep(load_sweep((cases / ".." / "sweeps" / "wall_phase_diagram.toml").lexically_normal().string()), sweep);
     }
