@@ -261,7 +261,7 @@ int main(int argc, char** argv) {
       ->add_option("--from-ply", plect.from_ply,
                    "Slendernesses reached from the ply of the previous one in --slenderness (by continuation in\n"
                    "L/2R, then in the barrier's log_softness), then followed in turns up to their --turns and down\n"
-                   "to --turns-min: at L/2R = 1000 this is how the ply is reached (README). With --hard-from,\n"
+                   "to --turns-min: at L/2R = 1000 this is how the ply is reached (docs/plectonemes.md). With --hard-from,\n"
                    "from the previous one's exact ply, continued in L/2R with exact contact")
       ->delimiter(',')
       ->capture_default_str();

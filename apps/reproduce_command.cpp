@@ -695,7 +695,7 @@ void plectonemes(const fs::path& cases, const fs::path& out, bool full, std::vec
 // sweep's 10, 20, 20) and down (to 4.5, with `full` to 4) into out/plectoneme_<L/2R>_ply.csv. At
 // each ply's largest turns: (61) and (58b) with R itself, H_A = H_B; over all its points the
 // self-distance; and the legs reaching their ends (a contact force or the line's pressure
-// reaching 0 would have stopped them). L/2R = 1000 with exact contact is a CLI run (README).
+// reaching 0 would have stopped them). L/2R = 1000 with exact contact is a CLI run (docs/plectonemes.md).
 void exact_plies(const std::string& case_path, const fs::path& out, bool full, std::vector<ReportRow>* rows) {
   PlectonemesArguments args;
   args.case_path = case_path;

@@ -329,7 +329,7 @@ TEST(StatedContacts, KeptMovedAndReleasedAreTold) {
 
 TEST(FailedSolve, AfterTheNLoptSearchSaysWhatWasTried) {
   // From the free arch at Delta = 0.04 the active-set loop reaches two point contacts that do not
-  // converge (the flat contact is reached by continuation; see the README).
+  // converge (the flat contact is reached by continuation; see docs/contact.md).
   const ContactRun r = run({{"Delta", 0.04}});
   ASSERT_FALSE(r.solve.result.summary.converged());
   const std::string& m = r.solve.result.summary.message;

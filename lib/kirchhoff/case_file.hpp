@@ -1,4 +1,4 @@
-// Case files: a TOML description of a rod problem (see cases/ and the README for the keys).
+// Case files: a TOML description of a rod problem (see cases/ and docs/case-files.md for the keys).
 // Every number in the rod, end and guess tables may be an expression in the [parameters]
 // (muParser syntax), and material properties may also use the arclength s.
 #pragma once

@@ -99,7 +99,7 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
 
 // A slenderness reached the way an experimenter thins a rod - at L/2R = 1000 faster than from the
 // untwisted rod (which, with steps checked for passing the rod through itself, reaches the same
-// ply at 20 turns in 1419 s against 897 s for this whole leg; README): starts from the last point
+// ply at 20 turns in 1419 s against 897 s for this whole leg; docs/plectonemes.md): starts from the last point
 // of a thicker rod's branch (base_state_path, a ply at its largest turns), continues it in
 // slenderness to `slenderness` and in log_softness to options.ply_log_softness, then in turns up
 // to turns_max (CSV branch 0) and from the same start down to turns_min (branch 1). The start is
