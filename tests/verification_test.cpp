@@ -139,6 +139,26 @@ TEST(SoftWall, NoConvergedSolutionBeyondTheWall) {
   }
 }
 
+// The residual tolerance is absolute: a rod of length 1e-100 meets it at the case's guess, whose
+// P = 12 is not the equilibrium (P = 4 K(k)^2 EI / L^2 ~ 1e201). Such a solve once converged after
+// 0 iterations; now one Newton correction from the guess says its residual is small only by
+// scale. At L = 1 a guess that is the solution itself (its correction ~1e-10, far below the
+// 1e-4 allowed) still converges after 0 iterations.
+TEST(ZeroIterationCheck, RefusesAResidualSmallOnlyByTheCasesScale) {
+  const Case tiny = load_case(testing::case_path("simply_supported.toml"), {{"L", 1e-100}});
+  const DefinitionSolve at_tiny_scale = solve_definition(tiny.definition, tiny.start_guess);
+  EXPECT_EQ(at_tiny_scale.result.summary.status, SolverStatus::CheckFailed);
+  EXPECT_NE(at_tiny_scale.result.summary.message.find("not meaningful at this case's scale"), std::string::npos)
+      << at_tiny_scale.result.summary.message;
+
+  const Case unit = load_case(testing::case_path("simply_supported.toml"));
+  const DefinitionSolve first = solve_definition(unit.definition, unit.start_guess);
+  ASSERT_TRUE(first.result.summary.converged());
+  const ShootingResult again = solve(*first.problem, first.result.x);
+  EXPECT_TRUE(again.summary.converged()) << again.summary.message;
+  EXPECT_EQ(again.summary.iterations, 0);
+}
+
 // Both steppers give the same equilibrium on every shipped case. Dopri5 returned NaN profiles
 // (odeint's dense output sampled s = 0 before its first step) that the solve called converged.
 class BothSteppers : public ::testing::TestWithParam<std::string> {};

@@ -1099,6 +1099,7 @@ ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) 
   result.summary = solve_with_fallback(problem, result.x, problem.definition().options.newton);
   result.parameters = problem.parameters_at(result.x);
   if (result.summary.converged()) mark_check_failure(&result, unknowns_failure(problem, result));
+  if (result.summary.converged()) mark_check_failure(&result, zero_iteration_failure(problem, result));
   if (!result.summary.converged() || !result.parameters.contains("unfolding")) return result;
   if (std::abs(result.parameters.get("unfolding")) > kUnfoldingTolerance) {
     result.summary.status = SolverStatus::UnfoldingNotZero;

@@ -18,6 +18,21 @@ std::string at(double s) {
   return os.str();
 }
 
+// J^-1 F with J equilibrated by rows and columns first (LAPACK's dgeequ idea): a case in units far
+// from 1 has Jacobian entries spread over hundreds of orders of magnitude (a rod of length 1e-100:
+// d y(L) / d P ~ L^3), which an unscaled solve reads as rank deficiency. NaN when the equilibrated
+// matrix is still singular (rcond below 1e-12), where no correction can be told.
+Eigen::VectorXd equilibrated_newton_correction(const Eigen::MatrixXd& J, const Eigen::VectorXd& F) {
+  const auto power_of_two_inverse = [](double m) { return m > 0.0 ? std::exp2(-std::ilogb(m)) : 1.0; };
+  Eigen::VectorXd rows(J.rows()), columns(J.cols());
+  for (int i = 0; i < J.rows(); ++i) rows[i] = power_of_two_inverse(J.row(i).lpNorm<Eigen::Infinity>());
+  const Eigen::MatrixXd row_scaled = rows.asDiagonal() * J;
+  for (int j = 0; j < J.cols(); ++j) columns[j] = power_of_two_inverse(row_scaled.col(j).lpNorm<Eigen::Infinity>());
+  const Eigen::FullPivLU<Eigen::MatrixXd> lu(row_scaled * columns.asDiagonal());
+  if (!(lu.rcond() > 1e-12)) return Eigen::VectorXd::Constant(F.size(), std::nan(""));
+  return columns.asDiagonal() * lu.solve(rows.asDiagonal() * F);
+}
+
 }  // namespace
 
 std::string unknowns_failure(const ShootingProblem& problem, const ShootingResult& result) {
@@ -41,6 +56,25 @@ std::string unknowns_failure(const ShootingProblem& problem, const ShootingResul
     return os.str();
   }
   return {};
+}
+
+std::string zero_iteration_failure(const ShootingProblem& problem, const ShootingResult& result) {
+  if (result.summary.iterations > 0) return {};
+  Eigen::VectorXd F;
+  Eigen::MatrixXd J;
+  std::string failure;
+  if (!problem.evaluate(result.x, &F, &J, &failure) || !J.allFinite()) return {};  // unknowns_failure's job
+  const Eigen::VectorXd correction = equilibrated_newton_correction(J, F);
+  if (!correction.allFinite()) return {};  // singular even when equilibrated: a branch point, say
+  const double size = 1.0 + result.x.lpNorm<Eigen::Infinity>();
+  const double step = correction.lpNorm<Eigen::Infinity>();
+  if (step <= kGuessCorrectionTolerance * size) return {};
+  std::ostringstream os;
+  os << "the guess meets the residual tolerance as it is (residual " << max_abs_or_nan(F)
+     << ", 0 iterations), but one Newton correction from it moves the unknowns by " << step << " against their size "
+     << size - 1.0 << ": the absolute tolerance is not meaningful at this case's scale; give lengths, "
+     << "stiffnesses and loads in units that make them of order 1";
+  return os.str();
 }
 
 std::string profile_failure(const RodModel& model, const std::vector<RodPoint>& profile) {

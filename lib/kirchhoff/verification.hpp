@@ -17,6 +17,20 @@ namespace kirchhoff {
 // tolerance, or 1e3 times it for a step that stopped at round-off: NewtonOptions::step_tolerance).
 std::string unknowns_failure(const ShootingProblem& problem, const ShootingResult& result);
 
+// A guess that already meets the residual tolerance (Newton converged after 0 iterations) is a
+// solution only if the tolerance means something at the case's scale: the residual tolerance is
+// absolute, so a rod of length 1e-100 meets it at any guess. One Newton correction from the
+// solution, J^-1 F, must be small beside the unknowns (kGuessCorrectionTolerance (1 + |x|)); a
+// correction that large says the residual is small only because the case's lengths, stiffnesses
+// or loads are far from 1. Costs one Jacobian, and only for solves that took no Newton step (after
+// a step, the step itself shows the scale).
+std::string zero_iteration_failure(const ShootingProblem& problem, const ShootingResult& result);
+
+// A correction below 1e-4 of the unknowns' size is far above what a converged residual gives (|F|
+// <= 1e-10 through a Jacobian even as ill-conditioned as 1e-5 near a fold: 1e-5), and far below
+// what a residual that is small only by scale gives (orders of magnitude beyond the unknowns).
+inline constexpr double kGuessCorrectionTolerance = 1e-4;
+
 // Every sampled state is finite, and the rod stays strictly inside the domain of its external
 // field's potential (a soft wall's W_ext = b / (a - y) is infinite at the wall and has no
 // physical meaning beyond it: a solution there is a solution of the equations, not of the rod).
