@@ -276,15 +276,163 @@ TEST(Stability, StraightRodHeldAtFullLengthIsADegenerateConstraint) {
   }
 }
 
+// The full frame (positions as configuration variables, used where the energy depends on where
+// the rod is) against the rotation-only frame on equilibria whose energy does not: both must give
+// the same index and zero modes, and the same conjugate points (with no field gradient the
+// translations stay constant fields, so det U of the full frame is det U of the rotation frame).
+// The chord constraint of the rotation frame is there replaced by separate constraints on each
+// held end position, and the translations are zero modes of the load-controlled problem instead
+// of being left out: two different routes to one count.
+TEST(Stability, FullFrameCountsAsTheRotationFrameWhereTheEnergyIgnoresPosition) {
+  struct Row { std::string name; ParameterOverrides set; };
+  const double phi_c = analytic::clamped_twisted_critical_moment(1.0, 0.0, 1.0) / 0.769230769230769;
+  const std::vector<Row> rows = {
+      {"euler_column.toml", {{"P", 20.0}, {"theta_guess", 0.0}}},  {"euler_column.toml", {{"P", 200.0}, {"theta_guess", 0.0}}},
+      {"euler_column.toml", {{"P", 12.0}, {"theta_guess", 1.0}}},  {"euler_column.toml", {{"P", 30.0}, {"theta_guess", 2.5}}},
+      {"euler_column.toml", {{"P", 100.0}, {"theta_guess", 1.5}}}, {"clamped_clamped.toml", {{"s_mode", 0.0}}},
+      {"clamped_clamped.toml", {{"s_mode", 1.0}}},                 {"simply_supported.toml", {{"theta0", 2.0}}},
+      {"twisted_clamped.toml", {{"phi", 5.0}}},                    {"twisted_clamped.toml", {{"phi", phi_c + 0.1}}},
+      {"heavy_cantilever.toml", {}},                               {"tapered.toml", {}}};
+  StabilityOptions full;
+  full.positions_as_configuration = true;
+  for (const Row& row : rows) {
+    SCOPED_TRACE(row.name);
+    const auto solved = solve_case(row.name, row.set);
+    const StabilityReport rotation = index_of(solved);
+    const StabilityReport positions = analyse_stability(*solved.problem, solved.solution.result.x, full);
+    ASSERT_TRUE(rotation.defined()) << rotation.reason;
+    ASSERT_TRUE(positions.defined()) << positions.reason;
+    EXPECT_EQ(*positions.index, *rotation.index);
+    EXPECT_EQ(positions.zero_modes, rotation.zero_modes);
+    // Located to ~1e-7 L by each (see StraightColumnCountsTheEulerLoadsBelowTheLoad): 1e-5.
+    ASSERT_EQ(positions.conjugate_points.size(), rotation.conjugate_points.size());
+    for (size_t j = 0; j < rotation.conjugate_points.size(); ++j)
+      EXPECT_NEAR(positions.conjugate_points[j], rotation.conjugate_points[j], 1e-5);
+  }
+  // Point contacts on the wall: the sliding term and the contact's constraint through the full
+  // frame, stable while sliding, index 1 from Delta ~ 0.028 when held at its material point.
+  for (double delta : {0.026, 0.030}) {
+    SCOPED_TRACE("wall.toml, Delta = " + std::to_string(delta));
+    const Case c = load_case(testing::case_path("wall.toml"), {{"Delta", delta}});
+    const DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
+    ASSERT_TRUE(solved.result.summary.converged());
+    for (bool sliding : {true, false}) {
+      StabilityOptions rotation_options, full_options = full;
+      rotation_options.contact_sliding = full_options.contact_sliding = sliding;
+      const StabilityReport rotation = analyse_stability(*solved.problem, solved.result.x, rotation_options);
+      const StabilityReport positions = analyse_stability(*solved.problem, solved.result.x, full_options);
+      ASSERT_TRUE(rotation.defined() && positions.defined()) << rotation.reason << positions.reason;
+      EXPECT_EQ(*positions.index, *rotation.index);
+      EXPECT_EQ(positions.zero_modes, rotation.zero_modes);
+    }
+  }
+}
+
+// A Winkler foundation V = k/2 (r.e_y)^2 (force -k y e_y): a field whose force depends on position.
+class Foundation final : public ExternalField {
+ public:
+  explicit Foundation(double k) : k_(k) {}
+  double potential(double, const Vec3& r) const override { return 0.5 * k_ * r.y() * r.y(); }
+  Vec3 force(double, const Vec3& r) const override { return Vec3(0, -k_ * r.y(), 0); }
+  Mat3 force_gradient(double, const Vec3&) const override {
+    Mat3 g = Mat3::Zero();
+    g(1, 1) = -k_;
+    return g;
+  }
+
+ private:
+  double k_;
+};
+
+// The straight pinned column under a dead load P on a foundation of stiffness k (EI = L = 1):
+// its second variation int (w''^2 - P w'^2 + k w^2) / 2 with w = w'' = 0 at the ends has the
+// sine modes sin(j pi s) as eigenfunctions, with (j pi)^4 + k - P (j pi)^2, so the index is the
+// number of j whose load (j pi)^2 + k / (j pi)^2 is below P. k = 500 puts them at 60.5, 52.1, 94.5,
+// 161.1, 248.8 (j = 1..5): the second mode goes first, and every load below differs from the
+// Euler count without the foundation (pi^2, 4 pi^2, 9 pi^2, ...: 2, 2, 3, 4, 5). The field's
+// Hessian enters through the Jacobi fields' dn' = k dy, which the rotation-only frame cannot
+// carry: the index comes from the full frame.
+TEST(Stability, StraightColumnOnAFoundationCountsTheModesBelowTheLoad) {
+  const double k = 500.0;
+  for (double P : {40.0, 55.0, 70.0, 100.0, 200.0}) {
+    SCOPED_TRACE("P = " + std::to_string(P));
+    Case c = load_case(testing::case_path("euler_column.toml"), {{"P", P}, {"theta_guess", 0.0}});
+    const ModelFunction bare = c.definition.model;
+    c.definition.model = [bare, k](const Parameters& p) {
+      RodModel m = bare(p);
+      m.field = std::make_shared<Foundation>(k);
+      return m;
+    };
+    ShootingProblem problem(c.definition);
+    const ShootingResult solved = solve(problem, problem.initial_unknowns(c.start_guess));
+    ASSERT_TRUE(solved.summary.converged());
+    ASSERT_LT(std::abs(problem.sample(solved.x, {0.5}).front().r.y()), 1e-12);  // straight
+    const StabilityReport r = analyse_stability(problem, solved.x);
+    ASSERT_TRUE(r.defined()) << r.reason;
+    int below = 0;
+    for (int j = 1; j < 20; ++j)
+      if (j * j * M_PI * M_PI + k / (j * j * M_PI * M_PI) < P) ++below;
+    EXPECT_EQ(*r.index, below);
+    EXPECT_EQ(r.zero_modes, 0);
+  }
+}
+
+// The soft wall (soft_wall.toml): the symmetric arch pushed down by the barrier b / (a - y) along
+// its whole length. At the shipped b = 0.1 it has index 1 (a 400-element discretised energy with
+// the barrier: lowest eigenvalue -27.4); followed in log_b towards the hard wall, whose symmetric
+// point contact at this Delta is stable (HardWallPointContactSlidesAndIsStableUntilItFlattens), it
+// regains its stability exactly at the branch point the continuation finds from the Jacobian
+// (log_b = -2.068, where the asymmetric equilibria branch off): index 1 on every point before it,
+// 0 on every point after, and the branch point itself has a zero mode.
+TEST(Stability, SoftWallArchRegainsItsStabilityAtTheBranchPointTowardsTheHardWall) {
+  const auto shipped = solve_case("soft_wall.toml");
+  const StabilityReport r = index_of(shipped);
+  ASSERT_TRUE(r.defined()) << r.reason;
+  EXPECT_EQ(*r.index, 1);
+  EXPECT_EQ(r.zero_modes, 0);
+
+  Case c = load_case(testing::case_path("soft_wall.toml"));
+  ShootingProblem problem(c.definition);
+  ContinuationOptions o;
+  o.parameter = "log_b";
+  o.target = -2.5;
+  o.initial_step = 0.2;
+  o.max_step = 2.0;
+  o.samples = 101;
+  o.compute_stability = true;
+  Continuation run(problem, o);
+  const ContinuationResult branch = run.run(problem.initial_unknowns(c.start_guess));
+  ASSERT_EQ(branch.reason, StopReason::ReachedTarget) << branch.message;
+  double bp = NAN;
+  for (const auto& p : branch.points)
+    if (p.type == PointType::BranchPoint) {
+      EXPECT_TRUE(std::isnan(bp)) << "a second branch point at log_b = " << p.parameter;
+      bp = p.parameter;
+      EXPECT_EQ(p.zero_modes, 1);
+    }
+  ASSERT_FALSE(std::isnan(bp));
+  EXPECT_NEAR(bp, -2.068, 0.01);  // where this run located it (the exchange is checked below)
+  int before = 0, after = 0;
+  for (const auto& p : branch.points) {
+    if (p.type == PointType::BranchPoint) continue;
+    ASSERT_TRUE(p.stability_index.has_value()) << "log_b = " << p.parameter;
+    EXPECT_EQ(*p.stability_index, p.parameter > bp ? 1 : 0) << "log_b = " << p.parameter;
+    ++(p.parameter > bp ? before : after);
+  }
+  EXPECT_GT(before, 10);
+  EXPECT_GT(after, 5);
+}
+
 TEST(Stability, UnsupportedCasesSayWhy) {
   // The Reissner rod's end carries a dead couple and is free to turn in 3D: not conservative.
   const StabilityReport couple = index_of(solve_case("reissner.toml"));
   EXPECT_FALSE(couple.defined());
   EXPECT_NE(couple.reason.find("not conservative"), std::string::npos) << couple.reason;
-  const auto soft = solve_case("soft_wall.toml");
-  const StabilityReport r = index_of(soft);
+  // A sleeve's length: not an end load.
+  const auto sleeve = solve_case("sleeve.toml");
+  const StabilityReport r = index_of(sleeve);
   EXPECT_FALSE(r.defined());
-  EXPECT_NE(r.reason.find("depends on position"), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("not an end load"), std::string::npos) << r.reason;
   EXPECT_EQ(describe(r).rfind("index undefined", 0), 0u);
 }
 

@@ -25,6 +25,9 @@ struct Scales {
   // nearly uniform rate ~ 2 rate / L, instead of spending most of a turn within a short stretch
   // near each conjugate point, where a step could pass a whole turn unseen.
   double rate = 1.0;
+  // The force's momentum is divided by it too where positions are configuration variables (the
+  // full frame below): the same factor on every momentum keeps the rescaling symplectic.
+  double force_rate = 1.0;
 };
 
 // Canonical coordinates of the rod's configuration (position, then rotation, along the
@@ -69,7 +72,7 @@ CanonicalMap canonical_map(const RodEquations& eq, const Coordinates& c, const S
   map.T.topRows(kr) = c.position_dirs.transpose() * eq.slot_map(Slot::Position) / sc.length;
   map.T.middleRows(kr, n - kr) = c.rotation_dirs.transpose() * rotation_jacobian;
   map.T.middleRows(n, kr) =
-      c.position_dirs.transpose() * eq.slot_map(Slot::Force) * (sc.length * sc.length / sc.bending);
+      c.position_dirs.transpose() * eq.slot_map(Slot::Force) * (sc.length * sc.length / (sc.bending * sc.force_rate));
   map.T.bottomRows(n - kr) =
       c.rotation_dirs.transpose() * eq.slot_map(Slot::Moment) * (sc.length / (sc.bending * sc.rate));
   map.G = Eigen::MatrixXd::Zero(n, n);
@@ -182,8 +185,6 @@ std::string unsupported(const ShootingProblem& problem, const Eigen::VectorXd& x
   for (const PointContact& c : problem.contacts_at(x)) {
     if (c.extended)
       return "an extended contact (the rod lying on the obstacle): its second variation is not implemented";
-    if (!obstacles[c.obstacle].is_flat())
-      return "a contact with a curved obstacle: its second variation (the obstacle's curvature) is not implemented";
     if (problem.equations(problem.parameters_at(x))->model().extensible)
       return "a contact of an extensible rod: not implemented";
   }
@@ -217,13 +218,16 @@ struct Frame {
   Eigen::MatrixXd dY;  // N x kpsi: state perturbations of the fields
   Eigen::MatrixXd U, P, P_physical;  // rotation blocks, kpsi x kpsi each; [U; P] orthonormal
   Eigen::MatrixXd R;                  // position perturbation of the fields (kr x kpsi), slaved
-  // One field per isoperimetric constraint: the response to a unit change of the end load along
-  // it, then one per point contact, zero up to its contact, the response to a unit change of its
-  // force beyond.
+  // One field per isoperimetric constraint's multiplier: first those starting at s = 0 (the
+  // response to a unit change of the end load along a held chord direction; with the full frame,
+  // of the start's load along a position it holds), then one per point contact, zero up to its
+  // contact, the response to a unit change of its force beyond; with the full frame last one per
+  // position the end holds, identically zero (its load enters through the end's conditions).
   Eigen::MatrixXd particular, particular_U, particular_P, particular_P_physical, particular_R;
-  // The contacts' constraints nu.dr(s_c) / L on the frame's fields and on the particular ones,
+  // The constraints read before s = L on the frame's fields and on the particular ones: with the
+  // full frame the positions the start holds (at s = 0), then the contacts' nu.dr(s_c) / L,
   // recorded as each contact is passed.
-  Eigen::MatrixXd contact_rows_frame, contact_rows_particular;
+  Eigen::MatrixXd recorded_rows_frame, recorded_rows_particular;
 };
 
 // Follows lifted eigenphases, and where they pass odd multiples of pi (a stack per eigenphase:
@@ -264,6 +268,10 @@ class StabilityAnalysis {
     std::vector<double> s(17);
     for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
     profile_ = problem_.sample(x_, s);
+    full_ = options_.positions_as_configuration || positions_enter_the_energy();
+    const int n = coords_.size(), kr = coords_.kr();
+    offset_ = full_ ? 0 : kr;
+    mU_ = full_ ? n : n - kr;
   }
 
   // The wavenumber of the Jacobi fields, L sqrt(|n| / B) and L |m| / B at their largest over the
@@ -275,6 +283,11 @@ class StabilityAnalysis {
       for (int k = 0; k < 3; ++k) stiffness = std::min(stiffness, model.B[k](q.s));
     for (const RodPoint& q : profile_)
       rate = std::max({rate, scales_.length * std::sqrt(q.n.norm() / stiffness), scales_.length * q.m.norm() / stiffness});
+    // A field stiffness k (|df/dr|) makes the fields oscillate like a beam on a foundation, with
+    // wavenumber (k / B)^(1/4).
+    if (model.field)
+      for (const RodPoint& q : profile_)
+        rate = std::max(rate, scales_.length * std::pow(model.field->force_gradient(q.s, q.r).norm() / stiffness, 0.25));
     return rate;
   }
 
@@ -286,11 +299,13 @@ class StabilityAnalysis {
     Eigen::MatrixXd rotation;  // kpsi x b, rotation coordinates
   };
   Held held_at(const EndCondition& end, const std::vector<std::string>& multipliers) const;
-  std::string field_reason() const;
+  bool positions_enter_the_energy() const;
+  // The configuration directions (the frame's U coordinates) an end holds in the load-controlled
+  // problem: its held rotations; positions are never held there.
+  Eigen::MatrixXd held_configuration(const Held& held) const;
   Eigen::MatrixXd constraint_directions(const Held& start, const Held& end) const;
-  Frame start_frame(const Held& start, const Eigen::MatrixXd& constraints, int contacts) const;
-  std::string pass_contact(Frame* f, const PointContact& contact, int number, int chord_count, PhaseTrack* track,
-                           double* shear);
+  Frame start_frame(const Held& start, const Eigen::MatrixXd& start_multipliers, int contacts, int end_multipliers) const;
+  std::string pass_contact(Frame* f, const PointContact& contact, int number, PhaseTrack* track, double* shear);
   void canonical_blocks(Frame* f) const;
   void orthonormalise(Frame* f) const;
   void advance(Frame* f, double s1, PhaseTrack* track, int depth);
@@ -301,6 +316,9 @@ class StabilityAnalysis {
   std::string end_moment_reason(const Frame& f, const Held& end) const;
   bool constraint_correction(const Frame& f, const Held& end, const Eigen::MatrixXd& constraints,
                              const Eigen::MatrixXd& zero_modes, StabilityReport* report) const;
+  // The shear of the canonical momenta a point quadratic form 1/2 z^T S z of the lab
+  // perturbation z = (dr, dpsi) makes (p += S_c u), in the frame's U coordinates.
+  Eigen::MatrixXd canonical_shear(const Eigen::MatrixXd& lab_S) const;
 
   const ShootingProblem& problem_;
   const Eigen::VectorXd& x_;
@@ -311,6 +329,13 @@ class StabilityAnalysis {
   Scales scales_;
   std::vector<RodPoint> profile_;  // the equilibrium at 17 equally spaced points, for the checks above
   long rhs_ = 0;
+  // The full frame: positions are configuration variables beside the rotation (see
+  // positions_enter_the_energy); its U block holds (dr / L, dpsi), offset_ = 0. Otherwise the
+  // rotation alone, offset_ = kr. mU_ is the size of U.
+  bool full_ = false;
+  int offset_ = 0, mU_ = 0;
+  // Multipliers whose particular fields start at s = 0 and constraints recorded before L (see Frame).
+  int start_multipliers_ = 0, recorded_before_contacts_ = 0;
 };
 
 StabilityAnalysis::Held StabilityAnalysis::held_at(const EndCondition& end,
@@ -323,16 +348,53 @@ StabilityAnalysis::Held StabilityAnalysis::held_at(const EndCondition& end,
   return h;
 }
 
-// A field whose force depends on position (a soft wall, a self-contact barrier) makes the
-// position a configuration variable of its own; only position-independent fields are covered.
-std::string StabilityAnalysis::field_reason() const {
+// Whether positions are configuration variables of their own, beside the rotation: where the
+// energy depends on where the rod is, not only on its shape - a field whose force depends on
+// position (a soft wall, a barrier: f = -grad V(r)), or a contact with a curved obstacle, whose
+// second variation holds the obstacle's curvature at the perturbed contact point dr(s_c).
+//
+// Why the rotation alone no longer suffices. The load-controlled problem's energy is
+//   E[r0, R] = int W(u, v) + int V(r) - F_L.r(L) + F_0.r(0),   r(s) = r0 + int_0^s R v,
+// so its second variation holds int dr.Hess V dr with dr(s) = dr0 + int_0^s (dpsi x d3 + ...): a
+// non-local term in the rotation, and the translation dr0 costs energy, so the rigid
+// translations are not the zero modes they are without such a field. With (r, R) as the
+// configuration the term is local: the Jacobi fields carry dr, and dn' = -(df/dr) dr (the
+// shooting core's variational equations already linearise the field, so nothing changes there).
+// This is a problem of Lagrange - r' = d3 is a constraint whose multiplier is n, and the
+// Hamiltonian's Hessian in the momenta is B^-1 on dm and zero on dn (inextensible rods): the
+// Legendre condition holds on the strains, as before, not on the position. Morse's index theorem
+// still holds for such problems when they are normal (no perturbation keeps r' = d3 by force
+// alone: here a field with dr = dpsi = dm = 0 must have dn along a straight stretch's axis, which
+// the load-controlled frame, dn(0) = 0, never contains), and a crossing of the Lagrangian frame
+// through det U = 0 has the crossing form dm.B^-1 dm >= 0: the eigenphases of W still pass -1 in
+// one direction only. A crossing with dm = 0 as well would be non-regular; the count refuses any
+// passage the other way, so such a case is reported undefined, never guessed.
+//
+// Why the chord constraint changes. With V depending on r, holding r(0) and r(L) is not the same
+// as holding r(L) - r(0): each held position is a constraint of its own, e.r(0) and e.r(L), whose
+// multiplier is that end's reaction (a force doing work on it). D is then d(held positions) /
+// d(reactions) along the load-controlled equilibria, a k x k matrix with k the positions held at
+// either end; the bordered-Hessian count index = index_dead + n_+(D) + r_Z - k is unchanged (it
+// needs only a quadratic form and linear constraints). Where df/dr = 0 it reduces to the chord
+// count: the translations are then zero modes of the load-controlled problem, r_Z is the rank of
+// the held directions, and the loads doing no work on the translations are the balanced pairs,
+// whose D is the chord's. (The tests check that the two frames agree on every such case.)
+bool StabilityAnalysis::positions_enter_the_energy() const {
   const auto& field = eq_->model().field;
-  if (!field) return "";
-  for (const RodPoint& q : profile_)
-    if (field->force_gradient(q.s, q.r).norm() > 0)
-      return "the external field depends on position (a soft wall or barrier): its Hessian in the second "
-             "variation is not implemented";
-  return "";
+  if (field)
+    for (const RodPoint& q : profile_)
+      if (field->force_gradient(q.s, q.r).norm() > 0) return true;
+  const std::vector<Obstacle> obstacles = problem_.obstacles(p_);
+  for (const PointContact& c : problem_.contacts_at(x_))
+    if (!obstacles[c.obstacle].is_flat()) return true;
+  return false;
+}
+
+Eigen::MatrixXd StabilityAnalysis::held_configuration(const Held& held) const {
+  if (!full_) return held.rotation;
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(mU_, held.rotation.cols());
+  out.bottomRows(held.rotation.rows()) = held.rotation;
+  return out;
 }
 
 // Directions along which both ends hold the position: the isoperimetric constraints
@@ -346,40 +408,53 @@ Eigen::MatrixXd StabilityAnalysis::constraint_directions(const Held& start, cons
   return column_basis(start.position * pairs.topRows(start.position.cols()));
 }
 
-// Jacobi fields of the load-controlled problem meeting the start's rotation conditions (dr = 0,
-// dn = 0), then one particular field per constraint direction: a unit change of the end load
-// along it (dn = e_j).
-Frame StabilityAnalysis::start_frame(const Held& start, const Eigen::MatrixXd& constraints, int contacts) const {
-  const int n = coords_.size(), kr = coords_.kr(), kpsi = n - kr;
-  const Eigen::MatrixXd free_rotation = complement(start.rotation, kpsi);
-  const int columns = kpsi + static_cast<int>(constraints.cols());
-  Eigen::MatrixXd z = Eigen::MatrixXd::Zero(2 * n, columns);
-  z.block(kr, 0, kpsi, free_rotation.cols()) = free_rotation;
-  z.block(n + kr, free_rotation.cols(), kpsi, start.rotation.cols()) = start.rotation;
-  z.block(n, kpsi, kr, constraints.cols()) = constraints;
+// Jacobi fields of the load-controlled problem meeting the start's conditions: its rotation
+// conditions, dn = 0 (a dead load), and dr = 0 - or, with the full frame, dr free (one field per
+// translation). Then one particular field per multiplier starting at s = 0, with dn(0) given by
+// the columns of start_multipliers (a unit change of the load along a held chord, dn = e_j; with
+// the full frame, of the start's reaction along a position it holds, dn(0) = -e_j, the force on
+// the rod being -n(0)), room for one per contact and, with the full frame, one per position the
+// end holds (zero fields: see Frame).
+Frame StabilityAnalysis::start_frame(const Held& start, const Eigen::MatrixXd& start_multipliers, int contacts,
+                                     int end_multipliers) const {
+  const int n = coords_.size(), kr = coords_.kr();
+  const Eigen::MatrixXd held = held_configuration(start);
+  const Eigen::MatrixXd free = complement(held, mU_);
+  const int starting = static_cast<int>(start_multipliers.cols());
+  Eigen::MatrixXd z = Eigen::MatrixXd::Zero(2 * n, mU_ + starting);
+  z.block(offset_, 0, mU_, free.cols()) = free;
+  z.block(n + offset_, free.cols(), mU_, held.cols()) = held;
+  z.block(n, mU_, kr, starting) = start_multipliers;
   Frame f;
   f.s = 0.0;
   f.y = x_.head(problem_.state_size());
   const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f.y, 0.0);
   const Eigen::MatrixXd dY = map.T.completeOrthogonalDecomposition().solve(z);
-  f.dY = dY.leftCols(kpsi);
-  f.particular = Eigen::MatrixXd::Zero(dY.rows(), constraints.cols() + contacts);
-  f.particular.leftCols(constraints.cols()) = dY.rightCols(constraints.cols());
-  f.contact_rows_frame = Eigen::MatrixXd::Zero(contacts, kpsi);
-  f.contact_rows_particular = Eigen::MatrixXd::Zero(contacts, constraints.cols() + contacts);
+  f.dY = dY.leftCols(mU_);
+  const int multipliers = starting + contacts + end_multipliers;
+  f.particular = Eigen::MatrixXd::Zero(dY.rows(), multipliers);
+  f.particular.leftCols(starting) = dY.rightCols(starting);
   canonical_blocks(&f);
+  // With the full frame, the start's held positions are constraints read here.
+  const int recorded = recorded_before_contacts_ + contacts;
+  f.recorded_rows_frame = Eigen::MatrixXd::Zero(recorded, mU_);
+  f.recorded_rows_particular = Eigen::MatrixXd::Zero(recorded, multipliers);
+  if (recorded_before_contacts_ > 0) {
+    f.recorded_rows_frame.topRows(recorded_before_contacts_) = start.position.transpose() * f.R;
+    f.recorded_rows_particular.topRows(recorded_before_contacts_) = start.position.transpose() * f.particular_R;
+  }
   return f;
 }
 
 void StabilityAnalysis::canonical_blocks(Frame* f) const {
-  const int n = coords_.size(), kr = coords_.kr(), kpsi = n - kr;
+  const int n = coords_.size(), kr = coords_.kr();
   const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f->y, f->s);
   auto blocks = [&](const Eigen::MatrixXd& dY, Eigen::MatrixXd* U, Eigen::MatrixXd* P, Eigen::MatrixXd* P_phys,
                     Eigen::MatrixXd* R) {
     const Eigen::MatrixXd z = map.T * dY;
-    *U = z.middleRows(kr, kpsi);
-    *P_phys = z.bottomRows(kpsi);
-    *P = *P_phys + map.G.bottomRightCorner(kpsi, kpsi) * *U;
+    *U = z.middleRows(offset_, mU_);
+    *P_phys = z.middleRows(n + offset_, mU_);
+    *P = *P_phys + map.G.bottomRightCorner(mU_, mU_) * *U;
     *R = z.topRows(kr);
   };
   blocks(f->dY, &f->U, &f->P, &f->P_physical, &f->R);
@@ -399,7 +474,7 @@ void StabilityAnalysis::orthonormalise(Frame* f) const {
   f->P = f->P * Rinv;
   f->P_physical = f->P_physical * Rinv;
   f->R = f->R * Rinv;
-  f->contact_rows_frame = f->contact_rows_frame * Rinv;
+  f->recorded_rows_frame = f->recorded_rows_frame * Rinv;
 }
 
 // Matches new eigenphases to the lifted old ones (nearest on the circle) and lifts them. A phase
@@ -456,8 +531,8 @@ void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int dept
   next.s = s1;
   next.dY = flow.Phi * f->dY;
   next.particular = flow.Phi * f->particular;
-  next.contact_rows_frame = f->contact_rows_frame;
-  next.contact_rows_particular = f->contact_rows_particular;
+  next.recorded_rows_frame = f->recorded_rows_frame;
+  next.recorded_rows_particular = f->recorded_rows_particular;
   canonical_blocks(&next);
   orthonormalise(&next);
   const Eigen::VectorXd phases = eigenphases(next.U, next.P);
@@ -478,39 +553,52 @@ void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int dept
   *f = next;
 }
 
-// Across a point contact on a plane (normal nu, force f > 0, the rod curving away at the rate
-// g'' = nu.d3' > 0):
+// Across a point contact (normal nu, force f > 0, the rod curving away from the obstacle):
 //  - the equilibrium's force jumps by -f nu; in the load-controlled problem the contact force is
 //    a dead load on its material point, so the fields' dn is continuous;
-//  - the contact point slides: to second order the rod stays off the plane iff min_s of its gap
-//    does, and that minimum over the sliding contact point adds f (nu.dr')^2 / (2 g'') to the
-//    second variation, with nu.dr' = dpsi.(d3 x nu). (Holding the contact at its material point
-//    instead leaves this term out and gives another, wrong count.) For the fields this is a jump
-//    of the moment dm += (f / g'') w (w.dpsi), w = d3 x nu: a shear p += S u that leaves U, so
-//    no conjugate point, unchanged; the eigenphases are followed through it in small steps;
+//  - the contact point slides along the obstacle: to second order the rod stays off it iff the
+//    minimum over s of its gap G(s) = g(r(s)) does. With G(s_c) = G'(s_c) = 0 and G''(s_c) > 0,
+//      min_s G = dG(s_c) + 1/2 d2G(s_c) - (dG'(s_c))^2 / (2 G''(s_c))  (to second order),
+//    and the Lagrangian E - lambda min_s G (lambda = f / |grad g|) gains, per unit |grad g|,
+//      f (nu.dr' + k.dr)^2 / (2 g'') - f dr.K dr / 2,
+//    K = Hess g / |grad g| the obstacle's curvature, k = K d3, nu.dr' = dpsi.(d3 x nu) and
+//    g'' = nu.d3' + d3.K d3 the rate at which the rod curves away from the obstacle (relative
+//    to it). On a plane K = 0: f (nu.dr')^2 / (2 g''). The curvature term is the multiplier
+//    times the constraint's curvature: a convex obstacle (K >= 0) lets a tangential shift open
+//    the gap, which lowers the energy. (Holding the contact at its material point instead leaves
+//    out the sliding term and gives another, wrong count.) For the fields, a point quadratic
+//    form 1/2 z.S z of z = (dr, dpsi) is a jump of the momenta (dn, dm) += S z: a shear
+//    p += S u that leaves U, so no conjugate point; on a curved obstacle it holds dr, which only
+//    the full frame carries;
 //  - nu.dr(s_c) = 0 is one more isoperimetric constraint, its multiplier the change of the force:
 //    its particular field starts here with dn = -nu.
-std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contact, int number, int chord_count,
-                                            PhaseTrack* track, double* shear) {
+std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contact, int number, PhaseTrack* track,
+                                            double* shear) {
   const int n = coords_.size(), kr = coords_.kr();
   const RodPoint here = eq_->point(f->y, f->s);
   const Obstacle obstacle = problem_.obstacles(p_)[contact.obstacle];  // obstacles() returns a copy
   const Vec3 nu = obstacle.normal(here.r);
+  const Mat3 K = obstacle.hessian(here.r) / obstacle.gradient(here.r).norm();
   const Vec3 d3 = here.R.col(2), curving = here.R * here.u.cross(Vec3::UnitZ());  // d3' of an inextensible rod
-  const double g2 = nu.dot(curving), scale = 1.0 / scales_.length;
+  const double g2 = nu.dot(curving) + d3.dot(K * d3), scale = 1.0 / scales_.length;
   if (!(contact.force > 1e-10 * scales_.bending / (scales_.length * scales_.length)))
     return "a contact with zero force (weakly active): the index depends on higher-order terms, not defined here";
   if (!(g2 > 1e-9 * scale))
-    return "a contact where the rod does not curve away from the plane (g'' = 0: it is about to flatten onto it)";
+    return "a contact where the rod does not curve away from the obstacle (g'' = 0: it is about to flatten or wrap "
+           "onto it)";
+  if (!full_ && K.norm() > 0) throw std::logic_error("stability: a curved obstacle needs the full frame");
   const Eigen::VectorXd nu_r = coords_.position_dirs.transpose() * nu;
-  f->contact_rows_frame.row(number) = nu_r.transpose() * f->R;
-  f->contact_rows_particular.row(number) = nu_r.transpose() * f->particular_R;
+  f->recorded_rows_frame.row(recorded_before_contacts_ + number) = nu_r.transpose() * f->R;
+  f->recorded_rows_particular.row(recorded_before_contacts_ + number) = nu_r.transpose() * f->particular_R;
   // The equilibrium's jump.
   f->y += eq_->slot_map(Slot::Force).transpose() * (-contact.force * nu);
-  // The shear p += S u in canonical coordinates.
-  const Eigen::VectorXd w = coords_.rotation_dirs.transpose() * d3.cross(nu);
-  const double stiffness = options_.contact_sliding ? contact.force / g2 : 0.0;  // f / g''
-  const Eigen::MatrixXd S = (scales_.length / (scales_.bending * scales_.rate)) * stiffness * w * w.transpose();
+  // The point form on z = (dr, dpsi) in the lab: S = (f / g'') a a^T - f diag(K, 0), a = (k, w).
+  Eigen::Matrix<double, 6, 1> a;
+  a << K * d3, d3.cross(nu);
+  Eigen::Matrix<double, 6, 6> S_lab = Eigen::Matrix<double, 6, 6>::Zero();
+  if (options_.contact_sliding) S_lab += (contact.force / g2) * a * a.transpose();
+  S_lab.topLeftCorner<3, 3>() -= contact.force * K;
+  const Eigen::MatrixXd S = canonical_shear(S_lab);
   *shear = S.norm();
   // The shear leaves U, so no eigenphase passes -1 through it: each stays in its sheet between
   // consecutive odd multiples of pi (it may turn almost a whole turn inside it, so it is not
@@ -528,28 +616,42 @@ std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contac
     track->lifted[j] = sheet + sheared[best];
     track->lowest[j] = std::min(track->lowest[j], track->lifted[j]);
   }
-  // The same shear on the fields' state: dm += (f / g'') w (w.dpsi).
-  const Vec3 w_lab = d3.cross(nu);
-  f->dY += eq_->slot_map(Slot::Moment).transpose() * (stiffness * w_lab * w_lab.transpose()) *
-           lab_rotation_jacobian(*eq_, f->y, here.R) * f->dY;
+  // The same jump on the fields' state: (dn, dm) += S_lab (dr, dpsi).
+  Eigen::MatrixXd to_lab(6, f->dY.rows());
+  to_lab << eq_->slot_map(Slot::Position), lab_rotation_jacobian(*eq_, f->y, here.R);
+  Eigen::MatrixXd from_lab(f->dY.rows(), 6);
+  from_lab << eq_->slot_map(Slot::Force).transpose(), eq_->slot_map(Slot::Moment).transpose();
+  f->dY += from_lab * S_lab * to_lab * f->dY;
   // The force's particular field.
   Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * n);
   z.segment(n, kr) = -nu_r;
   const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f->y, f->s);
-  f->particular.col(chord_count + number) = map.T.completeOrthogonalDecomposition().solve(z);
+  f->particular.col(start_multipliers_ + number) = map.T.completeOrthogonalDecomposition().solve(z);
   canonical_blocks(f);
   orthonormalise(f);
   return "";
+}
+
+// z = (dr, dpsi) in the lab is (L position_dirs u_r, rotation_dirs u_psi) in the frame's U
+// coordinates, and the momenta (dn, dm) are scaled by (L^2, L) / (B rate): S_c = L / (B rate)
+// J^T S J with J = diag(L position_dirs, rotation_dirs) - symmetric, as a point form must be.
+// The rotation-only frame keeps the rotation block (S has no position part there).
+Eigen::MatrixXd StabilityAnalysis::canonical_shear(const Eigen::MatrixXd& lab_S) const {
+  const int kr = coords_.kr(), kpsi = coords_.size() - kr;
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(6, coords_.size());
+  J.topLeftCorner(3, kr) = scales_.length * coords_.position_dirs;
+  J.bottomRightCorner(3, kpsi) = coords_.rotation_dirs;
+  const Eigen::MatrixXd S = (scales_.length / (scales_.bending * scales_.rate)) * J.transpose() * lab_S * J;
+  return S.bottomRightCorner(mU_, mU_);
 }
 
 // A dead couple on an end free to turn about two or more axes does work that depends on the path
 // of the rotation (Ziegler): not conservative, and the second variation is not defined. In the
 // canonical coordinates the end's natural conditions then fail to be a Lagrangian plane.
 std::string StabilityAnalysis::end_moment_reason(const Frame& f, const Held& end) const {
-  const int kpsi = coords_.size() - coords_.kr();
   const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f.y, f.s);
-  const Eigen::MatrixXd G = map.G.bottomRightCorner(kpsi, kpsi);
-  const Eigen::MatrixXd free_rotation = complement(end.rotation, kpsi);
+  const Eigen::MatrixXd G = map.G.bottomRightCorner(mU_, mU_);
+  const Eigen::MatrixXd free_rotation = complement(held_configuration(end), mU_);
   if ((free_rotation.transpose() * G * free_rotation).norm() > 1e-10 * (1.0 + G.norm()))
     return "the end's loads are not conservative (a dead couple on an end free to rotate in 3D)";
   return "";
@@ -595,9 +697,10 @@ bool StabilityAnalysis::count_interior(const Frame& f, const PhaseTrack& track, 
 Eigen::MatrixXd StabilityAnalysis::end_terms(const Frame& f, const Held& end, StabilityReport* report) const {
   const int m = static_cast<int>(f.U.cols());
   const double tol = options_.zero_tolerance;
-  const Eigen::MatrixXd free_rotation = complement(end.rotation, m);
+  const Eigen::MatrixXd held = held_configuration(end);
+  const Eigen::MatrixXd free_rotation = complement(held, m);
   const Eigen::MatrixXd kernel_U = null_space(f.U, m, tol);
-  const Eigen::MatrixXd admissible = null_space(end.rotation.transpose() * f.U, m, tol);
+  const Eigen::MatrixXd admissible = null_space(held.transpose() * f.U, m, tol);
   const Eigen::MatrixXd rest = column_basis(admissible - kernel_U * (kernel_U.transpose() * admissible));
   const Eigen::MatrixXd q = f.P.transpose() * f.U;
   const Eigen::MatrixXd q_rest = rest.transpose() * (0.5 * (q + q.transpose())) * rest;
@@ -609,8 +712,8 @@ Eigen::MatrixXd StabilityAnalysis::end_terms(const Frame& f, const Held& end, St
   }
   const Eigen::MatrixXd natural_failure = free_rotation.transpose() * f.P_physical * kernel_U;
   report->end_count = negative + static_cast<int>(column_basis(natural_failure, tol).cols());
-  Eigen::MatrixXd conditions(end.rotation.cols() + free_rotation.cols(), m);
-  conditions << end.rotation.transpose() * f.U, free_rotation.transpose() * f.P_physical;
+  Eigen::MatrixXd conditions(held.cols() + free_rotation.cols(), m);
+  conditions << held.transpose() * f.U, free_rotation.transpose() * f.P_physical;
   return null_space(conditions, m, tol);
 }
 
@@ -624,12 +727,17 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
                                               const Eigen::MatrixXd& zero_modes, StabilityReport* report) const {
   const int m = static_cast<int>(f.U.cols());
   const double tol = options_.zero_tolerance;
-  // Every isoperimetric constraint's value on the frame's fields and on the particular ones:
-  // the chord along the held directions at s = L, then the contacts' nu.dr(s_c).
+  // Every isoperimetric constraint's value on the frame's fields and on the particular ones, in
+  // the order of the multipliers (Frame::particular): the chord along the held directions at
+  // s = L, then the contacts' nu.dr(s_c); with the full frame the start's held positions, the
+  // contacts, then the end's held positions (`constraints` is then end.position).
   const int all_constraints = static_cast<int>(f.particular.cols());
+  const int recorded = static_cast<int>(f.recorded_rows_frame.rows()), at_end = static_cast<int>(constraints.cols());
   Eigen::MatrixXd values(all_constraints, m + all_constraints);
-  values.topRows(constraints.cols()) << constraints.transpose() * f.R, constraints.transpose() * f.particular_R;
-  values.bottomRows(f.contact_rows_frame.rows()) << f.contact_rows_frame, f.contact_rows_particular;
+  values.block(full_ ? recorded : 0, 0, at_end, m + all_constraints) << constraints.transpose() * f.R,
+      constraints.transpose() * f.particular_R;
+  values.block(full_ ? 0 : at_end, 0, recorded, m + all_constraints) << f.recorded_rows_frame,
+      f.recorded_rows_particular;
   // A constraint that no perturbation changes to first order - the chord of a straight
   // inextensible rod held at its full length - is degenerate: it holds at second order only
   // (every perturbation shortens the chord), and its multiplier (the axial force) is
@@ -643,13 +751,18 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
   }
   const Eigen::MatrixXd frame_values = active.transpose() * values.leftCols(m);
   const Eigen::MatrixXd particular_values = active.transpose() * values.rightCols(all_constraints) * active;
+  // With the full frame, a unit change of the end's reaction along a held position e enters the
+  // end's natural conditions: dn(L) = e (its particular field is zero).
+  Eigen::MatrixXd end_loads = Eigen::MatrixXd::Zero(m, all_constraints);
+  if (full_) end_loads.block(0, all_constraints - at_end, coords_.kr(), at_end) = constraints;
   const Eigen::MatrixXd particular_U = f.particular_U * active,
-                        particular_P_physical = f.particular_P_physical * active;
+                        particular_P_physical = (f.particular_P_physical - end_loads) * active;
   const int k = static_cast<int>(active.cols());
-  const Eigen::MatrixXd free_rotation = complement(end.rotation, m);
+  const Eigen::MatrixXd held = held_configuration(end);
+  const Eigen::MatrixXd free_rotation = complement(held, m);
   Eigen::MatrixXd conditions(m, m), loads(m, k);
-  conditions << end.rotation.transpose() * f.U, free_rotation.transpose() * f.P_physical;
-  loads << end.rotation.transpose() * particular_U, free_rotation.transpose() * particular_P_physical;
+  conditions << held.transpose() * f.U, free_rotation.transpose() * f.P_physical;
+  loads << held.transpose() * particular_U, free_rotation.transpose() * particular_P_physical;
   report->zero_modes = 0;
   int correction = 0;
   if (k > 0) {
@@ -666,7 +779,6 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
         if (eig.eigenvalues()[i] > tol) ++positive;
     }
     correction = r_z + positive - k;
-
   }
   Eigen::MatrixXd all(m + k, m + k);
   all.topLeftCorner(m, m) = conditions;
@@ -683,7 +795,6 @@ StabilityReport StabilityAnalysis::run() {
   StabilityReport report;
   std::vector<std::string> multipliers;
   std::string why = unsupported(problem_, x_);
-  if (why.empty()) why = field_reason();
   if (why.empty()) why = classify_unknowns(problem_, p_, &multipliers);
   if (!why.empty()) {
     report.reason = why;
@@ -691,11 +802,18 @@ StabilityReport StabilityAnalysis::run() {
   }
   const ProblemDefinition& d = problem_.definition();
   const Held start = held_at(d.start, multipliers), end = held_at(d.end, multipliers);
-  const Eigen::MatrixXd constraints = constraint_directions(start, end);
+  // The isoperimetric constraints read at s = L: the held chord, or with the full frame every
+  // position the end holds (and those the start holds, read at s = 0).
+  const Eigen::MatrixXd constraints = full_ ? end.position : constraint_directions(start, end);
+  const Eigen::MatrixXd start_multipliers = full_ ? Eigen::MatrixXd(-start.position) : constraints;
+  start_multipliers_ = static_cast<int>(start_multipliers.cols());
+  recorded_before_contacts_ = full_ ? static_cast<int>(start.position.cols()) : 0;
   const std::vector<PointContact> contacts = problem_.contacts_at(x_);
   scales_.rate = field_rate();
+  if (full_) scales_.force_rate = scales_.rate;
 
-  Frame f = start_frame(start, constraints, static_cast<int>(contacts.size()));
+  Frame f = start_frame(start, start_multipliers, static_cast<int>(contacts.size()),
+                        full_ ? static_cast<int>(end.position.cols()) : 0);
   const int m = static_cast<int>(f.U.cols());
   const Eigen::MatrixXd lagrange = f.U.transpose() * f.P - f.P.transpose() * f.U;
   if (lagrange.norm() > 1e-8 * (1.0 + f.U.norm() * f.P.norm())) {
@@ -744,9 +862,7 @@ StabilityReport StabilityAnalysis::run() {
     for (int k = 1; k <= steps; ++k) advance(&f, breaks[i] + step * k, &track, 0);
     for (size_t c = 0; c < contacts.size(); ++c) {
       if (std::abs(contacts[c].s - breaks[i + 1]) > 1e-12 * scales_.length) continue;
-      if (std::string why = pass_contact(&f, contacts[c], static_cast<int>(c), static_cast<int>(constraints.cols()),
-                                         &track, &shear);
-          !why.empty()) {
+      if (std::string why = pass_contact(&f, contacts[c], static_cast<int>(c), &track, &shear); !why.empty()) {
         report.reason = why;
         return report;
       }
@@ -768,10 +884,11 @@ StabilityReport StabilityAnalysis::run() {
   const Eigen::MatrixXd zero_modes = end_terms(f, end, &report);
   report.dead_load_index = report.interior_count + report.end_count;
   if (!constraint_correction(f, end, constraints, zero_modes, &report)) return report;
-  // Rigid translations along directions neither end holds map equilibria to equilibria.
+  // Rigid translations along directions neither end holds map equilibria to equilibria (the full
+  // frame carries them, and counts them where they are zero modes).
   Eigen::MatrixXd held(coords_.kr(), start.position.cols() + end.position.cols());
   held << start.position, end.position;
-  report.zero_modes += coords_.kr() - static_cast<int>(column_basis(held).cols());
+  if (!full_) report.zero_modes += coords_.kr() - static_cast<int>(column_basis(held).cols());
   report.index = report.dead_load_index + report.constraint_correction;
   if (*report.index < 0) {
     report.reason = "the isoperimetric correction exceeds the load-controlled index: degenerate constraints";

@@ -33,19 +33,29 @@
 //     zero modes of the load-controlled problem (D is then taken on the loads doing no work on
 //     them). Along the axis of a straight inextensible rod the chord cannot change to first
 //     order, so that constraint is empty and dropped (the axial force is indeterminate).
-// Point contacts on a plane (force f > 0, the rod curving away at g'' > 0): the contact force is
-// a dead load of the load-controlled problem, nu.dr(s_c) = 0 one more isoperimetric constraint
-// (multiplier: the change of the force), and the contact point slides along the plane, which
-// adds f (nu.dr')^2 / (2 g'') to the second variation (a jump of the Jacobi fields' moment).
+// Where the energy depends on where the rod is - a field whose force depends on position (a soft
+// wall, a barrier) or a contact with a curved obstacle - the rotation alone is not the
+// configuration: the translation costs energy and the second variation holds dr.Hess V dr, non-
+// local in the rotation. The positions are then configuration variables too (the "full frame":
+// U holds (dr, dpsi), the Jacobi fields carry dn' = -(df/dr) dr), and every position an end holds
+// is a constraint of its own (k = those held at either end, D = d(held positions)/d(reactions));
+// stability.cpp says why the count stays valid (a problem of Lagrange: crossings are still
+// one-way). Without such a dependence the full frame gives the same count (tested).
+// Point contacts (force f > 0, the rod curving away from the obstacle at g'' > 0): the contact
+// force is a dead load of the load-controlled problem, nu.dr(s_c) = 0 one more isoperimetric
+// constraint (multiplier: the change of the force), and the contact point slides along the
+// obstacle, which adds f (nu.dr' + k.dr)^2 / (2 g'') - f dr.K dr / 2 to the second variation
+// (K = Hess g / |grad g| the obstacle's curvature, k = K d3, g'' = nu.d3' + d3.K d3; on a plane
+// K = 0): a jump of the Jacobi fields' force and moment.
 // Zero modes (Jacobi fields meeting every condition: symmetries such as the isotropic rod's
 // rotation about its axis, rigid motions, or the rod at a bifurcation) are reported apart from
 // the index, never counted in it.
 //
-// Not covered (index null with the reason): extended contacts and contacts with curved
-// obstacles, contacts with zero force (weakly active) or at the point of flattening (g'' = 0),
-// half-turn symmetric half rods, position-dependent fields (soft walls, barriers), unknown
-// parameters that are not end loads, non-conservative loads (a dead couple on a 3D end free to
-// rotate), degenerate constraints (a straight rod held at its full length), degenerate crossings.
+// Not covered (index null with the reason): extended contacts, contacts of extensible rods,
+// contacts with zero force (weakly active) or where the rod is about to flatten or wrap onto the
+// obstacle (g'' = 0), half-turn symmetric half rods, unknown parameters that are not end loads,
+// non-conservative loads (a dead couple on a 3D end free to rotate), degenerate constraints (a
+// straight rod held at its full length), degenerate crossings.
 #pragma once
 
 #include <Eigen/Dense>
@@ -78,6 +88,11 @@ struct StabilityOptions {
   // Let point contacts slide along their plane (the right second variation). false holds them at
   // their material point instead, only to show the difference (tests, docs).
   bool contact_sliding = true;
+  // Carry the positions as configuration variables beside the rotation (the full frame) even
+  // where the energy does not depend on where the rod is. It is used automatically where it does
+  // (position-dependent fields, contacts with curved obstacles); forcing it elsewhere only checks
+  // that the two frames count alike (tests).
+  bool positions_as_configuration = false;
 };
 
 struct StabilityReport {
