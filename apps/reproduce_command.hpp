@@ -1,13 +1,13 @@
-// `kirchhoff reproduce`: recomputes the reference paper's results that the toolkit covers and
-// writes a report (markdown and JSON) with numeric and analytic values side by side, plus the
-// CSV profiles behind the figures.
+// `kirchhoff reproduce`: maps its arguments onto the library's `reproduce` (kirchhoff/reproduce.hpp),
+// which recomputes the reference paper's results and writes the report and the figure data.
 #pragma once
 
 #include <string>
 
 namespace kirchhoff::cli {
 
-// `full` adds Fig. 11's L/2R = 500 and 1000 (the whole `kirchhoff plectonemes` sweep, ~30 minutes).
+// Progress on stderr; exit status 0 when every row passes, 1 when a row fails or a result cannot
+// be computed. `full` adds Fig. 11's L/2R = 500 and 1000 and the wall's phase diagram.
 int run_reproduce(const std::string& out_dir, const std::string& cases_dir, bool full = false);
 
 }  // namespace kirchhoff::cli
