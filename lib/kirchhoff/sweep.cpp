@@ -314,186 +314,275 @@ SweepSpec load_sweep(const std::string& path) {
   return load_sweep_text(text, path);
 }
 
-SweepSpec load_sweep_text(const std::string& text, const std::string& path) {
+namespace {
+
+// The file's text checked for size, nesting and encoding, then parsed.
+Value parse_sweep_text(const std::string& text, const std::string& path) {
   if (text.size() > sweep_limits::kMaxFileBytes) throw SweepError(path + ": larger than 1 MiB: not a sweep file");
   if (const int line = toml_line_beyond_nesting(text, case_limits::kMaxNesting))
     throw SweepError(path + ":" + std::to_string(line) + ": arrays and tables nest too deeply");
   if (const std::size_t at = toml_invalid_utf8_at(text); at < text.size())
     throw SweepError(path + ": not valid UTF-8 (byte " + std::to_string(at) + ")");
-  Value root;
   try {
     std::istringstream stream(text);
-    root = toml::parse(stream, path);
+    return toml::parse(stream, path);
   } catch (const std::exception& e) {
     throw SweepError(path + ": TOML syntax error: " + e.what());
   }
-  const Reader r(path);
+}
+
+// The file's top-level keys: what every [[jobs]] table starts from.
+struct SweepTop {
+  std::string case_text;
+  const Value* case_value = nullptr;
+  ParameterOverrides set;
+  SolverOverrides solver;
+  const Value* jobs = nullptr;  // a non-empty array
+};
+
+SweepTop read_top(const Reader& r, const Value& root, SweepSpec* spec) {
   r.allow_keys(root, "", {"title", "case", "set", "solver", "jobs"});
+  SweepTop top;
+  if (const Value* v = Reader::find(root, "title")) spec->title = r.string(*v, "title");
+  top.case_value = Reader::find(root, "case");
+  if (top.case_value) top.case_text = r.string(*top.case_value, "case");
+  if (const Value* v = Reader::find(root, "set")) top.set = r.overrides(*v, "set");
+  if (const Value* v = Reader::find(root, "solver")) top.solver = r.solver(*v, "solver");
+  top.jobs = Reader::find(root, "jobs");
+  if (!top.jobs) r.fail("jobs", "no [[jobs]] tables: nothing to run");
+  if (!top.jobs->is_array() || top.jobs->as_array().empty())
+    r.fail(*top.jobs, "jobs", "must be [[jobs]] tables (an array of tables), got " + type_name(*top.jobs));
+  return top;
+}
+
+// One [[jobs]] table as it is read: its key in messages, its values and where its case came from.
+struct Group {
+  const Value& table;
+  std::string key;         // "jobs[<g>]"
+  std::string name;        // prefix of the job ids
+  SweepJob prototype;      // every job of the group, before its point's values
+  const Value* case_value = nullptr;  // the group's `case`, else the top-level one
+  std::string case_key;               // the key that names it
+};
+
+// kind and name (unique across the file: it prefixes the job ids and names folders).
+void read_kind_and_name(const Reader& r, Group* g, std::set<std::string>* names) {
+  const Value* kind = Reader::find(g->table, "kind");
+  if (!kind) r.fail(g->table, g->key + ".kind", "missing (solve, equilibria, continue or plectonemes)");
+  g->prototype.kind = parse_kind(r, *kind, g->key + ".kind");
+  g->name = to_string(g->prototype.kind);
+  const Value* name = Reader::find(g->table, "name");
+  if (name) {
+    g->name = r.string(*name, g->key + ".name");
+    if (!valid_name(g->name))
+      r.fail(*name, g->key + ".name", "'" + g->name + "' is not 1-64 letters, digits, '_' or '-' (it names folders)");
+  }
+  if (!names->insert(g->name).second)
+    r.fail(name ? *name : g->table, g->key + ".name",
+           "'" + g->name + "' names another [[jobs]] table too: give each its own name (it prefixes the job ids)");
+}
+
+// The case (the group's, else the file's, resolved against the file's folder), the overrides
+// (the file's, replaced or extended by the group's) and the [solver] keys (the file's, then the
+// group's).
+void read_case_and_overrides(const Reader& r, const SweepTop& top, Group* g) {
+  std::string case_text = top.case_text;
+  g->case_value = Reader::find(g->table, "case");
+  if (g->case_value) case_text = r.string(*g->case_value, g->key + ".case");
+  g->case_key = g->case_value ? g->key + ".case" : "case";
+  if (!g->case_value) g->case_value = top.case_value;
+  if (case_text.empty()) r.fail(g->table, g->key + ".case", "no case: give `case` at the top or in the [[jobs]] table");
+  SweepJob& job = g->prototype;
+  job.case_path = resolve(r.path(), case_text);
+  job.case_name = case_text;
+  job.set = top.set;
+  if (const Value* v = Reader::find(g->table, "set"))
+    for (auto& [n, x] : r.overrides(*v, g->key + ".set")) {
+      const std::string nn = n;
+      auto it = std::find_if(job.set.begin(), job.set.end(), [&nn](const auto& e) { return e.first == nn; });
+      if (it != job.set.end()) it->second = x;
+      else job.set.emplace_back(n, x);
+    }
+  job.solver = top.solver;
+  if (const Value* v = Reader::find(g->table, "solver"))
+    for (auto& entry : r.solver(*v, g->key + ".solver")) job.solver.push_back(entry);
+}
+
+// cost, direct, max_seconds, max_equilibria, profiles.
+void read_job_options(const Reader& r, Group* g) {
+  SweepJob& job = g->prototype;
+  const std::string& key = g->key;
+  job.cost = default_cost(job.kind);
+  if (const Value* v = Reader::find(g->table, "cost")) {
+    job.cost = r.number(*v, key + ".cost");
+    if (!(job.cost > 0)) r.fail(*v, key + ".cost", "must be > 0");
+  }
+  if (const Value* v = Reader::find(g->table, "direct")) {
+    if (job.kind != SweepJobKind::Solve) r.fail(*v, key + ".direct", "only solve jobs take it");
+    job.direct = r.boolean(*v, key + ".direct");
+  }
+  if (const Value* v = Reader::find(g->table, "max_seconds")) {
+    job.max_seconds = r.number(*v, key + ".max_seconds");
+    if (job.max_seconds < 0) r.fail(*v, key + ".max_seconds", "must be >= 0 (0: no limit)");
+  }
+  if (const Value* v = Reader::find(g->table, "max_equilibria")) {
+    if (job.kind != SweepJobKind::Equilibria) r.fail(*v, key + ".max_equilibria", "only equilibria jobs take it");
+    job.max_equilibria = static_cast<int>(r.integer(*v, key + ".max_equilibria", 1, 1000));
+  }
+  if (const Value* v = Reader::find(g->table, "profiles")) job.profiles = r.boolean(*v, key + ".profiles");
+}
+
+// continue's keys are refused on other kinds; plectonemes' keys (from_ply, from_ply_turns,
+// hard_from) read, and refused on other kinds, and a plectonemes job's set and solver refused.
+void read_kind_keys(const Reader& r, Group* g) {
+  SweepJob& job = g->prototype;
+  const std::string& key = g->key;
+  for (const char* k : {"param", "to", "max_points", "step", "min_step", "max_step", "branch_points", "stability"})
+    if (const Value* v = Reader::find(g->table, k); v && job.kind != SweepJobKind::Continue)
+      r.fail(*v, key + "." + k, "only continue jobs take it");
+  for (auto [k, field] : {std::pair<const char*, double*>{"from_ply", &job.from_ply},
+                          {"from_ply_turns", &job.from_ply_turns}, {"hard_from", &job.hard_from}})
+    if (const Value* v = Reader::find(g->table, k)) {
+      if (job.kind != SweepJobKind::Plectonemes) r.fail(*v, key + "." + k, "only plectonemes jobs take it");
+      *field = r.number(*v, key + "." + k);
+      if (!(*field >= 0)) r.fail(*v, key + "." + k, "must be >= 0");
+    }
+  if (job.kind != SweepJobKind::Plectonemes) return;
+  if (const Value* v = Reader::find(g->table, "set"))
+    r.fail(*v, key + ".set", "plectonemes jobs run their case file as it is (slenderness and turns from the grid or list)");
+  if (const Value* v = Reader::find(g->table, "solver")) r.fail(*v, key + ".solver", "plectonemes jobs take the case's [solver]");
+}
+
+// A continue job's branch: param (required), to, max_points, the steps, branch_points, stability.
+void read_continue_keys(const Reader& r, Group* g) {
+  SweepJob& job = g->prototype;
+  const std::string& key = g->key;
+  const Value* param = Reader::find(g->table, "param");
+  if (!param) r.fail(g->table, key + ".param", "missing: the parameter a continue job follows its branch in");
+  job.param = r.string(*param, key + ".param");
+  if (const Value* v = Reader::find(g->table, "to")) job.to = r.number(*v, key + ".to");
+  if (const Value* v = Reader::find(g->table, "max_points"))
+    job.max_points = static_cast<int>(r.integer(*v, key + ".max_points", 1, 1000000));
+  for (auto [k, field] :
+       {std::pair<const char*, double*>{"step", &job.step}, {"min_step", &job.min_step}, {"max_step", &job.max_step}})
+    if (const Value* v = Reader::find(g->table, k)) {
+      *field = r.number(*v, key + "." + k);
+      if (!(*field > 0)) r.fail(*v, key + "." + k, "must be > 0");
+    }
+  if (const Value* v = Reader::find(g->table, "branch_points")) job.branch_points = r.boolean(*v, key + ".branch_points");
+  if (const Value* v = Reader::find(g->table, "stability")) job.stability = r.boolean(*v, key + ".stability");
+}
+
+using SweptKeys = std::map<std::string, std::pair<const Value*, std::string>>;  // name -> (value, key)
+
+// The group's case loaded with its overrides: a case that does not load is reported at the key
+// that names it (the group's set, else its case). Adds the case's derived names to the columns.
+Case load_group_case(const Reader& r, const Group& g, SweepSpec* spec) {
+  Case c;
+  try {
+    c = load_case(g.prototype.case_path, g.prototype.set, "", g.prototype.solver);
+  } catch (const CaseError& e) {
+    const Value* at = Reader::find(g.table, "set") ? Reader::find(g.table, "set") : g.case_value;
+    r.fail(at ? *at : g.table, at == g.case_value ? g.case_key : g.key + ".set", e.what());
+  }
+  for (const auto& d : c.derived)
+    if (std::find(spec->derived_columns.begin(), spec->derived_columns.end(), d) == spec->derived_columns.end())
+      spec->derived_columns.push_back(d);
+  return c;
+}
+
+// The continued and swept parameters exist in the case and are not computed ones.
+void check_parameters(const Reader& r, const Group& g, const Case& c, const SweptKeys& where) {
+  const std::string& case_path = g.prototype.case_path;
+  if (const Value* param = Reader::find(g.table, "param")) {
+    if (!c.file_parameters.contains(g.prototype.param))
+      r.fail(*param, g.key + ".param", "no parameter '" + g.prototype.param + "' in " + case_path);
+    if (const std::string refusal =
+            dependent_parameter_refusal(c.definition.dependent_parameters, g.prototype.param, "continue in");
+        !refusal.empty())
+      r.fail(*param, g.key + ".param", refusal);
+  }
+  for (const auto& [pname, at] : where) {
+    if (!c.file_parameters.contains(pname)) {
+      std::string have;
+      for (const auto& n : c.file_parameters.names()) have += (have.empty() ? "" : ", ") + n;
+      r.fail(*at.first, at.second, "no parameter '" + pname + "' in " + case_path + " (have: " + have + ")");
+    }
+    if (const std::string refusal = dependent_parameter_refusal(c.definition.dependent_parameters, pname, "sweep");
+        !refusal.empty())
+      r.fail(*at.first, at.second, refusal);
+  }
+}
+
+// The case at the group's first point (refused values are reported before any job runs), and a
+// plectonemes job's slenderness and turns at every point.
+void check_points(const Reader& r, const Group& g, const std::vector<ParameterOverrides>& group_points) {
+  try {
+    SweepJob first = g.prototype;
+    first.values = group_points.front();
+    load_case(g.prototype.case_path, first.overrides(), "", g.prototype.solver);
+  } catch (const CaseError& e) {
+    r.fail(g.table, g.key, std::string("at its first point: ") + e.what());
+  }
+  if (g.prototype.kind != SweepJobKind::Plectonemes) return;
+  for (const char* needed : {"slenderness", "turns"})
+    for (const auto& point : group_points)
+      if (std::none_of(point.begin(), point.end(), [needed](const auto& e) { return e.first == needed; }))
+        r.fail(g.table, g.key, std::string("a plectonemes job needs '") + needed +
+                                   "' in its grid or list (the branch's L/2R and its largest turns)");
+}
+
+// One job per point, ids "<name>-<k>" (or the name alone for a single point), in order.
+void expand_jobs(const Reader& r, const Group& g, const std::vector<ParameterOverrides>& group_points,
+                 SweepSpec* spec) {
+  if (spec->jobs.size() + group_points.size() > sweep_limits::kMaxJobs)
+    r.fail(g.table, g.key, "the sweep has more than " + std::to_string(sweep_limits::kMaxJobs) + " jobs");
+  for (std::size_t k = 0; k < group_points.size(); ++k) {
+    SweepJob job = g.prototype;
+    job.id = group_points.size() == 1 ? g.name : g.name + "-" + padded(k + 1, group_points.size());
+    job.order = static_cast<int>(spec->jobs.size());
+    job.values = group_points[k];
+    for (const auto& entry : job.values)
+      if (std::find(spec->parameter_columns.begin(), spec->parameter_columns.end(), entry.first) ==
+          spec->parameter_columns.end())
+        spec->parameter_columns.push_back(entry.first);
+    spec->jobs.push_back(std::move(job));
+  }
+}
+
+// The g-th [[jobs]] table (from 0), read, checked against its case and expanded into jobs.
+void read_group(const Reader& r, const SweepTop& top, std::size_t index, std::set<std::string>* names,
+                SweepSpec* spec) {
+  Group g{top.jobs->as_array()[index], "jobs[" + std::to_string(index + 1) + "]", "", SweepJob{}, nullptr, ""};
+  r.allow_keys(g.table, g.key, {"name", "kind", "case", "set", "solver", "grid", "list", "cost", "direct", "max_seconds",
+                                "max_equilibria", "profiles", "param", "to", "max_points", "step", "min_step",
+                                "max_step", "branch_points", "stability", "from_ply", "from_ply_turns", "hard_from"});
+  read_kind_and_name(r, &g, names);
+  read_case_and_overrides(r, top, &g);
+  read_job_options(r, &g);
+  read_kind_keys(r, &g);
+  if (g.prototype.kind == SweepJobKind::Continue) read_continue_keys(r, &g);
+  SweptKeys where;
+  const std::vector<ParameterOverrides> group_points = points(r, g.table, g.key, &where);
+  // The case, loaded once with the group's overrides, then with its first point: a case that
+  // does not load, unknown or computed parameters and refused values are reported before any
+  // job runs, at the key that names them.
+  const Case c = load_group_case(r, g, spec);
+  check_parameters(r, g, c, where);
+  check_points(r, g, group_points);
+  expand_jobs(r, g, group_points, spec);
+}
+
+}  // namespace
+
+SweepSpec load_sweep_text(const std::string& text, const std::string& path) {
+  const Value root = parse_sweep_text(text, path);
+  const Reader r(path);
   SweepSpec spec;
   spec.path = path;
-  if (const Value* v = Reader::find(root, "title")) spec.title = r.string(*v, "title");
-  std::string top_case;
-  const Value* top_case_value = Reader::find(root, "case");
-  if (top_case_value) top_case = r.string(*top_case_value, "case");
-  ParameterOverrides top_set;
-  if (const Value* v = Reader::find(root, "set")) top_set = r.overrides(*v, "set");
-  SolverOverrides top_solver;
-  if (const Value* v = Reader::find(root, "solver")) top_solver = r.solver(*v, "solver");
-  const Value* jobs = Reader::find(root, "jobs");
-  if (!jobs) r.fail("jobs", "no [[jobs]] tables: nothing to run");
-  if (!jobs->is_array() || jobs->as_array().empty())
-    r.fail(*jobs, "jobs", "must be [[jobs]] tables (an array of tables), got " + type_name(*jobs));
-
+  const SweepTop top = read_top(r, root, &spec);
   std::set<std::string> names;
-  const auto& groups = jobs->as_array();
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    const Value& group = groups[g];
-    const std::string key = "jobs[" + std::to_string(g + 1) + "]";
-    r.allow_keys(group, key, {"name", "kind", "case", "set", "solver", "grid", "list", "cost", "direct", "max_seconds",
-                              "max_equilibria", "profiles", "param", "to", "max_points", "step", "min_step",
-                              "max_step", "branch_points", "stability", "from_ply", "from_ply_turns", "hard_from"});
-    SweepJob prototype;
-    const Value* kind = Reader::find(group, "kind");
-    if (!kind) r.fail(group, key + ".kind", "missing (solve, equilibria, continue or plectonemes)");
-    prototype.kind = parse_kind(r, *kind, key + ".kind");
-    std::string name = to_string(prototype.kind);
-    if (const Value* v = Reader::find(group, "name")) {
-      name = r.string(*v, key + ".name");
-      if (!valid_name(name)) r.fail(*v, key + ".name", "'" + name + "' is not 1-64 letters, digits, '_' or '-' (it names folders)");
-    }
-    if (!names.insert(name).second)
-      r.fail(Reader::find(group, "name") ? *Reader::find(group, "name") : group, key + ".name",
-             "'" + name + "' names another [[jobs]] table too: give each its own name (it prefixes the job ids)");
-    std::string case_text = top_case;
-    const Value* case_value = Reader::find(group, "case");
-    if (case_value) case_text = r.string(*case_value, key + ".case");
-    const std::string case_key = case_value ? key + ".case" : "case";
-    if (!case_value) case_value = top_case_value;
-    if (case_text.empty()) r.fail(group, key + ".case", "no case: give `case` at the top or in the [[jobs]] table");
-    prototype.case_path = resolve(path, case_text);
-    prototype.case_name = case_text;
-    prototype.set = top_set;
-    if (const Value* v = Reader::find(group, "set"))
-      for (auto& [n, x] : r.overrides(*v, key + ".set")) {
-        const std::string nn = n;
-        auto it = std::find_if(prototype.set.begin(), prototype.set.end(), [&nn](const auto& e) { return e.first == nn; });
-        if (it != prototype.set.end()) it->second = x;
-        else prototype.set.emplace_back(n, x);
-      }
-    prototype.solver = top_solver;
-    if (const Value* v = Reader::find(group, "solver"))
-      for (auto& entry : r.solver(*v, key + ".solver")) prototype.solver.push_back(entry);
-    prototype.cost = default_cost(prototype.kind);
-    if (const Value* v = Reader::find(group, "cost")) {
-      prototype.cost = r.number(*v, key + ".cost");
-      if (!(prototype.cost > 0)) r.fail(*v, key + ".cost", "must be > 0");
-    }
-    if (const Value* v = Reader::find(group, "direct")) {
-      if (prototype.kind != SweepJobKind::Solve) r.fail(*v, key + ".direct", "only solve jobs take it");
-      prototype.direct = r.boolean(*v, key + ".direct");
-    }
-    if (const Value* v = Reader::find(group, "max_seconds")) {
-      prototype.max_seconds = r.number(*v, key + ".max_seconds");
-      if (prototype.max_seconds < 0) r.fail(*v, key + ".max_seconds", "must be >= 0 (0: no limit)");
-    }
-    if (const Value* v = Reader::find(group, "max_equilibria")) {
-      if (prototype.kind != SweepJobKind::Equilibria) r.fail(*v, key + ".max_equilibria", "only equilibria jobs take it");
-      prototype.max_equilibria = static_cast<int>(r.integer(*v, key + ".max_equilibria", 1, 1000));
-    }
-    if (const Value* v = Reader::find(group, "profiles")) prototype.profiles = r.boolean(*v, key + ".profiles");
-    // continue's keys, only there.
-    for (const char* k : {"param", "to", "max_points", "step", "min_step", "max_step", "branch_points", "stability"})
-      if (const Value* v = Reader::find(group, k); v && prototype.kind != SweepJobKind::Continue)
-        r.fail(*v, key + "." + k, "only continue jobs take it");
-    for (const char* k : {"from_ply", "from_ply_turns", "hard_from"})
-      if (const Value* v = Reader::find(group, k)) {
-        if (prototype.kind != SweepJobKind::Plectonemes) r.fail(*v, key + "." + k, "only plectonemes jobs take it");
-        const double x = r.number(*v, key + "." + k);
-        if (!(x >= 0)) r.fail(*v, key + "." + k, "must be >= 0");
-        (std::string(k) == "from_ply" ? prototype.from_ply : std::string(k) == "hard_from" ? prototype.hard_from
-                                                                                          : prototype.from_ply_turns) = x;
-      }
-    if (prototype.kind == SweepJobKind::Plectonemes) {
-      if (const Value* v = Reader::find(group, "set"))
-        r.fail(*v, key + ".set", "plectonemes jobs run their case file as it is (slenderness and turns from the grid or list)");
-      if (const Value* v = Reader::find(group, "solver")) r.fail(*v, key + ".solver", "plectonemes jobs take the case's [solver]");
-    }
-    const Value* param_value = Reader::find(group, "param");
-    if (prototype.kind == SweepJobKind::Continue) {
-      if (!param_value) r.fail(group, key + ".param", "missing: the parameter a continue job follows its branch in");
-      prototype.param = r.string(*param_value, key + ".param");
-      if (const Value* v = Reader::find(group, "to")) prototype.to = r.number(*v, key + ".to");
-      if (const Value* v = Reader::find(group, "max_points"))
-        prototype.max_points = static_cast<int>(r.integer(*v, key + ".max_points", 1, 1000000));
-      for (auto [k, field] : {std::pair<const char*, double*>{"step", &prototype.step}, {"min_step", &prototype.min_step},
-                              {"max_step", &prototype.max_step}})
-        if (const Value* v = Reader::find(group, k)) {
-          *field = r.number(*v, key + "." + k);
-          if (!(*field > 0)) r.fail(*v, key + "." + k, "must be > 0");
-        }
-      if (const Value* v = Reader::find(group, "branch_points")) prototype.branch_points = r.boolean(*v, key + ".branch_points");
-      if (const Value* v = Reader::find(group, "stability")) prototype.stability = r.boolean(*v, key + ".stability");
-    }
-
-    std::map<std::string, std::pair<const Value*, std::string>> where;
-    const std::vector<ParameterOverrides> group_points = points(r, group, key, &where);
-    // The case, loaded once with the group's overrides, then with its first point: a case that
-    // does not load, unknown or computed parameters and refused values are reported before any
-    // job runs, at the key that names them.
-    Case c;
-    try {
-      c = load_case(prototype.case_path, prototype.set, "", prototype.solver);
-    } catch (const CaseError& e) {
-      const Value* at = Reader::find(group, "set") ? Reader::find(group, "set") : case_value;
-      r.fail(at ? *at : group, at == case_value ? case_key : key + ".set", e.what());
-    }
-    for (const auto& d : c.derived)
-      if (std::find(spec.derived_columns.begin(), spec.derived_columns.end(), d) == spec.derived_columns.end())
-        spec.derived_columns.push_back(d);
-    if (param_value) {
-      if (!c.file_parameters.contains(prototype.param))
-        r.fail(*param_value, key + ".param", "no parameter '" + prototype.param + "' in " + prototype.case_path);
-      if (const std::string refusal =
-              dependent_parameter_refusal(c.definition.dependent_parameters, prototype.param, "continue in");
-          !refusal.empty())
-        r.fail(*param_value, key + ".param", refusal);
-    }
-    for (const auto& [pname, at] : where) {
-      if (!c.file_parameters.contains(pname)) {
-        std::string have;
-        for (const auto& n : c.file_parameters.names()) have += (have.empty() ? "" : ", ") + n;
-        r.fail(*at.first, at.second, "no parameter '" + pname + "' in " + prototype.case_path + " (have: " + have + ")");
-      }
-      if (const std::string refusal = dependent_parameter_refusal(c.definition.dependent_parameters, pname, "sweep"); !refusal.empty())
-        r.fail(*at.first, at.second, refusal);
-    }
-    try {
-      SweepJob first = prototype;
-      first.values = group_points.front();
-      load_case(prototype.case_path, first.overrides(), "", prototype.solver);
-    } catch (const CaseError& e) {
-      r.fail(group, key, std::string("at its first point: ") + e.what());
-    }
-    if (prototype.kind == SweepJobKind::Plectonemes)
-      for (const char* needed : {"slenderness", "turns"})
-        for (const auto& point : group_points)
-          if (std::none_of(point.begin(), point.end(), [needed](const auto& e) { return e.first == needed; }))
-            r.fail(group, key, std::string("a plectonemes job needs '") + needed +
-                                   "' in its grid or list (the branch's L/2R and its largest turns)");
-    if (spec.jobs.size() + group_points.size() > sweep_limits::kMaxJobs)
-      r.fail(group, key, "the sweep has more than " + std::to_string(sweep_limits::kMaxJobs) + " jobs");
-    for (std::size_t k = 0; k < group_points.size(); ++k) {
-      SweepJob job = prototype;
-      job.id = group_points.size() == 1 ? name : name + "-" + padded(k + 1, group_points.size());
-      job.order = static_cast<int>(spec.jobs.size());
-      job.values = group_points[k];
-      for (const auto& entry : job.values)
-        if (std::find(spec.parameter_columns.begin(), spec.parameter_columns.end(), entry.first) ==
-            spec.parameter_columns.end())
-          spec.parameter_columns.push_back(entry.first);
-      spec.jobs.push_back(std::move(job));
-    }
-  }
+  for (std::size_t g = 0; g < top.jobs->as_array().size(); ++g) read_group(r, top, g, &names, &spec);
   return spec;
 }
 
