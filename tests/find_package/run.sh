@@ -1,10 +1,31 @@
 #!/usr/bin/env bash
 # Installs the build into a scratch prefix, configures and builds tests/find_package against it
-# with find_package(kirchhoff), and runs the consumer on a case file.
+# with find_package(kirchhoff), and runs the consumer on a case file. Only the public headers
+# (lib/CMakeLists.txt, listed in BUILD/kirchhoff_public_headers.txt) are meant to be installed:
+# any other header in the prefix is removed first, and a translation unit including every public
+# header is compiled there too, so a public header that includes an internal one fails the build.
 set -euo pipefail
 build="$1" source="$2" scratch="$3"
 rm -rf "$scratch"
 cmake --install "$build" --prefix "$scratch/prefix" > /dev/null
-cmake -S "$source/tests/find_package" -B "$scratch/consumer" -DCMAKE_PREFIX_PATH="$scratch/prefix" > /dev/null
+public="$build/kirchhoff_public_headers.txt"
+[ -s "$public" ] || { echo "no list of public headers: $public" >&2; exit 1; }
+installed="$scratch/prefix/include/kirchhoff"
+all="$scratch/all_public_headers.cpp"
+mkdir -p "$scratch"
+: > "$all"
+count=0
+while read -r header; do
+  name=$(basename "$header")
+  [ -f "$installed/$name" ] || { echo "public header not installed: $name" >&2; exit 1; }
+  echo "#include <kirchhoff/$name>" >> "$all"
+  count=$((count + 1))
+done < "$public"
+for file in "$installed"/*; do
+  grep -qx ".*/$(basename "$file")" "$public" || { echo "not public, removed: $(basename "$file")"; rm "$file"; }
+done
+echo "compiling the $count public headers from the installed tree"
+cmake -S "$source/tests/find_package" -B "$scratch/consumer" -DCMAKE_PREFIX_PATH="$scratch/prefix" \
+      -DKIRCHHOFF_ALL_HEADERS="$all" > /dev/null
 cmake --build "$scratch/consumer" > /dev/null
 "$scratch/consumer/consumer" "$source/cases/simply_supported.toml"
