@@ -7,7 +7,9 @@
 
 namespace kirchhoff::cli {
 
-int run_plectonemes(const PlectonemesArguments& args) {
+int run_plectonemes(const PlectonemesArguments& arguments) {
+  PlectonemesArguments args = arguments;
+  args.progress = [](const std::string& line) { std::cerr << line << "\n"; };
   try {
     const PlectonemeSweep sweep = sweep_plectonemes(args, std::cout);
     std::cout << "sweep: " << sweep.points << " points in " << std::setprecision(4) << sweep.seconds << " s ("

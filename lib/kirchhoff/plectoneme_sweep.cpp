@@ -7,7 +7,6 @@
 #include <functional>
 #include <fstream>
 #include <iomanip>
-#include <iostream>
 #include <numeric>
 #include <optional>
 #include <sstream>
@@ -48,6 +47,16 @@ const std::vector<std::string> kHardMeasured = {"T_ext",         "helix_angle", 
                                                 "self_distance", "min_contact_force", "min_wrap_pressure",
                                                 "ply_clearance", "contact_count"};
 
+// A progress line to options.progress (nothing when it is not set), its parts streamed as
+// std::cerr would print them.
+template <class... Parts>
+void progress_line(const PlectonemeRunOptions& options, const Parts&... parts) {
+  if (!options.progress) return;
+  std::ostringstream line;
+  (line << ... << parts);
+  options.progress(line.str());
+}
+
 std::map<std::string, double> columns(const ContinuationPoint& p, double EI, const std::vector<std::string>& measured) {
   std::map<std::string, double> c;
   for (const auto& name : measured) c[name] = p.derived.count(name) ? p.derived.at(name) : NAN;
@@ -60,13 +69,26 @@ std::map<std::string, double> columns(const ContinuationPoint& p, double EI, con
   return c;
 }
 
-// The CSV ends with its endpoint row: the branch was followed to its target.
+// The fields of one CSV line (the branch CSVs quote nothing: their text fields hold no commas).
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> fields;
+  std::istringstream in(line);
+  for (std::string field; std::getline(in, field, ',');) fields.push_back(field);
+  return fields;
+}
+
+// The CSV ends with its endpoint row (its `type` column): the branch was followed to its target.
+// A file without a `type` column, or with a last row cut short before it, is not complete.
 bool branch_complete(const std::filesystem::path& csv) {
   std::ifstream in(csv);
-  std::string line, last;
+  std::string header, line, last;
+  std::getline(in, header);
   while (std::getline(in, line))
     if (!line.empty()) last = line;
-  return last.find(",endpoint,") != std::string::npos;
+  const std::vector<std::string> names = csv_fields(header), fields = csv_fields(last);
+  const auto type = std::find(names.begin(), names.end(), "type");
+  const auto column = static_cast<size_t>(type - names.begin());
+  return type != names.end() && column < fields.size() && fields[column] == "endpoint";
 }
 
 // Forces, and with them the unknowns, the pseudo-arclength and the residual's round-off, scale as
@@ -257,8 +279,8 @@ class BranchCsv {
       summary_->ply.push_back(summary_->last);
     }
     if (options_.progress_every > 0 && summary_->points % options_.progress_every == 0)
-      std::cerr << "  L/2R = " << slenderness_ << "  point " << state_.row << "  turns = " << std::setprecision(6)
-                << p.parameter << "\n";
+      progress_line(options_, "  L/2R = ", slenderness_, "  point ", state_.row, "  turns = ", std::setprecision(6),
+                    p.parameter);
     if (options_.after_point) options_.after_point();
   }
 
@@ -424,8 +446,8 @@ ContinuationPoint stiffened_to(ShootingProblem& barrier, const ContinuationPoint
                                const PlectonemeRunOptions& options) {
   const double distance = barrier_self_distance(barrier, at.x, slenderness);
   const double log_softness = barrier.parameters().get("log_softness");
-  std::cerr << "  the barrier ply at turns = " << at.parameter << ", log_softness " << std::setprecision(6)
-            << log_softness << ": self_distance " << distance << "\n";
+  progress_line(options, "  the barrier ply at turns = ", at.parameter, ", log_softness ", std::setprecision(6),
+                log_softness, ": self_distance ", distance);
   if (distance <= gap) return at;
   // Continued like the barrier branch (its Jacobian at sensitivity_tol); `barrier` itself keeps the
   // case's, as the exact ply made from it must for its first solve.
@@ -446,7 +468,7 @@ ContinuationPoint stiffened_to(ShootingProblem& barrier, const ContinuationPoint
   }
   ContinuationPoint stiff = r.points.back();
   barrier.set_parameter("log_softness", stiff.parameter);
-  std::cerr << "  stiffened to log_softness " << stiff.parameter << " (" << r.points.size() << " steps)\n";
+  progress_line(options, "  stiffened to log_softness ", stiff.parameter, " (", r.points.size(), " steps)");
   stiff.parameter = at.parameter;
   return stiff;
 }
@@ -499,7 +521,7 @@ void follow_hard_ply(const Case& c, double slenderness, const ContinuationPoint&
         failures.clear();
         break;
       } catch (const std::runtime_error& e) {
-        std::cerr << "  " << e.what() << "\n";
+        progress_line(options, "  ", e.what());
         failures += (failures.empty() ? "" : "; ") + ("from self_distance " + std::to_string(gap) + ": ") + e.what();
       }
     }
@@ -583,7 +605,7 @@ ContinuationPoint move_ply(ShootingProblem& problem, const std::string& paramete
   int points = 0;
   auto progress = [&](const ContinuationPoint& p) {
     if (options.progress_every > 0 && ++points % options.progress_every == 0)
-      std::cerr << "  " << parameter << " = " << std::setprecision(6) << p.parameter << "\n";
+      progress_line(options, "  ", parameter, " = ", std::setprecision(6), p.parameter);
   };
   const ContinuationResult r = Continuation(problem, o).run(x, progress);
   if (r.reason != StopReason::ReachedTarget || r.points.empty())
@@ -617,7 +639,7 @@ PlectonemeBranchSummary follow_from_ply(const std::string& case_path, const std:
     if (base.parameter_name != "turns")
       throw std::runtime_error(base_state_path + ": not the end of a plectoneme branch followed in turns");
     problem.set_parameter("turns", base.last.parameter);
-    std::cerr << "  from the L/2R = " << base_slenderness << " ply at turns = " << base.last.parameter << "\n";
+    progress_line(options, "  from the L/2R = ", base_slenderness, " ply at turns = ", base.last.parameter);
     ContinuationPoint p = move_ply(problem, "slenderness", base.last.x, slenderness, slenderness, options);
     p = move_ply(problem, "log_softness", p.x, options.ply_log_softness, slenderness, options);
     start.parameter_name = "turns";
@@ -665,7 +687,7 @@ PlectonemeBranchSummary follow_hard_from_ply(const std::string& case_path, const
     // The thicker rod's segments, moving with R: coarser per R on the way, re-segmented at the end.
     ShootingProblem moving = hard_ply_problem(thicker, slenderness, base);
     moving.set_parameter("turns", base.last.parameter);
-    std::cerr << "  from the L/2R = " << base_slenderness << " exact ply at turns = " << base.last.parameter << "\n";
+    progress_line(options, "  from the L/2R = ", base_slenderness, " exact ply at turns = ", base.last.parameter);
     const ContinuationPoint p =
         move_ply(moving, "slenderness", base.last.x, slenderness, slenderness, options, complementarity_events());
     // (The re-segmented problem takes its parameters from `moving` at p.)
@@ -729,13 +751,13 @@ PlectonemeSweep sweep_plectonemes(const PlectonemesArguments& args, std::ostream
     const std::string csv = csv_of(sl);
     const bool exact_only = via_ply && args.hard_from > 0.0;
     if (exact_only)
-      std::cerr << "L/2R = " << sl << ": from the L/2R = " << args.slenderness[k - 1]
-                << " exact ply, then turns up to " << args.turns[k] << " and down to " << args.turns_min << "\n";
+      progress_line(args, "L/2R = ", sl, ": from the L/2R = ", args.slenderness[k - 1], " exact ply, then turns up to ",
+                    args.turns[k], " and down to ", args.turns_min);
     else if (via_ply)
-      std::cerr << "L/2R = " << sl << ": from the L/2R = " << args.slenderness[k - 1] << " ply, then turns up to "
-                << args.turns[k] << " and down to " << args.turns_min << "\n";
+      progress_line(args, "L/2R = ", sl, ": from the L/2R = ", args.slenderness[k - 1], " ply, then turns up to ",
+                    args.turns[k], " and down to ", args.turns_min);
     else
-      std::cerr << "L/2R = " << sl << ": turns 0 -> " << args.turns[k] << "\n";
+      progress_line(args, "L/2R = ", sl, ": turns 0 -> ", args.turns[k]);
     PlectonemeRunOptions options = args;  // every branch's options are the sweep's
     options.hard_turns_min = args.turns_min;
     PlectonemeSweepBranch branch;

@@ -3,7 +3,7 @@
 // untwisted rod (or from a thicker rod's ply), written as CSV rows of T_ext rho^2/EI against the
 // helical angle beside eq. (61), resumable after a kill (run_state.hpp). The physics of such runs
 // (forces and tolerances scaled with the slenderness, the ply handed to exact contact) is here;
-// progress goes to stderr.
+// progress lines go to a callback (PlectonemeRunOptions::progress) that the CLI sets to print.
 #pragma once
 
 #include <functional>
@@ -43,7 +43,10 @@ struct PlectonemeBranchSummary {
 };
 
 struct PlectonemeRunOptions {
-  int progress_every = 0;                 // a progress line on stderr every this many points (0: none)
+  // Where progress lines go ("  L/2R = 200  point 50  turns = 3.1", the handover's steps, each
+  // slenderness's start), without their newline; unset: nowhere. The CLI prints them on stderr.
+  std::function<void(const std::string&)> progress;
+  int progress_every = 0;                 // a progress line every this many points (0: none)
   double max_step = kPlectonemeMaxStep;   // at L/2R = 100, scaled with the forces (1/R^2)
   // A point whose chord iterations converged within this many keeps the previous Jacobian
   // (ContinuationOptions::reuse_jacobian_iterations; -1: every point computes its own).
@@ -151,7 +154,8 @@ struct PlectonemeSweep {
 };
 
 // The sweep: each slenderness in turn (follow_plectoneme_branch, follow_from_ply or
-// follow_hard_from_ply), progress on stderr and a line per finished slenderness on `report`.
+// follow_hard_from_ply), progress lines to args.progress and a line per finished slenderness on
+// `report`.
 // Throws CaseError, before anything runs, for arguments that cannot make a sweep (lists of
 // different lengths, a slenderness from a ply the sweep would not have), and std::runtime_error
 // ("L/2R = <slenderness>: ...") when a branch fails; the branches before it stay written.

@@ -28,6 +28,7 @@ PlectonemesArguments exact_ply_sweep(const Step& step) {
   args.from_ply = {200, 500};
   args.turns_min = step.full ? 4.0 : 4.5;
   args.progress_every = step.full ? 250 : 0;
+  args.progress = step.progress;
   return args;
 }
 

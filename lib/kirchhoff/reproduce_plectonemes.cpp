@@ -54,6 +54,7 @@ void follow(const Step& step, std::vector<Run>& runs, size_t k) {
   const std::string case_path = (step.cases / "plectoneme.toml").string();
   PlectonemeRunOptions options;
   options.progress_every = step.full ? 250 : 0;
+  options.progress = step.progress;
   run.branch = run.from_ply ? follow_from_ply(case_path, csv_of(step.out, runs[k - 1].slenderness) + ".state.json",
                                               runs[k - 1].slenderness, run.slenderness, 4.0, run.turns,
                                               csv_of(step.out, run.slenderness), options)
