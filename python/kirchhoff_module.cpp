@@ -14,11 +14,17 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -28,6 +34,9 @@
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/case_continue.hpp"
 #include "kirchhoff/case_solve.hpp"
+#include "kirchhoff/continue_outputs.hpp"
+#include "kirchhoff/reproduce.hpp"
+#include "kirchhoff/run_state.hpp"
 #include "kirchhoff/plectoneme_sweep.hpp"
 #include "kirchhoff/result_json.hpp"
 #include "kirchhoff/contact.hpp"
@@ -189,6 +198,11 @@ struct PyBranch {
 struct PyCase {
   Case c;
   std::string phase_condition;  // as given to load_case ("" = the case's own)
+  // As given to load_case: continue_(start_from=..., resume=...) loads the case again with the
+  // other run's parameter values.
+  std::string path;
+  ParameterOverrides overrides;
+  SolverOverrides solver;
 };
 
 // A Python value as the TOML text of a [solver] value (the CLI's --solver KEY=VALUE): True,
@@ -231,6 +245,9 @@ PyCase py_load_case(const std::string& path, const py::object& set, const std::s
     out.c = load_case(path, overrides, phase_condition, solver_overrides);
   }
   out.phase_condition = phase_condition;
+  out.path = path;
+  out.overrides = overrides;
+  out.solver = solver_overrides;
   return out;
 }
 
@@ -388,6 +405,7 @@ std::vector<ContinuationEvent> events_from(const py::object& obj, bool stop) {
 struct BranchPoint {
   ContinuationPoint point;
   int branch;
+  int row;  // RunPoint::row: continuous across branches and across a resume
 };
 
 py::dict branch_points_dict(const std::vector<BranchPoint>& pts, const std::vector<std::string>& derived) {
@@ -395,7 +413,7 @@ py::dict branch_points_dict(const std::vector<BranchPoint>& pts, const std::vect
   py::dict d;
   auto f = [&](const char* name, auto&& g) { d[name] = column<double>(n, [&](size_t i) { return g(pts[i].point); }); };
   auto i = [&](const char* name, auto&& g) { d[name] = column<long>(n, [&](size_t k) { return static_cast<long>(g(pts[k])); }); };
-  d["index"] = column<long>(n, [](size_t k) { return static_cast<long>(k); });
+  d["index"] = column<long>(n, [&](size_t k) { return static_cast<long>(pts[k].row); });
   i("branch", [](const BranchPoint& b) { return b.branch; });
   f("parameter", [](const ContinuationPoint& p) { return p.parameter; });
   f("arclength", [](const ContinuationPoint& p) { return p.arclength; });
@@ -484,18 +502,66 @@ class CollectingSink : public ContinueSink {
  public:
   std::vector<BranchPoint> points;
   void point(const RunPoint& p) override {
-    points.push_back({*p.point, p.branch});
+    points.push_back({*p.point, p.branch, p.row});
     points.back().point.jacobian.reset();
     py::gil_scoped_acquire acquire;
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
   }
 };
 
+// A path argument (str or os.PathLike) as text; "" for None.
+std::string path_text(const py::object& path) {
+  return path.is_none() ? "" : py::module_::import("os").attr("fspath")(path).cast<std::string>();
+}
+
+// What identifies a run for resume=True (ContinueRequest::identity; the CLI's run_arguments): the
+// case file (path and content hash), how it was loaded, and the arguments that decide the points.
+std::string python_run_identity(const PyCase& pc, const ContinueRequest& r, const std::string& start_from) {
+  std::ifstream in(pc.path, std::ios::binary);
+  std::uint64_t hash = 14695981039346656037ull;  // FNV-1a, as the CLI's
+  for (char ch; in.get(ch);) hash = (hash ^ static_cast<unsigned char>(ch)) * 1099511628211ull;
+  std::ostringstream o;
+  o << std::setprecision(17) << "python case=" << pc.path << " case_hash=" << std::hex << hash << std::dec;
+  for (const auto& entry : pc.overrides) o << " set=" << entry.first << "=" << entry.second;
+  for (const auto& entry : pc.solver) o << " solver=" << entry.first << "=" << entry.second;
+  o << " phase=" << pc.phase_condition << " param=" << r.parameter << " to=" << r.target << " direction=" << r.direction
+    << " step=" << r.initial_step << " min_step=" << r.min_step << " max_step=" << r.max_step
+    << " max_points=" << r.max_points << " switch_at_bp=" << r.switch_at_bp << " side=" << r.switch_side
+    << " branch_points=" << r.detect_branch_points << " stability=" << r.compute_stability << " samples=" << r.samples;
+  for (const auto& e : r.events) o << (e.stop ? " event=" : " record=") << e.quantity << "=" << e.value;
+  if (!start_from.empty()) o << " start_from=" << start_from;
+  return o.str();
+}
+
+// resume / start_from as the CLI's --resume / --start-from: where the run starts, and the case
+// loaded again when the other run's parameter values differ from pc's (run_state.hpp).
+Case plan_python_start(const PyCase& pc, const std::string& state_path, bool resume, const std::string& start_from,
+                       const std::string& start_param, ContinueRequest* request) {
+  ParameterOverrides overrides = pc.overrides;
+  bool reload = false;
+  if (resume) {
+    if (state_path.empty()) throw CaseError("resume=True needs state=PATH, the state file of the run to resume");
+    if (!std::filesystem::exists(state_path))
+      throw CaseError("cannot resume: no state file " + state_path + " (a run saves it after its first point)");
+    request->resume = resumable_state(state_path, request->identity);
+    if (request->resume->has_set_parameters) overrides = request->resume->set_parameters, reload = true;
+  } else if (!start_from.empty()) {
+    const RunStart start = plan_start_from(start_from, start_param, pc.overrides);
+    overrides = start.parameters, reload = true;
+    request->start = start.at;
+    request->start_name = start_from;
+  }
+  request->set_parameters = overrides;
+  return reload ? load_case(pc.path, overrides, pc.phase_condition, pc.solver) : pc.c;
+}
+
 // The CLI's `continue` (continue_case: the same statuses and messages), its points in memory.
 PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::object& to, double step,
                      double min_step, double max_step, int max_points, const py::object& events,
                      const py::object& record, int switch_at_bp, double side, int samples, double direction,
-                     bool branch_points, bool stability, bool deflate, int deflate_max) {
+                     bool branch_points, bool stability, bool deflate, int deflate_max, double max_seconds,
+                     const py::object& state, bool resume, const py::object& start_from,
+                     const std::string& start_param) {
   ContinueRequest request;
   request.parameter = parameter;
   if (!to.is_none()) request.target = to.cast<double>();
@@ -514,12 +580,21 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
   request.phase_condition = pc.phase_condition;
   request.deflate = deflate;
   request.deflate_max = deflate_max;
-  if (std::string why = request.validate(pc.c); !why.empty()) throw CaseError(why);
+  request.max_seconds = max_seconds;
+  const std::string state_path = path_text(state), from = path_text(start_from);
+  if (deflate && !state_path.empty()) throw CaseError("state: a deflate run is not resumable, so it saves no state");
+  request.identity = python_run_identity(pc, request, from);
+  const Case c = plan_python_start(pc, state_path, resume, from, start_param, &request);
+  if (std::string why = request.validate(c); !why.empty()) throw CaseError(why);
   CollectingSink collect;
+  // The state after every point and at the end, as the CLI's --checkpoint 0.
+  StateFileSink state_file(state_path, std::chrono::steady_clock::duration::zero());
+  std::vector<ContinueSink*> sinks = {&collect};
+  if (!state_path.empty()) sinks.push_back(&state_file);
   ContinueRunResult result;
   {
     py::gil_scoped_release release;
-    result = continue_case(pc.c, request, {&collect});
+    result = continue_case(c, request, sinks);
   }
   PyBranch out;
   out.parameter = parameter;
@@ -531,6 +606,34 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
   out.size = collect.points.size();
   out.points = branch_points_dict(collect.points, result.derived);
   return out;
+}
+
+// kirchhoff.reproduce(out, full): the CLI's `reproduce` (reproduce.hpp), its report rows as dicts.
+py::list py_reproduce(const py::object& out, bool full, const py::object& cases) {
+  const ReproduceRequest request{path_text(out), cases.is_none() ? std::string(KIRCHHOFF_CASES_DIR) : path_text(cases),
+                                 full};
+  ReproduceResult result;
+  {
+    py::gil_scoped_release release;
+    result = reproduce(request, [](const std::string& line) { std::cerr << "  " << line << "\n"; });  // as the CLI's
+  }
+  const auto optional = [](const std::optional<double>& v) { return v ? py::object(py::float_(*v)) : py::object(py::none()); };
+  py::list rows;
+  for (const ReportRow& r : result.rows) {
+    py::dict d;
+    d["id"] = r.id;
+    d["quantity"] = r.quantity;
+    d["paper"] = optional(r.paper);
+    d["analytic"] = optional(r.analytic);
+    d["numeric"] = r.numeric;
+    d["rel_error"] = r.checked() ? py::object(py::float_(r.rel_error())) : py::object(py::none());
+    d["tolerance"] = r.checked() ? py::object(py::float_(r.tolerance)) : py::object(py::none());
+    d["status"] = r.status();
+    d["stability"] = r.stability;
+    d["note"] = r.note;
+    rows.append(d);
+  }
+  return rows;
 }
 
 // A CSV the sweep wrote, as a dict of its columns: numpy arrays of numbers, lists of str for the
@@ -591,6 +694,7 @@ py::dict py_plectonemes(const std::string& out, const std::vector<double>& slend
   args.hard_from = hard_from;
   args.resume = resume;
   args.sensitivity_tol = sensitivity_tol;
+  args.progress = [](const std::string& line) { std::cerr << line << "\n"; };  // as the CLI's
   if (hard_from < 0) throw CaseError("hard_from must be >= 0 (got " + std::to_string(hard_from) + ")");
   if (sensitivity_tol < 0) throw CaseError("sensitivity_tol must be >= 0");
   // Ctrl-C stops the sweep after its next point (the KeyboardInterrupt stays pending until the
@@ -830,7 +934,9 @@ Returns:
            py::arg("max_points") = 500, py::arg("events") = py::none(), py::arg("record") = py::none(),
            py::arg("switch_at_bp") = 0, py::arg("side") = 1.0, py::arg("samples") = 101,
            py::arg("direction") = 1.0, py::arg("branch_points") = true, py::arg("stability") = true,
-           py::arg("deflate") = false, py::arg("deflate_max") = 16,
+           py::arg("deflate") = false, py::arg("deflate_max") = 16, py::arg("max_seconds") = 0.0,
+           py::arg("state") = py::none(), py::arg("resume") = false, py::arg("start_from") = py::none(),
+           py::arg("start_param") = "",
            R"doc(Pseudo-arclength continuation in one parameter (the CLI's `continue`).
 
 Args:
@@ -852,9 +958,21 @@ Args:
         it is not defined; zero_modes beside it), as the CLI's CSV.
     deflate (bool): follow every branch through the equilibria found at the start by deflation
         (as equilibria() lists them, at most deflate_max): branch k starts at the k-th by energy.
+    max_seconds (float): wall-clock limit of the whole run (0: none); past it the run stops
+        with reason 'time_limit', resumable with state= and resume=True.
+    state (str or path, optional): the run's state file (the CLI's OUT.csv.state.json), saved
+        after every point and at the end.
+    resume (bool): go on from the state file `state` of an interrupted run (time_limit, Ctrl-C)
+        made with the same case and arguments (another run's state is refused): the Branch
+        holds the points after the last one saved, their `index` continuing the run's, so the
+        two Branches together are the uninterrupted run's points.
+    start_from (str or path, optional): another run's state file: start at its last point
+        (its unknowns, active contacts and parameter values, then this case's `set`), as the
+        CLI's --start-from. start_param names that run's parameter for files too old to say.
 
 Returns:
-    Branch (points of all branches concatenated, with a `branch` column).
+    Branch (points of all branches concatenated, with a `branch` column; `index` is the row of
+    the run, as in the CLI's CSV).
 
 Raises:
     CaseError (ValueError): unknown parameter or derived quantity, invalid options.)doc")
@@ -918,6 +1036,25 @@ Returns:
 
 Raises:
     CaseError (ValueError): the file cannot be used; the message names the key and the reason.)doc");
+
+  m.def("reproduce", &py_reproduce, py::arg("out"), py::arg("full") = false, py::kw_only(), py::arg("cases") = py::none(),
+        R"doc(Recompute the reference paper's results (the CLI's `kirchhoff reproduce`, the same files).
+
+Writes out/report.md, out/report.json and the figure data in out/profiles/ (and with full=True
+out/wall_phase/); progress on stderr. A few minutes; full=True about 20.
+
+Args:
+    out (str or path): output folder (created).
+    full (bool): add Fig. 11's L/2R = 500 and 1000 and the hard wall's phase diagram.
+    cases (str or path, optional): the cases folder (default: the shipped cases/).
+
+Returns:
+    list of dict, one per report row: id, quantity, paper and analytic (None where there is
+    none), numeric, rel_error and tolerance (None for rows with nothing exact to check),
+    status ('pass', 'FAIL' or 'info'), stability, note.
+
+Raises:
+    RuntimeError: a result that could not be computed (the report is then not written).)doc");
 
   m.def("sweep", &py_sweep, py::arg("spec"), py::arg("out"), py::kw_only(), py::arg("resume") = false,
         R"doc(Runs a sweep file serially (the CLI's `kirchhoff sweep SPEC --out OUT`, the same files:

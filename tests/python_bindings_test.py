@@ -5,10 +5,13 @@ Run by ctest (python_bindings) with PYTHONPATH=<build>/python and KIRCHHOFF_CASE
 by hand:
     PYTHONPATH=build/python KIRCHHOFF_CASES_DIR=cases /usr/bin/python3 tests/python_bindings_test.py -v
 """
+import contextlib
+import json
 import math
 import os
 import pathlib
 import re
+import sys
 import tempfile
 import threading
 import _thread
@@ -21,6 +24,23 @@ import kirchhoff
 CASES = pathlib.Path(os.environ.get("KIRCHHOFF_CASES_DIR", pathlib.Path(__file__).resolve().parent.parent / "cases"))
 
 PROFILE_KEYS = {"s", "x", "y", "z", "theta", "nx", "ny", "nz", "mx", "my", "mz", "u1", "u2", "u3", "H", "m3"}
+
+
+@contextlib.contextmanager
+def captured_stderr():
+    """What the library writes on file descriptor 2 inside the block, in .text after it."""
+    holder = type("Captured", (), {"text": ""})()
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile(mode="w+") as f:
+        os.dup2(f.fileno(), 2)
+        try:
+            yield holder
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            f.seek(0)
+            holder.text = f.read()
 
 
 def case_path(name):
@@ -464,6 +484,108 @@ class ContinuationTest(unittest.TestCase):
         self.assertEqual(set(b.points["branch"].tolist()), {0})
 
 
+class ContinueRunControlTest(unittest.TestCase):
+    """continue_'s max_seconds, state/resume and start_from, as the CLI's --max-seconds, --resume
+    and --start-from."""
+
+    def test_time_limited_run_resumed_gives_the_uninterrupted_points(self):
+        # The straight column to P = 400 (six branch points, ~1100 points in ~3 s) stopped after
+        # 0.3 s, then resumed from its state file: the two Branches together are the
+        # uninterrupted run's points, bit for bit (the resumed march repeats its steps).
+        case = kirchhoff.load_case(case_path("euler_column.toml"), set={"P": 1.0, "theta_guess": 0.0})
+        run = dict(to=400.0, max_step=0.5, max_points=5000)
+        whole = case.continue_("P", **run)
+        self.assertEqual(whole.reason, "reached_target")
+        with tempfile.TemporaryDirectory() as tmp:
+            state = pathlib.Path(tmp) / "column.state.json"
+            first = case.continue_("P", **run, max_seconds=0.3, state=state)
+            self.assertEqual(first.reason, "time_limit")
+            self.assertFalse(first.ok)
+            self.assertTrue(state.exists())
+            rest = case.continue_("P", **run, state=state, resume=True)
+            self.assertEqual(rest.reason, "reached_target")
+            after = rest.points["index"][0]
+            self.assertGreater(after, 0)
+            kept = first.points["index"] < after
+            np.testing.assert_array_equal(np.concatenate([first.points["index"][kept], rest.points["index"]]),
+                                          whole.points["index"])
+            for column in ("parameter", "theta0"):
+                np.testing.assert_array_equal(
+                    np.concatenate([first.points[column][kept], rest.points[column]]), whole.points[column])
+            types = [t for t, k in zip(first.points["type"], kept) if k] + rest.points["type"]  # (lists of str)
+            self.assertEqual(types, whole.points["type"])
+
+    def test_resume_refuses_another_runs_state_and_needs_one(self):
+        case = kirchhoff.load_case(case_path("simply_supported.toml"))
+        with tempfile.TemporaryDirectory() as tmp:
+            state = str(pathlib.Path(tmp) / "a.state.json")
+            case.continue_("theta0", to=1.2, state=state)
+            with self.assertRaises(kirchhoff.CaseError) as cm:
+                case.continue_("theta0", to=1.3, state=state, resume=True)  # another target: another run
+            self.assertIn("other arguments", str(cm.exception))
+            with self.assertRaises(kirchhoff.CaseError) as cm:
+                case.continue_("theta0", to=1.2, resume=True)
+            self.assertIn("needs state=PATH", str(cm.exception))
+            with self.assertRaises(kirchhoff.CaseError) as cm:
+                case.continue_("theta0", to=1.2, state=str(pathlib.Path(tmp) / "none.json"), resume=True)
+            self.assertIn("no state file", str(cm.exception))
+            with self.assertRaises(ValueError):
+                case.continue_("theta0", to=1.2, max_seconds=-1)
+
+    def test_start_from_another_runs_last_point(self):
+        # From the end of a run in theta0 to 1.5, on to 2: the run starts at theta0 = 1.5 (its
+        # first point, type 'start') and reaches the elliptic load 4 K(k)^2 EI/L^2 at theta0 = 2
+        # (1e-9: Newton to 1e-10 on residuals integrated at 1e-12, as the solve tests).
+        case = kirchhoff.load_case(case_path("simply_supported.toml"))
+        with tempfile.TemporaryDirectory() as tmp:
+            state = pathlib.Path(tmp) / "to_1.5.state.json"
+            first = case.continue_("theta0", to=1.5, state=state)
+            self.assertEqual(first.reason, "reached_target")
+            b = case.continue_("theta0", to=2.0, start_from=state)
+            self.assertEqual(b.reason, "reached_target")
+            self.assertEqual(b.points["type"][0], "start")
+            self.assertAlmostEqual(b.points["parameter"][0], 1.5, delta=1e-12)
+            self.assertAlmostEqual(b.points["P"][0], first.points["P"][-1], delta=1e-9 * first.points["P"][-1])
+            exact = kirchhoff.analytic_pinned_load(1.0, 1.0, 2.0)
+            self.assertLess(abs(b.points["P"][-1] / exact - 1), 1e-9)
+            # A state of a run whose parameters this case does not have is refused, naming it.
+            with self.assertRaises(ValueError) as cm:
+                kirchhoff.load_case(case_path("euler_column.toml")).continue_("P", to=12.0, start_from=state)
+            self.assertIn("theta0", str(cm.exception))
+
+
+class ReproduceTest(unittest.TestCase):
+    def test_rows_are_the_reports(self):
+        # The quick run (2-3 minutes): every row passes, and the rows returned are report.json's,
+        # in order, with the same values (the CLI's `reproduce` test checks its exit status).
+        with tempfile.TemporaryDirectory() as tmp:
+            rows = kirchhoff.reproduce(tmp)
+            with open(pathlib.Path(tmp) / "report.json") as f:
+                report = json.load(f)
+            self.assertEqual(len(rows), len(report))
+            self.assertGreater(len(rows), 80)
+            def same(value, saved):  # JSON writes NaN as null; its numbers round-trip exactly
+                return value == saved or (saved is None and (value is None or math.isnan(value)))
+            for row, saved in zip(rows, report):
+                self.assertEqual(row["id"], saved["id"])
+                self.assertEqual(row["quantity"], saved["quantity"])
+                for key in ("numeric", "analytic", "paper", "rel_error", "tolerance"):
+                    self.assertTrue(same(row[key], saved[key]), (row["id"], key, row[key], saved[key]))
+                self.assertEqual(row["status"], {True: "pass", False: "FAIL", None: "info"}[saved["pass"]])
+            self.assertNotIn("FAIL", [r["status"] for r in rows])
+            self.assertTrue((pathlib.Path(tmp) / "profiles" / "fig5_cavity_branch.csv").exists())
+
+    def test_a_case_that_cannot_be_loaded_raises_and_writes_no_report(self):
+        # The whole run (a few minutes) is ctest's `reproduce` through the CLI, over the same
+        # library function; here its binding, from a cases folder without the cases.
+        with tempfile.TemporaryDirectory() as tmp:
+            out = pathlib.Path(tmp) / "out"
+            with self.assertRaises(ValueError) as cm:
+                kirchhoff.reproduce(out, cases=tmp)
+            self.assertIn("simply_supported.toml", str(cm.exception))
+            self.assertFalse((out / "report.md").exists())
+
+
 class VibrateTest(unittest.TestCase):
     def test_pinned_column_frequencies_and_flat_h_vib(self):
         # Straight column under the dead load P = pi^2/2: omega_k^2 = (k pi)^4 - P (k pi)^2 (eq. 96).
@@ -552,6 +674,19 @@ class PlectonemesTest(unittest.TestCase):
             again = kirchhoff.plectonemes(tmp, [100], [5.2], hard_from=5, turns_min=4.9, resume=True)
             self.assertEqual(again["points"], 0)
             np.testing.assert_array_equal(again["branches"][100.0]["exact"]["T_ext"], exact["T_ext"])
+
+    def test_progress_lines_on_stderr_and_a_finished_branch_left_alone(self):
+        # A quarter turn at L/2R = 100: the sweep's progress line for the slenderness reaches
+        # stderr through the library's progress callback (as the CLI's); resumed, the branch
+        # whose CSV ends with its endpoint row (read by the `type` column) computes nothing.
+        with tempfile.TemporaryDirectory() as tmp:
+            with captured_stderr() as err:
+                r = kirchhoff.plectonemes(tmp, [100], [0.25])
+            self.assertIn("L/2R = 100: turns 0 -> 0.25", err.text)
+            self.assertEqual(r["branches"][100.0]["stop"], "reached_target")
+            self.assertGreater(r["points"], 1)
+            again = kirchhoff.plectonemes(tmp, [100], [0.25], resume=True)
+            self.assertEqual(again["points"], 0)
 
     def test_interrupted_sweep_resumes_without_losing_rows(self):
         # Ctrl-C (interrupt_main, 2 s into L/2R = 100 to 3 turns, a ~6 s run) raises
