@@ -36,7 +36,7 @@ void buckled_column(const Step& step, const ShootingProblem& problem, Continuati
   b.target = NAN;
   b.initial_step = 0.05;
   b.max_step = 1.0;
-  b.events = {{"theta0", 3.0, true}};
+  b.events = {{"theta0", 3.0, true, ""}};
   b.compute_stability = true;  // make_figures.py draws stable parts solid, unstable ones dashed
   Continuation buckled(problem, b);
   const ContinuationResult branch = buckled.switch_branch(first);
