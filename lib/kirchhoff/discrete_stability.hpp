@@ -9,9 +9,12 @@
 //   positions     r_i = r_0 + h/2 sum_{k<i} (t(theta_k) + t(theta_k+1)), t = (cos, sin) (trapezoid);
 //   bending       sum_e B(s_e+1/2) / (2 h) (theta_e+1 - theta_e - h u_hat(s_e+1/2))^2 (midpoint);
 //   dead loads    -F_0.r_0 - F_L.r_N - M_0 theta_0 - M_L theta_N (the given end loads);
-//   field         -sum_i h c_i f(s_i).r_i (trapezoid weights c_i; a uniform field only, whose
-//                 potential is linear in r, so this is exact up to a constant).
-// Both rules are second order, so equilibria and eigenvalues converge as h^2.
+//   field         sum_i h c_i W(s_i, r_i) (trapezoid weights c_i): for a uniform field
+//                 -sum_i h c_i f.r_i; for one that depends on position (a soft wall's barrier)
+//                 the lumped potential, whose Hessian adds sum_i (dr_i/dz)^T (-h c_i df/dr)
+//                 (dr_i/dz) to the second variation, r_0 included.
+// Both rules are second order, so equilibria and eigenvalues converge as h^2 (first order with a
+// contact, below).
 //
 // Constraints, read from the case as stability.hpp reads it: imposed positions and rotations are
 // held (e.r_0, e.r_N, theta_0, theta_N at their imposed values); an unknown parameter that is an
@@ -19,6 +22,17 @@
 // solution's value (its load stays in the energy at the solved value; the constraint's multiplier
 // takes up the O(h^2) difference). Extra conditions (the end slope theta0 of
 // simply_supported.toml) only select the equilibrium and are not imposed.
+//
+// Point contacts (positive force, on a plane or a disc) are bilateral constraints whose contact
+// point slides: the rod's closest approach to the obstacle, the minimum of the quadratic through
+// the gaps of the three nodes around the contact, is held at zero (discrete_stability_contact.hpp).
+// Its multiplier is minus the contact force, and its Hessian brings the sliding term
+// f (dg')^2 / g'' (holding the gap at a node would leave it out: another, wrong count) and, on a
+// disc, the obstacle's curvature. The interpolant's g'' is a second difference across the jump of
+// g''' that the contact force makes, so eigenvalues converge at first order with a contact.
+// Where the energy depends on the start position (a field that depends on position, a contact
+// with a disc), its admissible perturbation, fixed by the held positions as dr_0 = R dtheta,
+// enters the projected form; a start that may translate is then not covered.
 //
 // From the shooting solution sampled at the nodes, Newton solves the discrete KKT system
 // (gradient of the Lagrangian, constraints) with the exact Hessian. The Hessian of the Lagrangian
@@ -37,11 +51,16 @@
 //   - the lowest eigenvalues at N and N/2 agreeing to kDiscreteStabilityAgreement of the sum of
 //     their parts' magnitudes (bending and loads), index and zero modes equal, and every eigenvalue counted with a sign that
 //     the refinement cannot change (|mu_N| > |mu_N - mu_N/2|, three times the Richardson
-//     error estimate, and the same sign at N/2).
+//     error estimate, and the same sign at N/2; with a contact, first order, |mu_N| > twice the
+//     change, the error estimate itself);
+//   - each contact pushing in the discrete solve (its multiplier negative) with its closest
+//     approach within one element of its interpolant's middle node.
 // Not covered (index empty, reason given): spatial or extensible rods, natural shear or stretch,
-// active contacts, half rods by symmetry, fields depending on position, an end closed by the
-// continuity of H (a sleeve), unknown parameters that are not end loads, dependent constraints
-// (a straight rod whose chord is held: no perturbation keeps it to first order).
+// extended contacts, contacts with a level-set obstacle, a contact with zero force (weakly
+// active) or where the rod flattens onto the obstacle (g'' = 0), half rods by symmetry, a field
+// that depends on position (or a disc contact) on a rod whose start may translate, an end closed
+// by the continuity of H (a sleeve), unknown parameters that are not end loads, dependent
+// constraints (a straight rod whose chord is held: no perturbation keeps it to first order).
 #pragma once
 
 #include <Eigen/Dense>
