@@ -33,12 +33,6 @@ double sign_of(double v) { return v < 0 ? -1.0 : 1.0; }
 // by locating inside a step, and a resumed run finds it again by redoing that step.
 bool resumable_type(PointType t) { return t == PointType::Start || t == PointType::Regular; }
 
-// Obstacles or contacts: the march's looser matrices are not used
-// (ContinuationOptions::march_sensitivity_tol).
-bool has_contact(const ProblemDefinition& d) {
-  return !d.obstacles.empty() || d.moving_obstacles || !d.contacts.empty();
-}
-
 }  // namespace
 
 const char* to_string(PointType type) {
@@ -82,7 +76,6 @@ std::string ContinuationOptions::validate() const {
   if (samples < 2 || samples > 100000) return "samples must be in [2, 100000]";
   if (!(0 <= grow_iterations && grow_iterations < shrink_iterations))
     return "grow_iterations must be >= 0 and below shrink_iterations";
-  if (!(march_sensitivity_tol >= 0)) return "march_sensitivity_tol must be >= 0 (0: the problem's own)";
   if (reuse_jacobian_iterations >= 0 && detect_branch_points)
     return "reusing Jacobians needs detect_branch_points = false (the test functions need each point's own)";
   return {};
@@ -105,13 +98,6 @@ Continuation::Continuation(const ShootingProblem& problem, ContinuationOptions o
   // layer's (it reads the derived list completed with the events' quantities above).
   if (!options_.recorder) options_.recorder = rod_point_recorder(options_);
   n_ = problem_.size();
-  const ProblemDefinition& d = problem_.definition();
-  if (!has_contact(d) &&
-      options_.march_sensitivity_tol > std::max(d.options.integrator.sensitivity_tol, d.options.integrator.abs_tol)) {
-    ProblemDefinition loose = d;
-    loose.options.integrator.sensitivity_tol = options_.march_sensitivity_tol;
-    march_problem_.emplace(std::move(loose));
-  }
 }
 
 Eigen::VectorXd Continuation::join(const Eigen::VectorXd& x, double lambda) const {
@@ -120,8 +106,7 @@ Eigen::VectorXd Continuation::join(const Eigen::VectorXd& x, double lambda) cons
   return z;
 }
 
-bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
-                            bool march) {
+bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure) {
   const double lambda = z[n_];
   const Eigen::VectorXd x = z.head(n_);
   problem_.set_parameter(options_.parameter, lambda);
@@ -130,12 +115,9 @@ bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen:
     return problem_.evaluate(x, F, nullptr, failure);
   }
   ++evaluations_.matrices;
-  // (Its residual is the same number as problem_'s: the state is integrated at the same tolerance.)
-  ShootingProblem& p = march && march_problem_ ? *march_problem_ : problem_;
-  if (&p != &problem_) p.set_parameter(options_.parameter, lambda);
   Eigen::VectorXd y_end, F_lambda;
-  if (!p.evaluate_with_end(x, F, A, &y_end, failure)) return false;
-  if (!p.parameter_derivative(x, options_.parameter, &F_lambda, failure, &y_end)) return false;
+  if (!problem_.evaluate_with_end(x, F, A, &y_end, failure)) return false;
+  if (!problem_.parameter_derivative(x, options_.parameter, &F_lambda, failure, &y_end)) return false;
   // A column appended in place: the matrices of long rods are tens of megabytes, and realloc
   // extends such blocks without copying them.
   A->conservativeResize(n_, n_ + 1);
@@ -184,7 +166,7 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
       if (!(max_abs_or_nan(G) <= kModifiedNewtonContraction * previous)) lu.reset();
     }
     if (!lu) {
-      if (!evaluate(z, &F, &A, &failure, true)) {
+      if (!evaluate(z, &F, &A, &failure)) {
         last_corrector_failure_ = failure;
         return false;
       }
@@ -229,8 +211,7 @@ std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z
     Eigen::VectorXd F;
     Eigen::MatrixXd own;
     std::string failure;
-    // The march's matrix at the points it can resume from (restore() evaluates the same one).
-    if (!evaluate(z, &F, &own, &failure, resumable_type(type))) return std::nullopt;
+    if (!evaluate(z, &F, &own, &failure)) return std::nullopt;
     A = std::make_shared<const Eigen::MatrixXd>(std::move(own));
   }
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n_ + 1);
@@ -274,7 +255,7 @@ std::optional<ContinuationPoint> Continuation::restore(const ContinuationPoint& 
   Eigen::VectorXd F;
   Eigen::MatrixXd A;
   std::string failure;
-  if (!evaluate(z, &F, &A, &failure, resumable_type(saved.type))) return std::nullopt;
+  if (!evaluate(z, &F, &A, &failure)) return std::nullopt;
   // The saved tangent, not one solved for again: bordered by another row (the point's own
   // tangent instead of its predecessor's) the solve gives the same direction to round-off only.
   ContinuationPoint p = make_point(z, saved.tangent, std::make_shared<const Eigen::MatrixXd>(std::move(A)), false,
