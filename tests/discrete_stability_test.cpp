@@ -415,6 +415,29 @@ TEST(DiscreteStability, StableAndUnstableWallContactsCoexist) {
   }
 }
 
+// wall.toml's asymmetric contact far from mid-span at Delta = 0.0307 (s = 0.454754, f = 49.1106;
+// found by `equilibria`, here from a guess next to it): the discretised energy finds it stable,
+// with a lowest eigenvalue far from zero at every resolution (12.127, 11.907, 11.782 at 200, 400,
+// 800 elements), where the conjugate-point count gives index 1. The disagreement is recorded in
+// docs/stability-cross-check.md; this test pins the discretised energy's side of it.
+TEST(DiscreteStability, FarAsymmetricWallContactIsStableByTheDiscretisedEnergy) {
+  std::string text = read_case("wall.toml");
+  const std::string guess_force = "force = [\"-P_guess\", 0]";
+  ASSERT_NE(text.find(guess_force), std::string::npos);
+  text.replace(text.find(guess_force), guess_force.size(), "force = [\"-P_guess\", -24.33]");
+  text += "\n[[guess.contacts]]\nobstacle = \"wall\"\ns = 0.4548\nforce = 49.1\n";
+  const Solved s = solve_with_contacts(text, {{"Delta", 0.0307}, {"P_guess", 131.24}, {"m_guess", 1.213}});
+  const auto contacts = s.problem->contacts_at(s.x);
+  ASSERT_EQ(contacts.size(), 1u);
+  ASSERT_NEAR(contacts[0].s, 0.454754, 1e-6);
+  const DiscreteStability d = discrete_stability(*s.problem, s.x, kElements);
+  ASSERT_TRUE(d.defined()) << d.reason;
+  EXPECT_TRUE(d.trustworthy) << d.check_message;
+  EXPECT_EQ(*d.index, 0);
+  // Farther from zero than any discretisation error seen on contacts (the change from N/2 is 0.22).
+  EXPECT_GT(d.lowest_eigenvalues[0], 10.0);
+}
+
 // A contact with a curved obstacle: indenter.toml's rod on a pin and a roller, pushed up at
 // mid-span by a disc of radius 0.05. Stable by both counts (the conjugate points include the
 // disc's curvature where the other helper's stability.cpp does; the discretised energy through the
