@@ -268,7 +268,7 @@ class StabilityAnalysis {
     std::vector<double> s(17);
     for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
     profile_ = problem_.sample(x_, s);
-    full_ = options_.positions_as_configuration || positions_enter_the_energy();
+    full_ = options_.positions_as_configuration || positions_are_configuration();
     const int n = coords_.size(), kr = coords_.kr();
     offset_ = full_ ? 0 : kr;
     mU_ = full_ ? n : n - kr;
@@ -299,7 +299,7 @@ class StabilityAnalysis {
     Eigen::MatrixXd rotation;  // kpsi x b, rotation coordinates
   };
   Held held_at(const EndCondition& end, const std::vector<std::string>& multipliers) const;
-  bool positions_enter_the_energy() const;
+  bool positions_are_configuration() const;
   // The configuration directions (the frame's U coordinates) an end holds in the load-controlled
   // problem: its held rotations; positions are never held there.
   Eigen::MatrixXd held_configuration(const Held& held) const;
@@ -330,7 +330,7 @@ class StabilityAnalysis {
   std::vector<RodPoint> profile_;  // the equilibrium at 17 equally spaced points, for the checks above
   long rhs_ = 0;
   // The full frame: positions are configuration variables beside the rotation (see
-  // positions_enter_the_energy); its U block holds (dr / L, dpsi), offset_ = 0. Otherwise the
+  // positions_are_configuration); its U block holds (dr / L, dpsi), offset_ = 0. Otherwise the
   // rotation alone, offset_ = kr. mU_ is the size of U.
   bool full_ = false;
   int offset_ = 0, mU_ = 0;
@@ -351,7 +351,11 @@ StabilityAnalysis::Held StabilityAnalysis::held_at(const EndCondition& end,
 // Whether positions are configuration variables of their own, beside the rotation: where the
 // energy depends on where the rod is, not only on its shape - a field whose force depends on
 // position (a soft wall, a barrier: f = -grad V(r)), or a contact with a curved obstacle, whose
-// second variation holds the obstacle's curvature at the perturbed contact point dr(s_c).
+// second variation holds the obstacle's curvature at the perturbed contact point dr(s_c) - and
+// wherever a point contact is active at all: its force is a multiplier whose change is a load on
+// an interior point, which the end loads of the rotation frame do not balance (the response to it
+// alone is not an equilibrium; D came out unsymmetric), while the full frame has the translations
+// to take it and keeps only the loads that do no work on its zero modes.
 //
 // Why the rotation alone no longer suffices. The load-controlled problem's energy is
 //   E[r0, R] = int W(u, v) + int V(r) - F_L.r(L) + F_0.r(0),   r(s) = r0 + int_0^s R v,
@@ -379,15 +383,12 @@ StabilityAnalysis::Held StabilityAnalysis::held_at(const EndCondition& end,
 // count: the translations are then zero modes of the load-controlled problem, r_Z is the rank of
 // the held directions, and the loads doing no work on the translations are the balanced pairs,
 // whose D is the chord's. (The tests check that the two frames agree on every such case.)
-bool StabilityAnalysis::positions_enter_the_energy() const {
+bool StabilityAnalysis::positions_are_configuration() const {
   const auto& field = eq_->model().field;
   if (field)
     for (const RodPoint& q : profile_)
       if (field->force_gradient(q.s, q.r).norm() > 0) return true;
-  const std::vector<Obstacle> obstacles = problem_.obstacles(p_);
-  for (const PointContact& c : problem_.contacts_at(x_))
-    if (!obstacles[c.obstacle].is_flat()) return true;
-  return false;
+  return !problem_.contacts_at(x_).empty();
 }
 
 Eigen::MatrixXd StabilityAnalysis::held_configuration(const Held& held) const {
@@ -616,12 +617,16 @@ std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contac
     track->lifted[j] = sheet + sheared[best];
     track->lowest[j] = std::min(track->lowest[j], track->lifted[j]);
   }
-  // The same jump on the fields' state: (dn, dm) += S_lab (dr, dpsi).
+  // The same jump on the fields' state, (dn, dm) += S_lab (dr, dpsi): on the frame and on the
+  // particular fields that have started (they are Jacobi fields of the same system; leaving them
+  // out makes D = dg/dlambda lose its symmetry).
   Eigen::MatrixXd to_lab(6, f->dY.rows());
   to_lab << eq_->slot_map(Slot::Position), lab_rotation_jacobian(*eq_, f->y, here.R);
   Eigen::MatrixXd from_lab(f->dY.rows(), 6);
   from_lab << eq_->slot_map(Slot::Force).transpose(), eq_->slot_map(Slot::Moment).transpose();
-  f->dY += from_lab * S_lab * to_lab * f->dY;
+  const Eigen::MatrixXd jump = from_lab * S_lab * to_lab;
+  f->dY += jump * f->dY;
+  f->particular += jump * f->particular;
   // The force's particular field.
   Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * n);
   z.segment(n, kr) = -nu_r;
@@ -768,10 +773,14 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
   if (k > 0) {
     const Eigen::MatrixXd c = -conditions.completeOrthogonalDecomposition().solve(loads);
     const Eigen::MatrixXd chord = frame_values * c + particular_values;  // D, k x k
+
     const Eigen::MatrixXd chord_zero = frame_values * zero_modes;        // k x z
     const int r_z = static_cast<int>(column_basis(chord_zero, tol).cols());
     const Eigen::MatrixXd quiet = null_space(chord_zero.transpose(), k, tol);  // loads doing no work on them
-    const Eigen::MatrixXd D = quiet.transpose() * (0.5 * (chord + chord.transpose())) * quiet;
+    // D = C H^-1 C^T is symmetric (reciprocity of the multipliers' responses): 1e-14 of its size
+    // on the cases of the tests once every Jacobi field gets each contact's jump.
+    const Eigen::MatrixXd D_quiet = quiet.transpose() * chord * quiet;
+    const Eigen::MatrixXd D = 0.5 * (D_quiet + D_quiet.transpose());
     int positive = 0;
     if (D.rows() > 0) {
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(D);
