@@ -153,8 +153,9 @@ int run_solve(const SolveArguments& args) {
     }
   }
   const StabilityReport stability = analyse_stability(*problem, sol.result.x);
-  // The independent check where it applies (planar rods without contacts): its lowest
-  // eigenvalues, and whether its index agrees.
+  // The independent check where it applies (planar inextensible rods, point contacts on planes
+  // and discs, position-dependent fields included): its lowest eigenvalues, and whether its index
+  // agrees.
   const DiscreteStability discrete = discrete_stability(*problem, sol.result.x);
   if (args.json) {
     nlohmann::json j = solution_json(c, *problem, sol, stability, &discrete);
