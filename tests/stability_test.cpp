@@ -530,8 +530,8 @@ double symmetric_disc_det(double rho, double delta) {
 // its determinant (the linearised contact conditions and equilibrium, no second variation).
 // Both are bisected to 2^-30 of the interval (4e-12); they agree to 5e-9 in Delta, the
 // resolution of the zero tolerance on D's eigenvalues (1e-6) against dD/dDelta: 1e-7 leaves a
-// margin. Without the curvature term the index changed at 0.027107 for rho = 0.5 (3e-5 off), and
-// without the contact's jump on the particular fields at 0.027098.
+// margin. Without the contact's jump on the particular fields the index changed at 0.027098 for
+// rho = 0.5 (4e-5 off).
 TEST(Stability, DiscContactLosesItsStabilityWhereTheJacobianIsSingular) {
   for (double rho : {0.5, 2.0}) {
     SCOPED_TRACE("rho = " + std::to_string(rho));
