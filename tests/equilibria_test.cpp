@@ -199,7 +199,7 @@ void expect_admissible(const Equilibrium& e) {
 
 TEST(Equilibria, WallNearFlatteningHasSymmetricAndAsymmetricContacts) {
   const EquilibriaSearch s = search("wall.toml", {{"Delta", 0.0307}});
-  int symmetric = 0, asymmetric = 0, free_down = 0;
+  int symmetric = 0, asymmetric = 0, far = 0, free_down = 0;
   std::vector<double> asymmetric_s;
   for (const auto& e : s.equilibria) {
     expect_admissible(e);
@@ -217,13 +217,32 @@ TEST(Equilibria, WallNearFlatteningHasSymmetricAndAsymmetricContacts) {
     } else {
       ++asymmetric;
       asymmetric_s.push_back(c.s);
-      EXPECT_EQ(*e.stability.index, 1);  // docs/stability.md: -2.57 in the discretised energy
+      if (std::abs(c.s - 0.5) > 1e-2) {
+        // The far contacts (s = 0.454754 and its mirror, P = 131.24, f = 49.11) are stable: the
+        // discretised energy with a sliding contact (discrete_stability) has its lowest
+        // eigenvalue at +12.13, +11.91, +11.78 with 200, 400, 800 elements, an independent
+        // finite-element second variation (sliding term, chord and contact constraints) +11.70
+        // at 2000, and a descent of the discretised obstacle problem from perturbations returns
+        // there. The conjugate points give load-controlled index 3 and correction -3 (they gave
+        // -2, index 1, while a flat contact went through the rotation frame, whose end loads do
+        // not balance a change of the contact force, and the contact's sliding jump missed the
+        // multipliers' particular fields: D = dg/dlambda came out unsymmetric and wrong).
+        ++far;
+        EXPECT_EQ(*e.stability.index, 0) << "s = " << c.s;
+      } else {
+        // The near-symmetric contacts (s = 0.499225, energy 1.62780782 above the symmetric
+        // contact's 1.627807704) sit at the maximum of the energy along the one-contact family
+        // between the symmetric contact's minimum and the far contact: index 1 (the barrier-
+        // discretised energy of docs/stability.md: -2.57; a descent from it runs to the far one).
+        EXPECT_EQ(*e.stability.index, 1) << "s = " << c.s;
+      }
     }
   }
   EXPECT_EQ(symmetric, 1);
   EXPECT_EQ(free_down, 1);
+  EXPECT_EQ(far, 2);
   // The asymmetric contacts come in mirror pairs s, L - s.
-  ASSERT_GE(asymmetric, 2);
+  ASSERT_GE(asymmetric, 4);
   EXPECT_EQ(asymmetric % 2, 0);
   std::sort(asymmetric_s.begin(), asymmetric_s.end());
   for (size_t i = 0; i < asymmetric_s.size(); ++i)
@@ -243,7 +262,10 @@ TEST(Equilibria, WallBeyondFlatteningHasAFlatContactBesideAsymmetricOnes) {
     } else if (std::abs(c.s - 0.5) > 1e-3) {
       ++asymmetric;
       ASSERT_TRUE(e.stability.index);
-      EXPECT_EQ(*e.stability.index, 1);
+      // Stable (s = 0.428545, f = 41.77, and its mirror): the discretised energy with a sliding
+      // contact has its lowest eigenvalue at +24.65, +24.54, +24.60 with 200, 400, 800 elements.
+      // The conjugate points agree since D = dg/dlambda is computed consistently (see above).
+      EXPECT_EQ(*e.stability.index, 0) << "s = " << c.s;
     }
   }
   ASSERT_NE(flat, nullptr);
