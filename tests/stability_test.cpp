@@ -264,6 +264,43 @@ TEST(Stability, AsymmetricContactCoexistsWithTheStableSymmetricOne) {
   EXPECT_EQ(*stable.index, 0);
 }
 
+// wall.toml's asymmetric contact far from mid-span (s = 0.454754, f = 49.1106 at Delta = 0.0307,
+// found by `equilibria`; here from a guess next to it) is stable. Known independently of this
+// code: the second variation int eta'^2/2 + (n.d3) eta^2/2 + f eta(s_c)^2 / (2 |kappa_c|) on 2000
+// P1 elements, eta(0) = eta(L) = 0, from the equilibrium's values at s = 0, has index 3 under
+// load control (three conjugate points). Restricted to its constraints (the chord's two components
+// and nu.dr(s_c)), its index is 0 (lowest eigenvalue +11.70). The discretised energy gives
+// +11.78 at 800 elements (discrete_stability_test). With the contact held at its material point
+// (no sliding term) the same script gives index 3 under load control and index 1 constrained
+// (-42.3). The counts are integers, so they need no tolerance. The correction was -2 (index 1)
+// while the contact went through the rotation frame and its jump missed the multipliers' fields.
+TEST(Stability, FarAsymmetricWallContactIsStable) {
+  std::ifstream file(testing::case_path("wall.toml"));
+  std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const std::string guess_force = "force = [\"-P_guess\", 0]";
+  ASSERT_NE(text.find(guess_force), std::string::npos);
+  text.replace(text.find(guess_force), guess_force.size(), "force = [\"-P_guess\", -24.33]");
+  text += "\n[[guess.contacts]]\nobstacle = \"wall\"\ns = 0.4548\nforce = 49.1\n";
+  const Case c =
+      load_case_text(text, "wall_far_contact.toml", {{"Delta", 0.0307}, {"P_guess", 131.24}, {"m_guess", 1.213}});
+  const DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
+  ASSERT_TRUE(solved.result.summary.converged());
+  const auto contacts = solved.problem->contacts_at(solved.result.x);
+  ASSERT_EQ(contacts.size(), 1u);
+  ASSERT_NEAR(contacts[0].s, 0.454754, 1e-6);  // the equilibrium of the docs, printed to 6 digits
+  const StabilityReport r = analyse_stability(*solved.problem, solved.result.x);
+  ASSERT_TRUE(r.defined()) << r.reason;
+  EXPECT_EQ(r.dead_load_index, 3);
+  EXPECT_EQ(r.constraint_correction, -3);
+  EXPECT_EQ(*r.index, 0);
+  StabilityOptions held;
+  held.contact_sliding = false;
+  const StabilityReport pinned = analyse_stability(*solved.problem, solved.result.x, held);
+  ASSERT_TRUE(pinned.defined()) << pinned.reason;
+  EXPECT_EQ(pinned.dead_load_index, 3);
+  EXPECT_EQ(*pinned.index, 1);
+}
+
 // The straight rod with its chord held at full length (simply_supported at theta0 = 0): every
 // perturbation shortens the chord at second order and the axial force is indeterminate (it was
 // whatever Newton's guess made it), so the index is not defined.
