@@ -418,8 +418,9 @@ TEST(DiscreteStability, StableAndUnstableWallContactsCoexist) {
 // wall.toml's asymmetric contact far from mid-span at Delta = 0.0307 (s = 0.454754, f = 49.1106;
 // found by `equilibria`, here from a guess next to it): the discretised energy finds it stable,
 // with a lowest eigenvalue far from zero at every resolution (12.127, 11.907, 11.782 at 200, 400,
-// 800 elements), where the conjugate-point count gives index 1. The disagreement is recorded in
-// docs/stability-cross-check.md; this test pins the discretised energy's side of it.
+// 800 elements). The conjugate-point count once gave index 1 here (an inconsistent D = dg/dlambda
+// for point contacts, docs/stability-cross-check.md); it now gives 0 too
+// (Stability.FarAsymmetricWallContactIsStable), and this test keeps the discretised side.
 TEST(DiscreteStability, FarAsymmetricWallContactIsStableByTheDiscretisedEnergy) {
   std::string text = read_case("wall.toml");
   const std::string guess_force = "force = [\"-P_guess\", 0]";
