@@ -256,6 +256,9 @@ void run_plectonemes(const SweepJob& job, const fs::path& folder, json* result) 
   (*result)["status"] = "ok";
   (*result)["reason"] = "";
   (*result)["points"] = sweep.points;
+  // The index's quantities (T_ext, helix angle, ...) are those of the job's own slenderness: the
+  // last branch (a from_ply job computes the thicker one first), at its last ply point.
+  if (!branches.empty()) (*result)["derived"] = branches.back()["last_ply_point"];
   (*result)["branches"] = std::move(branches);
   (*result)["files"] = std::move(files);
 }
