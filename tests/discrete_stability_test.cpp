@@ -11,8 +11,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/stability.hpp"
@@ -44,11 +42,6 @@ Solved solve_text(const std::string& text, const ParameterOverrides& overrides) 
   EXPECT_TRUE(r.summary.converged()) << r.summary.brief_report();
   out.x = r.x;
   return out;
-}
-
-std::string read_case(const std::string& name) {
-  std::ifstream file(testing::case_path(name));
-  return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
 }
 
 // Solves a case text with its obstacles (the active-set loop of contact.hpp).
@@ -272,22 +265,6 @@ TEST(DiscreteStability, ClosestApproachOfThreeGapsIsTheParabolasMinimum) {
   }
 }
 
-// A Winkler foundation V = k y^2 / 2 per length (force -k y e_y, gradient -k e_y e_y^T).
-class Winkler final : public ExternalField {
- public:
-  explicit Winkler(double k) : k_(k) {}
-  double potential(double, const Vec3& r) const override { return 0.5 * k_ * r.y() * r.y(); }
-  Vec3 force(double, const Vec3& r) const override { return Vec3(0.0, -k_ * r.y(), 0.0); }
-  Mat3 force_gradient(double, const Vec3&) const override {
-    Mat3 g = Mat3::Zero();
-    g(1, 1) = -k_;
-    return g;
-  }
-
- private:
-  double k_;
-};
-
 // The straight pinned column under the dead load P on a Winkler foundation k: in y the second
 // variation is int (B y''^2 + k y^2 - P y'^2) with y(0) = y(L) = 0 and the moment-free ends'
 // y'' = 0, so y = sin(q s), q = m pi, diagonalise it; per int dtheta^2 = int y'^2 its eigenvalues
@@ -302,7 +279,7 @@ TEST(DiscreteStability, StraightColumnOnAWinklerFoundationHasTheClosedFormEigenv
     ProblemDefinition definition = c.definition;
     definition.model = [inner = c.definition.model, stiffness = k](const Parameters& p) {
       RodModel m = inner(p);
-      m.field = std::make_shared<Winkler>(stiffness);
+      m.field = std::make_shared<testing::WinklerFoundation>(stiffness);
       return m;
     };
     ShootingProblem problem(definition);
@@ -350,7 +327,7 @@ TEST(DiscreteStability, SoftWallAgreesWithConjugatePointsAndVibration) {
 TEST(DiscreteStability, SymmetricWallContactIsStableByBothCounts) {
   for (double delta : {0.026, 0.028, 0.030}) {
     SCOPED_TRACE("Delta = " + std::to_string(delta));
-    const Solved s = solve_with_contacts(read_case("wall.toml"), {{"Delta", delta}});
+    const Solved s = solve_with_contacts(testing::case_text("wall.toml"), {{"Delta", delta}});
     ASSERT_EQ(s.problem->contacts_at(s.x).size(), 1u);
     const DiscreteStability d = discrete_stability(*s.problem, s.x, kElements);
     ASSERT_TRUE(d.defined()) << d.reason;
@@ -371,7 +348,7 @@ TEST(DiscreteStability, SymmetricWallContactIsStableByBothCounts) {
 // checks the contact constraint and its multiplier independently of the sliding term (which
 // symmetric modes do not feel).
 TEST(DiscreteStability, SymmetricModesAtTheWallContactAreTheHalfRods) {
-  const Solved whole = solve_with_contacts(read_case("wall.toml"), {});
+  const Solved whole = solve_with_contacts(testing::case_text("wall.toml"), {});
   const Solved half = solve_shipped("wall_symmetric.toml", {});
   const DiscreteStability w = discrete_stability(*whole.problem, whole.x, 2 * kElements);
   const DiscreteStability h = discrete_stability(*half.problem, half.x, kElements);
@@ -390,7 +367,7 @@ TEST(DiscreteStability, SymmetricModesAtTheWallContactAreTheHalfRods) {
 // one at s = 0.50437 (and its mirror image), index 1 - by both counts. Both are solved from a
 // contact guess; which one Newton reaches depends on the guess's arclength.
 TEST(DiscreteStability, StableAndUnstableWallContactsCoexist) {
-  const std::string text = read_case("wall.toml");
+  const std::string text = testing::case_text("wall.toml");
   auto with_guess = [&](double s) {
     return text + "\n[[guess.contacts]]\nobstacle = \"wall\"\ns = " + std::to_string(s) + "\nforce = 55.0\n";
   };
@@ -422,12 +399,7 @@ TEST(DiscreteStability, StableAndUnstableWallContactsCoexist) {
 // for point contacts, docs/stability-cross-check.md); it now gives 0 too
 // (Stability.FarAsymmetricWallContactIsStable), and this test keeps the discretised side.
 TEST(DiscreteStability, FarAsymmetricWallContactIsStableByTheDiscretisedEnergy) {
-  std::string text = read_case("wall.toml");
-  const std::string guess_force = "force = [\"-P_guess\", 0]";
-  ASSERT_NE(text.find(guess_force), std::string::npos);
-  text.replace(text.find(guess_force), guess_force.size(), "force = [\"-P_guess\", -24.33]");
-  text += "\n[[guess.contacts]]\nobstacle = \"wall\"\ns = 0.4548\nforce = 49.1\n";
-  const Solved s = solve_with_contacts(text, {{"Delta", 0.0307}, {"P_guess", 131.24}, {"m_guess", 1.213}});
+  const Solved s = solve_with_contacts(testing::far_asymmetric_wall_contact_text(), {{"Delta", 0.0307}, {"P_guess", 131.24}, {"m_guess", 1.213}});
   const auto contacts = s.problem->contacts_at(s.x);
   ASSERT_EQ(contacts.size(), 1u);
   ASSERT_NEAR(contacts[0].s, 0.454754, 1e-6);
@@ -444,7 +416,7 @@ TEST(DiscreteStability, FarAsymmetricWallContactIsStableByTheDiscretisedEnergy) 
 // disc's curvature where the other helper's stability.cpp does; the discretised energy through the
 // gap's Hessian).
 TEST(DiscreteStability, IndenterContactIsStable) {
-  const Solved s = solve_with_contacts(read_case("indenter.toml"), {});
+  const Solved s = solve_with_contacts(testing::case_text("indenter.toml"), {});
   const DiscreteStability d = discrete_stability(*s.problem, s.x, kElements);
   ASSERT_TRUE(d.defined()) << d.reason;
   EXPECT_TRUE(d.trustworthy) << d.check_message;
@@ -527,7 +499,7 @@ TEST(DiscreteStability, UnsupportedCasesSayWhy) {
     EXPECT_EQ(describe(d).rfind("discrete index undefined", 0), 0u);
   }
   // The rod wrapped on the indenter lies on it over an interval: an extended contact.
-  const Solved wrapped = solve_with_contacts(read_case("wrapped_indenter.toml"), {});
+  const Solved wrapped = solve_with_contacts(testing::case_text("wrapped_indenter.toml"), {});
   EXPECT_NE(discrete_stability(*wrapped.problem, wrapped.x).reason.find("extended contact"), std::string::npos);
   const Solved s = solve_text(kExtensible, {});
   EXPECT_NE(discrete_stability(*s.problem, s.x).reason.find("extensible"), std::string::npos);
@@ -539,7 +511,7 @@ TEST(DiscreteStability, UnsupportedCasesSayWhy) {
 // with its force set to zero by hand (the unknowns are then not an equilibrium, but the check
 // refuses before it solves anything).
 TEST(DiscreteStability, ZeroForceContactIsNotDefined) {
-  Solved s = solve_with_contacts(read_case("wall.toml"), {});
+  Solved s = solve_with_contacts(testing::case_text("wall.toml"), {});
   const PointContact c = s.problem->contacts_at(s.x).at(0);
   for (int i = 0; i < s.x.size(); ++i)
     if (s.x[i] == c.force) s.x[i] = 0.0;

@@ -9,9 +9,7 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <iterator>
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/continuation.hpp"
@@ -191,8 +189,7 @@ TEST(Stability, GravityAndExtensibleRodsAreStableWhereExpected) {
   EXPECT_EQ(*heavy.index, 0);
   // The extensible, shearable, naturally curved Reissner rod of the tour under its dead end force
   // alone (its end couple removed: a dead couple in 3D is not conservative).
-  std::ifstream file(testing::case_path("reissner.toml"));
-  std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  std::string text = testing::case_text("reissner.toml");
   const std::string couple = "moment = [0, 0.2, \"Mz\"]";
   ASSERT_NE(text.find(couple), std::string::npos);
   text.replace(text.find(couple), couple.size(), "moment = [0, 0, 0]");
@@ -236,8 +233,7 @@ TEST(Stability, HardWallPointContactSlidesAndIsStableUntilItFlattens) {
 // -2.57 at Delta = 0.0307), while the symmetric contact at the same Delta, reached by
 // continuation, is stable.
 TEST(Stability, AsymmetricContactCoexistsWithTheStableSymmetricOne) {
-  std::ifstream file(testing::case_path("wall.toml"));
-  std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  std::string text = testing::case_text("wall.toml");
   text += "\n[[guess.contacts]]\nobstacle = \"wall\"\ns = 0.5\nforce = 64.0\n";
   const Case asymmetric_case =
       load_case_text(text, "wall_contact_guess.toml", {{"Delta", 0.0307}, {"P_guess", 154.0}, {"m_guess", 4.0}});
@@ -275,14 +271,8 @@ TEST(Stability, AsymmetricContactCoexistsWithTheStableSymmetricOne) {
 // (-42.3). The counts are integers, so they need no tolerance. The correction was -2 (index 1)
 // while the contact went through the rotation frame and its jump missed the multipliers' fields.
 TEST(Stability, FarAsymmetricWallContactIsStable) {
-  std::ifstream file(testing::case_path("wall.toml"));
-  std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  const std::string guess_force = "force = [\"-P_guess\", 0]";
-  ASSERT_NE(text.find(guess_force), std::string::npos);
-  text.replace(text.find(guess_force), guess_force.size(), "force = [\"-P_guess\", -24.33]");
-  text += "\n[[guess.contacts]]\nobstacle = \"wall\"\ns = 0.4548\nforce = 49.1\n";
-  const Case c =
-      load_case_text(text, "wall_far_contact.toml", {{"Delta", 0.0307}, {"P_guess", 131.24}, {"m_guess", 1.213}});
+  const Case c = load_case_text(testing::far_asymmetric_wall_contact_text(), "wall_far_contact.toml",
+                                {{"Delta", 0.0307}, {"P_guess", 131.24}, {"m_guess", 1.213}});
   const DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
   ASSERT_TRUE(solved.result.summary.converged());
   const auto contacts = solved.problem->contacts_at(solved.result.x);
@@ -349,22 +339,6 @@ TEST(Stability, FullFrameCountsAsTheRotationFrameWhereTheEnergyIgnoresPosition) 
   }
 }
 
-// A Winkler foundation V = k/2 (r.e_y)^2 (force -k y e_y): a field whose force depends on position.
-class Foundation final : public ExternalField {
- public:
-  explicit Foundation(double k) : k_(k) {}
-  double potential(double, const Vec3& r) const override { return 0.5 * k_ * r.y() * r.y(); }
-  Vec3 force(double, const Vec3& r) const override { return Vec3(0, -k_ * r.y(), 0); }
-  Mat3 force_gradient(double, const Vec3&) const override {
-    Mat3 g = Mat3::Zero();
-    g(1, 1) = -k_;
-    return g;
-  }
-
- private:
-  double k_;
-};
-
 // The straight pinned column under a dead load P on a foundation of stiffness k (EI = L = 1):
 // its second variation int (w''^2 - P w'^2 + k w^2) / 2 with w = w'' = 0 at the ends has the
 // sine modes sin(j pi s) as eigenfunctions, with (j pi)^4 + k - P (j pi)^2, so the index is the
@@ -381,7 +355,7 @@ TEST(Stability, StraightColumnOnAFoundationCountsTheModesBelowTheLoad) {
     const ModelFunction bare = c.definition.model;
     c.definition.model = [bare, k](const Parameters& p) {
       RodModel m = bare(p);
-      m.field = std::make_shared<Foundation>(k);
+      m.field = std::make_shared<testing::WinklerFoundation>(k);
       return m;
     };
     ShootingProblem problem(c.definition);
@@ -456,8 +430,7 @@ TEST(Stability, SoftWallArchRegainsItsStabilityAtTheBranchPointTowardsTheHardWal
 // eigenvalue -10.3 for rho = 0.5, +7.1 for rho = 2) and 0.030 (-26.8 for rho = 0.5, +2.2 for
 // rho = 10, tending to the plane's +3.1).
 Case disc_wall(double rho, double delta) {
-  std::ifstream file(testing::case_path("wall.toml"));
-  std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  std::string text = testing::case_text("wall.toml");
   const std::string plane = "type = \"plane\"\nname = \"wall\"\npoint = [0, \"a\"]\n";
   const std::string normal = "normal = [0, -1, 0]";
   EXPECT_NE(text.find(plane), std::string::npos);

@@ -3,16 +3,55 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/invariants.hpp"
+#include "kirchhoff/rod_model.hpp"
 #include "kirchhoff/solution.hpp"
 
 namespace kirchhoff::testing {
 
 inline std::string case_path(const std::string& name) { return std::string(KIRCHHOFF_CASES_DIR) + "/" + name; }
+
+// The text of a shipped case file, for tests that edit it before loading it.
+inline std::string case_text(const std::string& name) {
+  std::ifstream file(case_path(name));
+  EXPECT_TRUE(file.good()) << case_path(name);
+  return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+}
+
+// wall.toml with a guess next to its asymmetric point contact far from mid-span (s = 0.454754,
+// f = 49.1106 at Delta = 0.0307, found by `equilibria`); load it with {{"Delta", 0.0307},
+// {"P_guess", 131.24}, {"m_guess", 1.213}}.
+inline std::string far_asymmetric_wall_contact_text() {
+  std::string text = case_text("wall.toml");
+  const std::string guess_force = "force = [\"-P_guess\", 0]";
+  const auto at = text.find(guess_force);
+  EXPECT_NE(at, std::string::npos) << "wall.toml's guess force changed";
+  if (at != std::string::npos) text.replace(at, guess_force.size(), "force = [\"-P_guess\", -24.33]");
+  return text + "\n[[guess.contacts]]\nobstacle = \"wall\"\ns = 0.4548\nforce = 49.1\n";
+}
+
+// A Winkler foundation V = k y^2 / 2 per length (force -k y e_y, gradient -k e_y e_y^T): a field
+// whose force depends on position, with closed-form eigenvalues on a straight column.
+class WinklerFoundation final : public ExternalField {
+ public:
+  explicit WinklerFoundation(double k) : k_(k) {}
+  double potential(double, const Vec3& r) const override { return 0.5 * k_ * r.y() * r.y(); }
+  Vec3 force(double, const Vec3& r) const override { return Vec3(0.0, -k_ * r.y(), 0.0); }
+  Mat3 force_gradient(double, const Vec3&) const override {
+    Mat3 g = Mat3::Zero();
+    g(1, 1) = -k_;
+    return g;
+  }
+
+ private:
+  double k_;
+};
 
 struct Solved {
   Case c;
