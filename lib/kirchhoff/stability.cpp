@@ -1,6 +1,8 @@
 // The index of an equilibrium by conjugate points (see stability.hpp for the method).
 #include "kirchhoff/stability.hpp"
 
+#include "kirchhoff/stability_symmetric.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -188,9 +190,15 @@ std::string unsupported(const ShootingProblem& problem, const Eigen::VectorXd& x
     if (problem.equations(problem.parameters_at(x))->model().extensible)
       return "a contact of an extensible rod: not implemented";
   }
-  if (d.start.is_half_turn_symmetry() || d.end.is_half_turn_symmetry())
-    return "half of a symmetric rod (half-turn end): the whole rod's index needs the antisymmetric "
-           "perturbations too, which are not implemented";
+  if (d.start.is_half_turn_symmetry())
+    return "half of a symmetric rod with the symmetry point at s = 0: only a half-turn end at s = L is "
+           "implemented";
+  if (d.end.is_half_turn_symmetry() && d.end.half_turn_director() == 0)
+    return "half of a symmetric rod whose half-turn end imposes the loop's rotation (balanced by an unknown "
+           "parameter): not implemented";
+  if (d.end.is_half_turn_symmetry() && !problem.contacts_at(x).empty())
+    return "half of a symmetric rod with contacts (hard self-contact): the antisymmetric perturbations of a pair "
+           "contact are not implemented";
   return "";
 }
 
@@ -259,8 +267,12 @@ int odd_multiples_between(double a, double b) {  // odd k with a < k pi < b (a <
 
 class StabilityAnalysis {
  public:
-  StabilityAnalysis(const ShootingProblem& problem, const Eigen::VectorXd& x, const StabilityOptions& options)
-      : problem_(problem), x_(x), options_(options), p_(problem.parameters_at(x)), eq_(problem.equations(p_)) {
+  // `end` replaces the problem's end conditions and `equations` (when not null) its equations: the
+  // antisymmetric half of a half-turn symmetric rod (stability_symmetric.hpp).
+  StabilityAnalysis(const ShootingProblem& problem, const Eigen::VectorXd& x, const StabilityOptions& options,
+                    const EndCondition& end, std::shared_ptr<const RodEquations> equations)
+      : problem_(problem), x_(x), options_(options), end_(end), p_(problem.parameters_at(x)),
+        eq_(equations ? std::move(equations) : problem.equations(p_)) {
     coords_.position_dirs = eq_->admissible_directions(Slot::Position);
     coords_.rotation_dirs = eq_->admissible_directions(Slot::Orientation);
     scales_.length = eq_->model().length;
@@ -323,6 +335,7 @@ class StabilityAnalysis {
   const ShootingProblem& problem_;
   const Eigen::VectorXd& x_;
   StabilityOptions options_;
+  const EndCondition& end_;
   Parameters p_;
   std::shared_ptr<const RodEquations> eq_;
   Coordinates coords_;
@@ -652,12 +665,15 @@ Eigen::MatrixXd StabilityAnalysis::canonical_shear(const Eigen::MatrixXd& lab_S)
 
 // A dead couple on an end free to turn about two or more axes does work that depends on the path
 // of the rotation (Ziegler): not conservative, and the second variation is not defined. In the
-// canonical coordinates the end's natural conditions then fail to be a Lagrangian plane.
+// canonical coordinates the end's natural conditions then fail to be a Lagrangian plane. The test
+// is relative to the zero tolerance, not round-off: where the couple's work vanishes because the
+// equilibrium makes it so (the antisymmetric half of a half-turn end, free to turn across the axis:
+// the work is m.a, zero to the solve's tolerance, ~1e-9 of |m|), that is what zero means.
 std::string StabilityAnalysis::end_moment_reason(const Frame& f, const Held& end) const {
   const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f.y, f.s);
   const Eigen::MatrixXd G = map.G.bottomRightCorner(mU_, mU_);
   const Eigen::MatrixXd free_rotation = complement(held_configuration(end), mU_);
-  if ((free_rotation.transpose() * G * free_rotation).norm() > 1e-10 * (1.0 + G.norm()))
+  if ((free_rotation.transpose() * G * free_rotation).norm() > options_.zero_tolerance * (1.0 + G.norm()))
     return "the end's loads are not conservative (a dead couple on an end free to rotate in 3D)";
   return "";
 }
@@ -810,7 +826,7 @@ StabilityReport StabilityAnalysis::run() {
     return report;
   }
   const ProblemDefinition& d = problem_.definition();
-  const Held start = held_at(d.start, multipliers), end = held_at(d.end, multipliers);
+  const Held start = held_at(d.start, multipliers), end = held_at(end_, multipliers);
   // The isoperimetric constraints read at s = L: the held chord, or with the full frame every
   // position the end holds (and those the start holds, read at s = 0).
   const Eigen::MatrixXd constraints = full_ ? end.position : constraint_directions(start, end);
@@ -908,10 +924,55 @@ StabilityReport StabilityAnalysis::run() {
 
 }  // namespace
 
+namespace {
+
+// The whole rod's index from its two halves (stability_symmetric.hpp): the counts add, and the
+// conjugate points are those of both half problems (half-rod arclengths). Undefined when either is.
+StabilityReport whole_rod(const StabilityReport& symmetric, const StabilityReport& antisymmetric) {
+  for (const auto* part : {&symmetric, &antisymmetric})
+    if (!part->defined()) {
+      StabilityReport out = *part;
+      out.reason = std::string(part == &symmetric ? "symmetric" : "antisymmetric") +
+                   " perturbations of the half-turn symmetric rod: " + part->reason;
+      out.rhs_evaluations = symmetric.rhs_evaluations + antisymmetric.rhs_evaluations;
+      return out;
+    }
+  StabilityReport out;
+  out.index = *symmetric.index + *antisymmetric.index;
+  out.symmetric_index = symmetric.index;
+  out.antisymmetric_index = antisymmetric.index;
+  out.zero_modes = symmetric.zero_modes + antisymmetric.zero_modes;
+  out.conjugate_points = symmetric.conjugate_points;
+  out.conjugate_points.insert(out.conjugate_points.end(), antisymmetric.conjugate_points.begin(),
+                              antisymmetric.conjugate_points.end());
+  std::sort(out.conjugate_points.begin(), out.conjugate_points.end());
+  out.interior_count = symmetric.interior_count + antisymmetric.interior_count;
+  out.end_count = symmetric.end_count + antisymmetric.end_count;
+  out.dead_load_index = symmetric.dead_load_index + antisymmetric.dead_load_index;
+  out.constraint_count = symmetric.constraint_count + antisymmetric.constraint_count;
+  out.constraint_correction = symmetric.constraint_correction + antisymmetric.constraint_correction;
+  out.rhs_evaluations = symmetric.rhs_evaluations + antisymmetric.rhs_evaluations;
+  return out;
+}
+
+}  // namespace
+
 StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::VectorXd& x,
                                   const StabilityOptions& options) {
   try {
-    return StabilityAnalysis(problem, x, options).run();
+    const EndCondition& end = problem.definition().end;
+    if (!end.is_half_turn_symmetry() || !unsupported(problem, x).empty())
+      return StabilityAnalysis(problem, x, options, end, nullptr).run();
+    // Half of a half-turn symmetric rod: the end as stated holds the symmetric perturbations; the
+    // antisymmetric ones have the complementary conditions and, with self-contact, the pair
+    // energy's other second variation.
+    const StabilityReport symmetric = StabilityAnalysis(problem, x, options, end, nullptr).run();
+    const EndCondition anti_end = antisymmetric_half_turn_end(end.half_turn_axis());
+    const StabilityReport antisymmetric =
+        StabilityAnalysis(problem, x, options, anti_end,
+                          antisymmetric_equations(*problem.equations(problem.parameters_at(x))))
+            .run();
+    return whole_rod(symmetric, antisymmetric);
   } catch (const IntegrationError& e) {
     StabilityReport report;
     report.reason = std::string("the Jacobi fields could not be integrated: ") + e.what();

@@ -105,6 +105,9 @@ struct StabilityReport {
   int dead_load_index = 0;               // interior_count + end_count: every end load dead
   int constraint_count = 0;              // end positions held at both ends (isoperimetric)
   int constraint_correction = 0;         // index - dead_load_index
+  // Half of a half-turn symmetric rod (a `half_turn` end): the counts above are the whole rod's,
+  // the sums of the symmetric and antisymmetric halves, whose indices are these (empty otherwise).
+  std::optional<int> symmetric_index, antisymmetric_index;
   std::string method = "conjugate_points";
   long rhs_evaluations = 0;
   bool defined() const { return index.has_value(); }

@@ -1,0 +1,186 @@
+// The index of a rod solved on half its length by a half-turn symmetry (a `half_turn` end:
+// cases/plectoneme.toml) is the whole rod's, symmetric and antisymmetric perturbations both
+// (stability_symmetric.hpp). Checked against the whole rod solved as a clamped-clamped rod of its
+// full length without any symmetry (its index by conjugate points, which the Euler, Greenhill and
+// clamped-clamped tests of stability_test.cpp check against closed forms), and, with the
+// self-contact on, against the folds of the plectoneme branch.
+#include "kirchhoff/stability.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+
+#include "kirchhoff/continuation.hpp"
+#include "test_support.hpp"
+
+namespace kirchhoff {
+namespace {
+
+// cases/plectoneme.toml, optionally without its self-contact (the same half rod, free to pass
+// through itself: the index is then a property of the elastic energy alone and the whole rod
+// without symmetry has the same energy), on few shooting segments: without the barrier nothing
+// needs the case's 20 (they keep its stiff barrier resolved).
+std::string half_rod_text(bool self_contact) {
+  std::string text = testing::case_text("plectoneme.toml");
+  if (!self_contact) {
+    const auto at = text.find("self_contact = {");
+    EXPECT_NE(at, std::string::npos) << "plectoneme.toml's self-contact line changed";
+    if (at != std::string::npos) text.erase(at, text.find('\n', at) - at);
+    const std::string segments = "segments = \"slenderness / 5\"";
+    const auto s = text.find(segments);
+    EXPECT_NE(s, std::string::npos) << "plectoneme.toml's segments changed";
+    if (s != std::string::npos) text.replace(s, segments.size(), "segments = 4");
+    text.erase(text.find("[output]"));  // its plectoneme quantities need the self-contact
+  }
+  return text;
+}
+
+// The whole rod of plectoneme.toml: both ends clamped on the e3 axis, end_distance L apart, the
+// frames turned by -/+ pi turns about e3 (the half-turn about e1 maps the first onto the second:
+// Rx(pi) Rz(-pi t) Rx(pi) = Rz(pi t)), no symmetry imposed.
+std::string whole_rod_text() {
+  return R"(
+title = "plectoneme.toml's whole rod, no symmetry imposed"
+model = "spatial"
+[parameters]
+turns = 0.0
+end_distance = 0.5
+L = 1.0
+EI = 1.0
+GJ = 0.769230769230769
+[rod]
+length = "L"
+B = "EI"
+B3 = "GJ"
+[start]
+type = "clamped"
+position = [0, 0, "-end_distance*L/2"]
+orientation = { axis = [0, 0, 1], angle = "-_pi*turns" }
+[end]
+type = "clamped"
+position = [0, 0, "end_distance*L/2"]
+orientation = { axis = [0, 0, 1], angle = "_pi*turns" }
+[solver]
+segments = 8
+tolerance = 1e-8
+)";
+}
+
+struct Whole {
+  StabilityReport report;
+  double mismatch = 0.0;  // |r(L - s) - Q r(s)| at its largest: the solve found the mirror image
+};
+
+// The whole rod's index, solved from the half rod's state at s = 0 (the whole rod's reactions
+// there are the half rod's).
+Whole whole_rod(const ShootingProblem& half, const Eigen::VectorXd& x, double turns) {
+  Case whole = load_case_text(whole_rod_text(), "whole_rod.toml", {{"turns", turns}});
+  whole.start_guess = half.sample(x, {0.0})[0];
+  ShootingProblem problem(whole.definition);
+  const ShootingResult r = solve(problem, problem.initial_unknowns(whole.start_guess));
+  EXPECT_TRUE(r.summary.converged()) << "turns = " << turns << ": " << r.summary.brief_report();
+  Whole out;
+  const std::vector<double> s = {0.1, 0.25, 0.4};
+  const auto a = problem.sample(r.x, s);
+  const auto b = problem.sample(r.x, {0.6, 0.75, 0.9});
+  const Eigen::AngleAxisd Q(M_PI, Vec3::UnitX());
+  const auto h = half.sample(x, s);
+  for (size_t i = 0; i < s.size(); ++i) out.mismatch = std::max(out.mismatch, (b[s.size() - 1 - i].r - Q * a[i].r).norm());
+  out.report = analyse_stability(problem, r.x);
+  return out;
+}
+
+// Half and whole rod at the points of a half-rod branch: the half rod's index (symmetric +
+// antisymmetric) must be the whole rod's wherever both are regular. Points next to a fold or a
+// bifurcation (an extra zero mode on either side, within the zero tolerance) are skipped, and so
+// are whole-rod solves that did not converge to the mirror image of the half rod. Returns the
+// number of points compared and the antisymmetric indices seen.
+struct Comparison {
+  int compared = 0;
+  std::vector<int> symmetric, antisymmetric;
+};
+
+Comparison compare_along(const Case& c, const ContinuationResult& branch, size_t every) {
+  Comparison out;
+  for (size_t i = 0; i < branch.points.size(); i += every) {
+    const ContinuationPoint& p = branch.points[i];
+    ShootingProblem here(c.definition);
+    here.set_parameter("turns", p.parameter);
+    const StabilityReport half = analyse_stability(here, p.x);
+    const Whole whole = whole_rod(here, p.x, p.parameter);
+    std::cout << "turns " << p.parameter << " half: " << describe(half) << " (symmetric "
+              << half.symmetric_index.value_or(-1) << ", antisymmetric " << half.antisymmetric_index.value_or(-1)
+              << "); whole: " << describe(whole.report) << "; mirror mismatch " << whole.mismatch << "\n";
+    // Both are solved to 1e-8 (plectoneme.toml's tolerance): their
+    // centrelines agree to ~1e-9 when they are the same equilibrium; 1e-6 leaves margin and still
+    // tells a different one (the nearest other equilibria are 1e-1 away). A whole-rod solve may
+    // also drift along its zero mode (turning the isotropic rod about the clamps' axis e3 costs
+    // nothing): a turned copy, with the same index, is skipped too (3 of 48 points, 1e-6 .. 1e-5).
+    if (!(whole.mismatch < 1e-6)) continue;
+    EXPECT_TRUE(half.defined()) << half.reason;
+    EXPECT_TRUE(whole.report.defined()) << whole.report.reason;
+    if (!half.defined() || !whole.report.defined()) continue;
+    if (half.zero_modes != 1 || whole.report.zero_modes != 1) continue;  // next to a fold
+    EXPECT_EQ(*half.index, *whole.report.index) << "turns = " << p.parameter;
+    out.symmetric.push_back(*half.symmetric_index);
+    out.antisymmetric.push_back(*half.antisymmetric_index);
+    ++out.compared;
+  }
+  return out;
+}
+
+ContinuationResult follow_turns(const ShootingProblem& problem, const Case& c, double target, int max_points) {
+  ContinuationOptions o;
+  o.parameter = "turns";
+  o.target = target;
+  o.initial_step = 0.5;
+  o.max_step = 2.0;
+  o.max_points = max_points;
+  o.samples = 41;
+  o.compute_stability = false;
+  Continuation run(problem, o);
+  return run.run(problem.initial_unknowns(c.start_guess));
+}
+
+// The case's own branch without the barrier: from the planar arch at turns = 0 through the two
+// folds where the end loop forms (turns = 1.770 and back at 0.230; the rod passes through itself
+// there, which without the barrier costs nothing) to turns = 2, which the branch reaches only past
+// both. Every equilibrium is counted by both.
+TEST(StabilitySymmetric, HalfRodIndexIsTheWholeRodsAlongTheLoopFormingFolds) {
+  const Case c = load_case_text(half_rod_text(false), "half.toml");
+  ShootingProblem problem(c.definition);
+  const ContinuationResult branch = follow_turns(problem, c, 2.0, 400);
+  std::vector<double> folds;
+  for (const auto& p : branch.points)
+    if (p.type == PointType::Fold) folds.push_back(p.parameter);
+  ASSERT_EQ(folds.size(), 2u);
+  const Comparison r = compare_along(c, branch, 6);
+  EXPECT_GE(r.compared, 40);  // of 48 sampled; those next to the folds are skipped
+  // The index changes at the folds, in the symmetric half (0, 1 between them, 0 again); no
+  // antisymmetric direction loses stability on this branch.
+  EXPECT_EQ(*std::min_element(r.symmetric.begin(), r.symmetric.end()), 0);
+  EXPECT_EQ(*std::max_element(r.symmetric.begin(), r.symmetric.end()), 1);
+  EXPECT_EQ(*std::max_element(r.antisymmetric.begin(), r.antisymmetric.end()), 0);
+}
+
+// The planar clamped-clamped rod's third mode (two periods of the arch, r(L - s) = Q r(s)): its
+// S-shaped perturbations are antisymmetric, so the antisymmetric half counts some of its index.
+TEST(StabilitySymmetric, ThirdModeCountsAntisymmetricDirections) {
+  // Two periods of the arch, each of length L/2 and chord end_distance L/2: the same elliptic
+  // modulus, so 4 times the compression and twice the clamping moment.
+  const Case c = load_case_text(half_rod_text(false), "half.toml", {{"guess_n", -4 * 53.2741126}, {"guess_m", 2 * 9.9437843}});
+  ShootingProblem problem(c.definition);
+  const ContinuationResult branch = follow_turns(problem, c, 0.5, 60);
+  const Comparison r = compare_along(c, branch, 3);
+  EXPECT_GE(r.compared, 15);  // of 20 sampled
+  // Two of the whole rod's four directions are antisymmetric (the whole-rod count checks the sum).
+  for (size_t i = 0; i < r.antisymmetric.size(); ++i) {
+    EXPECT_EQ(r.symmetric[i], 2);
+    EXPECT_EQ(r.antisymmetric[i], 2);
+  }
+}
+
+}  // namespace
+}  // namespace kirchhoff
