@@ -13,6 +13,8 @@
 #include <iostream>
 
 #include "kirchhoff/continuation.hpp"
+#include "kirchhoff/self_contact.hpp"
+#include "kirchhoff/stability_symmetric.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {
@@ -179,6 +181,44 @@ TEST(StabilitySymmetric, ThirdModeCountsAntisymmetricDirections) {
   for (size_t i = 0; i < r.antisymmetric.size(); ++i) {
     EXPECT_EQ(r.symmetric[i], 2);
     EXPECT_EQ(r.antisymmetric[i], 2);
+  }
+}
+
+// The self-contact's second variation on each half, against finite differences of the whole
+// rod's pair energy E = 2 w phi(|d| / 2 - R), d = r(s) - r(L - s) (stability_symmetric.hpp), at a
+// cross-section 0.3 R off contact: perturbing r(s) by e delta and r(L - s) by +-e Q delta,
+// d2E/de2 = 2 delta.H delta with H the half problem's field Hessian (-force_gradient): the case's
+// own barrier for +, the antisymmetric one for -.
+TEST(StabilitySymmetric, PairEnergysSecondVariationOnEachHalf) {
+  const Case c = load_case_text(half_rod_text(true), "half.toml");
+  const ShootingProblem problem(c.definition);
+  const auto eq = problem.equations(c.definition.parameters);
+  const auto anti = antisymmetric_equations(*eq);
+  ASSERT_TRUE(anti);
+  const HalfTurnSelfContact* barrier = find_half_turn_self_contact(eq->model());
+  ASSERT_NE(barrier, nullptr);
+  const double R = barrier->geometry().radius, s = 0.1;
+  ASSERT_EQ(barrier->weight(s), 1.0);
+  ASSERT_TRUE(barrier->geometry().axis.isApprox(Vec3::UnitX()));
+  const Vec3 r = Vec3(0.3, R * 1.3 * 0.6, R * 1.3 * 0.8);  // 1.3 R from the e1 axis
+  const Eigen::AngleAxisd Q(M_PI, Vec3::UnitX());
+  const Vec3 delta = Vec3(0.7, -0.4, 0.59).normalized();
+  for (const double parity : {1.0, -1.0}) {
+    auto energy = [&](double e) {
+      const Vec3 d = (r + e * delta) - Q * (r + parity * e * delta);
+      // w phi(|d| / 2 - R) is the barrier at a point |d| / 2 from the axis (e1; e2 is across it).
+      return 2.0 * barrier->potential(s, barrier->geometry().origin + 0.5 * d.norm() * Vec3::UnitY());
+    };
+    // Central second difference: truncation ~ h^2 / 12 of the fourth derivative, which varies on
+    // the barrier's range c ~ R (h = 1e-3 R: ~1e-7 relative), round-off ~ 1e-16 E / h^2 (~1e-9
+    // relative here): 1e-5 relative leaves margin and still fails on any wrong term (the
+    // antisymmetric and symmetric values differ by orders of magnitude).
+    const double h = 1e-3 * R;
+    const double fd = (energy(h) - 2 * energy(0.0) + energy(-h)) / (h * h);
+    const RodEquations& half = parity > 0 ? *eq : *anti;
+    const double H = -delta.dot(half.model().field->force_gradient(s, r) * delta);
+    std::cout << "parity " << parity << ": finite differences " << fd << ", 2 delta.H delta " << 2 * H << "\n";
+    EXPECT_NEAR(fd, 2 * H, 1e-5 * std::abs(fd)) << "parity " << parity;
   }
 }
 
