@@ -67,7 +67,7 @@ ParameterOverrides parse_overrides(const std::vector<std::string>& texts) {
 
 int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
                    const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed,
-                   double max_seconds, bool direct, const std::vector<std::string>& solver) {
+                   double max_seconds, bool direct, const std::vector<std::string>& solver, bool analyse) {
   Case& c = out->c;
   try {
     c = load_case(case_path, parse_overrides(overrides), phase_condition, parse_solver_overrides(solver));
@@ -82,7 +82,8 @@ int load_and_solve(const std::string& case_path, const std::vector<std::string>&
   CaseSolveOptions options;
   options.seed = seed;
   options.direct = direct;
-  CaseSolve solved;
+  options.solution = options.stability = options.stability_check = analyse;
+  CaseSolve& solved = out->solved;
   try {
     solved = solve_case(c, options);
   } catch (const InfeasibleContact& e) {
@@ -102,23 +103,21 @@ int load_and_solve(const std::string& case_path, const std::vector<std::string>&
     if (json) std::cout << failure_json(c, "seed_failed", 0, INFINITY, e.what()).dump(2) << "\n";
     return kExitNotConverged;
   }
-  out->path = std::move(solved.path);
-  if (!out->path.seed_summary.empty()) std::cerr << "seed: " << out->path.seed_summary << "\n";
+  if (!solved.path.seed_summary.empty()) std::cerr << "seed: " << solved.path.seed_summary << "\n";
   if (!solved.failure.empty()) {
     std::cerr << "error: " << c.path << ": " << solved.failure << ": " << solved.message << "\n";
     if (json) {
       const NewtonSummary& summary = solved.solved.result.summary;
       nlohmann::json j = failure_json(c, solved.failure, summary.iterations, summary.residual_norm, solved.message);
-      j["path"] = path_json(out->path);
+      j["path"] = path_json(solved.path);
       std::cout << j.dump(2) << "\n";
     }
     return kExitNotConverged;
   }
-  out->problem = std::move(solved.solved.problem);
-  out->result = std::move(solved.solved.result);
   if (!json)
     for (const auto& line : solved.solved.contact_log) std::cerr << "contact: " << line << "\n";
-  if (!out->result.summary.converged()) return report_not_converged(c, out->result.summary, json);
+  // Newton's verdict, or the solution's checks' (verification.hpp): a failure is a status, not a result.
+  if (!solved.converged()) return report_not_converged(c, solved.summary(), json);
   return kExitOk;
 }
 
@@ -138,32 +137,28 @@ int run_solve(const SolveArguments& args) {
       status != kExitOk)
     return status;
   const Case& c = solved.c;
-  const std::unique_ptr<ShootingProblem>& problem = solved.problem;
-  ShootingResult result = std::move(solved.result);
-  const Solution sol = make_solution(*problem, std::move(result), c.samples, c.derived);
-  // The profile is checked as it is made (verification.hpp): a failure is a status, not a result.
-  if (!sol.result.summary.converged()) return report_not_converged(c, sol.result.summary, args.json);
+  const CaseSolve& run = solved.solved;
+  const ShootingProblem& problem = *run.solved.problem;
+  const Solution& sol = *run.solution;
   if (!args.profile_path.empty()) {
     try {
-      write_profile_csv(args.profile_path, problem->equations(sol.result.parameters)->model(), sol.profile,
-                        problem->definition().kind);
+      write_profile_csv(args.profile_path, problem.equations(sol.result.parameters)->model(), sol.profile,
+                        problem.definition().kind);
     } catch (const std::runtime_error& e) {
       std::cerr << "error: " << e.what() << "\n";
       return kExitBadInput;
     }
   }
-  const StabilityReport stability = analyse_stability(*problem, sol.result.x);
-  // The independent check where it applies (planar inextensible rods, point contacts on planes
-  // and discs, position-dependent fields included): its lowest eigenvalues, and whether its index
-  // agrees.
-  const DiscreteStability discrete = discrete_stability(*problem, sol.result.x);
+  // The stability index and its independent check (where it applies), as solve_case made them.
+  const StabilityReport& stability = *run.stability;
+  const DiscreteStability& discrete = *run.stability_check;
   if (args.json) {
-    nlohmann::json j = solution_json(c, *problem, sol, stability, &discrete);
-    j["path"] = path_json(solved.path);
+    nlohmann::json j = solution_json(c, problem, sol, stability, &discrete);
+    j["path"] = path_json(run.path);
     std::cout << j.dump(2) << "\n";
   } else {
     print_human(c, sol, stability, discrete);
-    print_path(solved.path);
+    print_path(run.path);
   }
   return kExitOk;
 }

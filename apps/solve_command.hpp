@@ -35,16 +35,15 @@ ParameterOverrides parse_overrides(const std::vector<std::string>& texts);
 // A case loaded and solved the way `solve` does it (case_solve.hpp).
 struct SolvedCase {
   Case c;
-  std::unique_ptr<ShootingProblem> problem;
-  ShootingResult result;
-  SolvePath path;
+  CaseSolve solved;
 };
 // Loads and solves; on failure prints the reason (and, with json, a failure object on stdout)
-// and returns the exit status, else kExitOk.
+// and returns the exit status, else kExitOk. With `analyse` (solve's own), the solution, its
+// checks and its stability are made too (CaseSolveOptions); without, only the equilibrium.
 int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
                    const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed = {},
                    double max_seconds = kDefaultSolveSeconds, bool direct = false,
-                   const std::vector<std::string>& solver = {});
+                   const std::vector<std::string>& solver = {}, bool analyse = true);
 // Prints why a solve is not a trustworthy equilibrium (and, with json, the failure object) and
 // returns kExitNotConverged.
 int report_not_converged(const Case& c, const NewtonSummary& summary, bool json);

@@ -100,20 +100,22 @@ void print_table(const Case& c, const VibrationAnalysis& analysis) {
 
 int run_vibrate(const VibrateArguments& args) {
   SolvedCase solved;
+  // The equilibrium alone: the vibration analysis needs no profile and no stability index.
   if (const int status = load_and_solve(args.case_path, args.overrides, "", args.json, &solved, {}, kDefaultSolveSeconds, false,
-                                        args.solver); status != kExitOk)
+                                        args.solver, false); status != kExitOk)
     return status;
   if (solved.c.definition.kind != RodKind::Planar) {
     std::cerr << "error: " << args.case_path
               << ": vibrate handles planar rods only (the vibration equations B.4 are planar); this case is spatial\n";
     return kExitBadInput;
   }
+  const DefinitionSolve& equilibrium = solved.solved.solved;
   VibrationOptions options;
   options.modes = args.modes;
   options.rho_s = args.rho_s;
   VibrationAnalysis analysis;
   try {
-    analysis = VibrationProblem(*solved.problem, solved.result.x, options).analyse();
+    analysis = VibrationProblem(*equilibrium.problem, equilibrium.result.x, options).analyse();
   } catch (const std::invalid_argument& e) {
     std::cerr << "error: " << args.case_path << ": " << e.what() << "\n";
     return kExitBadInput;
@@ -133,7 +135,7 @@ int run_vibrate(const VibrateArguments& args) {
       write_all(analysis.unstable_modes, "unstable_mode_", &unstable_files);
     }
     const nlohmann::json json =
-        vibration_json(solved.c, solved.result, options, analysis, profile_files, unstable_files);
+        vibration_json(solved.c, equilibrium.result, options, analysis, profile_files, unstable_files);
     if (!args.out_path.empty()) {
       std::ofstream out(args.out_path);
       if (!out) throw std::runtime_error("cannot write " + args.out_path);

@@ -294,32 +294,28 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   std::string seed_refused;  // raised as ValueError once the GIL is back
 
   PySolution out;
-  std::unique_ptr<ShootingProblem> problem;
-  std::unique_ptr<Solution> sol;
+  CaseSolve solved;
   bool integration_failed = false;
   ShootingResult failed;
-  SolvePath path;
-  std::string path_failure;  // a homotopy that stopped short: its status word
   {
     py::gil_scoped_release release;
-    ShootingResult solved_result;
     try {
       // The library's solve of a case, as the CLI's: homotopy from the file's values when
-      // parameters changed (or direct), the active-set loop with obstacles, Ipopt's seed.
+      // parameters changed (or direct), the active-set loop with obstacles, Ipopt's seed; then
+      // the solution at `samples` points, its checks, and its stability.
       CaseSolveOptions options;
       options.direct = direct;
       options.seed.ipopt = seed == "ipopt";
       options.seed.segments = seed_segments;
-      CaseSolve solved = solve_case(c, options);
-      path = std::move(solved.path);
+      options.samples = samples;
+      solved = solve_case(c, options);
       if (!solved.failure.empty()) {
-        path_failure = solved.failure;
         integration_failed = true;
         failed.summary = solved.solved.result.summary;  // the failed start solve's, or no residual
         failed.summary.message = solved.message;
+      } else if (!solved.converged()) {  // Newton's verdict, or the profile's checks' (verification.hpp)
+        failed = solved.solution ? solved.solution->result : solved.solved.result;
       }
-      problem = std::move(solved.solved.problem);
-      solved_result = std::move(solved.solved.result);
     } catch (const InfeasibleContact& e) {
       integration_failed = true;
       failed.summary.status = SolverStatus::MaxIterations;
@@ -339,21 +335,12 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
       failed.summary.residual_norm = INFINITY;
       failed.summary.message = e.what();
     }
-    if (!seed_refused.empty()) integration_failed = true;
-    if (!integration_failed) {
-      ShootingResult result = std::move(solved_result);
-      if (result.summary.converged())
-        sol = std::make_unique<Solution>(make_solution(*problem, std::move(result), samples, c.derived));
-      else
-        failed = std::move(result);
-      if (sol && !sol->result.summary.converged()) {  // its profile failed the checks (verification.hpp)
-        failed = std::move(sol->result);
-        sol.reset();
-      }
-    }
   }
+  const std::unique_ptr<ShootingProblem>& problem = solved.solved.problem;
+  const Solution* sol = !integration_failed && seed_refused.empty() && solved.converged() ? &*solved.solution : nullptr;
+  const std::string& path_failure = solved.failure;  // a homotopy that stopped short: its status word
   // As the CLI's JSON "path" (one builder for both).
-  out.path = py::module_::import("json").attr("loads")(path_json(path).dump());
+  out.path = py::module_::import("json").attr("loads")(path_json(solved.path).dump());
   if (!seed_refused.empty()) throw py::value_error(seed_refused);
   const ShootingResult& r = sol ? sol->result : failed;
   out.status = path_failure.empty() ? to_string(r.summary.status) : path_failure;
@@ -374,8 +361,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   out.invariants = invariants_dict(sol->invariants);
   out.profile = profile_dict(problem->equations(sol->result.parameters)->model(), sol->profile,
                              problem->definition().kind);
-  out.stability = stability_dict(analyse_stability(*problem, sol->result.x),
-                                 discrete_stability(*problem, sol->result.x));
+  out.stability = stability_dict(*solved.stability, *solved.stability_check);
   out.contacts = contacts_list(*problem, *sol);
   for (const auto& o : stated_contact_outcomes(c.definition.contacts, sol->contacts,
                                                problem->obstacles(sol->result.parameters),

@@ -68,6 +68,43 @@ CaseSolve by_homotopy(const Case& c, std::vector<ParameterChange> changes, Homot
   return out;
 }
 
+// The equilibrium reached, by the seed, the homotopy or directly (the options' choice).
+CaseSolve reach_equilibrium(const Case& c, const CaseSolveOptions& options) {
+  if (options.seed.ipopt) {
+    CaseSolve out;
+    out.path.method = "ipopt_seed";
+    DiscreteSeed seed;
+    out.solved = as_definition_solve(
+        solve_from_discrete_seed(c.definition, options.seed.segments, options.seed.amplitude, &seed));
+    out.path.seed_summary = seed.summary;
+    return out;
+  }
+  std::vector<ParameterChange> changes = homotopy_changes(c);
+  if (!options.direct && !changes.empty()) {
+    HomotopyOptions homotopy = options.homotopy;
+    homotopy.deadline = std::min(homotopy.deadline, c.definition.options.newton.deadline);
+    return by_homotopy(c, std::move(changes), homotopy);
+  }
+  CaseSolve out;
+  out.path.method = "direct";
+  out.solved = solve_definition(c.definition, c.start_guess);
+  return out;
+}
+
+// What is reported of a converged equilibrium: its solution, checked as it is made, then (unless
+// the checks failed) its stability.
+void analyse(const Case& c, const CaseSolveOptions& options, CaseSolve* out) {
+  const ShootingProblem& problem = *out->solved.problem;
+  if (options.solution) {
+    out->solution = make_solution(problem, out->solved.result, options.samples > 0 ? options.samples : c.samples,
+                                  c.derived);
+    if (!out->solution->result.summary.converged()) return;
+  }
+  const Eigen::VectorXd& x = out->solved.result.x;
+  if (options.stability) out->stability = analyse_stability(problem, x);
+  if (options.stability_check) out->stability_check = discrete_stability(problem, x);
+}
+
 }  // namespace
 
 std::vector<ParameterChange> homotopy_changes(const Case& c) {
@@ -90,24 +127,8 @@ std::vector<ParameterChange> homotopy_changes(const Case& c) {
 }
 
 CaseSolve solve_case(const Case& c, const CaseSolveOptions& options) {
-  if (options.seed.ipopt) {
-    CaseSolve out;
-    out.path.method = "ipopt_seed";
-    DiscreteSeed seed;
-    out.solved = as_definition_solve(
-        solve_from_discrete_seed(c.definition, options.seed.segments, options.seed.amplitude, &seed));
-    out.path.seed_summary = seed.summary;
-    return out;
-  }
-  std::vector<ParameterChange> changes = homotopy_changes(c);
-  if (!options.direct && !changes.empty()) {
-    HomotopyOptions homotopy = options.homotopy;
-    homotopy.deadline = std::min(homotopy.deadline, c.definition.options.newton.deadline);
-    return by_homotopy(c, std::move(changes), homotopy);
-  }
-  CaseSolve out;
-  out.path.method = "direct";
-  out.solved = solve_definition(c.definition, c.start_guess);
+  CaseSolve out = reach_equilibrium(c, options);
+  if (out.failure.empty() && out.solved.result.summary.converged()) analyse(c, options, &out);
   return out;
 }
 

@@ -7,14 +7,21 @@
 //   - directly, by Newton (with the active-set loop when there are obstacles) from the case's
 //     guess at those values: with `direct`, and when only guesses of solved-for parameters change;
 //   - from Ipopt's minimum of the discretised energy at those values (seed ipopt): its own start.
+// and then, once converged, what both front ends report of it: the solution (profile, derived
+// quantities, invariants, its checks) and the stability index with its independent check, so
+// that the front ends only translate.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "kirchhoff/case_file.hpp"
 #include "kirchhoff/contact.hpp"
+#include "kirchhoff/discrete_stability.hpp"
 #include "kirchhoff/homotopy.hpp"
+#include "kirchhoff/solution.hpp"
+#include "kirchhoff/stability.hpp"
 
 namespace kirchhoff {
 
@@ -30,6 +37,11 @@ struct CaseSolveOptions {
   bool direct = false;  // Newton from the guess at the requested values, no homotopy
   StartSeed seed;
   HomotopyOptions homotopy;  // its deadline defaults to the case's wall-clock limit
+  // What is made of a converged equilibrium (each left empty in the result when off):
+  bool solution = true;         // make_solution: profile, derived quantities, invariants, checks
+  int samples = 0;              // the solution's profile points; 0: the case's [output] samples
+  bool stability = true;        // analyse_stability: the index by conjugate points
+  bool stability_check = true;  // discrete_stability: the index's independent check, where it applies
 };
 
 // How the equilibrium was reached.
@@ -51,6 +63,18 @@ struct CaseSolve {
   // stopped, and what to do).
   std::string failure;
   std::string message;
+  // Once Newton converged (and no failure): the solution made from solved.result (a copy; its
+  // status is the profile checks' verdict, verification.hpp), and, when that passed (or no
+  // solution was asked for), the stability of the equilibrium and its independent check.
+  std::optional<Solution> solution;
+  std::optional<StabilityReport> stability;
+  std::optional<DiscreteStability> stability_check;
+
+  // The verdict on the whole solve: the path's or Newton's summary, or the solution's checks'.
+  const NewtonSummary& summary() const {
+    return solution ? solution->result.summary : solved.result.summary;
+  }
+  bool converged() const { return failure.empty() && summary().converged(); }
 };
 
 // Throws what solve_definition and solve_from_discrete_seed throw (IntegrationError,
