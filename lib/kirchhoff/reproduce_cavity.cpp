@@ -26,13 +26,10 @@ struct CavityPoint {
 
 std::vector<CavityPoint> follow_cavity(const fs::path& cases) {
   const Case c = load_case((cases / "cavity.toml").string());
-  ContinuationOptions o;
-  o.parameter = "Delta";
-  o.target = 0.2;
-  o.max_step = 2.0;
-  o.max_points = 6000;
-  o.compute_invariants = false;
-  o.derived = {"P", "H", "contact_length", "contact_count", "kappa_contact", "contact_s", "min_gap", "min_contact_force"};
+  ContinuationOptions o = report_continuation(
+      "Delta", 0.2, 2.0, ReportPoints::Followed,
+      {"P", "H", "contact_length", "contact_count", "kappa_contact", "contact_s", "min_gap", "min_contact_force"});
+  o.max_points = 6000;  // the whole branch, through its contact changes to lift-off
   std::vector<CavityPoint> points;
   ProblemDefinition leg = c.definition;
   auto on_leg = [&](const std::vector<PointContact>& active) { leg.contacts = active; };

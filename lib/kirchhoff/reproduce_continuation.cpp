@@ -31,11 +31,9 @@ std::vector<ContinuationPoint> column_branch_points(const ShootingProblem& probl
 
 // The first buckled branch, switched onto at the first branch point, to theta0 = 3: P(theta0)
 // against 4K(k)^2 at every regular point, into euler_buckled_branch.csv.
-void buckled_column(const Step& step, const ShootingProblem& problem, ContinuationOptions b,
-                    const ContinuationPoint& first) {
-  b.target = NAN;
+void buckled_column(const Step& step, const ShootingProblem& problem, const ContinuationPoint& first) {
+  ContinuationOptions b = report_continuation("P", NAN, 1.0, ReportPoints::Located, {"theta0"});
   b.initial_step = 0.05;
-  b.max_step = 1.0;
   b.events = {{"theta0", 3.0, true, ""}};
   b.compute_stability = true;  // make_figures.py draws stable parts solid, unstable ones dashed
   Continuation buckled(problem, b);
@@ -61,12 +59,7 @@ void buckled_column(const Step& step, const ShootingProblem& problem, Continuati
 void twisted_branch_point(const Step& step) {
   const Case twisted = load_case((step.cases / "twisted_clamped.toml").string(), {{"phi", 6.0}});
   const ShootingProblem rod(twisted.definition);
-  ContinuationOptions t;
-  t.parameter = "phi";
-  t.target = 15.0;
-  t.max_step = 1.0;
-  t.samples = 21;
-  Continuation twist(rod, t);
+  Continuation twist(rod, report_continuation("phi", 15.0, 1.0, ReportPoints::Located));
   const ContinuationResult tr = twist.run(rod.initial_unknowns(twisted.start_guess));
   for (const auto& p : tr.points)
     if (p.type == PointType::BranchPoint) {
@@ -83,14 +76,9 @@ void twisted_branch_point(const Step& step) {
 void continuation(const Step& step) {
   const Case column = load_case((step.cases / "euler_column.toml").string(), {{"P", 1.0}, {"theta_guess", 0.0}});
   const ShootingProblem problem(column.definition);
-  ContinuationOptions o;
-  o.parameter = "P";
-  o.target = 100.0;
-  o.max_step = 5.0;
-  o.samples = 21;
-  o.derived = {"theta0"};
+  const ContinuationOptions o = report_continuation("P", 100.0, 5.0, ReportPoints::Located, {"theta0"});
   const std::vector<ContinuationPoint> bps = column_branch_points(problem, column, o, step.rows);
-  buckled_column(step, problem, o, bps[0]);
+  buckled_column(step, problem, bps[0]);
   twisted_branch_point(step);
 }
 

@@ -27,13 +27,8 @@ SoftWallSolutions follow_soft_wall(const Step& step) {
                            {{"log_b", -4.0}, {"Delta", 0.005}, {"P_guess", 40.0}, {"m_guess", 0.9}});
   SoftWallSolutions out{std::make_unique<ShootingProblem>(c.definition), {}};
   ShootingProblem& problem = *out.problem;
-  ContinuationOptions o;
-  o.parameter = "Delta";
-  o.target = 0.026;
-  o.max_step = 2.0;
-  o.samples = 21;
-  o.compute_invariants = false;
-  ContinuationResult shortening = Continuation(problem, o).run(problem.initial_unknowns(c.start_guess));
+  ContinuationResult shortening = Continuation(problem, report_continuation("Delta", 0.026, 2.0, ReportPoints::Followed))
+                                      .run(problem.initial_unknowns(c.start_guess));
   if (shortening.reason != StopReason::ReachedTarget) throw std::runtime_error("soft wall: continuation in Delta failed");
   problem.set_parameter("Delta", 0.026);
   auto record = [&](const ContinuationPoint& p) {
@@ -50,11 +45,8 @@ SoftWallSolutions follow_soft_wall(const Step& step) {
     double from = -4.0;
     for (double target : targets) {
       problem.set_parameter("log_b", from);
-      ContinuationOptions ob = o;
-      ob.parameter = "log_b";
-      ob.target = target;
-      ob.max_step = 0.5;
-      const ContinuationResult r = Continuation(problem, ob).run(x);
+      const ContinuationResult r =
+          Continuation(problem, report_continuation("log_b", target, 0.5, ReportPoints::Followed)).run(x);
       if (r.reason != StopReason::ReachedTarget) throw std::runtime_error("soft wall: continuation in b failed");
       if (from == -4.0) record(r.points.front());
       record(r.points.back());

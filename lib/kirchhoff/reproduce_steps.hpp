@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "kirchhoff/case_file.hpp"
+#include "kirchhoff/continuation.hpp"
 #include "kirchhoff/reproduce.hpp"
 #include "kirchhoff/shooting.hpp"
 #include "kirchhoff/solution.hpp"
@@ -37,6 +38,23 @@ struct Solved {
 
 // Throws std::runtime_error("<file>: <brief report>") when Newton does not converge.
 Solved solve_for_report(const fs::path& file, const ParameterOverrides& overrides, int samples);
+
+// What the points of a group's continuation are for, which decides what each records.
+enum class ReportPoints {
+  // Special points located (branch points, a target): the rows read their parameters and the
+  // derived quantities asked for, not their profiles, so the invariants each point carries are
+  // sampled on a coarse profile of 21 points.
+  Located,
+  // A branch followed for its derived quantities or its end: no invariants, the derived
+  // quantities on the default profile of 101 points.
+  Followed,
+};
+
+// The continuations the groups run, all of one shape: `parameter` towards `target` (NaN: none; an
+// event or a branch switch ends the run) in pseudo-arclength steps up to `max_step` (each
+// branch's own scale), recording `derived` at every point as `points` says.
+ContinuationOptions report_continuation(const std::string& parameter, double target, double max_step,
+                                        ReportPoints points, const std::vector<std::string>& derived = {});
 
 // 4 significant digits, as the notes print values.
 std::string format_short(double v);

@@ -1,5 +1,5 @@
 // What `reproduce`'s groups share (reproduce_steps.hpp): a case solved from its guess with its
-// stability, and the short number format of the notes.
+// stability, the options of their continuations, and the short number format of the notes.
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
@@ -18,6 +18,24 @@ Solved solve_for_report(const fs::path& file, const ParameterOverrides& override
   out.solution = make_solution(*out.problem, std::move(r), samples, c.derived);
   out.stability = describe(analyse_stability(*out.problem, out.solution.result.x));
   return out;
+}
+
+ContinuationOptions report_continuation(const std::string& parameter, double target, double max_step,
+                                        ReportPoints points, const std::vector<std::string>& derived) {
+  ContinuationOptions o;
+  o.parameter = parameter;
+  o.target = target;
+  o.max_step = max_step;
+  o.derived = derived;
+  switch (points) {
+    case ReportPoints::Located:
+      o.samples = 21;
+      break;
+    case ReportPoints::Followed:
+      o.compute_invariants = false;
+      break;
+  }
+  return o;
 }
 
 std::string format_short(double v) {
