@@ -77,6 +77,10 @@ TEST_F(SweepRunTest, IndexHasOneRowPerJobInJobOrder) {
   EXPECT_TRUE(fs::exists(dir_ / "a" / "jobs" / "branch" / "branch.csv"));
   EXPECT_EQ(rows[16].rfind("ply,plectonemes,,,100.0,0.25,ok,", 0), 0u) << rows[16];
   EXPECT_TRUE(fs::exists(dir_ / "a" / "jobs" / "ply" / "plectoneme_100.csv"));
+  // The plectonemes job's own progress lines (as `kirchhoff plectonemes` prints them) among the
+  // sweep's, after the job's id.
+  const auto log = testing::lines_of(dir_ / "a.log");
+  EXPECT_NE(std::find(log.begin(), log.end(), "ply: L/2R = 100: turns 0 -> 0.25"), log.end());
   EXPECT_EQ(testing::lines_of(dir_ / "a" / "times.csv").size(), 17u);
   // Again into the same folder without --resume: refused, nothing touched.
   EXPECT_EQ(testing::run_to_end(sweep(spec, dir_ / "a"), dir_ / "b.log"), 2);

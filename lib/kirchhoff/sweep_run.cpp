@@ -207,8 +207,9 @@ void run_continue(const SweepJob& job, const Case& c, const fs::path& folder, js
 }
 
 // A plectonemes job: sweep_plectonemes (`kirchhoff plectonemes`) for the job's slenderness, the
-// thicker one first with from_ply; its CSVs into the job's folder.
-void run_plectonemes(const SweepJob& job, const fs::path& folder, json* result) {
+// thicker one first with from_ply; its CSVs into the job's folder, its progress lines (as the
+// command's, every 50 points) to `progress` after the job's id.
+void run_plectonemes(const SweepJob& job, const fs::path& folder, const SweepProgress& progress, json* result) {
   auto value = [&job](const std::string& name) {
     for (const auto& [n, x] : job.values)
       if (n == name) return x;
@@ -217,7 +218,11 @@ void run_plectonemes(const SweepJob& job, const fs::path& folder, json* result) 
   PlectonemesArguments args;
   args.case_path = job.case_path;
   args.out_dir = folder.string();
-  args.progress_every = 0;
+  if (progress) {
+    args.progress = [id = job.id, progress](const std::string& line) {
+      progress(id + ": " + line.substr(std::min(line.find_first_not_of(' '), line.size())));
+    };
+  }
   args.hard_from = job.hard_from;
   args.slenderness = {value("slenderness")};
   args.turns = {value("turns")};
@@ -291,7 +296,7 @@ std::string contact_state(const std::vector<Obstacle>& obstacles, const std::vec
   return "several";
 }
 
-JobOutcome run_sweep_job(const SweepJob& job, const std::string& dir) {
+JobOutcome run_sweep_job(const SweepJob& job, const std::string& dir, const SweepProgress& progress) {
   const auto start = std::chrono::steady_clock::now();
   const fs::path jobs = fs::path(dir) / "jobs";
   const fs::path partial = jobs / ("." + job.id + ".partial");
@@ -307,7 +312,7 @@ JobOutcome run_sweep_job(const SweepJob& job, const std::string& dir) {
   result["fingerprint"] = job.fingerprint();
   try {
     if (job.kind == SweepJobKind::Plectonemes) {
-      run_plectonemes(job, partial, &result);  // the sweep loads the case itself
+      run_plectonemes(job, partial, progress, &result);  // the sweep loads the case itself
     } else {
       Case c = load_case(job.case_path, job.overrides(), "", job.solver);
       if (job.kind == SweepJobKind::Solve) limit_wall_clock(c.definition.options, job.max_seconds);
@@ -457,7 +462,7 @@ SweepSummary run_sweep(const SweepSpec& spec, const SweepRunOptions& options) {
   int done = summary.skipped;
   for (int k : to_run) {
     const SweepJob& job = spec.jobs[static_cast<std::size_t>(k)];
-    const JobOutcome outcome = run_sweep_job(job, options.out_dir);
+    const JobOutcome outcome = run_sweep_job(job, options.out_dir, options.progress);
     record_job_time(options.out_dir, job.id, outcome.seconds, 0);
     ++summary.ran;
     if (options.progress) options.progress(describe_job_end(job, outcome, ++done, summary.jobs));

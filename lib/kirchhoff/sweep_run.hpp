@@ -34,10 +34,15 @@ struct JobOutcome {
   double seconds = 0.0;
 };
 
+// Where a sweep's progress lines go, without their newline; unset: nowhere.
+using SweepProgress = std::function<void(const std::string&)>;
+
 // Runs one job and writes its folder under dir (dir/jobs must exist). A failing job (not
 // converged, refused, an exception from the solver) is an outcome with its status, not an
-// exception; throws std::runtime_error only when the folder cannot be written.
-JobOutcome run_sweep_job(const SweepJob& job, const std::string& dir);
+// exception; throws std::runtime_error only when the folder cannot be written. A long job's own
+// progress lines go to `progress`, prefixed with the job's id: a plectonemes job's, as
+// `kirchhoff plectonemes` prints them ("ply: L/2R = 100  point 50  turns = 3.1").
+JobOutcome run_sweep_job(const SweepJob& job, const std::string& dir, const SweepProgress& progress = {});
 
 // Readies DIR for the sweep and returns the positions (in spec.jobs) of the jobs to run, in job
 // order. Without resume a folder that already holds job results is refused (SweepError); with
@@ -64,8 +69,9 @@ SweepIndex write_sweep_index(const SweepSpec& spec, const std::string& dir);
 struct SweepRunOptions {
   std::string out_dir;
   bool resume = false;
-  // One line per job as it finishes ("[3/40] phase-003 a=0.1 Delta=0.02: ok (1.2 s)").
-  std::function<void(const std::string&)> progress;
+  // One line per job as it finishes ("[3/40] phase-003 a=0.1 Delta=0.02: ok (1.2 s)"), and the
+  // progress lines of long jobs as they run (run_sweep_job).
+  SweepProgress progress;
 };
 
 struct SweepSummary {
