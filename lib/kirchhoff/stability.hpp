@@ -50,10 +50,15 @@
 // Zero modes (Jacobi fields meeting every condition: symmetries such as the isotropic rod's
 // rotation about its axis, rigid motions, or the rod at a bifurcation) are reported apart from
 // the index, never counted in it.
+// Half rods with a half-turn end (plectoneme.toml) get the whole rod's index: that of the half
+// rod as stated (the symmetric perturbations) plus that of the antisymmetric ones, a half-rod
+// problem with the complementary end conditions and, with self-contact, the pair energy's other
+// second variation (stability_symmetric.hpp).
 //
 // Not covered (index null with the reason): extended contacts, contacts of extensible rods,
 // contacts with zero force (weakly active) or where the rod is about to flatten or wrap onto the
-// obstacle (g'' = 0), half-turn symmetric half rods, unknown parameters that are not end loads,
+// obstacle (g'' = 0), half-turn ends that impose the loop's rotation, half-turn points at s = 0
+// and half-turn symmetric rods with contacts, unknown parameters that are not end loads,
 // non-conservative loads (a dead couple on a 3D end free to rotate), degenerate constraints (a
 // straight rod held at its full length), degenerate crossings.
 #pragma once
