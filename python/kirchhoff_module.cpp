@@ -443,12 +443,21 @@ py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
   options.profile_samples = samples;
   if (std::string e = options.validate(); !e.empty()) throw py::value_error(e);
   VibrationAnalysis analysis;
+  Parameters at;  // the equilibrium's parameters, solved-for ones included
   {
     py::gil_scoped_release release;
-    DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
-    if (!solved.result.summary.converged())
-      throw std::runtime_error(c.path + ": the equilibrium did not converge: " + solved.result.summary.brief_report());
-    analysis = VibrationProblem(*solved.problem, solved.result.x, options).analyse();  // invalid_argument -> ValueError
+    // The equilibrium as solve() and the CLI's `vibrate` reach it (homotopy from the file's
+    // values when parameters changed); the vibrations need neither its profile nor its index.
+    CaseSolveOptions solve_options;
+    solve_options.solution = solve_options.stability = solve_options.stability_check = false;
+    const CaseSolve solved = solve_case(c, solve_options);
+    if (!solved.failure.empty())
+      throw std::runtime_error(c.path + ": the equilibrium was not reached: " + solved.failure + ": " + solved.message);
+    if (!solved.converged())
+      throw std::runtime_error(c.path + ": the equilibrium did not converge: " + solved.summary().brief_report());
+    const DefinitionSolve& equilibrium = solved.solved;
+    analysis = VibrationProblem(*equilibrium.problem, equilibrium.result.x, options).analyse();  // invalid_argument -> ValueError
+    at = equilibrium.result.parameters;
   }
   auto mode_dict = [](const VibrationMode& m) {
     py::dict d;
@@ -478,6 +487,7 @@ py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
   out["omega2"] = analysis.omega2();
   out["frequencies"] = column<double>(analysis.modes.size(), [&](size_t k) { return analysis.modes[k].omega; });
   out["straight_equilibrium"] = analysis.straight_equilibrium;
+  out["parameters"] = parameters_dict(at);  // as the CLI's JSON "parameters"
   out["modes"] = mode_list;
   return out;
 }
@@ -996,7 +1006,8 @@ Returns:
     "ybar", "thetabar", "nbarx", "nbary", "mbar", "H_vib_along_s" (and "omega2", "growth_rate").
     "unstable_modes": the same for omega^2 < 0 (imaginary frequencies: the equilibrium is unstable
     under dead loads; their number, "negative_omega2_count", is its index), most negative first;
-    "unstable_searched" (bool) and "omega2" (every mode's omega^2, increasing).
+    "unstable_searched" (bool) and "omega2" (every mode's omega^2, increasing). "parameters": the
+    equilibrium's (those solved for included), as solve() gives them.
 
 Raises:
     ValueError: a spatial case, bad options, or a rod the vibration equations do not cover.

@@ -609,6 +609,14 @@ class VibrateTest(unittest.TestCase):
         self.assertFalse(mode["H_vib"]["applies"])
         self.assertGreater(mode["H_vib"]["relative_spread"], 1e-3)
 
+    def test_the_equilibrium_is_the_one_solve_reaches(self):
+        # Fig. 3 at theta0 = 3.1, where Newton from the guess lands elsewhere (HomotopyTest): the
+        # vibrations are about solve()'s equilibrium, reached by the same homotopy, to the last bit.
+        case = kirchhoff.load_case(case_path("simply_supported.toml"), set={"theta0": 3.1})
+        v = case.vibrate(modes=1)
+        self.assertEqual(v["parameters"], case.solve().parameters)
+        self.assertNotEqual(v["parameters"]["P"], case.solve(direct=True).parameters["P"])
+
     def test_spatial_case_and_bad_options_raise_value_error(self):
         with self.assertRaises(ValueError):
             kirchhoff.load_case(case_path("twisted_clamped.toml")).vibrate()
