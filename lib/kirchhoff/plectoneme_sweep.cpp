@@ -420,9 +420,9 @@ RunState solved_start(const HardPlyStart& seed, double slenderness, double turns
 // from 1.002, log_softness -7.8, in 3, the whole handover then fastest: Ipopt too starts nearer its
 // minimum, 56 iterations against 196 from 1.05). At L/2R = 100 the case's -4 leaves 1.108 and
 // Newton converged from there, but not at 300: the gap a fixed log_softness leaves grows with
-// the slenderness, so the stiffness is chosen by the gap, not set. (Not enough everywhere: at
-// L/2R = 500 and 15 turns, a ply 173 R long, Newton stalls from both gaps - the seed's residual,
-// ~5e3, sits at the isolated contacts beside the line and does not fall as the barrier stiffens.)
+// the slenderness, so the stiffness is chosen by the gap, not set. At L/2R = 500 and 15 turns, a
+// ply 173 R long, the first gap is not enough (Newton stalls at a residual of 3.96 after 50
+// iterations) and the second is (measured; docs/plectonemes.md).
 constexpr double kHandoverSelfDistances[] = {1.002, 1.0005};
 // The stiffening stops here: a ply whose strands the barrier still holds further apart is not
 // handed over (a branch without a ply at these turns never gets there).
@@ -597,6 +597,12 @@ ContinuationPoint move_ply(ShootingProblem& problem, const std::string& paramete
                            const std::vector<ContinuationEvent>& events = {}) {
   ContinuationOptions o = ply_continuation(problem, parameter, target, slenderness, options);
   o.samples = 11;
+  // A chord iteration on an older point's matrix can throw the slenderness far off: from the
+  // L/2R = 200 exact ply at 5 turns towards 500, one corrector iterate at 325.6 went to -222, where
+  // no rod exists (the self-contact radius L/(2 L/2R) < 0) and the run stopped with "self-contact
+  // radius must be > 0". Each point's own matrix keeps the correctors near the branch (the same
+  // move reaches 500 in 22 points); the move is short next to the legs.
+  if (parameter == "slenderness") o.reuse_jacobian_iterations = -1;
   if (!events.empty()) {
     o.events = events;
     o.derived = kHardMeasured;
