@@ -112,6 +112,8 @@ struct StabilityReport {
   int constraint_correction = 0;         // index - dead_load_index
   // Half of a half-turn symmetric rod (a `half_turn` end): the counts above are the whole rod's,
   // the sums of the symmetric and antisymmetric halves, whose indices are these (empty otherwise).
+  // Where the whole rod's index is not defined, symmetric_index may still be (the self-contact
+  // acting: stability_symmetric.hpp).
   std::optional<int> symmetric_index, antisymmetric_index;
   std::string method = "conjugate_points";
   long rhs_evaluations = 0;

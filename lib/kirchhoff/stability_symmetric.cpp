@@ -3,6 +3,9 @@
 
 #include "kirchhoff/self_contact.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace kirchhoff {
 namespace {
 
@@ -57,6 +60,18 @@ std::shared_ptr<const RodEquations> antisymmetric_equations(const RodEquations& 
   if (!find_half_turn_self_contact(model)) return nullptr;
   model.field = antisymmetric_field(model.field);
   return eq.is_planar() ? make_planar_equations(model) : make_spatial_equations(model);
+}
+
+double antisymmetric_barrier_stiffness(const RodEquations& eq, const std::vector<RodPoint>& samples) {
+  const RodModel& model = eq.model();
+  const HalfTurnSelfContact* barrier = find_half_turn_self_contact(model);
+  if (!barrier) return 0.0;
+  double largest = 0.0;
+  for (const RodPoint& q : samples) {
+    const Vec3 d = barrier->geometry().radial(q.r);
+    largest = std::max(largest, std::abs(barrier->force(q.s, q.r).dot(d)) / d.squaredNorm());
+  }
+  return largest * std::pow(model.length, 4) / model.B[0](0.0);
 }
 
 }  // namespace kirchhoff

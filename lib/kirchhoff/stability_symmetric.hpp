@@ -40,12 +40,25 @@
 //                  past each other along the axis lengthens d at second order and lowers the
 //                  repulsion). As a force gradient df/dr = -H = (f.d_r) / rho^2 a a^T, with f the
 //                  barrier's force and d_r the radial vector (f = -w phi' d_r / rho).
+// Where the barrier acts this is the second variation of the partner-pair energy above, but not
+// of the whole rod's self-contact: the case defines its energy on symmetric configurations only,
+// and pairing s with L - s for ever is one extension of it, not the physical one. Antisymmetric
+// perturbations slide the strands past each other; the pair of closest points then moves along
+// both strands (as a point contact slides along its obstacle, stability.hpp), and a contact
+// between strands lying along each other does not open, whereas the fixed partners separate and
+// the term above lowers the energy by ~ contact pressure / R x (a.dr)^2. Along plectoneme.toml's
+// branch it made every equilibrium past the end loop's closing unstable in one antisymmetric
+// direction (and the crossings non-monotone at some), against what the rod literature finds for
+// the ply under end-rotation control. So where the barrier acts the whole rod's index is not
+// reported (the symmetric half's is); the field above is what the antisymmetric half uses where
+// it does not act, to round-off (tested against finite differences of the pair energy).
 // One-body fields invariant under Q (gravity along a, none in the cases) keep their Hessian on both
 // halves: (Q dr).Hess V(Q r) (Q dr) = dr.Hess V(r) dr.
 #pragma once
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "kirchhoff/boundary_conditions.hpp"
 #include "kirchhoff/rod_equations.hpp"
@@ -61,5 +74,11 @@ EndCondition antisymmetric_half_turn_end(const Vec3& axis);
 // antisymmetric one (above); the equilibrium's force is unchanged. Null when the rod has no
 // half-turn self-contact (its own equations then serve both halves).
 std::shared_ptr<const RodEquations> antisymmetric_equations(const RodEquations& eq);
+
+// The largest stiffness of the antisymmetric barrier term, |w phi'| / rho (above), over the
+// equilibrium's samples, in units of B / L^4 (B the first bending stiffness at s = 0, L the half
+// rod's length): the term changes the second variation by at most this, relative to the elastic
+// energy of a perturbation of unit size. Zero without a half-turn self-contact.
+double antisymmetric_barrier_stiffness(const RodEquations& eq, const std::vector<RodPoint>& samples);
 
 }  // namespace kirchhoff
