@@ -129,5 +129,54 @@ TEST(Homotopy, FollowsContactSetChanges) {
   EXPECT_TRUE(s.solved.problem->definition().contacts.empty());
 }
 
+// A clamp turned by a parameter through half a turn: its frame's quaternion passes w = 0 there,
+// where a turn angle gauged into (-pi, pi] jumps by 2 pi, and Newton cannot carry the start clamp
+// across (the plectoneme case stalled at turns = 0.999 on its way to 1). A straight rod, its start
+// clamped turned by alpha about e3, its end sliding along e3 turned by 0, whole turns counted: the
+// clamp turned continuously from 0 to alpha twists the rod by -alpha, m3 = -C alpha / L exactly.
+constexpr const char* kTurnedClamp = R"(
+model = "spatial"
+[parameters]
+alpha = 0.0
+C = 0.769230769230769
+[rod]
+length = 1.0
+B = 1.0
+B3 = "C"
+[start]
+type = "clamped"
+position = [0, 0, 0]
+orientation = { axis = [0, 0, 1], angle = "alpha" }
+[end]
+type = "sliding"
+axis = [0, 0, 1]
+position = [0, 0, 0]
+force = [0, 0, 0]
+orientation = { axis = [0, 0, 1], angle = 0 }
+track_turns = true
+[guess]
+force = [0, 0, 0]
+moment = [0, 0, 0]
+[output]
+derived = ["M"]
+)";
+
+class TurnedClampHomotopy : public ::testing::TestWithParam<double> {};
+
+// Landing exactly on half a turn (pi, where w = 0), and past it (4, 2 pi: a whole turn).
+TEST_P(TurnedClampHomotopy, CarriesAClampThroughHalfATurn) {
+  const double alpha = GetParam();
+  const Case c = load_case_text(kTurnedClamp, "turned_clamp.toml", {{"alpha", alpha}});
+  const CaseSolve s = solve_case(c);
+  ASSERT_TRUE(s.failure.empty()) << s.failure << ": " << s.message;
+  EXPECT_EQ(s.path.homotopy.stop, "reached");
+  const Solution sol = make_solution(*s.solved.problem, s.solved.result, 11, c.derived);
+  // The straight twisted rod is exact in the equations; Newton's |F| <= 1e-10 and RK78 at 1e-12
+  // leave m3 to ~1e-11 (its size is ~1-5).
+  EXPECT_NEAR(sol.derived.at("M"), -0.769230769230769 * alpha, 1e-9);
+}
+
+INSTANTIATE_TEST_SUITE_P(HalfTurn, TurnedClampHomotopy, ::testing::Values(M_PI, 4.0, 2.0 * M_PI));
+
 }  // namespace
 }  // namespace kirchhoff

@@ -217,10 +217,12 @@ class SpatialEquations final : public RodEquations {
     Eigen::VectorXd g(2);
     g[0] = q.squaredNorm() - 1.0;
     const double w = q[0], qz = q[3], d = w * w + qz * qz;
-    // chi(0) is the twist of R(0) in (-pi, pi]: taken from q or -q alike (both are R(0)), so the
-    // turn count cannot jump by a whole turn through the sign of the quaternion.
-    const double sign = w < 0 ? -1.0 : 1.0;
-    g[1] = y[kChi] - 2.0 * std::atan2(sign * qz, sign * w);
+    // chi(0) is the twist of R(0) up to whole turns: 2 atan2(qz, w) is it for q and -q alike
+    // modulo 2 pi. The remainder keeps the residual continuous where the twist passes pi (w = 0):
+    // a gauge in a fixed interval such as (-pi, pi] jumps by 2 pi there, and Newton could not
+    // take a clamp turned by a parameter across half a turn (the plectoneme at turns = 1).
+    // chi(0) thus follows the clamp's turns continuously from where the guess put it.
+    g[1] = std::remainder(y[kChi] - 2.0 * std::atan2(qz, w), 2.0 * M_PI);
     if (jacobian) {
       jacobian->setZero(2, kStateSize);
       jacobian->block<1, 4>(0, kQ) = 2.0 * q.transpose();
