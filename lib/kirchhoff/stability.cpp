@@ -306,6 +306,13 @@ class StabilityAnalysis {
 
   StabilityReport run();
 
+  // Follow, at every step of the fields' integration, the largest stiffness of the antisymmetric
+  // barrier term of `original`'s half-turn self-contact (stability_symmetric.hpp) along the
+  // equilibrium: the steps are refined where the barrier is stiff (field_rate), and the distance
+  // from the axis is smooth in s, so its minimum is found to ~ its curvature x step^2.
+  void track_barrier(std::shared_ptr<const RodEquations> original) { barrier_eq_ = std::move(original); }
+  double barrier_stiffness() const { return barrier_stiffness_; }
+
  private:
   struct Held {
     Eigen::MatrixXd position;  // kr x a, position coordinates
@@ -350,6 +357,8 @@ class StabilityAnalysis {
   int offset_ = 0, mU_ = 0;
   // Multipliers whose particular fields start at s = 0 and constraints recorded before L (see Frame).
   int start_multipliers_ = 0, recorded_before_contacts_ = 0;
+  std::shared_ptr<const RodEquations> barrier_eq_;  // track_barrier
+  double barrier_stiffness_ = 0.0;
 };
 
 StabilityAnalysis::Held StabilityAnalysis::held_at(const EndCondition& end,
@@ -566,6 +575,9 @@ void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int dept
   }
   record(track->lifted, f->s, phases, s1, track);
   *f = next;
+  if (barrier_eq_)
+    barrier_stiffness_ =
+        std::max(barrier_stiffness_, antisymmetric_barrier_stiffness(*barrier_eq_, {eq_->point(f->y, f->s)}));
 }
 
 // Across a point contact (normal nu, force f > 0, the rod curving away from the obstacle):
@@ -968,29 +980,23 @@ StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::V
     // antisymmetric ones have the complementary conditions and, with self-contact, the pair
     // energy's other second variation.
     const StabilityReport symmetric = StabilityAnalysis(problem, x, options, end, nullptr).run();
-    // Where the self-contact acts, the whole rod's antisymmetric second variation is not that of
-    // the partner pairs (stability_symmetric.hpp): not reported. 2001 samples resolve the
-    // narrowest barrier force, a crossing's spike ~sqrt(R gap) ~ 1e-3 L wide (self_contact.hpp);
-    // below the zero tolerance the term moves no eigenvalue beyond what is called zero anyway.
     const auto equations = problem.equations(problem.parameters_at(x));
-    if (find_half_turn_self_contact(equations->model())) {
-      std::vector<double> s(2001);
-      for (size_t i = 0; i < s.size(); ++i) s[i] = equations->model().length * static_cast<double>(i) / (s.size() - 1);
-      if (antisymmetric_barrier_stiffness(*equations, problem.sample(x, s)) > options.zero_tolerance) {
-        StabilityReport out;
-        out.reason = "the self-contact acts: the whole rod's index needs the antisymmetric perturbations of the "
-                     "contact between the strands (their closest points sliding along both), which are not "
-                     "implemented; the symmetric perturbations' index is given";
-        out.symmetric_index = symmetric.index;
-        out.rhs_evaluations = symmetric.rhs_evaluations;
-        return out;
-      }
-    }
     const EndCondition anti_end = antisymmetric_half_turn_end(end.half_turn_axis());
-    const StabilityReport antisymmetric =
-        StabilityAnalysis(problem, x, options, anti_end,
-                          antisymmetric_equations(*problem.equations(problem.parameters_at(x))))
-            .run();
+    StabilityAnalysis anti(problem, x, options, anti_end, antisymmetric_equations(*equations));
+    anti.track_barrier(equations);
+    const StabilityReport antisymmetric = anti.run();
+    // Where the self-contact acts, the whole rod's antisymmetric second variation is not that of
+    // the partner pairs (stability_symmetric.hpp): not reported. Below the zero tolerance the
+    // term moves no eigenvalue beyond what is called zero anyway.
+    if (anti.barrier_stiffness() > options.zero_tolerance) {
+      StabilityReport out;
+      out.reason = "the self-contact acts: the whole rod's index needs the antisymmetric perturbations of the "
+                   "contact between the strands (their closest points sliding along both), which are not "
+                   "implemented; the symmetric perturbations' index is given";
+      out.symmetric_index = symmetric.index;
+      out.rhs_evaluations = symmetric.rhs_evaluations + antisymmetric.rhs_evaluations;
+      return out;
+    }
     return whole_rod(symmetric, antisymmetric);
   } catch (const IntegrationError& e) {
     StabilityReport report;
