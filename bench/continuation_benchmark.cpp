@@ -31,7 +31,7 @@
 //
 // Modes:
 //   continuation_benchmark [--reps N] [--euler-max-step H] [--twist-max-step H]
-//                          [--auto-euler DIR] [--auto-twist DIR]
+//                          [--auto-euler DIR] [--auto-twist DIR] [--tight-march]
 //                                        the timed table (default; --summary is accepted too):
 //                                        N repetitions of each timed run (default 7), medians;
 //                                        max steps default to 1.0 (127 points) and 0.23 (139);
@@ -95,6 +95,9 @@ constexpr double kAutoSpatialQuoted = 228.0;   // AUTO-07p, NTST = 10
 // Step limits that give about as many points as AUTO-07p's runs (133 and 138); tunable.
 double g_euler_max_step = 1.0;
 double g_twist_max_step = 0.23;
+// --tight-march: march_sensitivity_tol = 0 (every matrix at the state's tolerance, as before
+// that option).
+bool g_tight_march = false;
 // AUTO-07p run directories for the side-by-side measurement (empty: AUTO is not run).
 std::string g_auto_euler_dir, g_auto_twist_dir;
 
@@ -214,6 +217,7 @@ ContinuationOptions euler_branch_options(bool invariants) {
   // theta0 is read at s = 0, but describe() samples the whole rod anyway: two samples is the
   // least work; with the invariants on, the usual profile of 101 points.
   o.samples = invariants ? 101 : 2;
+  if (g_tight_march) o.march_sensitivity_tol = 0;
   return o;
 }
 
@@ -226,6 +230,7 @@ ContinuationOptions twist_branch_options() {
   o.derived = {"end_to_end"};
   o.compute_invariants = true;
   o.samples = 101;
+  if (g_tight_march) o.march_sensitivity_tol = 0;
   return o;
 }
 
@@ -1159,6 +1164,8 @@ int main(int argc, char** argv) {
         once = argv[++i];
       } else if (std::strcmp(argv[i], "--reps") == 0 && i + 1 < argc) {
         reps = positive_int(argv[++i], "--reps");
+      } else if (std::strcmp(argv[i], "--tight-march") == 0) {
+        g_tight_march = true;
       } else if (std::strcmp(argv[i], "--euler-max-step") == 0 && i + 1 < argc) {
         g_euler_max_step = positive_double(argv[++i], "--euler-max-step");
       } else if (std::strcmp(argv[i], "--twist-max-step") == 0 && i + 1 < argc) {

@@ -184,6 +184,67 @@ TEST(EulerColumn, ModifiedNewtonTakesFewerMatricesForTheSameBranch) {
             << full_count.residuals << " -> " << modified_count.residuals << "\n";
 }
 
+// The march's matrices with the variational equations at march_sensitivity_tol = 1e-8 (the
+// default) and at the state's own tolerance (0): the same branch. The looser matrices only steer
+// the predictor and the chords; every point is corrected on the same exact residual to 1e-10, so
+// both runs are on the Elastica to kLocated and take the same steps (the same number of points).
+// The tangents of regular points differ (the looser Phi is accurate to ~1e-8 of its size, F_lambda
+// by central differences on it to less; measured 8.9e-7 at most), which shows the looser matrices
+// were used: differing by more than 1e-13 (round-off) and less than 1e-5 (a predictor that far off
+// would not change the corrector counts, which must agree, but the bound catches a wrong matrix).
+TEST(EulerColumn, LooserMarchMatricesGiveTheSameBuckledBranch) {
+  ContinuationOptions tight = buckled_options(3.0);
+  tight.march_sensitivity_tol = 0;
+  const ContinuationResult a = first_buckled_branch(tight);
+  const ContinuationResult b = first_buckled_branch(buckled_options(3.0));
+  ASSERT_EQ(a.reason, StopReason::EventStop) << a.message;
+  ASSERT_EQ(b.reason, StopReason::EventStop) << b.message;
+  ASSERT_EQ(a.points.size(), b.points.size());
+  double largest_tangent_change = 0;
+  for (size_t k = 0; k < b.points.size(); ++k) {
+    const ContinuationPoint &p = b.points[k], &q = a.points[k];
+    ASSERT_EQ(p.type, q.type) << k;
+    EXPECT_EQ(p.newton_iterations, q.newton_iterations) << k;
+    const double theta0 = p.derived.at("theta0");
+    // The singular touching-ends branch point is checked to 1e-5 in FirstBuckledBranchMatches...
+    if (theta0 < 1e-3 || p.type == PointType::BranchPoint) continue;
+    const double exact = analytic::PinnedElastica{1.0, 1.0, theta0}.load();
+    EXPECT_NEAR(p.parameter / exact, 1.0, kLocated) << theta0;
+    EXPECT_NEAR(p.parameter / q.parameter, 1.0, kLocated) << theta0;
+    if (p.type == PointType::Regular) largest_tangent_change = std::max(largest_tangent_change, (p.tangent - q.tangent).norm());
+  }
+  EXPECT_GT(largest_tangent_change, 1e-13);
+  EXPECT_LT(largest_tangent_change, 1e-5);
+  std::cout << "largest change of a regular point's tangent " << largest_tangent_change << "\n";
+  EXPECT_NEAR(b.points.back().derived.at("theta0"), 3.0, 1e-9);
+}
+
+// A run with a target ends exactly on it: the located end point is corrected again at the target
+// itself. The secant stops within 1e-15 of it, which for targets of order 1e-2 is several ulps:
+// the soft wall's shortening continued to Delta = 0.026 ended at 0.0259999999999998 (with the
+// march's looser matrices), and `continue --start-from` that end then set that value, not 0.026.
+// The residual at the end is within the corrector's tolerance.
+TEST(SoftWall, TheEndPointIsExactlyOnTheTarget) {
+  for (double target : {0.026, 0.0237}) {
+    ContinuationOptions o;
+    o.parameter = "Delta";
+    o.target = target;
+    o.samples = 41;
+    o.derived = {"P"};
+    const BranchRun run = continue_case("soft_wall.toml", {{"log_b", -4.0}, {"Delta", 0.02}, {"m_guess", 1.0}}, o);
+    ASSERT_EQ(run.result.reason, StopReason::ReachedTarget) << run.result.message;
+    const ContinuationPoint& end = run.result.points.back();
+    EXPECT_EQ(end.type, PointType::Endpoint);
+    EXPECT_EQ(end.parameter, target);
+    ShootingProblem at_end = *run.problem;
+    at_end.set_parameter("Delta", end.parameter);
+    Eigen::VectorXd F;
+    std::string failure;
+    ASSERT_TRUE(at_end.evaluate(end.x, &F, nullptr, &failure)) << failure;
+    EXPECT_LE(F.lpNorm<Eigen::Infinity>(), run.continuation->options().corrector_tolerance);
+  }
+}
+
 // A step_check that refuses steps longer than 2 in P: the run shortens its steps and goes on
 // (every accepted step within the limit, the same target reached); one that refuses every step
 // stops the run as inadmissible with its reason.
@@ -271,6 +332,26 @@ TEST(TwistedRod, DoubleBranchPointAgreesWithTheClampedGreenhillCondition) {
   // At zero tension: M L / B = 8.9868 (twice the first root of tan x = x), phi = 1.3 M.
   const BranchRun run = continue_case("twisted_clamped.toml", {{"phi", 6.0}}, twist_options());
   EXPECT_NEAR(of_type(run.result, PointType::BranchPoint)[0].parameter, 11.6828645906, 1e-6);
+}
+
+// The double branch point with the march's looser matrices (the default) and without them: the
+// located point's correctors and matrices are the problem's own, and Brent stops on h to ~1e-12
+// of the step, so both agree to 1e-10 relative (measured: to the last bit of phi); two null
+// directions either way (the zero modes the stability test counts there).
+TEST(TwistedRod, DoubleBranchPointIsTheSameWithTheLooserMarchMatrices) {
+  ContinuationOptions tight = twist_options();
+  tight.stop_at_branch_point = 1;
+  ContinuationOptions loose = tight;
+  tight.march_sensitivity_tol = 0;
+  const BranchRun a = continue_case("twisted_clamped.toml", {{"phi", 6.0}}, tight);
+  const BranchRun b = continue_case("twisted_clamped.toml", {{"phi", 6.0}}, loose);
+  ASSERT_EQ(a.result.reason, StopReason::BranchPointStop);
+  ASSERT_EQ(b.result.reason, StopReason::BranchPointStop);
+  const ContinuationPoint &p = a.result.points.back(), &q = b.result.points.back();
+  EXPECT_NEAR(q.parameter / p.parameter, 1.0, 1e-10);
+  EXPECT_LE((q.x - p.x).norm(), 1e-10 * p.x.norm());
+  EXPECT_EQ(q.multiplicity, 2);
+  EXPECT_EQ(p.multiplicity, 2);
 }
 
 TEST(TwistedRod, BuckledBranchKeepsItsInvariants) {

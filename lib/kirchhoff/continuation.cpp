@@ -33,6 +33,12 @@ double sign_of(double v) { return v < 0 ? -1.0 : 1.0; }
 // by locating inside a step, and a resumed run finds it again by redoing that step.
 bool resumable_type(PointType t) { return t == PointType::Start || t == PointType::Regular; }
 
+// Obstacles or contacts: the march's looser matrices are not used
+// (ContinuationOptions::march_sensitivity_tol).
+bool has_contact(const ProblemDefinition& d) {
+  return !d.obstacles.empty() || d.moving_obstacles || !d.contacts.empty();
+}
+
 }  // namespace
 
 const char* to_string(PointType type) {
@@ -76,6 +82,7 @@ std::string ContinuationOptions::validate() const {
   if (samples < 2 || samples > 100000) return "samples must be in [2, 100000]";
   if (!(0 <= grow_iterations && grow_iterations < shrink_iterations))
     return "grow_iterations must be >= 0 and below shrink_iterations";
+  if (!(march_sensitivity_tol >= 0)) return "march_sensitivity_tol must be >= 0 (0: the problem's own)";
   if (reuse_jacobian_iterations >= 0 && detect_branch_points)
     return "reusing Jacobians needs detect_branch_points = false (the test functions need each point's own)";
   return {};
@@ -98,6 +105,13 @@ Continuation::Continuation(const ShootingProblem& problem, ContinuationOptions o
   // layer's (it reads the derived list completed with the events' quantities above).
   if (!options_.recorder) options_.recorder = rod_point_recorder(options_);
   n_ = problem_.size();
+  const ProblemDefinition& d = problem_.definition();
+  if (!has_contact(d) &&
+      options_.march_sensitivity_tol > std::max(d.options.integrator.sensitivity_tol, d.options.integrator.abs_tol)) {
+    ProblemDefinition loose = d;
+    loose.options.integrator.sensitivity_tol = options_.march_sensitivity_tol;
+    march_problem_.emplace(std::move(loose));
+  }
 }
 
 Eigen::VectorXd Continuation::join(const Eigen::VectorXd& x, double lambda) const {
@@ -106,7 +120,8 @@ Eigen::VectorXd Continuation::join(const Eigen::VectorXd& x, double lambda) cons
   return z;
 }
 
-bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure) {
+bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
+                            bool march) {
   const double lambda = z[n_];
   const Eigen::VectorXd x = z.head(n_);
   problem_.set_parameter(options_.parameter, lambda);
@@ -115,9 +130,12 @@ bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen:
     return problem_.evaluate(x, F, nullptr, failure);
   }
   ++evaluations_.matrices;
+  // (Its residual is the same number as problem_'s: the state is integrated at the same tolerance.)
+  ShootingProblem& p = march && march_problem_ ? *march_problem_ : problem_;
+  if (&p != &problem_) p.set_parameter(options_.parameter, lambda);
   Eigen::VectorXd y_end, F_lambda;
-  if (!problem_.evaluate_with_end(x, F, A, &y_end, failure)) return false;
-  if (!problem_.parameter_derivative(x, options_.parameter, &F_lambda, failure, &y_end)) return false;
+  if (!p.evaluate_with_end(x, F, A, &y_end, failure)) return false;
+  if (!p.parameter_derivative(x, options_.parameter, &F_lambda, failure, &y_end)) return false;
   // A column appended in place: the matrices of long rods are tens of megabytes, and realloc
   // extends such blocks without copying them.
   A->conservativeResize(n_, n_ + 1);
@@ -126,7 +144,7 @@ bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen:
 }
 
 bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
-                           int* iterations, const Eigen::MatrixXd* chord, bool* by_chord) {
+                           int* iterations, const Eigen::MatrixXd* chord, bool* by_chord, bool march) {
   Eigen::VectorXd F, G(n_ + 1);
   Eigen::MatrixXd A;
   std::string failure;
@@ -166,7 +184,7 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
       if (!(max_abs_or_nan(G) <= kModifiedNewtonContraction * previous)) lu.reset();
     }
     if (!lu) {
-      if (!evaluate(z, &F, &A, &failure)) {
+      if (!evaluate(z, &F, &A, &failure, march)) {
         last_corrector_failure_ = failure;
         return false;
       }
@@ -211,7 +229,8 @@ std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z
     Eigen::VectorXd F;
     Eigen::MatrixXd own;
     std::string failure;
-    if (!evaluate(z, &F, &own, &failure)) return std::nullopt;
+    // The march's matrix at the points it can resume from (restore() evaluates the same one).
+    if (!evaluate(z, &F, &own, &failure, resumable_type(type))) return std::nullopt;
     A = std::make_shared<const Eigen::MatrixXd>(std::move(own));
   }
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n_ + 1);
@@ -255,7 +274,7 @@ std::optional<ContinuationPoint> Continuation::restore(const ContinuationPoint& 
   Eigen::VectorXd F;
   Eigen::MatrixXd A;
   std::string failure;
-  if (!evaluate(z, &F, &A, &failure)) return std::nullopt;
+  if (!evaluate(z, &F, &A, &failure, resumable_type(saved.type))) return std::nullopt;
   // The saved tangent, not one solved for again: bordered by another row (the point's own
   // tangent instead of its predecessor's) the solve gives the same direction to round-off only.
   ContinuationPoint p = make_point(z, saved.tangent, std::make_shared<const Eigen::MatrixXd>(std::move(A)), false,
@@ -283,7 +302,18 @@ std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint
   Eigen::VectorXd z = z_pred;
   int iterations = 0;
   bool by_chord = false;
-  if (!correct(z, z_pred, from.tangent, &iterations, from.jacobian.get(), &by_chord)) return std::nullopt;
+  // The march's own steps with its matrices; a located point's correctors (and its matrix, in
+  // point_at) with the problem's own, as its test functions are.
+  const bool march = type == PointType::Regular;
+  if (!correct(z, z_pred, from.tangent, &iterations, from.jacobian.get(), &by_chord, march)) {
+    // Where Newton needs the matrix to more digits than the march's (a stiff self-contact
+    // barrier, where it stalled at a residual of 2e-8), the step is corrected again with the
+    // problem's own before it counts as failed. Its chord iterations on the same matrix from the
+    // same prediction would fail again: Newton at once.
+    if (!march || !march_problem_) return std::nullopt;
+    z = z_pred;
+    if (!correct(z, z_pred, from.tangent, &iterations)) return std::nullopt;
+  }
   // A corrector that converged quickly on the previous matrix shows that matrix still serves:
   // the new point keeps it for its tangent and the next chord instead of paying for its own.
   // (Not a modified-Newton matrix from an iterate of this corrector: tried at L/2R = 200, its
@@ -301,6 +331,20 @@ std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint
   }
   return point;
 }
+
+std::optional<ContinuationPoint> Continuation::at_parameter(const ContinuationPoint& located, double value) {
+  const Eigen::VectorXd z0 = join(located.x, located.parameter);
+  Eigen::VectorXd z = join(located.x, value), e = Eigen::VectorXd::Zero(n_ + 1);
+  e[n_] = 1.0;
+  int iterations = 0;
+  if (!correct(z, z, e, &iterations, located.jacobian.get())) return std::nullopt;
+  auto point = point_at(z, located.tangent, located.type, located.index, located.arclength + (z - z0).norm(),
+                        located.newton_iterations);
+  if (point) describe(&*point);
+  if (point && !point->check_failure.empty()) return std::nullopt;
+  return point;
+}
+
 std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& from, double h_max,
                                                       const std::function<double(const ContinuationPoint&)>& monitor,
                                                       bool minimise, PointType type) {
@@ -606,6 +650,9 @@ struct Continuation::Marcher {
                                 [this](const ContinuationPoint& from, double h_max, const detail::TestFunction& test,
                                        bool minimise, PointType type) {
                                   return c.locate(from, h_max, test, minimise, type);
+                                },
+                                [this](const ContinuationPoint& located, double value) {
+                                  return c.at_parameter(located, value);
                                 }};
     for (const auto& d : detectors)
       if (d->detect(step, found) == detail::Verdict::RetryShorter) return false;

@@ -88,6 +88,16 @@ struct ContinuationOptions {
   // Where the matrix costs tens of residuals (the variational equations of long multiple-shooting
   // rods) this is far cheaper per point.
   bool modified_newton = false;
+  // The matrices [F_x F_lambda] of the march's steps (the correctors', and the tangents of the
+  // regular points they reach) with the variational equations held to this tolerance
+  // (IntegratorOptions::sensitivity_tol) instead of the state's: a chord or a tangent needs the
+  // matrix to a few digits only, and every point is corrected on the exact residual (the state
+  // keeps its tolerance). Located special points (branch points, folds, events, the end: their
+  // correctors and their own matrices) keep the problem's own: their test functions reach 1e-12.
+  // Not applied to problems with obstacles or contacts (their events and energy differences
+  // follow Newton's last iterates to better than the looser matrices' 1e-9; docs/performance.md)
+  // nor where the problem's own sensitivity_tol is already looser. 0: the problem's own everywhere.
+  double march_sensitivity_tol = 1e-8;
   // On max |F| and |arclength condition|; NaN: 1e-10, or the problem's Newton residual tolerance
   // (a case's [solver] tolerance) when that is looser - rods with large forces need it.
   double corrector_tolerance = std::numeric_limits<double>::quiet_NaN();
@@ -245,13 +255,17 @@ class Continuation {
   const EvaluationCount& evaluations() const { return evaluations_; }
 
  private:
-  bool evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure);
+  // With `march` the matrix comes from march_problem_ when there is one (march_sensitivity_tol).
+  bool evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
+                bool march = false);
   // Newton on [F; normal.(z - z_predicted)] = 0. With `chord` (the Jacobian at a nearby point)
   // it first iterates with that fixed matrix, one integration without sensitivities per
   // iteration, and turns to (modified, with options_.modified_newton) Newton only if those
-  // iterations stop contracting.
+  // iterations stop contracting. With `march` its matrices are the march's
+  // (march_sensitivity_tol).
   bool correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
-               int* iterations, const Eigen::MatrixXd* chord = nullptr, bool* by_chord = nullptr);
+               int* iterations, const Eigen::MatrixXd* chord = nullptr, bool* by_chord = nullptr,
+               bool march = false);
   // Tangent at z oriented by `previous`, with the test functions, as a point (not described).
   // With `reused`, that matrix stands for [F_x F_lambda] at z (no evaluation).
   std::optional<ContinuationPoint> point_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous, PointType type,
@@ -278,9 +292,16 @@ class Continuation {
   void describe(ContinuationPoint* point);
   void record(ContinuationPoint* point);
   std::optional<ContinuationPoint> step_from(const ContinuationPoint& from, double h, PointType type);
+  // `located` (a point found by locate) corrected again at the parameter `value` exactly, with
+  // the problem's own matrices: a run's end lies on its target, not within the location's
+  // tolerance of it. Empty if that corrector fails.
+  std::optional<ContinuationPoint> at_parameter(const ContinuationPoint& located, double value);
   Eigen::VectorXd join(const Eigen::VectorXd& x, double lambda) const;
 
   ShootingProblem problem_;
+  // The problem with its variational equations at march_sensitivity_tol, for the march's matrices;
+  // empty where that does not apply (see ContinuationOptions).
+  std::optional<ShootingProblem> march_problem_;
   ContinuationOptions options_;
   int n_ = 0;  // number of shooting unknowns
   EvaluationCount evaluations_;

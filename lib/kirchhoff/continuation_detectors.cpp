@@ -21,6 +21,7 @@ class SignChange : public Detector {
     auto p = step.locate(step.current, step.h, test, false, type());
     if (!p) return Verdict::Nothing;
     if (!close_enough(*p) && step.can_shrink) return Verdict::RetryShorter;
+    refine(step, &*p);
     finish(&*p);
     found->push_back({std::move(*p), stop(), this});
     return Verdict::Found;
@@ -33,6 +34,8 @@ class SignChange : public Detector {
   // False: the located point missed (a corrector failed inside the step) and the step is retried
   // shorter while it can be.
   virtual bool close_enough(const ContinuationPoint&) const { return true; }
+  // The located point made exact where the test function allows it (the parameter's value).
+  virtual void refine(const StepView&, ContinuationPoint*) const {}
   virtual void finish(ContinuationPoint*) const {}
 };
 
@@ -47,12 +50,19 @@ class ParameterValue : public SignChange {
   std::optional<StopReason> stop() const override { return reason_; }
   // A corrector that failed inside the step leaves the location short of the target (or the whole
   // step's point, beyond it): retried with a shorter step rather than stopped off the target.
-  bool close_enough(const ContinuationPoint& p) const override {
-    return reason_ != StopReason::ReachedTarget ||
-           std::abs(p.parameter - value_) <= kTargetTolerance * std::max(1.0, std::abs(value_));
+  bool close_enough(const ContinuationPoint& p) const override { return reason_ != StopReason::ReachedTarget || near(p); }
+  // The secant leaves the parameter within round-off of the value, on whichever side; corrected
+  // again at the value itself, the end lies on it (a run started from it sets exactly that value).
+  // Kept as located if that corrector fails.
+  void refine(const StepView& step, ContinuationPoint* p) const override {
+    if (p->parameter == value_ || !near(*p)) return;
+    if (auto pinned = step.pin(*p, value_)) *p = std::move(*pinned);
   }
 
  private:
+  bool near(const ContinuationPoint& p) const {
+    return std::abs(p.parameter - value_) <= kTargetTolerance * std::max(1.0, std::abs(value_));
+  }
   double value_;
   StopReason reason_;
 };

@@ -32,6 +32,9 @@ using TestFunction = std::function<double(const ContinuationPoint&)>;
 // test function vanishes (minimise = false) or is minimal (true), typed `type`.
 using Locator = std::function<std::optional<ContinuationPoint>(const ContinuationPoint& from, double h_max,
                                                                const TestFunction& test, bool minimise, PointType type)>;
+// Continuation::at_parameter: a located point corrected again at exactly that parameter value
+// (empty if that fails).
+using ParameterPin = std::function<std::optional<ContinuationPoint>(const ContinuationPoint& located, double value)>;
 
 // One step of the march, current -> candidate, as the detectors see it.
 struct StepView {
@@ -43,6 +46,7 @@ struct StepView {
   bool just_reported_branch_point;  // the step that reached `current` found a branch point
   bool can_shrink;                  // the step may still be halved (above the minimum step)
   Locator locate;
+  ParameterPin pin;
 };
 
 // The counts the detectors' actions keep over a march (saved in MarchState).
