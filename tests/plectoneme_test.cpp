@@ -203,7 +203,11 @@ TEST(Plectoneme, SelfPassageGuardKeepsTheBranchAtTheSharpFold) {
   o.detect_branch_points = false;
   o.derived = {"T_ext", "m3"};
   o.samples = 101;
-  const ContinuationResult unguarded = Continuation(problem, o).run(start.x);
+  // The unguarded run used to jump at the fold onto a sheet two turns on (m3 < 0): the start
+  // frame's twist was gauged into (-pi, pi] and jumped by 2 pi where the clamp passes half a turn
+  // (turns = 1, just before this fold), which the corrector could exploit. With the twist gauged
+  // modulo whole turns (spatial_equations.cpp) that jump is gone; what is checked here is that the
+  // guarded run stays on the branch through the sharp fold and locates it.
   ContinuationOptions guarded_options = o;
   ASSERT_TRUE(guard_self_passage(problem, &guarded_options));
   const ContinuationResult guarded = Continuation(problem, guarded_options).run(start.x);
@@ -216,10 +220,6 @@ TEST(Plectoneme, SelfPassageGuardKeepsTheBranchAtTheSharpFold) {
     }
     return out;
   };
-  bool jumped = false;
-  for (const auto& p : after_first_fold(unguarded)) jumped |= p.derived.at("m3") < 0.0;
-  EXPECT_TRUE(jumped) << "the unguarded run no longer crosses the fold: this test's premise is gone";
-  EXPECT_GT(guarded.refused_steps, 0);
   int folds = 0;
   for (const auto& p : after_first_fold(guarded)) {
     EXPECT_GT(p.derived.at("m3"), 0.2) << "turns " << p.parameter;

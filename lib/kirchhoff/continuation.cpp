@@ -5,6 +5,7 @@
 #include <cmath>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 
 #include "kirchhoff/continuation_detectors.hpp"
 #include "kirchhoff/jacobian_lu.hpp"
@@ -122,6 +123,19 @@ Eigen::VectorXd Continuation::join(const Eigen::VectorXd& x, double lambda) cons
 
 bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
                             bool march) {
+  // A parameter value where no rod can be built (a self-contact radius below zero, reached by a
+  // corrector iterate far off the branch) is a failed evaluation, so the step is shortened as for
+  // any other; it used to end the whole run with the model's exception.
+  try {
+    return evaluate_at(z, F, A, failure, march);
+  } catch (const std::invalid_argument& e) {
+    if (failure) *failure = "no rod at " + options_.parameter + " = " + std::to_string(z[n_]) + ": " + e.what();
+    return false;
+  }
+}
+
+bool Continuation::evaluate_at(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
+                               bool march) {
   const double lambda = z[n_];
   const Eigen::VectorXd x = z.head(n_);
   problem_.set_parameter(options_.parameter, lambda);

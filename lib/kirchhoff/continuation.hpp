@@ -258,6 +258,8 @@ class Continuation {
   // With `march` the matrix comes from march_problem_ when there is one (march_sensitivity_tol).
   bool evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
                 bool march = false);
+  bool evaluate_at(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
+                   bool march);
   // Newton on [F; normal.(z - z_predicted)] = 0. With `chord` (the Jacobian at a nearby point)
   // it first iterates with that fixed matrix, one integration without sensitivities per
   // iteration, and turns to (modified, with options_.modified_newton) Newton only if those

@@ -968,6 +968,16 @@ StabilityReport whole_rod(const StabilityReport& symmetric, const StabilityRepor
   return out;
 }
 
+// The equilibrium at the shooting nodes, read from the unknowns (no integration).
+std::vector<RodPoint> node_points(const ShootingProblem& problem, const Eigen::VectorXd& x, const RodEquations& eq) {
+  const std::vector<double> s = problem.node_arclengths(x);
+  const int n = problem.state_size();
+  std::vector<RodPoint> nodes;
+  for (int i = 0; i < problem.segments() && i < static_cast<int>(s.size()); ++i)
+    nodes.push_back(eq.point(x.segment(i * n, n), s[i]));
+  return nodes;
+}
+
 }  // namespace
 
 StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::VectorXd& x,
@@ -979,24 +989,37 @@ StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::V
     // Half of a half-turn symmetric rod: the end as stated holds the symmetric perturbations; the
     // antisymmetric ones have the complementary conditions and, with self-contact, the pair
     // energy's other second variation.
-    const StabilityReport symmetric = StabilityAnalysis(problem, x, options, end, nullptr).run();
     const auto equations = problem.equations(problem.parameters_at(x));
-    const EndCondition anti_end = antisymmetric_half_turn_end(end.half_turn_axis());
-    StabilityAnalysis anti(problem, x, options, anti_end, antisymmetric_equations(*equations));
-    anti.track_barrier(equations);
-    const StabilityReport antisymmetric = anti.run();
+    // Acting already at a shooting node (a formed ply), the antisymmetric pass - its steps refined
+    // through the stiff barrier - could only end in the null below: it is not run.
+    const bool acts_at_nodes =
+        antisymmetric_barrier_stiffness(*equations, node_points(problem, x, *equations)) > options.zero_tolerance;
+    if (acts_at_nodes && !options.symmetric_index_where_contact_acts) {
+      StabilityReport out;
+      out.reason = "the self-contact acts: the whole rod's index needs the antisymmetric perturbations of the "
+                   "contact between the strands (their closest points sliding along both), which are not "
+                   "implemented";
+      return out;
+    }
+    const StabilityReport symmetric = StabilityAnalysis(problem, x, options, end, nullptr).run();
     // Where the self-contact acts, the whole rod's antisymmetric second variation is not that of
     // the partner pairs (stability_symmetric.hpp): not reported. Below the zero tolerance the
     // term moves no eigenvalue beyond what is called zero anyway.
-    if (anti.barrier_stiffness() > options.zero_tolerance) {
+    auto barrier_acts = [&](long rhs_evaluations) {
       StabilityReport out;
       out.reason = "the self-contact acts: the whole rod's index needs the antisymmetric perturbations of the "
                    "contact between the strands (their closest points sliding along both), which are not "
                    "implemented; the symmetric perturbations' index is given";
       out.symmetric_index = symmetric.index;
-      out.rhs_evaluations = symmetric.rhs_evaluations + antisymmetric.rhs_evaluations;
+      out.rhs_evaluations = symmetric.rhs_evaluations + rhs_evaluations;
       return out;
-    }
+    };
+    if (acts_at_nodes) return barrier_acts(0);
+    const EndCondition anti_end = antisymmetric_half_turn_end(end.half_turn_axis());
+    StabilityAnalysis anti(problem, x, options, anti_end, antisymmetric_equations(*equations));
+    anti.track_barrier(equations);
+    const StabilityReport antisymmetric = anti.run();
+    if (anti.barrier_stiffness() > options.zero_tolerance) return barrier_acts(antisymmetric.rhs_evaluations);
     return whole_rod(symmetric, antisymmetric);
   } catch (const IntegrationError& e) {
     StabilityReport report;

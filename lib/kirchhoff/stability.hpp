@@ -98,6 +98,11 @@ struct StabilityOptions {
   // (position-dependent fields, contacts with curved obstacles); forcing it elsewhere only checks
   // that the two frames count alike (tests).
   bool positions_as_configuration = false;
+  // On half of a half-turn symmetric rod whose self-contact acts at a shooting node (where the
+  // whole rod's index is not defined), still compute the symmetric half's index
+  // (StabilityReport::symmetric_index). Continuation records only the index, and skips it: through
+  // a formed ply it costs several times the rest of the point.
+  bool symmetric_index_where_contact_acts = true;
 };
 
 struct StabilityReport {
