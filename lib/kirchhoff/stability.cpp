@@ -968,6 +968,21 @@ StabilityReport whole_rod(const StabilityReport& symmetric, const StabilityRepor
   return out;
 }
 
+// Where the self-contact acts, the whole rod's antisymmetric second variation is not that of the
+// partner pairs (stability_symmetric.hpp): the index is not reported, the symmetric half's when
+// it was computed.
+StabilityReport self_contact_acts(const StabilityReport* symmetric, long rhs_evaluations) {
+  StabilityReport out;
+  out.reason = "the self-contact acts: the whole rod's index needs the antisymmetric perturbations of the "
+               "contact between the strands (their closest points sliding along both), which are not "
+               "implemented";
+  if (!symmetric) return out;
+  out.reason += "; the symmetric perturbations' index is given";
+  out.symmetric_index = symmetric->index;
+  out.rhs_evaluations = symmetric->rhs_evaluations + rhs_evaluations;
+  return out;
+}
+
 // The equilibrium at the shooting nodes, read from the unknowns (no integration).
 std::vector<RodPoint> node_points(const ShootingProblem& problem, const Eigen::VectorXd& x, const RodEquations& eq) {
   const std::vector<double> s = problem.node_arclengths(x);
@@ -994,32 +1009,16 @@ StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::V
     // through the stiff barrier - could only end in the null below: it is not run.
     const bool acts_at_nodes =
         antisymmetric_barrier_stiffness(*equations, node_points(problem, x, *equations)) > options.zero_tolerance;
-    if (acts_at_nodes && !options.symmetric_index_where_contact_acts) {
-      StabilityReport out;
-      out.reason = "the self-contact acts: the whole rod's index needs the antisymmetric perturbations of the "
-                   "contact between the strands (their closest points sliding along both), which are not "
-                   "implemented";
-      return out;
-    }
+    if (acts_at_nodes && !options.symmetric_index_where_contact_acts) return self_contact_acts(nullptr, 0);
     const StabilityReport symmetric = StabilityAnalysis(problem, x, options, end, nullptr).run();
-    // Where the self-contact acts, the whole rod's antisymmetric second variation is not that of
-    // the partner pairs (stability_symmetric.hpp): not reported. Below the zero tolerance the
-    // term moves no eigenvalue beyond what is called zero anyway.
-    auto barrier_acts = [&](long rhs_evaluations) {
-      StabilityReport out;
-      out.reason = "the self-contact acts: the whole rod's index needs the antisymmetric perturbations of the "
-                   "contact between the strands (their closest points sliding along both), which are not "
-                   "implemented; the symmetric perturbations' index is given";
-      out.symmetric_index = symmetric.index;
-      out.rhs_evaluations = symmetric.rhs_evaluations + rhs_evaluations;
-      return out;
-    };
-    if (acts_at_nodes) return barrier_acts(0);
+    if (acts_at_nodes) return self_contact_acts(&symmetric, 0);
     const EndCondition anti_end = antisymmetric_half_turn_end(end.half_turn_axis());
     StabilityAnalysis anti(problem, x, options, anti_end, antisymmetric_equations(*equations));
     anti.track_barrier(equations);
     const StabilityReport antisymmetric = anti.run();
-    if (anti.barrier_stiffness() > options.zero_tolerance) return barrier_acts(antisymmetric.rhs_evaluations);
+    // Below the zero tolerance the term moves no eigenvalue beyond what is called zero anyway.
+    if (anti.barrier_stiffness() > options.zero_tolerance)
+      return self_contact_acts(&symmetric, antisymmetric.rhs_evaluations);
     return whole_rod(symmetric, antisymmetric);
   } catch (const IntegrationError& e) {
     StabilityReport report;
