@@ -13,6 +13,7 @@
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/continuation.hpp"
+#include "kirchhoff/discrete_stability.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {
@@ -70,6 +71,35 @@ TEST(Stability, BuckledColumnModeKHasIndexKMinusOneUntilTheEndsMeet) {
     EXPECT_EQ(*r.index, row.index);
     EXPECT_EQ(r.zero_modes, 0);
   }
+}
+
+// Exactly where the first mode's ends meet (theta0 = theta_c, x(L) = 0, at P = lambda_1 = 21.549)
+// the lateral reaction is zero, and turning the whole rod about the pin is a zero mode: r(L) stays
+// on the roller's line, the energy is unchanged, and the internal force, -P e_x, turns only at
+// second order, so the dead load still balances it to first order. The index is 0 (the first
+// mode is stable until there); the discretised energy's lowest eigenvalue is zero within its
+// discretisation error. (With n_y != 0, the closed mode-2 and mode-3 rods at P = 50, the turn
+// changes the axial force by -n_y phi and is not a zero mode: equilibria_test.cpp.)
+TEST(Stability, ModeOneWhereItsEndsMeetHasTheTurnAboutThePinAsItsZeroMode) {
+  double lo = 2.0, hi = 2.6;  // x(L) of the mode-1 Elastica changes sign once in between
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (analytic::PinnedElastica{1.0, 1.0, mid}.end_to_end() > 0 ? lo : hi) = mid;
+  }
+  const double theta_c = 0.5 * (lo + hi), P = analytic::PinnedElastica{1.0, 1.0, theta_c}.load();
+  const auto solved = solve_case("euler_column.toml", {{"P", P}, {"theta_guess", theta_c}});
+  ASSERT_NEAR(solved.solution.derived.at("theta0"), theta_c, 1e-8);  // the mode-1 Elastica, not another
+  EXPECT_LT(solved.solution.derived.at("end_to_end"), 1e-9);
+  const StabilityReport r = index_of(solved);
+  ASSERT_TRUE(r.defined()) << r.reason;
+  EXPECT_EQ(*r.index, 0);
+  EXPECT_EQ(r.zero_modes, 1);
+  // Measured: -1.2e-4 at 400 elements, -4.8e-4 at 200 (second order towards 0); the next is 17.8.
+  const DiscreteStability d = discrete_stability(*solved.problem, solved.solution.result.x);
+  ASSERT_FALSE(d.lowest_eigenvalues.empty()) << d.reason;
+  EXPECT_LT(std::abs(d.lowest_eigenvalues[0]), 1e-3);
+  ASSERT_GE(d.lowest_eigenvalues.size(), 2u);
+  EXPECT_GT(d.lowest_eigenvalues[1], 1.0);
 }
 
 // Clamped-clamped rod with the end shortening imposed: the symmetric first mode is stable, the
