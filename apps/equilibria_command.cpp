@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -17,9 +18,34 @@
 namespace kirchhoff::cli {
 namespace {
 
+// The index, and the zero modes beside it ("1 +1 zero"): an equilibrium with zero modes is not
+// isolated (or sits at a bifurcation), which a count of equilibria must not hide.
 std::string index_text(const StabilityReport& s) {
   if (!s.index) return "-";
-  return s.stable() ? "0 (stable)" : std::to_string(*s.index);
+  const std::string index = s.stable() && s.zero_modes == 0 ? "0 (stable)" : std::to_string(*s.index);
+  return s.zero_modes > 0 ? index + " +" + std::to_string(s.zero_modes) + " zero" : index;
+}
+
+int count(const EquilibriaSearch& search, const std::function<bool(const Equilibrium&)>& which) {
+  return static_cast<int>(std::count_if(search.equilibria.begin(), search.equilibria.end(), which));
+}
+
+// One line per continuous family under the table: its members (table numbers) and what it is.
+void print_family_notes(const EquilibriaSearch& search) {
+  for (int family = 1; family <= search.families; ++family) {
+    std::ostringstream members;
+    int found = 0, zero_modes = 0;
+    for (size_t i = 0; i < search.equilibria.size(); ++i) {
+      if (search.equilibria[i].family != family) continue;
+      members << (found++ ? ", #" : "#") << i + 1;
+      zero_modes = search.equilibria[i].stability.zero_modes;
+    }
+    std::cout << "  family " << family << ": " << members.str() << " (" << zero_modes << " zero mode"
+              << (zero_modes > 1 ? "s" : "") << "): "
+              << (found > 1 ? std::to_string(found) + " points of one continuous family, the same rod moved rigidly"
+                            : "one point of a continuous family, or a bifurcation point")
+              << "\n";
+  }
 }
 
 std::string contacts_text(const Solution& sol) {
@@ -40,24 +66,39 @@ std::string contacts_text(const Solution& sol) {
 void print_table(const Case& c, const EquilibriaSearch& search) {
   std::cout << (c.title.empty() ? c.path : c.title) << "\n";
   std::cout << "  " << search.equilibria.size() << " distinct equilibria (" << search.stopped_because << ", "
-            << search.newton_runs << " Newton runs), "
-            << (std::any_of(search.equilibria.begin(), search.equilibria.end(),
-                            [](const Equilibrium& e) { return std::isnan(e.energy); })
+            << search.newton_runs << " Newton runs)";
+  if (search.families > 0) {
+    const int isolated = count(search, [](const Equilibrium& e) { return e.stability.defined() && e.family == 0; });
+    const int members = count(search, [](const Equilibrium& e) { return e.family > 0; });
+    std::cout << ": " << isolated << " isolated, " << members << " with zero modes on " << search.families
+              << " continuous famil" << (search.families > 1 ? "ies" : "y") << " (see below)";
+    if (const int undefined = static_cast<int>(search.equilibria.size()) - isolated - members; undefined > 0)
+      std::cout << ", " << undefined << " with the index undefined";
+  }
+  std::cout << ", ";
+  const bool some_energy_undefined = std::any_of(search.equilibria.begin(), search.equilibria.end(),
+                                                 [](const Equilibrium& e) { return std::isnan(e.energy); });
+  std::cout << (some_energy_undefined
                     ? "energy not defined for some (see docs/equilibria.md), those in the order found:\n"
                     : "by increasing energy:\n");
-  std::cout << "  " << std::setw(3) << "#" << std::setw(16) << "energy" << std::setw(12) << "index" << std::setw(11)
-            << "residual" << std::setw(11) << "H spread";
+  const bool families = search.families > 0;
+  std::cout << "  " << std::setw(3) << "#" << std::setw(16) << "energy" << std::setw(12) << "index";
+  if (families) std::cout << std::setw(8) << "family";
+  std::cout << std::setw(11) << "residual" << std::setw(11) << "H spread";
   for (const auto& name : c.derived) std::cout << std::setw(15) << name;
   std::cout << "  contacts\n";
   for (size_t i = 0; i < search.equilibria.size(); ++i) {
     const Equilibrium& e = search.equilibria[i];
     const Solution& sol = e.solution;
     std::cout << "  " << std::setw(3) << i + 1 << std::setw(16) << std::setprecision(10) << e.energy << std::setw(12)
-              << index_text(e.stability) << std::setw(11) << std::setprecision(2) << sol.result.summary.residual_norm
+              << index_text(e.stability);
+    if (families) std::cout << std::setw(8) << (e.family > 0 ? std::to_string(e.family) : "-");
+    std::cout << std::setw(11) << std::setprecision(2) << sol.result.summary.residual_norm
               << std::setw(11) << sol.invariants.H.relative_spread() << std::setprecision(8);
     for (const auto& name : c.derived) std::cout << std::setw(15) << sol.derived.at(name);
     std::cout << "  " << contacts_text(sol) << "\n";
   }
+  print_family_notes(search);
   for (size_t i = 0; i < search.equilibria.size(); ++i) {
     const StabilityReport& s = search.equilibria[i].stability;
     if (!s.index) std::cout << "  #" << i + 1 << ": index undefined: " << s.reason << "\n";
@@ -74,6 +115,7 @@ nlohmann::json search_json(const Case& c, const EquilibriaSearch& search) {
   out["parameters"] = parameters_json(c.definition.parameters);
   out["stopped_because"] = search.stopped_because;
   out["newton_runs"] = search.newton_runs;
+  out["families"] = search.families;
   out["equilibria"] = nlohmann::json::array();
   for (size_t i = 0; i < search.equilibria.size(); ++i) {
     const Equilibrium& e = search.equilibria[i];
@@ -81,6 +123,10 @@ nlohmann::json search_json(const Case& c, const EquilibriaSearch& search) {
     j["rank"] = i + 1;
     j["energy"] = std::isfinite(e.energy) ? nlohmann::json(e.energy) : nlohmann::json();
     j["found_by"] = e.found_by;
+    // No zero mode: an isolated equilibrium; null where the stability analysis is not defined.
+    j["isolated"] = e.stability.defined() ? nlohmann::json(e.stability.zero_modes == 0) : nlohmann::json();
+    // The continuous family it is a point of (docs/equilibria.md), null when isolated.
+    j["family"] = e.family > 0 ? nlohmann::json(e.family) : nlohmann::json();
     out["equilibria"].push_back(std::move(j));
   }
   out["rejected"] = nlohmann::json::array();

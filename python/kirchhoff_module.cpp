@@ -181,6 +181,7 @@ struct PySolution {
   py::object stability = py::none();  // as the CLI's JSON "stability"; None when not converged
   double energy = NAN;                // Case.equilibria(): total potential energy (NaN from solve())
   std::string found_by;               // Case.equilibria(): which seed led to it
+  py::object family = py::none();     // Case.equilibria(): its continuous family (1, 2, ...), None if isolated
   py::object path = py::none();       // as the CLI's JSON "path": how the equilibrium was reached
 };
 
@@ -736,6 +737,7 @@ PySolution equilibrium_solution(const Case& c, const Equilibrium& e) {
   out.message = e.found_by;
   out.energy = e.energy;
   out.found_by = e.found_by;
+  if (e.family > 0) out.family = py::int_(e.family);
   out.parameters = parameters_dict(sol.result.parameters);
   for (const auto& name : c.derived) out.derived[py::str(name)] = sol.derived.at(name);
   out.invariants = invariants_dict(sol.invariants);
@@ -842,6 +844,10 @@ Attributes:
                     "Total potential energy (Case.equilibria(): elastic energy plus the potential of the field\n"
                     "and of the given end loads, docs/equilibria.md; NaN from solve())")
       .def_readonly("found_by", &PySolution::found_by, "Case.equilibria(): which seed led to it ('' from solve())")
+      .def_readonly("family", &PySolution::family,
+                    "Case.equilibria(): the continuous family (1, 2, ...) of an equilibrium with zero modes, as the\n"
+                    "CLI's JSON 'family' (members: equal energies and a rigid motion between them,\n"
+                    "docs/equilibria.md); None for an isolated one and from solve()")
       .def("__bool__", [](const PySolution& s) { return s.converged; }, "True when converged.")
       .def("__repr__", &repr_solution);
 
@@ -986,7 +992,8 @@ Args:
 
 Returns:
     list of Solution, by increasing energy: each converged and admissible, with the fields
-    solve() gives (derived, invariants, profile, contacts, stability) and energy, found_by.)doc")
+    solve() gives (derived, invariants, profile, contacts, stability) and energy, found_by,
+    family (the continuous family of an equilibrium with zero modes, None when isolated).)doc")
       .def("vibrate", &py_vibrate, py::kw_only(), py::arg("modes") = 3, py::arg("rho_s") = 1.0,
            py::arg("samples") = 201,
            R"doc(Small-amplitude vibrations about the case's equilibrium (the CLI's `vibrate`, eqs. B.4).

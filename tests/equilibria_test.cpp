@@ -12,10 +12,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "kirchhoff/analytic.hpp"
 #include "kirchhoff/case_file.hpp"
+#include "kirchhoff/discrete_stability.hpp"
+#include "kirchhoff/equilibrium_families.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {
@@ -109,17 +113,73 @@ double elastica_theta0(double P, double EI, double L, int n) {
   return 0.5 * (lo + hi);
 }
 
+// The Euler column's rods whose ends meet (x(L) = 0), at the dead load P: each is a closed
+// mode-k Elastica (k half-waves) under the force |n| = k^2 lambda_1, lambda_1 the load at which the
+// mode-1 Elastica's ends meet (theta0 = theta_c, x(L) = 0), turned so that n_x = -P: the lateral
+// reaction is +-sqrt(|n|^2 - P^2), and each sign comes with its mirror image, four rods per k.
+// Energy: bending only (x(L) = 0), -|n| L cos(theta_c) (H = -|n| cos(theta_c) along the rod and
+// the chord along n is zero).
+// They are isolated equilibria, not points of a family: turning such a rod by phi about the pin
+// keeps its energy and r(L) = 0, but turns its internal force with it, changing the axial end
+// force by -n_y phi, which the dead load forbids unless n_y = 0 (the mode-1 rod exactly where its
+// ends meet, stability_test.cpp). So no zero mode, and the discretised energy (an independent
+// count) agrees: no eigenvalue near zero.
+void expect_isolated_rods_whose_ends_meet(const std::vector<const Equilibrium*>& meeting, double P) {
+  double lo = 2.0, hi = 2.6;  // x(L) of the mode-1 Elastica changes sign once in between
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (analytic::PinnedElastica{1.0, 1.0, mid}.end_to_end() > 0 ? lo : hi) = mid;
+  }
+  const double theta_c = 0.5 * (lo + hi), lambda_1 = analytic::PinnedElastica{1.0, 1.0, theta_c}.load();
+  ASSERT_EQ(meeting.size(), 8u);
+  int count[4] = {0, 0, 0, 0}, positive_reaction[4] = {0, 0, 0, 0};
+  for (const Equilibrium* e : meeting) {
+    const Vec3 n = e->solution.profile.front().n;
+    const int k = static_cast<int>(std::lround(std::sqrt(n.norm() / lambda_1)));
+    SCOPED_TRACE("closed mode " + std::to_string(k) + ", n_y = " + std::to_string(n.y()));
+    ASSERT_TRUE(k == 2 || k == 3);  // mode 1 closes at lambda_1 = 21.5 < P: no such rod at P = 50
+    ++count[k];
+    positive_reaction[k] += n.y() > 0;
+    EXPECT_LT(e->solution.derived.at("end_to_end"), 1e-9);
+    // The closed forms, from the elliptic integrals to ~1e-12: the solve's 1e-8 relative.
+    EXPECT_NEAR(n.x(), -P, 1e-8 * P);
+    EXPECT_NEAR(n.norm(), k * k * lambda_1, 1e-8 * n.norm());
+    EXPECT_NEAR(e->energy, -k * k * lambda_1 * std::cos(theta_c), 1e-8 * e->energy);
+    ASSERT_TRUE(e->stability.index) << e->stability.reason;
+    EXPECT_EQ(*e->stability.index, k);
+    EXPECT_EQ(e->stability.zero_modes, 0);
+  }
+  for (int k : {2, 3}) {
+    EXPECT_EQ(count[k], 4);
+    EXPECT_EQ(positive_reaction[k], 2);
+  }
+  // The independent count on one rod of each energy (the list is sorted by energy).
+  for (const Equilibrium* e : {meeting.front(), meeting.back()}) {
+    const DiscreteStability d = discrete_stability(*e->problem, e->solution.result.x);
+    ASSERT_TRUE(d.defined()) << d.reason;
+    EXPECT_TRUE(d.trustworthy) << d.check_message;
+    EXPECT_EQ(d.index, e->stability.index);
+    EXPECT_EQ(d.zero_modes, 0);
+    // A symmetry would give |mu| ~ 1e-10 (discrete_stability.hpp); measured, the eigenvalue closest
+    // to zero is -8.70 (mode 2) and -10.77 (mode 3) B / L^2, equal at N and N / 2 to 1e-4.
+    double closest = std::numeric_limits<double>::infinity();
+    for (double mu : d.lowest_eigenvalues) closest = std::min(closest, std::abs(mu));
+    EXPECT_GT(closest, 1.0);
+  }
+}
+
 TEST(Equilibria, EulerColumnAtP50) {
   const double P = 50.0, EI = 1.0, L = 1.0;
   const EquilibriaSearch s = search("euler_column.toml", {{"P", P}});
   // Besides the five classical equilibria the dead-load column has rods whose ends meet
   // (x(L) = 0: the roller's lateral reaction then does no moment about the pin, so n_y != 0 is
-  // allowed). The five are the ones with the ends apart.
-  std::vector<const Equilibrium*> apart;
+  // allowed). The five are the ones with the ends apart; the others are checked below.
+  std::vector<const Equilibrium*> apart, meeting;
   for (const auto& e : s.equilibria)
-    if (e.solution.derived.at("end_to_end") > 1e-9) apart.push_back(&e);
-    else EXPECT_LT(e.solution.derived.at("end_to_end"), 1e-9);
+    (e.solution.derived.at("end_to_end") > 1e-9 ? apart : meeting).push_back(&e);
   ASSERT_EQ(apart.size(), 5u);
+  expect_isolated_rods_whose_ends_meet(meeting, P);
+  EXPECT_EQ(s.families, 0);  // all thirteen isolated
   // By energy: mode 1 (both mirror images), mode 2 (both), the straight column.
   const int expected_modes[5] = {1, 1, 2, 2, 0};
   for (int k = 0; k < 5; ++k) {
@@ -307,6 +367,82 @@ TEST(Equilibria, TwistedRodListsEachCircleOfBuckledRodsOnce) {
                 1e-6);
 }
 
+// A rod pinned at both ends at the same point: both positions held, the reaction a multiplier, so
+// turning any equilibrium about the pin gives another (its force turned with it): every closed
+// Elastica is a circle of equilibria, each with one zero mode, of which deflation finds several
+// points. They are grouped into families, never dropped: within a family the rod is the same up to
+// the turn (checked independently of rigid_motion_distance on the tangent angle, theta(s) -
+// theta(0)); a rod and its mirror image (the loop run the other way round) are two families.
+constexpr const char* kRodPinnedTwiceAtOnePoint = R"(
+model = "planar"
+[parameters]
+F = 86.0
+[rod]
+length = 1.0
+B = 1.0
+[start]
+type = "pinned"
+position = [0, 0]
+[end]
+type = "pinned"
+position = [0, 0]
+[guess]
+orientation = { axis = [0, 0, 1], angle = 2.2 }
+force = ["-F", 0]
+)";
+
+TEST(Equilibria, PointsOfOneContinuousFamilyAreGroupedNotCounted) {
+  const Case c = load_case_text(kRodPinnedTwiceAtOnePoint, "pinned_twice.toml", {});
+  EquilibriaOptions options;
+  options.max_equilibria = 8;
+  const EquilibriaSearch s = find_equilibria(c.definition, c.start_guess, c.derived, 201, options);
+  expect_all_sound(s, c.definition.options.newton.residual_tolerance);
+  ASSERT_EQ(s.equilibria.size(), 8u);
+  ASSERT_GE(s.families, 2);
+  std::vector<int> members(s.families + 1, 0);
+  // The tangent angle relative to its start along the rod: what a turn in the plane keeps.
+  auto turning = [](const Equilibrium& e) {
+    std::vector<double> out;
+    for (const RodPoint& p : e.solution.profile) out.push_back(p.turn_angle - e.solution.profile.front().turn_angle);
+    return out;
+  };
+  for (size_t i = 0; i < s.equilibria.size(); ++i) {
+    const Equilibrium& e = s.equilibria[i];
+    ASSERT_TRUE(e.stability.index) << e.stability.reason;
+    EXPECT_EQ(e.stability.zero_modes, 1) << i;
+    ASSERT_GE(e.family, 1) << i;
+    ASSERT_LE(e.family, s.families) << i;
+    ++members[e.family];
+    for (size_t j = 0; j < i; ++j) {
+      const Equilibrium& o = s.equilibria[j];
+      double largest = 0.0;  // max_s of the difference of theta(s) - theta(0)
+      const auto a = turning(e), b = turning(o);
+      for (size_t k = 0; k < a.size(); ++k) largest = std::max(largest, std::abs(a[k] - b[k]));
+      SCOPED_TRACE("#" + std::to_string(i + 1) + " and #" + std::to_string(j + 1));
+      // Converged profiles agree to ~1e-9 (equilibria.hpp): 1e-6 for the same rod turned; a rod
+      // and its mirror image differ at O(1) (0.1 leaves a wide margin).
+      if (e.family == o.family) {
+        EXPECT_NEAR(e.energy, o.energy, 1e-10 * e.energy);
+        EXPECT_LT(largest, 1e-6);
+        EXPECT_LT(rigid_motion_distance(*o.problem, o.solution.result.x, *e.problem, e.solution.result.x, 1.0), 1e-6);
+      } else {
+        EXPECT_TRUE(std::abs(e.energy - o.energy) > 1e-6 * e.energy || largest > 0.1);
+      }
+    }
+  }
+  // Some family was found more than once (the point of grouping): measured, 2 + 2 points of the
+  // first closed mode's circle and its mirror image's, 3 + 1 of the second's.
+  EXPECT_GE(*std::max_element(members.begin(), members.end()), 2);
+  // The independent count: the discretised energy sees the turn about the pin as a zero
+  // eigenvalue (~1e-10, discrete_stability.hpp) beside the same index.
+  const Equilibrium& first = s.equilibria.front();
+  const DiscreteStability d = discrete_stability(*first.problem, first.solution.result.x);
+  ASSERT_TRUE(d.defined()) << d.reason;
+  EXPECT_TRUE(d.trustworthy) << d.check_message;
+  EXPECT_EQ(d.zero_modes, 1);
+  EXPECT_EQ(d.index, first.stability.index);
+}
+
 int run(const std::string& arguments, const std::string& out) {
   const std::string command = std::string(KIRCHHOFF_CLI) + " " + arguments + " > " + out + " 2>/dev/null";
   return WEXITSTATUS(std::system(command.c_str()));
@@ -330,14 +466,50 @@ TEST(EquilibriaCli, JsonListsTheModesWithEnergyIndexAndProfiles) {
     EXPECT_EQ(e["status"], "converged");
     EXPECT_EQ(e["rank"], k + 1);
     EXPECT_EQ(e["stability"]["index"], indices[k]);
+    EXPECT_EQ(e["isolated"], true);
+    EXPECT_TRUE(e["family"].is_null());
     EXPECT_TRUE(e["energy"].is_number());
     EXPECT_TRUE(std::filesystem::exists(dir / "profiles" / ("equilibrium_" + std::to_string(k + 1) + ".csv")));
   }
   EXPECT_EQ(j["stopped_because"], "max_equilibria reached");
+  EXPECT_EQ(j["families"], 0);
   // A bad --set is refused as input.
   EXPECT_EQ(run("equilibria " + case_path("clamped_clamped.toml") + " --set nope=1", out), 2);
   // Deflated continuation with a resume is refused (such a run is not resumable), not ignored.
   EXPECT_EQ(run("continue " + case_path("euler_column.toml") + " --param P --to 20 --deflate --resume", out), 2);
+}
+
+// Equilibria with zero modes are not isolated: the table says so (index "1 +1 zero", a family
+// column, the header's counts, one line per family) and the JSON gives "isolated" and "family".
+// The rod pinned twice at one point (PointsOfOneContinuousFamilyAreGroupedNotCounted): its first
+// four equilibria are one point of the first closed mode's circle, two of the second's, and one
+// of the second's mirror image.
+TEST(EquilibriaCli, PointsOfAContinuousFamilyAreListedAsOneFamily) {
+  const auto dir = std::filesystem::temp_directory_path() / "kirchhoff_equilibria_families";
+  std::filesystem::create_directories(dir);
+  const std::string case_file = (dir / "pinned_twice.toml").string();
+  std::ofstream(case_file) << kRodPinnedTwiceAtOnePoint;
+  const std::string args = "equilibria " + case_file + " --max 4";
+  const std::string text = (dir / "out.txt").string(), json = (dir / "out.json").string();
+  ASSERT_EQ(run(args, text), 0);
+  std::ifstream in_text(text);
+  const std::string table((std::istreambuf_iterator<char>(in_text)), std::istreambuf_iterator<char>());
+  EXPECT_NE(table.find("): 0 isolated, 4 with zero modes on 3 continuous families (see below)"), std::string::npos)
+      << table;
+  EXPECT_NE(table.find("1 +1 zero"), std::string::npos) << table;
+  EXPECT_NE(table.find("family 2: #2, #3 (1 zero mode): 2 points of one continuous family"), std::string::npos)
+      << table;
+  ASSERT_EQ(run(args + " --json", json), 0);
+  std::ifstream in_json(json);
+  const nlohmann::json j = nlohmann::json::parse(in_json);
+  EXPECT_EQ(j["families"], 3);
+  ASSERT_EQ(j["equilibria"].size(), 4u);
+  const int families[4] = {1, 2, 2, 3};
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(j["equilibria"][k]["isolated"], false) << k;
+    EXPECT_EQ(j["equilibria"][k]["family"], families[k]) << k;
+    EXPECT_EQ(j["equilibria"][k]["stability"]["zero_modes"], 1) << k;
+  }
 }
 
 }  // namespace

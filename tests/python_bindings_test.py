@@ -776,6 +776,20 @@ class EquilibriaTest(unittest.TestCase):
         self.assertAlmostEqual(energies[0], energies[1], delta=1e-8 * energies[0])
         self.assertNotAlmostEqual(eqs[0].profile["y"][100], eqs[1].profile["y"][100], places=3)
 
+    def test_points_of_a_continuous_family_share_its_number(self):
+        # A rod pinned at both ends at one point: every closed Elastica is a circle of equilibria
+        # (turned about the pin), of which the search finds several points (the CLI's JSON
+        # "family"; tests/equilibria_test.cpp checks the grouping).
+        with tempfile.TemporaryDirectory() as d:
+            path = pathlib.Path(d) / "pinned_twice.toml"
+            path.write_text('model = "planar"\n[parameters]\nF = 86.0\n[rod]\nlength = 1.0\nB = 1.0\n'
+                            '[start]\ntype = "pinned"\nposition = [0, 0]\n[end]\ntype = "pinned"\nposition = [0, 0]\n'
+                            '[guess]\norientation = { axis = [0, 0, 1], angle = 2.2 }\nforce = ["-F", 0]\n')
+            eqs = kirchhoff.load_case(str(path)).equilibria(max=4)
+        self.assertEqual([e.family for e in eqs], [1, 2, 2, 3])
+        self.assertEqual([e.stability["zero_modes"] for e in eqs], [1, 1, 1, 1])
+        self.assertIsNone(kirchhoff.load_case(case_path("clamped_clamped.toml")).equilibria(max=1)[0].family)
+
     def test_bad_options_raise(self):
         c = kirchhoff.load_case(case_path("clamped_clamped.toml"))
         with self.assertRaises(ValueError):

@@ -12,6 +12,7 @@
 #include "kirchhoff/closest_approach.hpp"
 #include "kirchhoff/contact.hpp"
 #include "kirchhoff/discrete_seed.hpp"
+#include "kirchhoff/equilibrium_families.hpp"
 #include "kirchhoff/invariants.hpp"
 #include "kirchhoff/link.hpp"
 #include "kirchhoff/verification.hpp"
@@ -309,6 +310,8 @@ class Search {
     std::stable_sort(out_.equilibria.begin(), out_.equilibria.end(), [](const Equilibrium& a, const Equilibrium& b) {
       return std::isnan(b.energy) ? !std::isnan(a.energy) : a.energy < b.energy;
     });
+    out_.families = group_continuous_families(&out_.equilibria, force_scale_, options_.distinct_tolerance,
+                                              options_.family_energy_tolerance, options_.compare_samples);
     return std::move(out_);
   }
 
@@ -616,7 +619,8 @@ EquilibriaSearch find_equilibria(const ProblemDefinition& definition, const RodP
                                  const std::vector<std::string>& derived_names, int samples,
                                  const EquilibriaOptions& options) {
   if (options.max_equilibria < 1 || options.restarts_per_seed < 1 || options.low_modes < 0 ||
-      std::any_of(options.mode_amplitudes.begin(), options.mode_amplitudes.end(), [](double a) { return !(a > 0); }) || !(options.distinct_tolerance > 0) || options.compare_samples < 2 ||
+      std::any_of(options.mode_amplitudes.begin(), options.mode_amplitudes.end(), [](double a) { return !(a > 0); }) ||
+      !(options.distinct_tolerance > 0) || !(options.family_energy_tolerance > 0) || options.compare_samples < 2 ||
       !(options.max_seconds >= 0))
     throw std::invalid_argument("equilibria: invalid options (counts >= 1, amplitudes and tolerances > 0)");
   return Search(definition, guess, derived_names, samples, options).run();

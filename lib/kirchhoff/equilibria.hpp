@@ -25,6 +25,11 @@
 // zero mode is compared modulo rotations about e3 as well (axial_orbit_distance): the isotropic
 // rod clamped on the axis has circles of equilibria, each listed once.
 //
+// Equilibria with zero modes are not isolated: each is one point of a continuous family (or a
+// bifurcation point). Members of one family that the search found as distinct points are grouped
+// (Equilibrium::family: equal energies and a rigid motion between them, equilibrium_families.hpp),
+// never dropped.
+//
 // Every reported equilibrium has passed: max |F| <= the case's Newton tolerance, the solution's
 // own checks (verification.hpp, link.hpp), and with obstacles 0 <= gap perp force >= 0 (gap >=
 // -penetration_tolerance along the rod, every contact force >= -force_tolerance, wrapped parts
@@ -61,6 +66,12 @@ struct EquilibriaOptions {
   // bifurcation, where they are not distinct in any useful sense.
   double distinct_tolerance = 1e-6;
   int compare_samples = 101;   // where profiles are compared
+  // Equilibria with zero modes whose energies agree to this (relative to |E| + F0 L) and that a
+  // rigid motion maps onto each other (within distinct_tolerance) are members of one continuous
+  // family (equilibrium_families.hpp). Energies are computed to ~1e-13 of their scale (Simpson,
+  // below), and a family's members have exactly equal energies: 1e-8 leaves five orders for the
+  // solve's error, while distinct equilibria differ at O(1) (or within 1e-8 of a bifurcation).
+  double family_energy_tolerance = 1e-8;
   // Complementarity, as contact.hpp's active-set loop judges it.
   double penetration_tolerance = 1e-9;
   double force_tolerance = 1e-9;
@@ -74,6 +85,9 @@ struct Equilibrium {
   StabilityReport stability;
   double energy = 0.0;   // total_potential_energy
   std::string found_by;  // which seed led to it
+  // The continuous family it belongs to (1, 2, ...), where it has zero modes; 0 for an isolated
+  // equilibrium or one whose index is not defined (equilibrium_families.hpp).
+  int family = 0;
 };
 
 struct RejectedPoint {
@@ -87,6 +101,7 @@ struct EquilibriaSearch {
   std::vector<RejectedPoint> rejected;  // converged points that are not equilibria, with why
   std::vector<std::string> log;         // one line per seed and outcome
   int newton_runs = 0;
+  int families = 0;  // continuous families among the equilibria (Equilibrium::family)
   // Why the search ended: "seeds exhausted", "max_equilibria reached", "time limit", "max_newton_runs".
   std::string stopped_because;
 };
