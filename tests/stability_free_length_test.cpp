@@ -184,6 +184,29 @@ TEST(FreeLength, SlingHasAStableAndAnUnstableEquilibriumAtTheSameSleeves) {
   EXPECT_EQ(*b.report.index, 1);
 }
 
+// The two equilibria of the two-sleeve rod meet at a fold as the first sleeve turns: `kirchhoff
+// continue` of kSlingCase in theta1 (theta2 = 1) locates it at theta1 = 1.96768195, ell =
+// 2.10198316 (its fold detector: the parameter component of the branch's tangent changing sign,
+// bisected - the whole problem's Jacobian, not this analysis). Just before it (theta1 = 1.96768)
+// the two equilibria are stable and index 1, with S of opposite signs and small (2e-3 of its
+// scale, against 1 away from the fold), and S interpolated linearly between them vanishes at the
+// fold's length to 2e-5 (the interpolation's error, ~ the square of their distance 3.4e-3).
+TEST(FreeLength, SlingExchangesStabilityAtTheFoldInTheSleeveAngle) {
+  const Sliding before = sling({{"theta1", 1.96768}, {"ell", 2.0}});
+  const Sliding after = sling({{"theta1", 1.96768}, {"ell", 2.09}});
+  const double la = length_of(before), lb = length_of(after);
+  ASSERT_GT(lb - la, 1e-3);  // two equilibria (measured 2.100262 and 2.103705)
+  const FreeLengthStability a = analyse_free_length(*before.problem, before.x);
+  const FreeLengthStability b = analyse_free_length(*after.problem, after.x);
+  ASSERT_TRUE(a.report.defined() && b.report.defined()) << a.report.reason << b.report.reason;
+  EXPECT_EQ(*a.report.index, 0);
+  EXPECT_EQ(*b.report.index, 1);
+  EXPECT_LT(std::abs(a.reduced_curvature), 1e-2 * a.curvature_scale);
+  EXPECT_LT(std::abs(b.reduced_curvature), 1e-2 * b.curvature_scale);
+  const double zero = la + a.reduced_curvature * (lb - la) / (a.reduced_curvature - b.reduced_curvature);
+  EXPECT_NEAR(zero, 2.10198316, 2e-5);
+}
+
 // The unknowns' layout with several shooting segments (the length's column after every node's
 // state): the same index, and S to 1e-6 of its scale, the Jacobian's own accuracy (each segment
 // integrated to 1e-12, the length's column by central differences either way); measured 4e-10.

@@ -86,9 +86,11 @@ std::string reduced_curvature(const ShootingProblem& problem, const Eigen::Vecto
   const Eigen::VectorXd dx = -lu.solve(F_ell);  // the fixed-length family's tangent dx/d ell
   if (!dx.allFinite() || (J_fixed * dx + F_ell).norm() > 1e-8 * (1.0 + F_ell.norm() + (J_fixed * dx).norm()))
     return "the problem with the length held has a singular Jacobian: the reduction on the length is not defined";
-  const double r_ell = J_full(k, c), along = r_x.dot(dx);
-  *S = -(r_ell + along);
-  *scale = std::abs(r_ell) + std::abs(along);
+  // The sizes of the products S sums, over which cancellation may lose digits (each has the
+  // units of S; r_ell itself vanishes where H is conserved along the rod).
+  const double r_ell = J_full(k, c);
+  *S = -(r_ell + r_x.dot(dx));
+  *scale = std::abs(r_ell) + r_x.cwiseProduct(dx.transpose()).cwiseAbs().sum();
   return "";
 }
 

@@ -22,7 +22,7 @@
 //      one linear solve with the Jacobian Newton uses, no extra Newton solves. Its accuracy is
 //      that of the ell column (central differences of the flow, kParameterStep = 1e-6) and of the
 //      H row (central differences of a closed form): S is zero (a zero mode) within
-//      kFreeLengthZeroTolerance of the sizes of the terms it is the difference of.
+//      kFreeLengthZeroTolerance of the sizes of the products it sums.
 //
 // Not covered (index null, reason given): an unknown that moves an obstacle (no energy of which
 // it is a degree of freedom), several unknowns that change the rod, other unknown parameters
@@ -40,11 +40,12 @@
 
 namespace kirchhoff {
 
-// S within this fraction of the sizes of its two terms (|r_ell| + |r_x dx/d ell|) is zero. The
-// terms are accurate to ~1e-8 of their size (the ell column's central differences: truncation
-// ~1e-12, round-off of the 1e-12 integration over the 1e-6 step ~1e-6 of the smallest term at
-// worst, measured ~1e-8 against Newton-solved families in the test), so 1e-5 leaves a margin
-// while a fold passed by 1e-5 of the scale is called a zero mode rather than guessed.
+// S within this fraction of the sizes of the products it sums (|r_ell| + sum_i |r_x,i dx_i/d ell|)
+// is zero. Those products are accurate to ~1e-8 of their size (the ell column's central
+// differences: truncation ~1e-12, round-off of the 1e-12 integration over the 1e-6 step ~1e-6 at
+// worst; S measured against energies along Newton-solved families agrees to 2e-8 of the scale),
+// so 1e-5 leaves a margin while a fold passed by 1e-5 of the scale is called a zero mode rather
+// than guessed.
 inline constexpr double kFreeLengthZeroTolerance = 1e-5;
 
 struct FreeLengthStability {
@@ -52,7 +53,7 @@ struct FreeLengthStability {
   StabilityReport fixed_length;  // of the problem with the length held at its value
   std::string parameter;         // the sliding length's name (empty: the problem has none)
   double reduced_curvature = 0.0;  // S = d^2 E*/d ell^2 (force per length); NaN where not computed
-  double curvature_scale = 0.0;    // |r_ell| + |r_x dx/d ell|: what S's zero test is relative to
+  double curvature_scale = 0.0;    // |r_ell| + sum_i |r_x,i dx_i/d ell|: what S's zero test is relative to
 };
 
 // The unknown parameter that changes the rod or an obstacle, "" when none does (then
