@@ -133,8 +133,8 @@ class FixedFamily {
     if (point) {
       const double L = problem.length(problem.parameters_at(r.x));
       const RodPoint exit = problem.sample(r.x, {exit_at_start_ ? 0.0 : L}).front();
-      const RodModel& model = problem.equations(problem.parameters_at(r.x))->model();
-      *point = {total_potential_energy(problem, r.x) + inside_H_ * ell, hamiltonian(model, exit)};
+      const auto equations = problem.equations(problem.parameters_at(r.x));
+      *point = {total_potential_energy(problem, r.x) + inside_H_ * ell, hamiltonian(equations->model(), exit)};
     }
     return r.x;
   }
@@ -332,8 +332,8 @@ TEST(FreeLength, ArmScaleMatchesTheSmallDeflectionLimit) {
 
 // Where the reduction does not apply the index stays null with the reason: the same arm-scale
 // equilibrium with ell chosen so that the tip is horizontal (an angle condition, not the sliding
-// condition) is not a sliding length; an unknown without any parameter changing the rod is not
-// this analysis's business.
+// condition) is not a sliding length, nor is a length that also scales the stiffness; a problem
+// without an unknown changing the rod is not this analysis's business.
 TEST(FreeLength, NullWhereTheLengthDoesNotSlide) {
   Case c = load_case(testing::case_path("arm_scale.toml"));
   ProblemDefinition& d = c.definition;
@@ -347,6 +347,14 @@ TEST(FreeLength, NullWhereTheLengthDoesNotSlide) {
   const StabilityReport report = analyse_free_length_stability(problem, r.x);
   EXPECT_FALSE(report.defined());
   EXPECT_NE(report.reason.find("not balanced by the continuity of H"), std::string::npos) << report.reason;
+
+  // The length also scaling the stiffness: the energy's slope is no longer -H at the exit.
+  std::string text = testing::case_text("arm_scale.toml");
+  text.replace(text.find("B = \"EI\""), 8, "B = \"EI * ell\"");
+  const Sliding scaled = solve_sliding(load_case_text(text, testing::case_path("arm_scale.toml")), 0.0);
+  const StabilityReport stiff = analyse_free_length_stability(*scaled.problem, scaled.x);
+  EXPECT_FALSE(stiff.defined());
+  EXPECT_NE(stiff.reason.find("not only its length"), std::string::npos) << stiff.reason;
 
   const auto column = testing::solve_case("euler_column.toml");
   const StabilityReport none = analyse_free_length_stability(*column.problem, column.solution.result.x);

@@ -47,6 +47,35 @@ std::string unsupported_reason(const ShootingProblem& problem, const std::string
   return "";
 }
 
+// Why dE_outside/d ell = -H at the exit (what S rests on) may fail here, "" when it holds: it
+// needs a Lagrangian without explicit s (a uniform rod, H conserved) whose only dependence on ell
+// is the rod's length, and no field (the part inside the sleeve would feel it, and its energy is
+// not part of the case).
+std::string energy_slope_reason(const ShootingProblem& problem, const Eigen::VectorXd& x, const std::string& name) {
+  const Parameters p = problem.parameters_at(x);
+  const auto equations = problem.equations(p);  // held: the next call replaces the problem's cache
+  const RodModel& model = equations->model();
+  if (model.field)
+    return "an external field acts on the sliding rod: the part inside the sleeve feels it too, and its energy is "
+           "not part of the case";
+  if (!model.is_uniform())
+    return "the sliding rod's properties vary along it: the energy's slope in its length is not the jump of H across the exit";
+  Parameters moved = p;
+  moved.set(name, p.get(name) * (1 + 1e-3) + 1e-3);
+  const auto other_equations = problem.equations(problem.completed(moved));
+  const RodModel& other = other_equations->model();
+  auto same = [](const std::array<Profile, 3>& a, const std::array<Profile, 3>& b) {
+    for (int i = 0; i < 3; ++i)
+      if (a[i](0.0) != b[i](0.0)) return false;
+    return true;
+  };
+  if (other.extensible != model.extensible || !same(model.B, other.B) || !same(model.A, other.A) ||
+      !same(model.u_hat, other.u_hat) || !same(model.v_hat, other.v_hat) || other.field)
+    return "the unknown parameter '" + name + "' changes the rod's properties, not only its length: it is not a "
+           "sliding length";
+  return "";
+}
+
 // Row k of `full` whose removal, with column `column`, leaves `fixed`: the H row. -1 when none
 // does (the two problems do not differ by that row and column alone).
 int hamiltonian_row(const Eigen::MatrixXd& full, const Eigen::MatrixXd& fixed, int column) {
@@ -138,6 +167,11 @@ FreeLengthStability analyse_free_length(const ShootingProblem& problem, const Ei
     fixed = fixed_length_problem(problem, x, out.parameter);
   } catch (const std::exception& e) {
     return undefined(out, e.what());
+  }
+  try {
+    if (std::string why = energy_slope_reason(problem, x, out.parameter); !why.empty()) return undefined(out, why);
+  } catch (const std::exception& e) {
+    return undefined(out, std::string("the rod could not be built at a nearby length: ") + e.what());
   }
   const std::string held = "with the length '" + out.parameter + "' held: ";
   out.fixed_length = analyse_stability(*fixed.problem, fixed.x, options);

@@ -27,8 +27,11 @@
 // Not covered (index null, reason given): an unknown that moves an obstacle (no energy of which
 // it is a degree of freedom), several unknowns that change the rod, other unknown parameters
 // beside it (end loads acting as multipliers), a length not balanced by an H condition at one end
-// (then it is not a sliding length), half-turn symmetric half rods, a fixed-length problem with a
-// zero mode (Q singular: the reduction is not defined) or whose own index is undefined.
+// (then it is not a sliding length), a length that changes the rod's properties besides its
+// length, a rod whose properties vary along it or that feels an external field (dE_outside/d ell
+// = -H needs a Lagrangian without explicit s, and a field would act on the part inside the sleeve
+// too, which the case does not describe), half-turn symmetric half rods, a fixed-length problem
+// with a zero mode (Q singular: the reduction is not defined) or whose own index is undefined.
 #pragma once
 
 #include <Eigen/Dense>
