@@ -273,6 +273,11 @@ py::dict stability_dict(const StabilityReport& st, const DiscreteStability& disc
     d["cross_check"] = check;
   }
   d["method"] = st.method;
+  if (st.reduced_energy_curvature) {
+    d["sliding_length"] = st.sliding_length;
+    d["fixed_length_index"] = *st.fixed_length_index;
+    d["reduced_energy_curvature"] = *st.reduced_energy_curvature;
+  }
   if (st.index) {
     d["load_controlled_index"] = st.dead_load_index;
     d["held_chord_directions"] = st.constraint_count;

@@ -72,6 +72,11 @@ nlohmann::json stability_json(const StabilityReport& st, const DiscreteStability
                         {"agrees", discrete->trustworthy && st.index && *st.index == *discrete->index}};
   }
   j["method"] = st.method;
+  if (st.reduced_energy_curvature) {
+    j["sliding_length"] = st.sliding_length;
+    j["fixed_length_index"] = *st.fixed_length_index;
+    j["reduced_energy_curvature"] = *st.reduced_energy_curvature;
+  }
   if (st.index) {
     j["load_controlled_index"] = st.dead_load_index;
     j["held_chord_directions"] = st.constraint_count;

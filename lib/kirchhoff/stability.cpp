@@ -2,6 +2,7 @@
 #include "kirchhoff/stability.hpp"
 
 #include "kirchhoff/self_contact.hpp"
+#include "kirchhoff/stability_free_length.hpp"
 #include "kirchhoff/stability_symmetric.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -998,6 +999,8 @@ std::vector<RodPoint> node_points(const ShootingProblem& problem, const Eigen::V
 StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::VectorXd& x,
                                   const StabilityOptions& options) {
   try {
+    // An unknown that changes the rod (a sleeve's sliding length): reduced on it, or null with why.
+    if (!rod_changing_unknown(problem).empty()) return analyse_free_length_stability(problem, x, options);
     const EndCondition& end = problem.definition().end;
     if (!end.is_half_turn_symmetry() || !unsupported(problem, x).empty())
       return StabilityAnalysis(problem, x, options, end, nullptr).run();

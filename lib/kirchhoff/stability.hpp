@@ -121,6 +121,12 @@ struct StabilityReport {
   // acting: stability_symmetric.hpp).
   std::optional<int> symmetric_index, antisymmetric_index;
   std::string method = "conjugate_points";
+  // A sliding length among the unknowns (stability_free_length.hpp, method
+  // "conjugate_points+reduced_energy"): its name, the index with it held, and S = d^2 E*/d ell^2
+  // along the equilibria at fixed length (index = fixed_length_index + 1 if S < 0).
+  std::string sliding_length;
+  std::optional<int> fixed_length_index;
+  std::optional<double> reduced_energy_curvature;
   long rhs_evaluations = 0;
   bool defined() const { return index.has_value(); }
   bool stable() const { return index && *index == 0; }

@@ -192,6 +192,9 @@ FreeLengthStability analyse_free_length(const ShootingProblem& problem, const Ei
   if (fold) out.report.zero_modes += 1;
   *out.report.index += (!fold && out.reduced_curvature < 0) ? 1 : 0;
   out.report.constraint_correction = *out.report.index - out.report.dead_load_index;
+  out.report.sliding_length = out.parameter;
+  out.report.fixed_length_index = out.fixed_length.index;
+  out.report.reduced_energy_curvature = out.reduced_curvature;
   return out;
 }
 
