@@ -58,7 +58,8 @@
 // Not covered (index null with the reason): extended contacts, contacts of extensible rods,
 // contacts with zero force (weakly active) or where the rod is about to flatten or wrap onto the
 // obstacle (g'' = 0), half-turn ends that impose the loop's rotation, half-turn points at s = 0
-// and half-turn symmetric rods with contacts, unknown parameters that are not end loads,
+// and half-turn symmetric rods with contacts, unknown parameters that are not end loads except a
+// sliding length closed by the continuity of H (stability_free_length.hpp),
 // non-conservative loads (a dead couple on a 3D end free to rotate), degenerate constraints (a
 // straight rod held at its full length), degenerate crossings.
 #pragma once
