@@ -782,26 +782,8 @@ std::string repr_solution(const PySolution& s) {
   return o.str();
 }
 
-}  // namespace
-
-PYBIND11_MODULE(kirchhoff, m) {
-  m.doc() = R"doc(Elastic-rod equilibria by shooting and pseudo-arclength continuation.
-
-    >>> import kirchhoff
-    >>> case = kirchhoff.load_case("cases/simply_supported.toml", set={"theta0": 1.0})
-    >>> sol = case.solve(samples=201)
-    >>> sol.status, sol.derived["P"]            # ('converged', 11.2224...)
-    >>> sol.profile["x"], sol.profile["y"]      # numpy arrays along the rod
-    >>> branch = kirchhoff.load_case("cases/euler_column.toml", set={"P": 1, "theta_guess": 0}) \
-    ...     .continue_("P", to=12, switch_at_bp=1, events={"theta0": 3.0})
-    >>> branch.points["parameter"], branch.points["theta0"], branch.points["type"]
-
-Bad input raises kirchhoff.CaseError (a ValueError) with the message the command-line tool
-prints; a solve that does not converge returns a Solution whose status says why.)doc";
-
-  auto& case_error = py::register_exception<CaseError>(m, "CaseError", PyExc_ValueError);
-  case_error.attr("__doc__") = "A case file or option that cannot be used (a subclass of ValueError).";
-
+// Solution, the result of Case.solve() and of each of Case.equilibria().
+void bind_solution(py::module_& m) {
   py::class_<PySolution>(m, "Solution", R"doc(The result of Case.solve().
 
 Attributes:
@@ -855,7 +837,10 @@ Attributes:
                     "docs/equilibria.md); None for an isolated one and from solve()")
       .def("__bool__", [](const PySolution& s) { return s.converged; }, "True when converged.")
       .def("__repr__", &repr_solution);
+}
 
+// Branch, the result of Case.continue_().
+void bind_branch(py::module_& m) {
   py::class_<PyBranch>(m, "Branch", R"doc(The result of Case.continue_().
 
 Attributes:
@@ -894,57 +879,19 @@ Attributes:
         return "<kirchhoff.Branch " + b.parameter + ": " + std::to_string(b.size) + " points, reason=" + b.reason +
                (b.message.empty() ? "" : " (" + b.message + ")") + ">";
       });
+}
 
-  py::class_<PyCase>(m, "Case", R"doc(A loaded case file (see load_case).
-
-Attributes:
-    path, title, description (str)
-    kind (str): "planar" or "spatial".
-    parameters (dict): [parameters] after the overrides given to load_case.
-    unknowns (list of str): parameters solved for ([solver] unknowns).
-    derived_names (list of str): the derived quantities reported ([output] derived).
-    samples (int): default profile samples ([output] samples).
-    phase_condition (str): the override given to load_case ("" for the case's own).)doc")
-      .def_property_readonly("path", [](const PyCase& p) { return p.c.path; })
-      .def_property_readonly("title", [](const PyCase& p) { return p.c.title; })
-      .def_property_readonly("description", [](const PyCase& p) { return p.c.description; })
-      .def_property_readonly("kind", [](const PyCase& p) {
-        return p.c.definition.kind == RodKind::Planar ? "planar" : "spatial";
-      })
-      .def_property_readonly("parameters", [](const PyCase& p) { return parameters_dict(p.c.definition.parameters); })
-      .def_property_readonly("unknowns", [](const PyCase& p) { return p.c.definition.unknown_parameters; })
-      .def_property_readonly("derived_names", [](const PyCase& p) { return p.c.derived; })
-      .def_property_readonly("samples", [](const PyCase& p) { return p.c.samples; })
-      .def_readonly("phase_condition", &PyCase::phase_condition)
-      .def("solve", &py_solve, py::arg("samples") = py::none(), py::kw_only(), py::arg("seed") = "guess",
-           py::arg("seed_segments") = 200, py::arg("max_seconds") = kDefaultSolveSeconds, py::arg("direct") = false,
-           R"doc(Solves the case by shooting.
-
-Parameters changed from the file's values (load(..., set=...)) are reached by continuation from
-the file's own values (a homotopy in all of them together), so the equilibrium lies on the branch
-the case's guess starts; a fold on the way gives status 'fold' with where it is in `message`.
-
-Args:
-    samples (int, optional): profile points (>= 2); default the case's [output] samples.
-    seed (str): 'guess' starts from the case's [guess]; 'ipopt' from Ipopt's minimum of the
-        discretised energy, its shape and contact set (planar clamped-clamped rods; ValueError
-        for other cases).
-    seed_segments (int): segments of that discretised rod.
-    max_seconds (float): wall-clock limit of the solve (0: none); past it the result's status
-        is 'time_limit'.
-    direct (bool): Newton from the case's guess at the requested values instead of the homotopy.
-
-Returns:
-    Solution. Non-convergence is reported in Solution.status, not raised.)doc")
-      .def("continue_", &py_continue, py::arg("param"), py::arg("to") = py::none(), py::kw_only(),
-           py::arg("step") = 0.05, py::arg("min_step") = 1e-7, py::arg("max_step") = 0.5,
-           py::arg("max_points") = 500, py::arg("events") = py::none(), py::arg("record") = py::none(),
-           py::arg("switch_at_bp") = 0, py::arg("side") = 1.0, py::arg("samples") = 101,
-           py::arg("direction") = 1.0, py::arg("branch_points") = true, py::arg("stability") = true,
-           py::arg("deflate") = false, py::arg("deflate_max") = 16, py::arg("max_seconds") = 0.0,
-           py::arg("state") = py::none(), py::arg("resume") = false, py::arg("start_from") = py::none(),
-           py::arg("start_param") = "",
-           R"doc(Pseudo-arclength continuation in one parameter (the CLI's `continue`).
+// Case.continue_().
+void bind_case_continuation(py::class_<PyCase>& cls) {
+  cls.def("continue_", &py_continue, py::arg("param"), py::arg("to") = py::none(), py::kw_only(),
+          py::arg("step") = 0.05, py::arg("min_step") = 1e-7, py::arg("max_step") = 0.5,
+          py::arg("max_points") = 500, py::arg("events") = py::none(), py::arg("record") = py::none(),
+          py::arg("switch_at_bp") = 0, py::arg("side") = 1.0, py::arg("samples") = 101,
+          py::arg("direction") = 1.0, py::arg("branch_points") = true, py::arg("stability") = true,
+          py::arg("deflate") = false, py::arg("deflate_max") = 16, py::arg("max_seconds") = 0.0,
+          py::arg("state") = py::none(), py::arg("resume") = false, py::arg("start_from") = py::none(),
+          py::arg("start_param") = "",
+          R"doc(Pseudo-arclength continuation in one parameter (the CLI's `continue`).
 
 Args:
     param (str): the continued parameter; its value in the case is the starting one.
@@ -982,10 +929,14 @@ Returns:
     the run, as in the CLI's CSV).
 
 Raises:
-    CaseError (ValueError): unknown parameter or derived quantity, invalid options.)doc")
-      .def("equilibria", &py_equilibria, py::kw_only(), py::arg("max") = 16, py::arg("max_seconds") = 120.0,
-           py::arg("samples") = py::none(),
-           R"doc(The distinct equilibria at the case's parameters (the CLI's `equilibria`), by deflated Newton.
+    CaseError (ValueError): unknown parameter or derived quantity, invalid options.)doc");
+}
+
+// Case.equilibria() and Case.vibrate().
+void bind_case_equilibria_and_vibrations(py::class_<PyCase>& cls) {
+  cls.def("equilibria", &py_equilibria, py::kw_only(), py::arg("max") = 16, py::arg("max_seconds") = 120.0,
+          py::arg("samples") = py::none(),
+          R"doc(The distinct equilibria at the case's parameters (the CLI's `equilibria`), by deflated Newton.
 
 Starts from the case's guess, its mirror images, the low modes of every equilibrium found and,
 for planar rods clamped at both ends, Ipopt's discretised minimisers (docs/equilibria.md).
@@ -1023,11 +974,61 @@ Returns:
 
 Raises:
     ValueError: a spatial case, bad options, or a rod the vibration equations do not cover.
-    RuntimeError: the equilibrium does not converge.)doc")
-      .def("__repr__", [](const PyCase& p) {
+    RuntimeError: the equilibrium does not converge.)doc");
+}
+
+// Case: the loaded case, its properties and what can be done with it.
+void bind_case(py::module_& m) {
+  py::class_<PyCase> cls(m, "Case", R"doc(A loaded case file (see load_case).
+
+Attributes:
+    path, title, description (str)
+    kind (str): "planar" or "spatial".
+    parameters (dict): [parameters] after the overrides given to load_case.
+    unknowns (list of str): parameters solved for ([solver] unknowns).
+    derived_names (list of str): the derived quantities reported ([output] derived).
+    samples (int): default profile samples ([output] samples).
+    phase_condition (str): the override given to load_case ("" for the case's own).)doc");
+  cls.def_property_readonly("path", [](const PyCase& p) { return p.c.path; })
+      .def_property_readonly("title", [](const PyCase& p) { return p.c.title; })
+      .def_property_readonly("description", [](const PyCase& p) { return p.c.description; })
+      .def_property_readonly("kind", [](const PyCase& p) {
+        return p.c.definition.kind == RodKind::Planar ? "planar" : "spatial";
+      })
+      .def_property_readonly("parameters", [](const PyCase& p) { return parameters_dict(p.c.definition.parameters); })
+      .def_property_readonly("unknowns", [](const PyCase& p) { return p.c.definition.unknown_parameters; })
+      .def_property_readonly("derived_names", [](const PyCase& p) { return p.c.derived; })
+      .def_property_readonly("samples", [](const PyCase& p) { return p.c.samples; })
+      .def_readonly("phase_condition", &PyCase::phase_condition);
+  cls.def("solve", &py_solve, py::arg("samples") = py::none(), py::kw_only(), py::arg("seed") = "guess",
+          py::arg("seed_segments") = 200, py::arg("max_seconds") = kDefaultSolveSeconds, py::arg("direct") = false,
+          R"doc(Solves the case by shooting.
+
+Parameters changed from the file's values (load(..., set=...)) are reached by continuation from
+the file's own values (a homotopy in all of them together), so the equilibrium lies on the branch
+the case's guess starts; a fold on the way gives status 'fold' with where it is in `message`.
+
+Args:
+    samples (int, optional): profile points (>= 2); default the case's [output] samples.
+    seed (str): 'guess' starts from the case's [guess]; 'ipopt' from Ipopt's minimum of the
+        discretised energy, its shape and contact set (planar clamped-clamped rods; ValueError
+        for other cases).
+    seed_segments (int): segments of that discretised rod.
+    max_seconds (float): wall-clock limit of the solve (0: none); past it the result's status
+        is 'time_limit'.
+    direct (bool): Newton from the case's guess at the requested values instead of the homotopy.
+
+Returns:
+    Solution. Non-convergence is reported in Solution.status, not raised.)doc");
+  bind_case_continuation(cls);
+  bind_case_equilibria_and_vibrations(cls);
+  cls.def("__repr__", [](const PyCase& p) {
         return "<kirchhoff.Case " + (p.c.title.empty() ? p.c.path : "'" + p.c.title + "'") + ">";
       });
+}
 
+// The whole jobs: load_case, reproduce, sweep, plectonemes.
+void bind_jobs(py::module_& m) {
   m.def("load_case", &py_load_case, py::arg("path"), py::arg("set") = py::none(), py::arg("phase_condition") = "",
         py::arg("solver") = py::none(),
         R"doc(Reads and checks a TOML case file.
@@ -1118,7 +1119,10 @@ Raises:
         slenderness from a ply the sweep would not have) or a case file that cannot be used.
     RuntimeError: a branch failed (its message says which and why; the CSVs so far are kept).
     KeyboardInterrupt: Ctrl-C (the sweep stops after its current point).)doc");
+}
 
+// derived_catalogue and the closed forms the tests and notebooks compare with.
+void bind_reference(py::module_& m) {
   m.def("derived_catalogue", &derived_catalogue,
         "The derived quantities a case or an event may name, with a one-line meaning each (dict).");
 
@@ -1141,6 +1145,32 @@ omega^2 = (EI (k pi/L)^4 - P (k pi/L)^2) / rho_s.)doc");
 T_ext = EI/(2 R^2) sin^4 theta (1 + 2/cos 2theta).)doc");
   m.def("analytic_helix_twisting_moment", &analytic::helix_twisting_moment, py::arg("theta"), py::arg("EI"),
         py::arg("R"), R"doc(Eq. (58b): m3 = 2 EI sin^3 theta cos theta / (R cos 2theta) in a ply of radius R.)doc");
+}
+
+}  // namespace
+PYBIND11_MODULE(kirchhoff, m) {
+  m.doc() = R"doc(Elastic-rod equilibria by shooting and pseudo-arclength continuation.
+
+    >>> import kirchhoff
+    >>> case = kirchhoff.load_case("cases/simply_supported.toml", set={"theta0": 1.0})
+    >>> sol = case.solve(samples=201)
+    >>> sol.status, sol.derived["P"]            # ('converged', 11.2224...)
+    >>> sol.profile["x"], sol.profile["y"]      # numpy arrays along the rod
+    >>> branch = kirchhoff.load_case("cases/euler_column.toml", set={"P": 1, "theta_guess": 0}) \
+    ...     .continue_("P", to=12, switch_at_bp=1, events={"theta0": 3.0})
+    >>> branch.points["parameter"], branch.points["theta0"], branch.points["type"]
+
+Bad input raises kirchhoff.CaseError (a ValueError) with the message the command-line tool
+prints; a solve that does not converge returns a Solution whose status says why.)doc";
+
+  auto& case_error = py::register_exception<CaseError>(m, "CaseError", PyExc_ValueError);
+  case_error.attr("__doc__") = "A case file or option that cannot be used (a subclass of ValueError).";
+  // Solution and Branch first: the signatures of Case's methods name them.
+  bind_solution(m);
+  bind_branch(m);
+  bind_case(m);
+  bind_jobs(m);
+  bind_reference(m);
 
   m.attr("__version__") = KIRCHHOFF_VERSION;
 }
