@@ -14,8 +14,6 @@
 namespace kirchhoff {
 namespace {
 
-// Central-difference step for F_lambda relative to 1 + |lambda| (see shooting.cpp).
-constexpr double kLambdaStep = 1e-6;
 // Step growth and shrink factors: the usual choices for predictor-corrector continuation.
 constexpr double kGrow = 1.5, kShrink = 0.5;
 // Secant/Brent location stops when the step interval is this small relative to the step.
