@@ -46,4 +46,22 @@ struct SegmentFlow {
   long steps = 0;
 };
 
+// The adaptive step sizes one integration proposes for its next step, handed from an interval to
+// the next adjacent one (RodEquations::flow_directions): a sequence of short intervals is then one
+// integration observed at their ends, instead of restarting each from a small trial step. Zero:
+// not known yet (the first trial step is IntegratorOptions::initial_step of the interval).
+struct CarriedSteps {
+  double directions = 0.0;  // of the state integrated with the directions
+  double state = 0.0;       // of the state alone (with IntegratorOptions::sensitivity_tol only)
+};
+
+// The state and given directions (state perturbations, columns) carried over an interval:
+// directions(s1) = Phi directions(s0).
+struct DirectionalFlow {
+  Eigen::VectorXd y;
+  Eigen::MatrixXd directions;
+  long rhs_evaluations = 0;
+  long steps = 0;
+};
+
 }  // namespace kirchhoff

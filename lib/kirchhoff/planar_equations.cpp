@@ -73,6 +73,16 @@ class PlanarEquations final : public RodEquations {
     return partial;
   }
 
+  DirectionalFlow flow_directions(const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions, double s0, double s1,
+                                  const IntegratorOptions& options, CarriedSteps* carried) const override {
+    auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
+    // The seeds of flow(): all of them with a field, else those x(s0), y(s0) do not enter.
+    static const std::vector<int> kAll{kX, kY, kTheta, kNx, kNy, kMoment};
+    static const std::vector<int> kSeeds{kTheta, kNx, kNy, kMoment};
+    return detail::flow_directions_through_seeds<kStateSize, 1, 2, 3, 4, 5, 6>(
+        f, y0, directions, model_.field ? kAll : kSeeds, s0, s1, options, carried);
+  }
+
   std::vector<Eigen::VectorXd> sample(const Eigen::VectorXd& y0, const std::vector<double>& s,
                                       const IntegratorOptions& options) const override {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };

@@ -50,6 +50,14 @@ class RodEquations {
   // Flow over [s0, s1]; throws IntegrationError when the integrator gives up.
   virtual SegmentFlow flow(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities,
                            const IntegratorOptions& options) const = 0;
+  // The state and the columns of `directions` (state perturbations at s0) carried to s1 by the
+  // variational equations, Phi directions, without forming Phi when there are fewer directions
+  // than Phi has non-trivial columns. *carried hands the adaptive step sizes from one call to the
+  // next, so adjacent intervals make one integration observed at their ends. Throws
+  // IntegrationError as flow() does.
+  virtual DirectionalFlow flow_directions(const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions, double s0,
+                                          double s1, const IntegratorOptions& options,
+                                          CarriedSteps* carried) const = 0;
   virtual std::vector<Eigen::VectorXd> sample(const Eigen::VectorXd& y0, const std::vector<double>& s,
                                               const IntegratorOptions& options) const = 0;
 

@@ -125,6 +125,18 @@ class SpatialEquations final : public RodEquations {
                              kSeeds);
   }
 
+  DirectionalFlow flow_directions(const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions, double s0, double s1,
+                                  const IntegratorOptions& options, CarriedSteps* carried) const override {
+    auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
+    // The seeds of flow(); the dual sizes those of the stability index's Jacobi fields (a frame
+    // of 3 or 6 columns and a few particular ones), then all the seeds.
+    static const std::vector<int> kFieldSeeds{kR,     kR + 1, kR + 2, kQ,     kQ + 1, kQ + 2, kQ + 3,
+                                              kN,     kN + 1, kN + 2, kM,     kM + 1, kM + 2};
+    static const std::vector<int> kSeeds(kFieldSeeds.begin() + 3, kFieldSeeds.end());
+    return detail::flow_directions_through_seeds<kStateSize, 3, 4, 5, 6, 8, 10, 13>(
+        f, y0, directions, model_.field || support_ ? kFieldSeeds : kSeeds, s0, s1, options, carried);
+  }
+
   std::vector<Eigen::VectorXd> sample(const Eigen::VectorXd& y0, const std::vector<double>& s,
                                       const IntegratorOptions& options) const override {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };

@@ -329,6 +329,7 @@ class StabilityAnalysis {
   std::string pass_contact(Frame* f, const PointContact& contact, int number, PhaseTrack* track, double* shear);
   void canonical_blocks(Frame* f) const;
   void orthonormalise(Frame* f) const;
+  Frame flowed(const Frame& f, double s1);
   void advance(Frame* f, double s1, PhaseTrack* track, int depth);
   void record(const Eigen::VectorXd& before, double s0, const Eigen::VectorXd& after, double s1, PhaseTrack* track);
   bool count_interior(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start,
@@ -351,6 +352,7 @@ class StabilityAnalysis {
   Scales scales_;
   std::vector<RodPoint> profile_;  // the equilibrium at 17 equally spaced points, for the checks above
   long rhs_ = 0;
+  CarriedSteps steps_;  // the step sizes the fields' integration proposes next (flowed)
   // The full frame: positions are configuration variables beside the rotation (see
   // positions_are_configuration); its U block holds (dr / L, dpsi), offset_ = 0. Otherwise the
   // rotation alone, offset_ = kr. mU_ is the size of U.
@@ -548,16 +550,35 @@ void StabilityAnalysis::record(const Eigen::VectorXd& before, double s0, const E
   track->lifted = lifted;
 }
 
-void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int depth) {
-  const SegmentFlow flow = eq_->flow(f->y, f->s, s1, true, problem_.definition().options.integrator);
+// The equilibrium, the frame's fields and the particular fields that have started carried to s1,
+// as one integration continued from the previous step's (steps_): the fields are the directions
+// of the variational equations, so only they are integrated, not the whole of Phi. Particular
+// fields that have not started yet are zero, and stay so.
+Frame StabilityAnalysis::flowed(const Frame& f, double s1) {
+  std::vector<int> started;
+  for (int c = 0; c < f.particular.cols(); ++c)
+    if (!f.particular.col(c).isZero(0.0)) started.push_back(c);
+  const int m = static_cast<int>(f.dY.cols());
+  Eigen::MatrixXd directions(f.dY.rows(), m + static_cast<int>(started.size()));
+  directions.leftCols(m) = f.dY;
+  for (size_t i = 0; i < started.size(); ++i) directions.col(m + static_cast<int>(i)) = f.particular.col(started[i]);
+  const DirectionalFlow flow =
+      eq_->flow_directions(f.y, directions, f.s, s1, problem_.definition().options.integrator, &steps_);
   rhs_ += flow.rhs_evaluations;
   Frame next;
   next.y = flow.y;
   next.s = s1;
-  next.dY = flow.Phi * f->dY;
-  next.particular = flow.Phi * f->particular;
-  next.recorded_rows_frame = f->recorded_rows_frame;
-  next.recorded_rows_particular = f->recorded_rows_particular;
+  next.dY = flow.directions.leftCols(m);
+  next.particular = Eigen::MatrixXd::Zero(f.particular.rows(), f.particular.cols());
+  for (size_t i = 0; i < started.size(); ++i) next.particular.col(started[i]) = flow.directions.col(m + static_cast<int>(i));
+  next.recorded_rows_frame = f.recorded_rows_frame;
+  next.recorded_rows_particular = f.recorded_rows_particular;
+  return next;
+}
+
+void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int depth) {
+  const CarriedSteps before = steps_;
+  Frame next = flowed(*f, s1);
   canonical_blocks(&next);
   orthonormalise(&next);
   const Eigen::VectorXd phases = eigenphases(next.U, next.P);
@@ -570,6 +591,7 @@ void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int dept
   const bool locate = passage && s1 - f->s > options_.passage_resolution * scales_.length / scales_.rate;
   if ((largest > options_.max_phase_step || locate) && depth < options_.max_halvings) {
     const double mid = 0.5 * (f->s + s1);
+    steps_ = before;  // the halves continue from f, not from the step taken past them
     advance(f, mid, track, depth + 1);
     advance(f, s1, track, depth + 1);
     return;
