@@ -14,6 +14,7 @@
 #include <sstream>
 #include <toml.hpp>
 
+#include "kirchhoff/case_reader.hpp"
 #include "kirchhoff/expression.hpp"
 #include "kirchhoff/plectoneme.hpp"
 #include "kirchhoff/self_contact.hpp"
@@ -21,223 +22,10 @@
 #include "kirchhoff/toml_nesting.hpp"
 
 namespace kirchhoff {
+
+using namespace case_reading;
+
 namespace {
-
-// Material properties are checked (positive, finite) at this many points along the rod.
-constexpr int kPositivitySamples = 101;
-
-using Value = toml::value;
-using namespace case_limits;
-
-// "1e+100" rather than std::to_string's "10000000000...".
-std::string shown(double v) {
-  std::ostringstream os;
-  os.precision(15);  // whole numbers up to 1e15 exactly (4294967297, not 4.29497e+09)
-  os << v;
-  return os.str();
-}
-
-
-std::string join(const std::set<std::string>& names) {
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
-
-// Values given on the command line (--solver KEY=VALUE) are parsed under this source name, so
-// that messages name the option instead of a line of the file.
-constexpr const char* kSolverOption = "--solver ";
-bool is_command_line(const Value& v) { return v.location().file_name().rfind(kSolverOption, 0) == 0; }
-
-// Reads typed values out of the TOML tree, turning every problem into a CaseError that names
-// the file, the line, the key and the reason.
-class Reader {
- public:
-  // Expressions may use the parameters, and are checked at their values.
-  Reader(std::string path, Parameters parameters)
-      : path_(std::move(path)), parameter_names_(parameters.names()), parameters_(std::move(parameters)) {}
-
-  [[noreturn]] void fail(const Value& v, const std::string& key, const std::string& reason) const {
-    std::ostringstream os;
-    os << path_;
-    const auto line = v.location().line();
-    if (is_command_line(v)) os << ": " << v.location().file_name();  // "--solver tolerance=..."
-    else if (line > 0) os << ":" << line;
-    os << ": key '" << key << "': " << reason;
-    throw CaseError(os.str());
-  }
-  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
-    throw CaseError(path_ + ": key '" + key + "': " + reason);
-  }
-
-  void allow_keys(const Value& table, const std::string& name, const std::set<std::string>& allowed) const {
-    if (!table.is_table()) fail(table, name, "must be a table");
-    for (const auto& [key, value] : table.as_table())
-      if (!allowed.count(key))
-        fail(value, qualified(name, key), "unknown key (expected one of: " + join(allowed) + ")");
-  }
-
-  static std::string qualified(const std::string& table, const std::string& key) {
-    return table.empty() ? key : table + "." + key;
-  }
-
-  static const Value* find(const Value& table, const std::string& key) {
-    if (!table.is_table()) return nullptr;
-    const auto& t = table.as_table();
-    const auto it = t.find(key);
-    return it == t.end() ? nullptr : &it->second;
-  }
-
-  // TOML allows inf and nan; no quantity of a rod may be either, or beyond kMaxMagnitude.
-  double number(const Value& v, const std::string& key) const {
-    double x = 0.0;
-    if (v.is_floating()) x = v.as_floating();
-    else if (v.is_integer()) x = static_cast<double>(v.as_integer());
-    else fail(v, key, "must be a number, got " + type_name(v));
-    check_magnitude(v, key, x);
-    return x;
-  }
-  void check_magnitude(const Value& v, const std::string& key, double x, const std::string& where = "") const {
-    if (!std::isfinite(x)) fail(v, key, "must be a finite number, got " + shown(x) + where);
-    if (std::abs(x) > kMaxMagnitude)
-      fail(v, key, "must have a magnitude <= " + shown(kMaxMagnitude) + " (so that the equations' products do not "
-                   "overflow), got " + shown(x) + where);
-  }
-  // An integer in [low, high], checked before it is narrowed to int: a TOML integer has 64 bits,
-  // and 9223372036854775807 must be refused, not wrapped. `why` says where the bound comes from.
-  int integer(const Value& v, const std::string& key, long low, long high, const std::string& why = "") const {
-    if (!v.is_integer()) fail(v, key, "must be an integer, got " + type_name(v));
-    return in_range(v, key, static_cast<double>(v.as_integer()), low, high, why, std::to_string(v.as_integer()));
-  }
-  int in_range(const Value& v, const std::string& key, double x, long low, long high, const std::string& why,
-               const std::string& as_given = "") const {
-    if (!(x >= static_cast<double>(low) && x <= static_cast<double>(high)))
-      fail(v, key, "must be in [" + std::to_string(low) + ", " + std::to_string(high) + "]" + why + ", got " +
-                       (as_given.empty() ? shown(x) : as_given));
-    return static_cast<int>(x);
-  }
-  // A value in (0, kMaxTolerance].
-  double tolerance(const Value& v, const std::string& key) const {
-    double x = 0.0;
-    if (v.is_floating()) x = v.as_floating();
-    else if (v.is_integer()) x = static_cast<double>(v.as_integer());
-    else fail(v, key, "must be a number, got " + type_name(v));
-    if (!(x > 0 && x <= kMaxTolerance))  // also refuses nan and inf
-      fail(v, key, "must be in (0, " + shown(kMaxTolerance) + "] (a looser tolerance gives answers wrong in the "
-                   "second digit), got " + shown(x));
-    return x;
-  }
-  // An array of at most `most` entries.
-  const toml::array& array(const Value& v, const std::string& key, int most, const std::string& what) const {
-    if (!v.is_array()) fail(v, key, "must be an array of " + what + ", got " + type_name(v));
-    if (v.as_array().size() > static_cast<std::size_t>(most))
-      fail(v, key, "has " + std::to_string(v.as_array().size()) + " entries, at most " + std::to_string(most) +
-                       " are allowed");
-    return v.as_array();
-  }
-  bool boolean(const Value& v, const std::string& key) const {
-    if (v.is_boolean()) return v.as_boolean();
-    fail(v, key, "must be true or false, got " + type_name(v));
-  }
-  std::string string(const Value& v, const std::string& key) const {
-    if (v.is_string()) return v.as_string().str;
-    fail(v, key, "must be a string, got " + type_name(v));
-  }
-  std::vector<std::string> strings(const Value& v, const std::string& key) const {
-    std::vector<std::string> out;
-    for (const auto& e : array(v, key, kMaxNames, "strings")) out.push_back(string(e, key));
-    return out;
-  }
-
-  // An expression of the parameters (and of s when uses_s). One that does not use s is also
-  // evaluated here, at the case's parameter values, and refused unless finite and within
-  // kMaxMagnitude ("1/0", "exp(1000)", "1e60 * 1e60"); material profiles are checked along the
-  // rod once its length is known.
-  Expression expression(const Value& v, const std::string& key, bool uses_s = false) const {
-    if (v.is_floating() || v.is_integer()) return Expression::constant(number(v, key));
-    if (!v.is_string()) fail(v, key, "must be a number or an expression string, got " + type_name(v));
-    std::optional<Expression> e;
-    try {
-      e.emplace(v.as_string().str, parameter_names_, uses_s);
-    } catch (const std::invalid_argument& error) {
-      fail(v, key, error.what());
-    }
-    if (!e->depends_on_s()) (void)value(*e, v, key);
-    note_uses(*e, key);
-    return *e;
-  }
-
-  // The parameters the problem itself (not its [guess]) depends on, as far as read so far.
-  const std::set<std::string>& problem_uses() const { return problem_uses_; }
-
-  // e at the case's parameter values and arclength s: finite and within kMaxMagnitude.
-  double value(const Expression& e, const Value& v, const std::string& key, double s = 0.0) const {
-    double x = 0.0;
-    try {
-      x = e(parameters_, s);
-    } catch (const std::invalid_argument& error) {
-      fail(v, key, error.what());
-    }
-    check_magnitude(v, key, x, e.depends_on_s() ? " at s = " + shown(s) : "");
-    return x;
-  }
-
-  // An expression of the parameters and the position x, y, z (a level set).
-  Expression position_expression(const Value& v, const std::string& key) const {
-    if (!v.is_string()) fail(v, key, "must be an expression string in x, y, z, got " + type_name(v));
-    std::vector<std::string> names = parameter_names_;
-    for (const char* axis : {"x", "y", "z"}) {
-      if (std::find(names.begin(), names.end(), axis) != names.end())
-        fail(v, key, std::string("x, y and z are the position here; rename the parameter '") + axis + "'");
-      names.push_back(axis);
-    }
-    try {
-      Expression e(v.as_string().str, names, false);
-      note_uses(e, key);
-      return e;
-    } catch (const std::invalid_argument& e) {
-      fail(v, key, e.what());
-    }
-  }
-
-  void note_uses(const Expression& e, const std::string& key) const {
-    if (key.rfind("guess", 0) == 0) return;
-    problem_uses_.insert(e.used_parameters().begin(), e.used_parameters().end());
-  }
-
-  std::array<Expression, 3> vector(const Value& v, const std::string& key, bool uses_s = false) const {
-    if (!v.is_array() || (v.as_array().size() != 3 && v.as_array().size() != 2))
-      fail(v, key, "must be an array of 2 or 3 numbers/expressions");
-    const auto& a = v.as_array();
-    return {expression(a[0], key, uses_s), expression(a[1], key, uses_s),
-            a.size() == 3 ? expression(a[2], key, uses_s) : Expression::constant(0.0)};
-  }
-
-  Vec3 unit_vector(const Value& v, const std::string& key) const {
-    if (!v.is_array() || v.as_array().size() != 3) fail(v, key, "must be an array of 3 numbers");
-    const auto& a = v.as_array();
-    const Vec3 out(number(a[0], key), number(a[1], key), number(a[2], key));
-    if (!(out.norm() > 0)) fail(v, key, "must be a non-zero vector");
-    return out.normalized();
-  }
-
-  const std::string& path() const { return path_; }
-
- private:
-  static std::string type_name(const Value& v) {
-    std::ostringstream os;
-    os << v.type();
-    return os.str();
-  }
-  std::string path_;
-  std::vector<std::string> parameter_names_;
-  Parameters parameters_;
-  mutable std::set<std::string> problem_uses_;  // see uses()
-};
-
-VectorTarget vector_target(const std::array<Expression, 3>& e) {
-  return [e](const Parameters& p) { return Vec3(e[0](p), e[1](p), e[2](p)); };
-}
 
 // A frame given as a matrix or as directors is a rotation when its columns are orthonormal and
 // right-handed to this: 10 significant digits ("0.8660254038" for sqrt(3)/2) are 1e-10 off, and
@@ -588,27 +376,6 @@ EndCondition read_end(const Reader& reader, const Value& root, const std::string
   return end;
 }
 
-// A material profile: the expression, checked positive along the rod when required.
-struct ProfileSpec {
-  Expression expression = Expression::constant(0.0);
-  const Value* source = nullptr;
-  std::string key;
-  Profile build(const Parameters& p) const {
-    return expression.depends_on_s() ? Profile(expression.bind(p)) : Profile(expression(p));
-  }
-};
-
-}  // namespace
-
-namespace {
-
-// A parameter name muParser can bind: a letter or '_', then letters, digits and '_'.
-bool is_identifier(const std::string& name) {
-  if (name.empty() || std::isdigit(static_cast<unsigned char>(name[0]))) return false;
-  return std::all_of(name.begin(), name.end(),
-                     [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
-}
-
 // The parameters a dependent one is ultimately computed from (those a user can set). Each
 // parameter is visited once: rules may share inputs (a chain using the two before it would
 // otherwise be walked 2^n times).
@@ -657,76 +424,6 @@ std::string dependent_parameter_refusal(const std::vector<DependentParameter>& d
   for (const auto& r : free_roots(dependents, name)) roots += (roots.empty() ? "" : ", ") + r;
   return name + " is computed from " + roots + " (an expression in [parameters]); " + action + " " + roots +
          " instead";
-}
-
-namespace {
-void apply_phase_condition(const Reader& reader, const Value* where, const std::string& name, ProblemDefinition& d) {
-  if (name == "axial") {
-    if (d.kind != RodKind::Spatial) reader.fail(*where, "solver.phase_condition", "'axial' is for spatial rods");
-    if (d.parameters.contains("unfolding"))
-      reader.fail(*where, "solver.phase_condition", "needs the parameter name 'unfolding' free");
-    add_axial_phase_condition(d);
-  } else if (name != "none") {
-    reader.fail(*where, "solver.phase_condition", "'" + name + "' is not 'none' or 'axial'");
-  }
-}
-
-// A --solver value as TOML ("1e-10", "true", "[\"P\"]"); text that is not one TOML value (rk78)
-// is the string it spells. Either carries the option as its source, for messages.
-Value solver_value(const std::string& path, const std::string& key, const std::string& text) {
-  const std::string source = kSolverOption + key + "=" + text;
-  auto parsed = [&](const std::string& toml_text) -> std::optional<Value> {
-    try {
-      std::istringstream in("value = " + toml_text);
-      const Value table = toml::parse(in, source);
-      if (table.as_table().size() == 1) return table.as_table().at("value");
-    } catch (const std::exception&) {
-    }
-    return std::nullopt;
-  };
-  if (auto v = parsed(text)) return *v;
-  std::string quoted = "\"";
-  for (const char ch : text) {
-    if (ch == '"' || ch == '\\') quoted += '\\';
-    if (static_cast<unsigned char>(ch) < 0x20) throw CaseError(path + ": " + source + ": control characters in the value");
-    quoted += ch;
-  }
-  if (auto v = parsed(quoted + "\"")) return *v;
-  throw CaseError(path + ": " + source + ": neither a TOML value nor a string");
-}
-
-// --solver KEY=VALUE in place of [solver] KEY, so that each is validated, and refused, exactly
-// as the file's own value would be.
-void merge_solver_overrides(Value& root, const SolverOverrides& solver, const std::string& path) {
-  if (solver.empty()) return;
-  auto& table = root.as_table();
-  if (!table.count("solver")) table["solver"] = toml::table{};
-  Value& solver_table = table["solver"];
-  if (!solver_table.is_table()) return;  // refused as the file's [solver] when read
-  for (const auto& [key, text] : solver) solver_table.as_table()[key] = solver_value(path, key, text);
-}
-
-}  // namespace
-
-std::pair<std::string, std::string> parse_solver_override(const std::string& text) {
-  const auto eq = text.find('=');
-  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
-    throw std::invalid_argument("'" + text + "' is not KEY=VALUE (a [solver] key and its value, e.g. tolerance=1e-10)");
-  const std::string key = text.substr(0, eq);
-  if (!is_identifier(key)) throw std::invalid_argument("'" + key + "' in '" + text + "' is not a [solver] key");
-  return {key, text.substr(eq + 1)};
-}
-
-SolverOverrides parse_solver_overrides(const std::vector<std::string>& texts) {
-  SolverOverrides out;
-  for (const auto& t : texts) {
-    try {
-      out.push_back(parse_solver_override(t));
-    } catch (const std::invalid_argument& e) {
-      throw CaseError(std::string("--solver ") + e.what());
-    }
-  }
-  return out;
 }
 
 namespace {
@@ -837,8 +534,11 @@ Case reload_case(const Case& c, const ParameterOverrides& overrides) {
   return load_case_text(c.text, c.path, overrides, c.phase_condition, c.solver_overrides);
 }
 
-Case load_case_text(const std::string& text, const std::string& path, const ParameterOverrides& overrides,
-                    const std::string& phase_condition, const SolverOverrides& solver) {
+namespace {
+
+// The raw text's limits (size, nesting depth, UTF-8), checked before toml11 sees it, then the
+// TOML tree.
+Value parse_case_text(const std::string& text, const std::string& path) {
   if (text.size() > kMaxFileBytes)
     throw CaseError(path + ": larger than " + std::to_string(kMaxFileBytes >> 20) + " MiB: not a case file");
   if (const int line = toml_line_beyond_nesting(text, kMaxNesting))
@@ -849,35 +549,24 @@ Case load_case_text(const std::string& text, const std::string& path, const Para
     throw CaseError(path + ":" + std::to_string(line) + ": not valid UTF-8 (byte " + std::to_string(at) +
                     "); a TOML file is UTF-8 text");
   }
-  Value root;
   try {
     std::istringstream stream(text);
-    root = toml::parse(stream, path);
+    return toml::parse(stream, path);
   } catch (const toml::syntax_error& e) {
     throw CaseError(path + ": TOML syntax error: " + e.what());
   } catch (const std::exception& e) {
     // toml11 reports some malformed values (out-of-range numbers, dates) with other exceptions.
     throw CaseError(path + ": TOML syntax error: " + e.what());
   }
+}
 
-  merge_solver_overrides(root, solver, path);
-
-  Case c;
-  c.path = path;
-  c.solver_overrides = solver;
-  // Parameters first: every expression may use them.
-  Parameters parameters;
-  const Reader plain(path, {});
-  plain.allow_keys(root, "", {"title", "description", "model", "parameters", "rod", "start", "end", "guess",
-                              "solver", "output", "obstacles"});
-  std::vector<DependentParameter> dependents;
-  read_parameters(plain, root, {}, &c.file_parameters, &dependents);
-  c.overrides = overrides;
-  c.text = text;
-  c.phase_condition = phase_condition;
+// Each --set names a parameter of the file that is a number (not computed from others), with a
+// finite value.
+void check_overrides(const std::string& path, const Parameters& file_parameters,
+                     const std::vector<DependentParameter>& dependents, const ParameterOverrides& overrides) {
   for (const auto& [name, value] : overrides) {
-    if (!c.file_parameters.contains(name)) {
-      std::set<std::string> names(c.file_parameters.names().begin(), c.file_parameters.names().end());
+    if (!file_parameters.contains(name)) {
+      std::set<std::string> names(file_parameters.names().begin(), file_parameters.names().end());
       throw CaseError(path + ": --set " + name + ": no parameter '" + name + "' in [parameters] (have: " +
                       join(names) + ")");
     }
@@ -888,311 +577,113 @@ Case load_case_text(const std::string& text, const std::string& path, const Para
       throw CaseError(path + ": --set " + name + ": " + shown(value) + " is not a finite number with magnitude <= " +
                       shown(kMaxMagnitude));
   }
-  dependents.clear();
-  read_parameters(plain, root, overrides, &parameters, &dependents);
-  const Reader reader(path, parameters);
-  if (const Value* v = Reader::find(root, "title")) c.title = reader.string(*v, "title");
-  if (const Value* v = Reader::find(root, "description")) c.description = reader.string(*v, "description");
-  ProblemDefinition& d = c.definition;
-  d.parameters = parameters;
-  d.dependent_parameters = dependents;
-  if (const Value* v = Reader::find(root, "model")) {
-    const std::string kind = reader.string(*v, "model");
-    if (kind == "planar") d.kind = RodKind::Planar;
-    else if (kind == "spatial") d.kind = RodKind::Spatial;
-    else reader.fail(*v, "model", "'" + kind + "' is not 'planar' or 'spatial'");
-  } else {
-    reader.fail(root, "model", "missing ('planar' or 'spatial')");
-  }
+}
 
-  // [rod]
-  const Value* rod = Reader::find(root, "rod");
-  if (!rod) reader.fail("rod", "missing table [rod]");
-  reader.allow_keys(*rod, "rod", {"length", "B", "B1", "B2", "B3", "extensible", "A1", "A2", "A3", "u_hat",
-                                  "v_hat", "gravity", "barrier", "self_contact"});
-  const Value* length_value = Reader::find(*rod, "length");
-  if (!length_value) reader.fail(*rod, "rod.length", "missing");
-  const Expression length = reader.expression(*length_value, "rod.length");
-  std::array<ProfileSpec, 3> B, A, u_hat, v_hat;
-  const char* bend_keys[3] = {"B1", "B2", "B3"};
-  const char* shear_keys[3] = {"A1", "A2", "A3"};
-  const double natural_v[3] = {0.0, 0.0, 1.0};
-  for (int i = 0; i < 3; ++i) {
-    B[i] = {Expression::constant(1.0), nullptr, std::string("rod.") + bend_keys[i]};
-    A[i] = {Expression::constant(1.0), nullptr, std::string("rod.") + shear_keys[i]};
-    u_hat[i] = {Expression::constant(0.0), nullptr, "rod.u_hat"};
-    v_hat[i] = {Expression::constant(natural_v[i]), nullptr, "rod.v_hat"};
-  }
-  if (const Value* v = Reader::find(*rod, "B"))  // isotropic bending: B1 = B2
-    for (int i = 0; i < 2; ++i) B[i] = {reader.expression(*v, "rod.B", true), v, "rod.B"};
-  for (int i = 0; i < 3; ++i) {
-    if (const Value* v = Reader::find(*rod, bend_keys[i])) {
-      const std::string key = std::string("rod.") + bend_keys[i];
-      if (i < 2 && Reader::find(*rod, "B")) reader.fail(*v, key, "give either B or B1/B2, not both");
-      B[i] = {reader.expression(*v, key, true), v, key};
-    }
-    if (const Value* v = Reader::find(*rod, shear_keys[i])) A[i] = {reader.expression(*v, A[i].key, true), v, A[i].key};
-  }
-  const Value* extensible_value = Reader::find(*rod, "extensible");
-  const bool extensible = extensible_value ? reader.boolean(*extensible_value, "rod.extensible") : false;
-  if (!extensible)
-    for (int i = 0; i < 3; ++i)
-      if (A[i].source) reader.fail(*A[i].source, A[i].key, "shear/stretch stiffness given but rod.extensible is false");
-  for (auto [key, spec] : {std::pair{"u_hat", &u_hat}, std::pair{"v_hat", &v_hat}}) {
-    if (const Value* v = Reader::find(*rod, key)) {
-      const auto e = reader.vector(*v, std::string("rod.") + key, true);
-      for (int i = 0; i < 3; ++i) (*spec)[i] = {e[i], v, std::string("rod.") + key};
-    }
-  }
-  // External fields.
-  // Each adds its field for the parameter values and the rod length.
-  std::function<void(const Parameters&, double, FieldSum*)> add_fields = [](const Parameters&, double, FieldSum*) {};
-  std::set<std::string> field_parameters;
-  if (const Value* g = Reader::find(*rod, "gravity")) {
-    reader.allow_keys(*g, "rod.gravity", {"weight", "up"});
-    const Value* w = Reader::find(*g, "weight");
-    if (!w) reader.fail(*g, "rod.gravity.weight", "missing (weight per unit length)");
-    const Expression weight = reader.expression(*w, "rod.gravity.weight");
-    const Value* up_value = Reader::find(*g, "up");
-    const Vec3 up = up_value ? reader.unit_vector(*up_value, "rod.gravity.up") : Vec3::UnitY();
-    for (const auto& n : weight.used_parameters()) field_parameters.insert(n);
-    add_fields = [prev = add_fields, weight, up](const Parameters& p, double length, FieldSum* f) {
-      prev(p, length, f);
-      f->add(std::make_shared<UniformGravity>(weight(p), up));
-    };
-  }
-  if (const Value* bw = Reader::find(*rod, "barrier")) {
-    reader.allow_keys(*bw, "rod.barrier", {"b", "a", "normal"});
-    const Value* b = Reader::find(*bw, "b");
-    const Value* a = Reader::find(*bw, "a");
-    if (!b || !a) reader.fail(*bw, "rod.barrier", "needs b (range) and a (wall height)");
-    const Expression range = reader.expression(*b, "rod.barrier.b"), height = reader.expression(*a, "rod.barrier.a");
-    const Value* normal_value = Reader::find(*bw, "normal");
-    const Vec3 normal = normal_value ? reader.unit_vector(*normal_value, "rod.barrier.normal") : Vec3::UnitY();
-    if (!(range(parameters) > 0)) reader.fail(*b, "rod.barrier.b", "must be > 0");
-    for (const auto& e : {range, height})
-      for (const auto& n : e.used_parameters()) field_parameters.insert(n);
-    add_fields = [prev = add_fields, range, height, normal](const Parameters& p, double length, FieldSum* f) {
-      prev(p, length, f);
-      f->add(std::make_shared<BarrierWall>(range(p), height(p), normal));
-    };
-  }
+// [parameters] as the file gives them (*file_parameters), then with the --set overrides applied
+// (returned, with the dependent parameters in *dependents).
+Parameters read_parameters_with_overrides(const Reader& plain, const Value& root, const ParameterOverrides& overrides,
+                                          Parameters* file_parameters, std::vector<DependentParameter>* dependents) {
+  std::vector<DependentParameter> file_dependents;
+  read_parameters(plain, root, {}, file_parameters, &file_dependents);
+  check_overrides(plain.path(), *file_parameters, file_dependents, overrides);
+  Parameters parameters;
+  read_parameters(plain, root, overrides, &parameters, dependents);
+  return parameters;
+}
 
-  if (const Value* sc = Reader::find(*rod, "self_contact")) {
-    const std::string key = "rod.self_contact";
-    if (d.kind != RodKind::Spatial) reader.fail(*sc, key, "self-contact is for spatial rods");
-    reader.allow_keys(*sc, key, {"radius", "axis", "softness", "range", "adjacent"});
-    const Value* radius_value = Reader::find(*sc, "radius");
-    if (!radius_value) reader.fail(*sc, key + ".radius", "missing (the cross-section radius R)");
-    const Expression radius = reader.expression(*radius_value, key + ".radius");
-    // Defaults (see self_contact.hpp): strength b = softness B1 / R, so that the gap at the
-    // pressures of a plectoneme (~0.05 B/R^3) is ~4e-4 R; the barrier decays over 0.25 R and is
-    // off within 4 R of the symmetry point.
-    std::optional<Expression> softness, range, adjacent;
-    if (const Value* v = Reader::find(*sc, "softness")) softness = reader.expression(*v, key + ".softness");
-    if (const Value* v = Reader::find(*sc, "range")) range = reader.expression(*v, key + ".range");
-    if (const Value* v = Reader::find(*sc, "adjacent")) adjacent = reader.expression(*v, key + ".adjacent");
-    for (const auto* e : {&softness, &range, &adjacent})
-      if (*e) for (const auto& n : (*e)->used_parameters()) field_parameters.insert(n);
-    for (const auto& n : radius.used_parameters()) field_parameters.insert(n);
-    if (!(radius(parameters) > 0)) reader.fail(*radius_value, key + ".radius", "must be > 0");
-    if (softness && !((*softness)(parameters) > 0)) reader.fail(*Reader::find(*sc, "softness"), key + ".softness", "must be > 0");
-    const Value* axis_value = Reader::find(*sc, "axis");
-    const Vec3 axis = axis_value ? reader.unit_vector(*axis_value, key + ".axis") : Vec3::UnitX();
-    const Expression bend = B[0].expression;
-    add_fields = [prev = add_fields, radius, softness, range, adjacent, axis, bend](const Parameters& p, double length,
-                                                                                  FieldSum* f) {
-      prev(p, length, f);
-      HalfTurnSelfContactOptions o;
-      o.radius = radius(p);
-      o.axis = axis;
-      o.symmetry_s = length;
-      o.strength = (softness ? (*softness)(p) : 1e-8) * bend(p, 0.0) / o.radius;
-      o.range = range ? (*range)(p) : 0.25 * o.radius;
-      o.adjacent = adjacent ? (*adjacent)(p) : 4.0 * o.radius;
-      f->add(std::make_shared<HalfTurnSelfContact>(o));
-    };
-  }
+RodKind read_model_kind(const Reader& reader, const Value& root) {
+  const Value* v = Reader::find(root, "model");
+  if (!v) reader.fail(root, "model", "missing ('planar' or 'spatial')");
+  const std::string kind = reader.string(*v, "model");
+  if (kind == "planar") return RodKind::Planar;
+  if (kind == "spatial") return RodKind::Spatial;
+  reader.fail(*v, "model", "'" + kind + "' is not 'planar' or 'spatial'");
+}
 
-  // Physical checks at the case's parameter values, naming the key. Expressions without s were
-  // checked finite when read; those with s are sampled along the rod here.
-  const double L = length(parameters);
-  if (!(L > 0)) reader.fail(*length_value, "rod.length", "must be > 0, got " + std::to_string(L));
-  for (const auto* group : {&B, &A, &u_hat, &v_hat}) {
-    if (group == &A && !extensible) continue;
-    const bool stiffness = group == &B || group == &A;
-    for (const auto& spec : *group) {
-      for (int k = 0; k < kPositivitySamples; ++k) {
-        const double s = L * k / (kPositivitySamples - 1);
-        // Defaults have no source; they are constants in range.
-        const double value = spec.source ? reader.value(spec.expression, *spec.source, spec.key, s) : spec.expression(parameters, s);
-        if (stiffness && !(value > 0)) {
-          const std::string reason = "stiffness must be > 0, got " + std::to_string(value) + " at s = " + std::to_string(s);
-          if (spec.source) reader.fail(*spec.source, spec.key, reason);
-          reader.fail(spec.key, reason);
-        }
-        if (!spec.expression.depends_on_s()) break;
-      }
-    }
-  }
-
-  for (const auto* e : {&length})
-    for (const auto& n : e->used_parameters()) d.model_parameters.insert(n);
-  for (const auto* group : {&B, &A, &u_hat, &v_hat})
-    for (const auto& spec : *group)
-      for (const auto& n : spec.expression.used_parameters()) d.model_parameters.insert(n);
-  d.model_parameters.insert(field_parameters.begin(), field_parameters.end());
-  d.model = [length, B, A, u_hat, v_hat, extensible, add_fields](const Parameters& p) {
-    RodModel m;
-    m.length = length(p);
-    m.extensible = extensible;
-    for (int i = 0; i < 3; ++i) {
-      m.B[i] = B[i].build(p);
-      m.A[i] = A[i].build(p);
-      m.u_hat[i] = u_hat[i].build(p);
-      m.v_hat[i] = v_hat[i].build(p);
-    }
-    auto fields = std::make_shared<FieldSum>();
-    add_fields(p, m.length, fields.get());
-    if (!fields->empty()) m.field = fields;
-    return m;
+// [guess]: the state at s = 0 before the start conditions are imposed on it; its contacts go to
+// d->contacts.
+RodPoint read_guess(const Reader& reader, const Value& root, const Parameters& parameters, ProblemDefinition* d) {
+  RodPoint guess;
+  guess.R = d->kind == RodKind::Planar ? planar_reference_frame() : Mat3::Identity();
+  const Value* g = Reader::find(root, "guess");
+  if (!g) return guess;
+  reader.allow_keys(*g, "guess", {"position", "orientation", "force", "moment", "contacts"});
+  auto vec = [&](const char* key, Vec3* target) {
+    if (const Value* v = Reader::find(*g, key))
+      *target = vector_target(reader.vector(*v, std::string("guess.") + key))(parameters);  // checked finite
   };
+  vec("position", &guess.r);
+  vec("force", &guess.n);
+  vec("moment", &guess.m);
+  if (const Value* v = Reader::find(*g, "orientation")) {
+    const OrientationTarget t = orientation_target(reader, *v, "guess.orientation", d->kind, parameters)(parameters);
+    guess.R = Eigen::AngleAxisd(t.angle, t.axis).toRotationMatrix() * guess.R;
+    guess.turn_angle = t.angle;
+  }
+  if (const Value* v = Reader::find(*g, "contacts")) read_contact_guesses(reader, *v, d);
+  return guess;
+}
 
-  d.start = read_end(reader, root, "start", d.kind, parameters);
-  d.end = read_end(reader, root, "end", d.kind, parameters);
-
-  // [[obstacles]]: rigid frictionless obstacles, as gap functions g(r) >= 0.
-  if (const Value* list = Reader::find(root, "obstacles")) read_obstacles(reader, *list, d.kind, &d);
-
-  // [solver]
-  if (const Value* s = Reader::find(root, "solver")) {
-    reader.allow_keys(*s, "solver", {"unknowns", "segments", "stepper", "abs_tol", "rel_tol", "sensitivity_tol",
-                                     "tolerance", "max_iterations", "jacobian", "fallback_search", "phase_condition",
-                                     "threads"});
-    ShootingOptions& o = d.options;
-    if (const Value* v = Reader::find(*s, "unknowns")) {
-      d.unknown_parameters = reader.strings(*v, "solver.unknowns");
-      for (const auto& name : d.unknown_parameters) {
-        if (!parameters.contains(name))
-          reader.fail(*v, "solver.unknowns", "'" + name + "' is not in [parameters] (give it there with a guess)");
-        if (find_dependent(dependents, name))
-          reader.fail(*v, "solver.unknowns", dependent_parameter_refusal(dependents, name, "solve for"));
+// A level set's gap must be finite where the rod is held and where its guess starts (at
+// guess_start): "1/0" compiles, and a gap that is inf everywhere is no obstacle at all, which
+// would be solved and reported as if it were one.
+void check_level_set_gaps(const Reader& reader, const Value& root, const Parameters& parameters,
+                          const Vec3& guess_start, const ProblemDefinition& d) {
+  const Value* list = Reader::find(root, "obstacles");
+  if (!list) return;
+  std::vector<std::pair<Vec3, std::string>> points{{guess_start, "the guess's start"}};
+  for (const char* end : {"start", "end"})
+    if (const Value* p = Reader::find(*Reader::find(root, end), "position"))
+      points.emplace_back(vector_target(reader.vector(*p, std::string(end) + ".position"))(parameters),
+                          std::string(end) + ".position");
+  for (std::size_t k = 0; k < d.obstacles.size(); ++k) {
+    if (d.obstacles[k].shape() != Obstacle::Shape::LevelSet) continue;
+    const Value& gap = *Reader::find(list->as_array()[k], "gap");
+    for (const auto& [r, where] : points) {
+      std::ostringstream at;
+      at << " at " << where << " (" << r.x() << ", " << r.y() << ", " << r.z() << ")";
+      double g = NAN;
+      try {
+        g = d.obstacles[k].gap(r);
+      } catch (const std::invalid_argument& e) {
+        reader.fail(gap, "obstacles.gap", e.what() + at.str());
       }
-    }
-    if (const Value* v = Reader::find(*s, "segments")) {
-      // An integer, or an expression of the parameters rounded (e.g. "slenderness / 5": long
-      // slender rods need more segments) evaluated at load time. Either is range-checked
-      // before it becomes an int ("1e10" once wrapped to -129542143).
-      const std::string why = " (Newton's Jacobian is dense: 13 x segments unknowns squared)";
-      if (v->is_string()) {
-        const double x = reader.value(reader.expression(*v, "solver.segments"), *v, "solver.segments");
-        o.segments = reader.in_range(*v, "solver.segments", std::round(x), 1, kMaxSegments, why);
-      } else {
-        o.segments = reader.integer(*v, "solver.segments", 1, kMaxSegments, why);
-      }
-      if (o.segments > 1 && !d.obstacles.empty())
-        reader.fail(*v, "solver.segments", "contact with obstacles needs single shooting (segments = 1)");
-    }
-    if (const Value* v = Reader::find(*s, "threads")) {
-      o.threads = reader.integer(*v, "solver.threads", 0, kMaxThreads, " (0: the machine's hardware concurrency)");
-    }
-    if (const Value* v = Reader::find(*s, "stepper")) {
-      const std::string name = reader.string(*v, "solver.stepper");
-      if (name == "rk78") o.integrator.stepper = IntegratorOptions::Stepper::RungeKutta78;
-      else if (name == "dopri5") o.integrator.stepper = IntegratorOptions::Stepper::Dopri5;
-      else reader.fail(*v, "solver.stepper", "'" + name + "' is not 'rk78' or 'dopri5'");
-    }
-    auto positive = [&](const char* key, double* target) {
-      if (const Value* v = Reader::find(*s, key)) *target = reader.tolerance(*v, std::string("solver.") + key);
-    };
-    positive("abs_tol", &o.integrator.abs_tol);
-    positive("rel_tol", &o.integrator.rel_tol);
-    positive("sensitivity_tol", &o.integrator.sensitivity_tol);
-    positive("tolerance", &o.newton.residual_tolerance);
-    if (const Value* v = Reader::find(*s, "max_iterations")) {
-      o.newton.max_iterations = reader.integer(*v, "solver.max_iterations", 1, kMaxIterations,
-                                               " (each iteration forms a Jacobian; Newton converges in tens)");
-    }
-    if (const Value* v = Reader::find(*s, "jacobian")) {
-      const std::string name = reader.string(*v, "solver.jacobian");
-      if (name == "finite_differences") o.newton.finite_difference_jacobian = true;
-      else if (name != "variational") reader.fail(*v, "solver.jacobian", "'" + name + "' is not 'variational' or 'finite_differences'");
-    }
-    if (const Value* v = Reader::find(*s, "fallback_search")) o.newton.fallback_search = reader.boolean(*v, "solver.fallback_search");
-    if (const Value* v = Reader::find(*s, "phase_condition"); v && phase_condition.empty())
-      apply_phase_condition(reader, v, reader.string(*v, "solver.phase_condition"), d);
-  }
-
-  if (!phase_condition.empty()) apply_phase_condition(reader, &root, phase_condition, d);
-
-  // [guess]: the state at s = 0 before the start conditions are imposed on it.
-  c.start_guess.R = d.kind == RodKind::Planar ? planar_reference_frame() : Mat3::Identity();
-  if (const Value* g = Reader::find(root, "guess")) {
-    reader.allow_keys(*g, "guess", {"position", "orientation", "force", "moment", "contacts"});
-    auto vec = [&](const char* key, Vec3* target) {
-      if (const Value* v = Reader::find(*g, key))
-        *target = vector_target(reader.vector(*v, std::string("guess.") + key))(parameters);  // checked finite
-    };
-    vec("position", &c.start_guess.r);
-    vec("force", &c.start_guess.n);
-    vec("moment", &c.start_guess.m);
-    if (const Value* v = Reader::find(*g, "orientation")) {
-      const OrientationTarget t = orientation_target(reader, *v, "guess.orientation", d.kind, parameters)(parameters);
-      c.start_guess.R = Eigen::AngleAxisd(t.angle, t.axis).toRotationMatrix() * c.start_guess.R;
-      c.start_guess.turn_angle = t.angle;
-    }
-    if (const Value* v = Reader::find(*g, "contacts")) read_contact_guesses(reader, *v, &d);
-  }
-
-  // A level set's gap must be finite where the rod is held and where its guess starts: "1/0"
-  // compiles, and a gap that is inf everywhere is no obstacle at all, which would be solved and
-  // reported as if it were one.
-  if (const Value* list = Reader::find(root, "obstacles")) {
-    std::vector<std::pair<Vec3, std::string>> points{{c.start_guess.r, "the guess's start"}};
-    for (const char* end : {"start", "end"})
-      if (const Value* p = Reader::find(*Reader::find(root, end), "position"))
-        points.emplace_back(vector_target(reader.vector(*p, std::string(end) + ".position"))(parameters),
-                            std::string(end) + ".position");
-    for (std::size_t k = 0; k < d.obstacles.size(); ++k) {
-      if (d.obstacles[k].shape() != Obstacle::Shape::LevelSet) continue;
-      const Value& gap = *Reader::find(list->as_array()[k], "gap");
-      for (const auto& [r, where] : points) {
-        std::ostringstream at;
-        at << " at " << where << " (" << r.x() << ", " << r.y() << ", " << r.z() << ")";
-        double g = NAN;
-        try {
-          g = d.obstacles[k].gap(r);
-        } catch (const std::invalid_argument& e) {
-          reader.fail(gap, "obstacles.gap", e.what() + at.str());
-        }
-        reader.check_magnitude(gap, "obstacles.gap", g, at.str());
-      }
+      reader.check_magnitude(gap, "obstacles.gap", g, at.str());
     }
   }
+}
 
-  // [output]
-  if (const Value* o = Reader::find(root, "output")) {
-    reader.allow_keys(*o, "output", {"derived", "samples"});
-    if (const Value* v = Reader::find(*o, "derived")) {
-      c.derived = reader.strings(*v, "output.derived");
-      for (const auto& name : c.derived)
-        if (!derived_catalogue().count(name)) {
-          std::set<std::string> names;
-          for (const auto& [n, meaning] : derived_catalogue()) names.insert(n);
-          reader.fail(*v, "output.derived", "'" + name + "' is not a derived quantity (known: " + join(names) + ")");
-        }
-      const bool self_contact = Reader::find(root, "rod") && Reader::find(*Reader::find(root, "rod"), "self_contact");
-      for (const auto& [name, meaning] : plectoneme_quantities())
-        if (!self_contact && std::find(c.derived.begin(), c.derived.end(), name) != c.derived.end())
-          reader.fail(*v, "output.derived", "'" + name + "' is a plectoneme quantity: it needs [rod.self_contact]");
+// [output].derived: names from derived_catalogue(); the plectoneme quantities need self-contact.
+std::vector<std::string> read_derived(const Reader& reader, const Value& v, const Value& root) {
+  std::vector<std::string> derived = reader.strings(v, "output.derived");
+  for (const auto& name : derived)
+    if (!derived_catalogue().count(name)) {
+      std::set<std::string> names;
+      for (const auto& [n, meaning] : derived_catalogue()) names.insert(n);
+      reader.fail(v, "output.derived", "'" + name + "' is not a derived quantity (known: " + join(names) + ")");
     }
-    if (const Value* v = Reader::find(*o, "samples")) {
-      c.samples = reader.integer(*v, "output.samples", 2, kMaxSamples,
-                                 " (1e5 samples resolve 1e-5 of the rod in a 21 MB profile)");
-    }
+  const bool self_contact = Reader::find(root, "rod") && Reader::find(*Reader::find(root, "rod"), "self_contact");
+  for (const auto& [name, meaning] : plectoneme_quantities())
+    if (!self_contact && std::find(derived.begin(), derived.end(), name) != derived.end())
+      reader.fail(v, "output.derived", "'" + name + "' is a plectoneme quantity: it needs [rod.self_contact]");
+  return derived;
+}
+
+// [output]: the derived quantities reported and the number of profile samples.
+void read_output(const Reader& reader, const Value& root, Case* c) {
+  const Value* o = Reader::find(root, "output");
+  if (!o) return;
+  reader.allow_keys(*o, "output", {"derived", "samples"});
+  if (const Value* v = Reader::find(*o, "derived")) c->derived = read_derived(reader, *v, root);
+  if (const Value* v = Reader::find(*o, "samples")) {
+    c->samples = reader.integer(*v, "output.samples", 2, kMaxSamples,
+                                " (1e5 samples resolve 1e-5 of the rod in a 21 MB profile)");
   }
+}
 
-  // Consistency of the boundary conditions, checked by the problem itself.
+// Consistency of the boundary conditions, checked by the problem itself; its message is
+// attributed to the table it names.
+void check_problem(const Reader& reader, const Value& root, const ProblemDefinition& d) {
   try {
     ShootingProblem check(d);
   } catch (const std::invalid_argument& e) {
@@ -1202,11 +693,56 @@ Case load_case_text(const std::string& text, const std::string& path, const Para
     if (v) reader.fail(*v, table, what);
     reader.fail(table, what);
   }
-  // A computed parameter the problem uses makes the problem use what it is computed from (later
-  // rules may use earlier ones: walked backwards).
-  c.problem_parameters = reader.problem_uses();
+}
+
+// The parameters the problem uses: a computed parameter it uses makes it use what that is
+// computed from (later rules may use earlier ones: walked backwards).
+std::set<std::string> problem_parameters(const Reader& reader, const ProblemDefinition& d) {
+  std::set<std::string> used = reader.problem_uses();
   for (auto rule = d.dependent_parameters.rbegin(); rule != d.dependent_parameters.rend(); ++rule)
-    if (c.problem_parameters.count(rule->name)) c.problem_parameters.insert(rule->uses.begin(), rule->uses.end());
+    if (used.count(rule->name)) used.insert(rule->uses.begin(), rule->uses.end());
+  return used;
+}
+
+}  // namespace
+
+Case load_case_text(const std::string& text, const std::string& path, const ParameterOverrides& overrides,
+                    const std::string& phase_condition, const SolverOverrides& solver) {
+  Value root = parse_case_text(text, path);
+  merge_solver_overrides(root, solver, path);
+
+  Case c;
+  c.path = path;
+  c.text = text;
+  c.overrides = overrides;
+  c.phase_condition = phase_condition;
+  c.solver_overrides = solver;
+  // Parameters first: every expression may use them.
+  const Reader plain(path, {});
+  plain.allow_keys(root, "", {"title", "description", "model", "parameters", "rod", "start", "end", "guess",
+                              "solver", "output", "obstacles"});
+  std::vector<DependentParameter> dependents;
+  const Parameters parameters = read_parameters_with_overrides(plain, root, overrides, &c.file_parameters, &dependents);
+  const Reader reader(path, parameters);
+  if (const Value* v = Reader::find(root, "title")) c.title = reader.string(*v, "title");
+  if (const Value* v = Reader::find(root, "description")) c.description = reader.string(*v, "description");
+
+  ProblemDefinition& d = c.definition;
+  d.parameters = parameters;
+  d.dependent_parameters = dependents;
+  d.kind = read_model_kind(reader, root);
+  read_rod(reader, root, parameters, &d);
+  d.start = read_end(reader, root, "start", d.kind, parameters);
+  d.end = read_end(reader, root, "end", d.kind, parameters);
+  // [[obstacles]]: rigid frictionless obstacles, as gap functions g(r) >= 0.
+  if (const Value* list = Reader::find(root, "obstacles")) read_obstacles(reader, *list, d.kind, &d);
+  if (const Value* s = Reader::find(root, "solver")) read_solver(reader, *s, parameters, dependents, phase_condition, &d);
+  if (!phase_condition.empty()) apply_phase_condition(reader, &root, phase_condition, d);
+  c.start_guess = read_guess(reader, root, parameters, &d);
+  check_level_set_gaps(reader, root, parameters, c.start_guess.r, d);
+  read_output(reader, root, &c);
+  check_problem(reader, root, d);
+  c.problem_parameters = problem_parameters(reader, d);
   return c;
 }
 
