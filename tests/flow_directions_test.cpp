@@ -65,6 +65,26 @@ TEST(FlowDirections, ArePhiTimesTheDirectionsForEveryDualSize) {
   }
 }
 
+// With sensitivity_tol looser than the state's, the state comes from a pass of its own at the
+// state's tolerance (as flow() does it) and the directions at the looser one.
+TEST(FlowDirections, LooseSensitivitiesKeepTheStateTight) {
+  const auto eq = make_spatial_equations(curved_rod(false));
+  IntegratorOptions options, loose;
+  loose.sensitivity_tol = 1e-8;
+  const Eigen::VectorXd y0 = eq->state(start_point(false));
+  const Eigen::MatrixXd D = Eigen::MatrixXd::Identity(14, 14).middleCols(3, 5);
+  CarriedSteps carried, loose_carried;
+  const DirectionalFlow tight = eq->flow_directions(y0, D, 0.0, 1.2, options, &carried);
+  const DirectionalFlow coarse = eq->flow_directions(y0, D, 0.0, 1.2, loose, &loose_carried);
+  EXPECT_GT(loose_carried.state, 0.0);
+  // The state: the same 1e-12 integration both times (the dual pass's state is not used).
+  EXPECT_LT((coarse.y - tight.y).norm(), kSameFlowTolerance);
+  // The directions: to ~1e-8 per step, not to the state's 1e-12; 1e-6 of their size bounds the
+  // difference over a unit rod while a direction integrated wrongly would be O(1).
+  EXPECT_LT((coarse.directions - tight.directions).norm(), 1e-6 * tight.directions.norm());
+  EXPECT_GT((coarse.directions - tight.directions).norm(), 0.0);
+}
+
 // Handing the proposed step on makes the pieces one integration: fewer right-hand sides than
 // restarting each piece from a small trial step (IntegratorOptions::initial_step), the same end.
 TEST(FlowDirections, CarriedStepsSaveTheRestarts) {
