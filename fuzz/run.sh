@@ -14,8 +14,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:?usage: fuzz/run.sh SECONDS}"
 jobs="${JOBS:-1}"
-# FUZZ_BUILD names a tree already configured with -DKIRCHHOFF_FUZZ=ON and the flags below
-# (.ci/sanitize's build-asan, which also holds the fast tests): it is built, not reconfigured.
+# FUZZ_BUILD names a tree already configured with -DKIRCHHOFF_FUZZ=ON and the same sanitizer
+# flags (.ci/sanitize's build-asan, which also holds the fast tests): it is built, not reconfigured.
 build="${FUZZ_BUILD:-build-fuzz}"
 
 runtime=$(clang++ -print-file-name=libclang_rt.fuzzer-x86_64.a 2>/dev/null || true)
@@ -24,13 +24,12 @@ if ! command -v clang++ >/dev/null || [ ! -f "$runtime" ]; then
   exit 2
 fi
 
-# The library is instrumented for coverage (fuzzer-no-link) and the sanitizers; only the target
-# links libFuzzer's main (fuzz/CMakeLists.txt). halt_on_error: UBSan otherwise only prints.
-sanitize="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
-sanitize+=" -Wno-unknown-warning-option"  # lib/ passes a GCC-only -Wno-maybe-uninitialized
+# The library with the sanitizers (fuzz/sanitizer_flags.sh); KIRCHHOFF_FUZZ instruments its
+# case-loading sources for coverage (lib/CMakeLists.txt) and links libFuzzer into the targets only.
+source fuzz/sanitizer_flags.sh
 if [ -z "${FUZZ_BUILD:-}" ]; then
   cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
-    -DCMAKE_CXX_FLAGS="$sanitize" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
+    -DCMAKE_CXX_FLAGS="$SANITIZER_FLAGS" -DCMAKE_EXE_LINKER_FLAGS="$SANITIZER_LINK_FLAGS" \
     -DKIRCHHOFF_FUZZ=ON -DKIRCHHOFF_BUILD_TESTS=OFF -DKIRCHHOFF_BUILD_BENCH=OFF -DKIRCHHOFF_BUILD_PYTHON=OFF >/dev/null
 fi
 cmake --build "$build" -j"${BUILD_JOBS:-$(nproc)}" --target case_file_fuzzer override_fuzzer
