@@ -1073,7 +1073,7 @@ std::string extended_contact_unsupported(const RodEquations& equations, const Ob
 
 void add_axial_phase_condition(ProblemDefinition& d) {
   if (d.kind != RodKind::Spatial) throw std::invalid_argument("the axial phase condition is for spatial rods");
-  const std::string name = "unfolding";
+  const std::string name = kUnfoldingParameter;
   d.parameters.set(name, 0.0);
   d.model = [inner = d.model, name](const Parameters& p) {
     RodModel m = inner(p);
@@ -1100,10 +1100,10 @@ ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) 
   result.parameters = problem.parameters_at(result.x);
   if (result.summary.converged()) mark_check_failure(&result, unknowns_failure(problem, result));
   if (result.summary.converged()) mark_check_failure(&result, zero_iteration_failure(problem, result));
-  if (!result.summary.converged() || !result.parameters.contains("unfolding")) return result;
-  if (std::abs(result.parameters.get("unfolding")) > kUnfoldingTolerance) {
+  if (!result.summary.converged() || !result.parameters.contains(kUnfoldingParameter)) return result;
+  if (std::abs(result.parameters.get(kUnfoldingParameter)) > kUnfoldingTolerance) {
     result.summary.status = SolverStatus::UnfoldingNotZero;
-    result.summary.message = "unfolding = " + std::to_string(result.parameters.get("unfolding")) +
+    result.summary.message = "unfolding = " + std::to_string(result.parameters.get(kUnfoldingParameter)) +
                              ": not an equilibrium (on the straight rod the axial phase condition is degenerate)";
     return result;
   }

@@ -259,6 +259,12 @@ class ShootingProblem final : public NonlinearSystem {
 //     and the phase condition is degenerate: solve the straight rod without it.)
 void add_axial_phase_condition(ProblemDefinition& definition);
 
+// The name of add_axial_phase_condition's unknown. It is zero at every equilibrium and only
+// selects one solution on each circle, so analyses that ask what an unknown parameter does (an
+// end load, a sliding length) pass over it.
+inline constexpr const char* kUnfoldingParameter = "unfolding";
+inline bool is_unfolding_parameter(const std::string& name) { return name == kUnfoldingParameter; }
+
 // |mu| above this at a converged point means the unfolded system was solved with a non-zero
 // couple (an artefact, not an equilibrium). At true solutions mu is zero to the Newton
 // tolerance times the conditioning, far below this.

@@ -134,7 +134,7 @@ std::string classify_unknowns(const ShootingProblem& problem, const Parameters& 
                               std::vector<std::string>* multipliers) {
   const ProblemDefinition& d = problem.definition();
   for (const std::string& name : d.unknown_parameters) {
-    if (name == "unfolding") continue;  // zero at every equilibrium; its phase condition only selects
+    if (is_unfolding_parameter(name)) continue;
     if (d.model_parameters.count(name) || d.obstacle_parameters.count(name))
       return "the unknown parameter '" + name + "' changes the rod or an obstacle, not an end load";
     bool load = false;

@@ -31,6 +31,8 @@ std::string unsupported_reason(const ShootingProblem& problem, const std::string
     return "the unknown parameter '" + name + "' moves an obstacle: it is not a degree of freedom of the energy";
   for (const std::string& other : d.unknown_parameters) {
     if (other == name) continue;
+    if (is_unfolding_parameter(other))
+      return "a sliding length solved with the axial phase condition's unfolding parameter: not implemented";
     if (d.model_parameters.count(other) || d.obstacle_parameters.count(other))
       return "several unknown parameters change the rod or an obstacle ('" + name + "', '" + other +
              "'): the reduction on one sliding length does not apply";
@@ -136,7 +138,7 @@ FreeLengthStability undefined(FreeLengthStability out, const std::string& reason
 std::string rod_changing_unknown(const ShootingProblem& problem) {
   const ProblemDefinition& d = problem.definition();
   for (const std::string& name : d.unknown_parameters) {
-    if (name == "unfolding") continue;  // zero at every equilibrium: its phase condition only selects
+    if (is_unfolding_parameter(name)) continue;
     if (d.model_parameters.count(name) || d.obstacle_parameters.count(name)) return name;
   }
   return "";
