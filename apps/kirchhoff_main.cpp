@@ -1,6 +1,7 @@
 // kirchhoff: equilibria of elastic rods by shooting, checked against Noether's invariants.
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <string>
 
 #include "continue_command.hpp"
 #include "plectonemes_command.hpp"
@@ -33,6 +34,23 @@ void add_seed_options(CLI::App* command, std::string* choice, kirchhoff::StartSe
       ->capture_default_str();
 }
 
+// The options every command that loads one case shares: the case file, --set and --solver.
+// `set_help` replaces --set's description where the command gives it more meaning (solve).
+template <class Arguments>
+void add_case_options(CLI::App* command, Arguments* args, const std::string& case_help = "Case file (TOML)",
+                      const std::string& set_help = "Override a parameter: NAME=VALUE (repeatable)") {
+  command->add_option("case", args->case_path, case_help)->required()->check(CLI::ExistingFile);
+  command->add_option("--set", args->overrides, set_help);
+  command->add_option("--solver", args->solver,
+                      "Override a [solver] key: KEY=VALUE, e.g. tolerance=1e-10, stepper=dopri5 (repeatable; "
+                      "checked as in the file)");
+}
+
+// --phase-condition (solve and continue).
+void add_phase_condition_option(CLI::App* command, std::string* phase_condition, const std::string& help) {
+  command->add_option("--phase-condition", *phase_condition, help)->check(CLI::IsMember({"none", "axial"}));
+}
+
 // The arguments of `check` and `reproduce`, whose run functions take them one by one.
 struct CheckArguments {
   std::string case_path;
@@ -49,13 +67,11 @@ struct ReproduceArguments {
 // asks whether it was given. *seed receives --seed ("guess" or "ipopt").
 CLI::App* add_solve_command(CLI::App& app, SolveArguments* args, std::string* seed) {
   auto* command = app.add_subcommand("solve", "Solve one equilibrium and report derived quantities and invariants");
-  command->add_option("case", args->case_path, "Case file (TOML)")->required()->check(CLI::ExistingFile);
-  command->add_option("--solver", args->solver, "Override a [solver] key: KEY=VALUE, e.g. tolerance=1e-10, stepper=dopri5 (repeatable; checked as in the file)");
-  command->add_option("--set", args->overrides,
-                      "Override a parameter: NAME=VALUE (repeatable). The equilibrium at the new values is\n"
-                      "reached by continuation from the case's own (a homotopy in all changed parameters\n"
-                      "together), so it lies on the branch the case's guess starts; a fold on the way is\n"
-                      "reported (exit 1), never jumped");
+  add_case_options(command, args, "Case file (TOML)",
+                   "Override a parameter: NAME=VALUE (repeatable). The equilibrium at the new values is\n"
+                   "reached by continuation from the case's own (a homotopy in all changed parameters\n"
+                   "together), so it lies on the branch the case's guess starts; a fold on the way is\n"
+                   "reported (exit 1), never jumped");
   command->add_flag("--direct", args->direct,
                     "Newton from the case's guess at the --set values instead of the homotopy (whichever\n"
                     "equilibrium attracts the guess)");
@@ -70,19 +86,15 @@ CLI::App* add_solve_command(CLI::App& app, SolveArguments* args, std::string* se
                    "Wall-clock limit of the solve in seconds (0: none); past it the solve stops with status "
                    "time_limit, exit 1")
       ->capture_default_str();
-  command
-      ->add_option("--phase-condition", args->phase_condition,
-                   "Override [solver] phase_condition: 'axial' selects one buckled solution of an isotropic\n"
-                   "twisted rod out of its circle of rotated copies (singular on the straight rod)")
-      ->check(CLI::IsMember({"none", "axial"}));
+  add_phase_condition_option(command, &args->phase_condition,
+                             "Override [solver] phase_condition: 'axial' selects one buckled solution of an isotropic\n"
+                             "twisted rod out of its circle of rotated copies (singular on the straight rod)");
   return command;
 }
 
 CLI::App* add_check_command(CLI::App& app, CheckArguments* args) {
   auto* command = app.add_subcommand("check", "Validate a case file without solving");
-  command->add_option("case", args->case_path, "Case file (TOML)")->required()->check(CLI::ExistingFile);
-  command->add_option("--set", args->overrides, "Override a parameter: NAME=VALUE (repeatable)");
-  command->add_option("--solver", args->solver, "Override a [solver] key: KEY=VALUE, e.g. tolerance=1e-10, stepper=dopri5 (repeatable; checked as in the file)");
+  add_case_options(command, args);
   return command;
 }
 
@@ -91,7 +103,7 @@ CLI::App* add_continue_command(CLI::App& app, ContinueArguments* args, std::stri
       "continue",
       "Follow a branch of equilibria in one parameter (pseudo-arclength), locating folds and branch points;\n"
       "one CSV row per point, flushed as it goes; --resume picks up a killed run");
-  command->add_option("case", args->case_path, "Case file (TOML)")->required()->check(CLI::ExistingFile);
+  add_case_options(command, args);
   command->add_option("--param", args->parameter, "Parameter to continue in (from [parameters])")->required();
   command->add_option("--to", args->to, "Stop when the parameter reaches this value")
       ->each([args](const std::string&) { args->has_to = true; });
@@ -144,10 +156,7 @@ CLI::App* add_continue_command(CLI::App& app, ContinueArguments* args, std::stri
                    "Save the state file (for --resume) at most once per this many seconds (0: after every\n"
                    "point); a resumed run recomputes the rows after the last save, the same rows")
       ->capture_default_str();
-  command->add_option("--set", args->overrides, "Override a parameter: NAME=VALUE (repeatable)");
-  command->add_option("--solver", args->solver, "Override a [solver] key: KEY=VALUE, e.g. tolerance=1e-10, stepper=dopri5 (repeatable; checked as in the file)");
-  command->add_option("--phase-condition", args->phase_condition, "As for solve")
-      ->check(CLI::IsMember({"none", "axial"}));
+  add_phase_condition_option(command, &args->phase_condition, "As for solve");
   return command;
 }
 
@@ -167,9 +176,7 @@ CLI::App* add_equilibria_command(CLI::App& app, EquilibriaArguments* args) {
       "Examples:\n"
       "  kirchhoff equilibria cases/euler_column.toml --set P=50\n"
       "  kirchhoff equilibria cases/wall.toml --set Delta=0.033 --max 6 --json --profiles wall_eq/");
-  command->add_option("case", args->case_path, "Case file (TOML)")->required()->check(CLI::ExistingFile);
-  command->add_option("--set", args->overrides, "Override a parameter: NAME=VALUE (repeatable)");
-  command->add_option("--solver", args->solver, "Override a [solver] key: KEY=VALUE, e.g. tolerance=1e-10, stepper=dopri5 (repeatable; checked as in the file)");
+  add_case_options(command, args);
   command->add_option("--max", args->max_equilibria, "Stop once this many distinct equilibria are found")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -209,9 +216,7 @@ CLI::App* add_vibrate_command(CLI::App& app, VibrateArguments* args) {
       "  kirchhoff vibrate cases/euler_column.toml --set P=4.934802200544679 --set theta_guess=0\n"
       "  kirchhoff vibrate cases/simply_supported.toml --set theta0=1 --modes 4 --out vib.json --profiles modes/\n"
       "  kirchhoff vibrate cases/heavy_cantilever.toml --set w=0 --rho-s 2 --json");
-  command->add_option("case", args->case_path, "Case file (TOML) of a planar rod")->required()->check(CLI::ExistingFile);
-  command->add_option("--set", args->overrides, "Override a parameter: NAME=VALUE (repeatable)");
-  command->add_option("--solver", args->solver, "Override a [solver] key: KEY=VALUE, e.g. tolerance=1e-10, stepper=dopri5 (repeatable; checked as in the file)");
+  add_case_options(command, args, "Case file (TOML) of a planar rod");
   command->add_option("--modes", args->modes, "Number of lowest frequencies to find")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
