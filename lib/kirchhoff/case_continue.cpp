@@ -55,7 +55,7 @@ ContinuationOptions options_for(const Case& c, const ContinueRequest& r) {
 // case whose problem has the unfolding parameter has it already).
 ProblemDefinition definition_for(const Case& c, const std::string& phase) {
   ProblemDefinition d = c.definition;
-  if (phase == "axial" && !d.parameters.contains("unfolding")) add_axial_phase_condition(d);
+  if (phase == "axial" && !d.parameters.contains(kUnfoldingParameter)) add_axial_phase_condition(d);
   return d;
 }
 

@@ -65,7 +65,7 @@ std::vector<std::string> read_unknowns(const Reader& reader, const Value& v, con
 void apply_phase_condition(const Reader& reader, const Value* where, const std::string& name, ProblemDefinition& d) {
   if (name == "axial") {
     if (d.kind != RodKind::Spatial) reader.fail(*where, "solver.phase_condition", "'axial' is for spatial rods");
-    if (d.parameters.contains("unfolding"))
+    if (d.parameters.contains(kUnfoldingParameter))
       reader.fail(*where, "solver.phase_condition", "needs the parameter name 'unfolding' free");
     add_axial_phase_condition(d);
   } else if (name != "none") {

@@ -484,7 +484,7 @@ class Search {
   // Why x is not an admissible equilibrium of its family's problem, or "".
   std::string inadmissibility(const ShootingProblem& problem, const Eigen::VectorXd& x) const {
     const Parameters p = problem.parameters_at(x);
-    if (p.contains("unfolding") && std::abs(p.get("unfolding")) > kUnfoldingTolerance)
+    if (p.contains(kUnfoldingParameter) && std::abs(p.get(kUnfoldingParameter)) > kUnfoldingTolerance)
       return "the symmetry-unfolding parameter is not zero (a solution of the unfolded system only)";
     if (problem.definition().obstacles.empty()) return "";
     std::ostringstream why;
