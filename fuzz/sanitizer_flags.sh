@@ -1,8 +1,9 @@
 # Sourced by .ci/sanitize and fuzz/run.sh: the clang flags of the instrumented tree they share.
 #
 # AddressSanitizer, and UndefinedBehaviorSanitizer halting on its first report, without three of
-# its checks that ASan already covers and that were a third of the build's time (Eigen's
-# expression templates are pointer and reference accesses throughout): `null` and `alignment`
+# its checks that ASan already covers and that took over a third of the compile time of the
+# heaviest source, stability.cpp (Eigen's expression templates are pointer and reference
+# accesses throughout): `null` and `alignment`
 # (a null or misaligned access faults, and ASan reports the fault with its stack) and
 # `object-size` (an access outside its object lands in ASan's redzones). The checks kept are the
 # arithmetic ones ASan cannot see: signed overflow, shifts, float-to-int, bounds of arrays,
