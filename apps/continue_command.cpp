@@ -13,10 +13,10 @@
 #include <optional>
 #include <sstream>
 
-#include "kirchhoff/case_continue.hpp"
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/continue_outputs.hpp"
-#include "kirchhoff/run_state.hpp"
+#include "kirchhoff/jobs/case_continue.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/jobs/continue_outputs.hpp"
+#include "kirchhoff/jobs/run_state.hpp"
 #include "solve_command.hpp"
 
 namespace kirchhoff::cli {

@@ -10,9 +10,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/equilibria.hpp"
-#include "kirchhoff/result_json.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/jobs/equilibria.hpp"
+#include "kirchhoff/jobs/result_json.hpp"
 #include "solve_command.hpp"
 
 namespace kirchhoff::cli {

@@ -3,7 +3,7 @@
 #include <iomanip>
 #include <iostream>
 
-#include "kirchhoff/case_file.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
 
 namespace kirchhoff::cli {
 

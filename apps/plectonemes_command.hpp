@@ -1,8 +1,8 @@
-// `kirchhoff plectonemes`: the Fig. 11 sweep (kirchhoff/plectoneme_sweep.hpp) with its report
+// `kirchhoff plectonemes`: the Fig. 11 sweep (kirchhoff/sweeps/plectoneme_sweep.hpp) with its report
 // and totals on stdout.
 #pragma once
 
-#include "kirchhoff/plectoneme_sweep.hpp"
+#include "kirchhoff/sweeps/plectoneme_sweep.hpp"
 
 namespace kirchhoff::cli {
 

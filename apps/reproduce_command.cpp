@@ -3,7 +3,7 @@
 #include <filesystem>
 #include <iostream>
 
-#include "kirchhoff/reproduce.hpp"
+#include "kirchhoff/reproduce/reproduce.hpp"
 #include "solve_command.hpp"
 
 namespace kirchhoff::cli {

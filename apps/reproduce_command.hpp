@@ -1,4 +1,4 @@
-// `kirchhoff reproduce`: maps its arguments onto the library's `reproduce` (kirchhoff/reproduce.hpp),
+// `kirchhoff reproduce`: maps its arguments onto the library's `reproduce` (kirchhoff/reproduce/reproduce.hpp),
 // which recomputes the reference paper's results and writes the report and the figure data.
 #pragma once
 

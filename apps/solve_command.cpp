@@ -3,10 +3,10 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/contact.hpp"
-#include "kirchhoff/solution.hpp"
-#include "kirchhoff/result_json.hpp"
+#include "kirchhoff/analysis/solution.hpp"
+#include "kirchhoff/contact/contact.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/jobs/result_json.hpp"
 
 namespace kirchhoff::cli {
 namespace {

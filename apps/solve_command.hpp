@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/case_solve.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/jobs/case_solve.hpp"
 
 namespace kirchhoff::cli {
 

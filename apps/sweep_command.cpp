@@ -2,11 +2,11 @@
 
 #include <iostream>
 
-#include "kirchhoff/sweep.hpp"
-#include "kirchhoff/sweep_run.hpp"
+#include "kirchhoff/sweeps/sweep.hpp"
+#include "kirchhoff/sweeps/sweep_run.hpp"
 #include "solve_command.hpp"
 #ifdef KIRCHHOFF_HAVE_MPI
-#include "kirchhoff/sweep_mpi.hpp"
+#include "kirchhoff/sweeps/detail/sweep_mpi.hpp"
 #endif
 
 namespace kirchhoff::cli {

@@ -6,8 +6,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "kirchhoff/vibration.hpp"
-#include "kirchhoff/result_json.hpp"
+#include "kirchhoff/analysis/vibration.hpp"
+#include "kirchhoff/jobs/result_json.hpp"
 #include "solve_command.hpp"
 
 namespace kirchhoff::cli {

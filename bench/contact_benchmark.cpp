@@ -27,11 +27,11 @@
 #include <string>
 #include <vector>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/contact.hpp"
-#include "kirchhoff/discrete_elastica.hpp"
-#include "kirchhoff/solution.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/analysis/discrete_elastica.hpp"
+#include "kirchhoff/analysis/solution.hpp"
+#include "kirchhoff/contact/contact.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
 
 namespace {
 

@@ -71,11 +71,11 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/continuation.hpp"
-#include "kirchhoff/shooting.hpp"
-#include "kirchhoff/solution.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/analysis/solution.hpp"
+#include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/shooting/shooting.hpp"
 
 namespace {
 

@@ -42,8 +42,8 @@
 
 #include <time.h>
 
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/shooting.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/shooting/shooting.hpp"
 
 namespace {
 

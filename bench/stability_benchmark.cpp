@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/stability.hpp"
+#include "kirchhoff/analysis/stability.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
 
 namespace {
 

@@ -13,8 +13,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/shooting.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/shooting/shooting.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

@@ -15,8 +15,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/toml_nesting.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/jobs/detail/toml_nesting.hpp"
 
 namespace {
 

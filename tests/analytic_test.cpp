@@ -1,11 +1,11 @@
-// Tests of the closed-form rod results in kirchhoff/analytic.hpp.
+// Tests of the closed-form rod results in kirchhoff/analysis/analytic.hpp.
 //
 // Tolerances. GSL's K(k), E(k), E(phi, k) and sn/cn/dn are accurate to a few ulps (~1e-15
 // relative) for the moduli used here (k <= sin 1.4 = 0.985); root solves are run to 4 eps.
 // Tolerances on exact identities therefore sit at 1e-12, leaving a few hundred ulps for the
 // chained operations, and tolerances on approximations follow the truncation error of the
 // approximation (stated at each test).
-#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
 
 #include <gtest/gtest.h>
 

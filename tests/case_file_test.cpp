@@ -20,10 +20,10 @@
 #include <tuple>
 #include <vector>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/shooting.hpp"
-#include "kirchhoff/solution.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/analysis/solution.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/shooting/shooting.hpp"
 
 namespace kirchhoff {
 namespace {

@@ -5,7 +5,7 @@
 // coexist on one rod.
 #include <cmath>
 
-#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

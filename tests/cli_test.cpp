@@ -19,7 +19,7 @@
 #include <tuple>
 #include <vector>
 
-#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
 
 namespace {
 

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <iostream>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/continuation.hpp"
-#include "kirchhoff/point_record.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/analysis/point_record.hpp"
+#include "kirchhoff/continuation/continuation.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

@@ -18,7 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_run_support.hpp"
-#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
 
 namespace {
 

@@ -6,8 +6,8 @@
 // is reported as failed.
 #include <cmath>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/discrete_elastica.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/analysis/discrete_elastica.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

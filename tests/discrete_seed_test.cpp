@@ -3,7 +3,7 @@
 // that it cannot reach from a contact-free guess, and they are the equilibria Ipopt found.
 #include <cmath>
 
-#include "kirchhoff/discrete_seed.hpp"
+#include "kirchhoff/analysis/discrete_seed.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

@@ -3,18 +3,18 @@
 // position-dependent fields.
 // Indices and zero-mode counts are integers and compared exactly; eigenvalues against closed forms
 // with the discretisation's own O(h^2) error, stated beside each comparison.
-#include "kirchhoff/discrete_stability.hpp"
+#include "kirchhoff/analysis/discrete_stability.hpp"
 
-#include "kirchhoff/discrete_stability_contact.hpp"
+#include "kirchhoff/analysis/detail/discrete_stability_contact.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 
-#include "kirchhoff/contact.hpp"
-#include "kirchhoff/stability.hpp"
-#include "kirchhoff/vibration.hpp"
+#include "kirchhoff/analysis/stability.hpp"
+#include "kirchhoff/analysis/vibration.hpp"
+#include "kirchhoff/contact/contact.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

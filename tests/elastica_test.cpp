@@ -1,7 +1,7 @@
 // The simply supported Elastica (Fig. 3) against the elliptic-integral solution and eq. (54).
 #include <cmath>
 
-#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

@@ -1,7 +1,7 @@
 // The equilibria search (equilibria.hpp) and deflated Newton (deflation.hpp): counts, indices and
 // energies of coexisting equilibria against closed forms, independent solves and the classical
 // results; the CLI's `equilibria` command.
-#include "kirchhoff/equilibria.hpp"
+#include "kirchhoff/jobs/equilibria.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -16,10 +16,10 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/discrete_stability.hpp"
-#include "kirchhoff/equilibrium_families.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/analysis/discrete_stability.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/jobs/detail/equilibrium_families.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

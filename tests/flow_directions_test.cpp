@@ -2,7 +2,7 @@
 // integration continued across adjacent intervals, are Phi directions.
 #include <Eigen/Geometry>
 
-#include "kirchhoff/rod_equations.hpp"
+#include "kirchhoff/equations/rod_equations.hpp"
 #include <gtest/gtest.h>
 
 namespace kirchhoff {

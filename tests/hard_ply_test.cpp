@@ -9,13 +9,13 @@
 #include <cmath>
 #include <iostream>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/continuation.hpp"
-#include "kirchhoff/hard_self_contact.hpp"
-#include "kirchhoff/newton.hpp"
-#include "kirchhoff/plectoneme.hpp"
-#include "kirchhoff/rod_on_cylinder.hpp"
-#include "kirchhoff/self_passage.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/contact/hard_self_contact.hpp"
+#include "kirchhoff/contact/plectoneme.hpp"
+#include "kirchhoff/contact/self_passage.hpp"
+#include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/equations/detail/rod_on_cylinder.hpp"
+#include "kirchhoff/shooting/newton.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

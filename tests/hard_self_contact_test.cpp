@@ -5,9 +5,9 @@
 
 #include <cmath>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/continuation.hpp"
-#include "kirchhoff/hard_self_contact.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/contact/hard_self_contact.hpp"
+#include "kirchhoff/continuation/continuation.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

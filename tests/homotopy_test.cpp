@@ -4,9 +4,9 @@
 // stay guesses.
 #include <cmath>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/case_solve.hpp"
-#include "kirchhoff/continuation.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/jobs/case_solve.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/spatial_bins.hpp"
-#include "kirchhoff/toml_nesting.hpp"
+#include "kirchhoff/contact/detail/spatial_bins.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/jobs/detail/toml_nesting.hpp"
 
 namespace kirchhoff {
 namespace {

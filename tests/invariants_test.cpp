@@ -3,7 +3,7 @@
 // constant for the twisted rod, and H including -W_ext for the heavy rod.
 #include <cmath>
 
-#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

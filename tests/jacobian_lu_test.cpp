@@ -1,6 +1,6 @@
 // The sparse path of JacobianLU must give what the dense LU gives on the matrices multiple
 // shooting makes: block-bidiagonal with dense border rows and columns.
-#include "kirchhoff/jacobian_lu.hpp"
+#include "kirchhoff/shooting/detail/jacobian_lu.hpp"
 
 #include <gtest/gtest.h>
 

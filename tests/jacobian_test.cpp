@@ -1,5 +1,5 @@
 // The shooting Jacobian from the variational equations against central finite differences.
-#include "kirchhoff/newton.hpp"
+#include "kirchhoff/shooting/newton.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "kirchhoff/link.hpp"
+#include "kirchhoff/shooting/link.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

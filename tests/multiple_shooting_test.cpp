@@ -1,6 +1,6 @@
 // Multiple shooting gives the same solution as single shooting, and reaches strongly loaded
 // rods whose single-shooting sensitivities blow up.
-#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

@@ -1,5 +1,5 @@
 // Damped Newton, its summary, and the NLopt fallback search for a starting point.
-#include "kirchhoff/newton.hpp"
+#include "kirchhoff/shooting/newton.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

@@ -4,9 +4,9 @@
 // sets, and against Ipopt's discrete Elastica.
 #include <cmath>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/contact.hpp"
-#include "kirchhoff/discrete_elastica.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/analysis/discrete_elastica.hpp"
+#include "kirchhoff/contact/contact.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

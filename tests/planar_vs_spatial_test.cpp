@@ -1,9 +1,9 @@
 // The planar Elastica is the 3D core restricted to the plane: same flow, same solutions.
 #include <Eigen/Geometry>
 
-#include "kirchhoff/rod_equations.hpp"
-#include "kirchhoff/shooting.hpp"
-#include "kirchhoff/solution.hpp"
+#include "kirchhoff/analysis/solution.hpp"
+#include "kirchhoff/equations/rod_equations.hpp"
+#include "kirchhoff/shooting/shooting.hpp"
 #include <gtest/gtest.h>
 
 namespace kirchhoff {

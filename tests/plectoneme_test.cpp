@@ -10,12 +10,12 @@
 
 #include <Eigen/Geometry>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/continuation.hpp"
-#include "kirchhoff/integrator.hpp"
-#include "kirchhoff/plectoneme.hpp"
-#include "kirchhoff/self_contact.hpp"
-#include "kirchhoff/self_passage.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/contact/plectoneme.hpp"
+#include "kirchhoff/contact/self_contact.hpp"
+#include "kirchhoff/contact/self_passage.hpp"
+#include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/equations/integrator.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "kirchhoff/rod_on_cylinder.hpp"
+#include "kirchhoff/equations/detail/rod_on_cylinder.hpp"
 
 namespace kirchhoff {
 namespace {

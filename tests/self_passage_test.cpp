@@ -6,8 +6,8 @@
 #include <set>
 #include <vector>
 
-#include "kirchhoff/self_passage.hpp"
-#include "kirchhoff/spatial_bins.hpp"
+#include "kirchhoff/contact/detail/spatial_bins.hpp"
+#include "kirchhoff/contact/self_passage.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

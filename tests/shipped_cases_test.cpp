@@ -16,8 +16,8 @@
 #include <map>
 #include <set>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/continuation.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/continuation/continuation.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

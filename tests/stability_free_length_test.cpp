@@ -5,10 +5,10 @@
 #include <cmath>
 #include <memory>
 
-#include "kirchhoff/discrete_stability.hpp"
-#include "kirchhoff/equilibria.hpp"
-#include "kirchhoff/invariants.hpp"
-#include "kirchhoff/stability_free_length.hpp"
+#include "kirchhoff/analysis/detail/stability_free_length.hpp"
+#include "kirchhoff/analysis/discrete_stability.hpp"
+#include "kirchhoff/equations/invariants.hpp"
+#include "kirchhoff/jobs/equilibria.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

@@ -4,7 +4,7 @@
 // full length without any symmetry (its index by conjugate points, which the Euler, Greenhill and
 // clamped-clamped tests of stability_test.cpp check against closed forms), and, with the
 // self-contact on, against the folds of the plectoneme branch.
-#include "kirchhoff/stability.hpp"
+#include "kirchhoff/analysis/stability.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,9 +12,9 @@
 #include <cmath>
 #include <iostream>
 
-#include "kirchhoff/continuation.hpp"
-#include "kirchhoff/self_contact.hpp"
-#include "kirchhoff/stability_symmetric.hpp"
+#include "kirchhoff/analysis/detail/stability_symmetric.hpp"
+#include "kirchhoff/contact/self_contact.hpp"
+#include "kirchhoff/continuation/continuation.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

@@ -3,7 +3,7 @@
 // Greenhill threshold, and a discretised energy's Hessian (python reproduction in
 // docs/stability.md). The index is an integer: the tests compare it exactly; where positions of
 // conjugate points are checked, the tolerance is that of the phase interpolation over one step.
-#include "kirchhoff/stability.hpp"
+#include "kirchhoff/analysis/stability.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,9 +11,9 @@
 #include <filesystem>
 #include <iostream>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/continuation.hpp"
-#include "kirchhoff/discrete_stability.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/analysis/discrete_stability.hpp"
+#include "kirchhoff/continuation/continuation.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "kirchhoff/sweep.hpp"
+#include "kirchhoff/sweeps/sweep.hpp"
 
 namespace kirchhoff {
 namespace {

@@ -1,5 +1,5 @@
 // Fig. 9 / eq. (57): on a tapered rod H is not invariant, and H'(s) = -EI'(s) theta'^2 / 2.
-#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

@@ -7,11 +7,11 @@
 #include <iterator>
 #include <string>
 
-#include "kirchhoff/case_file.hpp"
-#include "kirchhoff/contact.hpp"
-#include "kirchhoff/invariants.hpp"
-#include "kirchhoff/rod_model.hpp"
-#include "kirchhoff/solution.hpp"
+#include "kirchhoff/analysis/solution.hpp"
+#include "kirchhoff/contact/contact.hpp"
+#include "kirchhoff/equations/invariants.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/model/rod_model.hpp"
 
 namespace kirchhoff::testing {
 

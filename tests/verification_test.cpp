@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <thread>
 
-#include "kirchhoff/newton.hpp"
-#include "kirchhoff/verification.hpp"
+#include "kirchhoff/shooting/newton.hpp"
+#include "kirchhoff/shooting/verification.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

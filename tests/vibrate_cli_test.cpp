@@ -13,7 +13,7 @@
 #include <sstream>
 #include <string>
 
-#include "kirchhoff/analytic.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
 
 namespace {
 

@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/stability.hpp"
-#include "kirchhoff/vibration.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/analysis/stability.hpp"
+#include "kirchhoff/analysis/vibration.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

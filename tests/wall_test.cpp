@@ -3,8 +3,8 @@
 // approach to the hard wall as b -> 0.
 #include <cmath>
 
-#include "kirchhoff/analytic.hpp"
-#include "kirchhoff/continuation.hpp"
+#include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/continuation/continuation.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

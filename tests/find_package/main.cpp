@@ -1,9 +1,9 @@
 // Consumer of the installed library: solves the simply supported Elastica from its case file,
 // then continues it in theta0 from 1 to 2 as `kirchhoff continue` does (continue_case).
-#include <kirchhoff/analytic.hpp>
-#include <kirchhoff/case_continue.hpp>
-#include <kirchhoff/case_file.hpp>
-#include <kirchhoff/shooting.hpp>
+#include <kirchhoff/analysis/analytic.hpp>
+#include <kirchhoff/jobs/case_continue.hpp>
+#include <kirchhoff/jobs/case_file.hpp>
+#include <kirchhoff/shooting/shooting.hpp>
 #include <cmath>
 #include <cstdio>
 

@@ -1,0 +1,140 @@
+#include "kirchhoff/analysis/discrete_seed.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace kirchhoff {
+namespace {
+
+[[noreturn]] void out_of_scope(const std::string& why) {
+  throw std::invalid_argument("the Ipopt seed handles planar clamped-clamped Kirchhoff rods only: " + why);
+}
+
+// Whether an end is clamped: position and frame imposed in every direction, nothing else.
+bool is_clamped(const EndCondition& end) {
+  if (end.extra_count() != 0) return false;
+  bool position = false, orientation = false;
+  for (const auto& c : end.conditions()) {
+    if (c.directions != Directions::All) return false;
+    if (c.slot == Slot::Position) position = true;
+    else if (c.slot == Slot::Orientation) orientation = true;
+    else return false;
+  }
+  return position && orientation;
+}
+
+// The clamp's position and tangent angle.
+std::pair<Vec3, double> clamp(const RodEquations& eq, const EndCondition& end, bool at_start, const Parameters& p) {
+  RodPoint point;
+  point.R = planar_reference_frame();
+  end.impose_on(eq, at_start, p, &point);
+  const Vec3 t = point.R.col(2);
+  return {point.r, std::atan2(t.y(), t.x())};
+}
+
+DiscreteClampedElastica discrete_rod(const ProblemDefinition& d, const ShootingProblem& problem) {
+  if (d.kind != RodKind::Planar) out_of_scope("the case is spatial");
+  if (!d.unknown_parameters.empty()) out_of_scope("the case solves for parameters");
+  if (!is_clamped(d.start) || !is_clamped(d.end)) out_of_scope("both ends must be clamped");
+  const auto eq = problem.equations(d.parameters);
+  const RodModel& model = eq->model();
+  if (model.extensible) out_of_scope("the rod is extensible or shearable");
+  if (model.field) out_of_scope("the rod carries an external field");
+  for (int k = 0; k <= 20; ++k)
+    if (model.u_hat[1](model.length * k / 20) != 0.0) out_of_scope("the rod has a natural curvature");
+  DiscreteClampedElastica rod;
+  rod.L = model.length;
+  rod.EI = [B = model.B[1]](double s) { return B(s); };
+  std::tie(rod.start, rod.start_angle) = clamp(*eq, d.start, true, d.parameters);
+  std::tie(rod.end, rod.end_angle) = clamp(*eq, d.end, false, d.parameters);
+  rod.obstacles = problem.obstacles(d.parameters);
+  return rod;
+}
+
+// The contacts of one obstacle from the nodes' forces and gaps (see the header).
+void read_contacts(const std::vector<double>& force, const std::vector<double>& gap, int obstacle, bool flat,
+                   double h, double L, double force_scale, std::vector<PointContact>* out) {
+  // Inactive constraints keep multipliers ~1e-10 of the forces: a force counts above 1e-6 of
+  // the rod's force scale.
+  auto active = [&](size_t i) { return gap[i] < 1e-9 * L || force[i] > 1e-6 * force_scale; };
+  for (size_t i = 0; i < force.size();) {
+    if (!active(i)) {
+      ++i;
+      continue;
+    }
+    size_t j = i;
+    while (j + 1 < force.size() && active(j + 1)) ++j;
+    // Nodes i..j (arclengths (i + 1) h .. (j + 1) h).
+    PointContact c;
+    c.obstacle = obstacle;
+    if (flat && j >= i + 2) {
+      c.extended = true;
+      c.s = (i + 1) * h;
+      c.s_end = (j + 1) * h;
+      for (size_t k = i; k <= j; ++k) (2 * k <= i + j ? c.force : c.force_end) += force[k];
+    } else {
+      double total = 0.0, moment = 0.0;
+      for (size_t k = i; k <= j; ++k) {
+        total += force[k];
+        moment += force[k] * (k + 1) * h;
+      }
+      c.force = total;
+      c.s = total > 0 ? moment / total : 0.5 * (i + j + 2) * h;
+    }
+    out->push_back(c);
+    i = j + 1;
+  }
+}
+
+}  // namespace
+
+DiscreteSeed seed_from_discrete_energy(const ProblemDefinition& d, int segments, double amplitude) {
+  const ShootingProblem problem(d);
+  const DiscreteClampedElastica rod = discrete_rod(d, problem);
+  DiscreteSeed seed;
+  seed.discrete = solve_discrete_elastica(rod, segments, amplitude);
+  // converged: Ipopt succeeded and its solution passed the library's own KKT check (stationarity,
+  // end constraints, no penetration, no pulling force, complementarity); anything else is refused
+  // rather than read off. (The seed needs no refinement check: the shooting solve that starts from
+  // it is checked by its own residual and complementarity.)
+  if (!seed.discrete.converged)
+    throw std::runtime_error("the Ipopt seed did not converge (" + seed.discrete.status + ")");
+  const double h = rod.L / segments;
+  // Forces: the end reaction, or the Euler load's scale EI / L^2 when that is smaller.
+  const double force_scale = seed.discrete.n_start.norm() + rod.EI(0.0) / (rod.L * rod.L);
+  for (size_t o = 0; o < rod.obstacles.size(); ++o)
+    read_contacts(seed.discrete.node_forces[o], seed.discrete.node_gaps[o], static_cast<int>(o),
+                  rod.obstacles[o].is_flat(), h, rod.L, force_scale, &seed.contacts);
+  std::sort(seed.contacts.begin(), seed.contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
+  seed.start.r = rod.start;
+  seed.start.R = Eigen::AngleAxisd(rod.start_angle, Vec3::UnitZ()).toRotationMatrix() * planar_reference_frame();
+  seed.start.n = seed.discrete.n_start;
+  seed.start.m = Vec3(0.0, 0.0, seed.discrete.m_start);
+  std::ostringstream summary;
+  summary << "Ipopt on " << segments << " segments (" << seed.discrete.iterations << " iterations, energy "
+          << seed.discrete.energy << ", KKT checked: stationarity " << seed.discrete.kkt.stationarity
+          << ", complementarity " << seed.discrete.kkt.complementarity << "): " << seed.contacts.size() << " contact(s)";
+  for (const auto& c : seed.contacts) {
+    summary << (&c == &seed.contacts.front() ? ": " : ", ");
+    if (c.extended)
+      summary << "flat on obstacle " << c.obstacle << " over [" << c.s << ", " << c.s_end << "]";
+    else
+      summary << "obstacle " << c.obstacle << " at s = " << c.s << " (force " << c.force << ")";
+  }
+  seed.summary = summary.str();
+  return seed;
+}
+
+ContactSolveResult solve_from_discrete_seed(const ProblemDefinition& definition, int segments, double amplitude,
+                                            DiscreteSeed* seed_out) {
+  DiscreteSeed seed = seed_from_discrete_energy(definition, segments, amplitude);
+  ProblemDefinition seeded = definition;
+  seeded.contacts = seed.contacts;
+  ContactSolveResult out = solve_with_contacts(seeded, seed.start);
+  if (seed_out) *seed_out = std::move(seed);
+  return out;
+}
+
+}  // namespace kirchhoff

@@ -1,0 +1,125 @@
+// An independent check of the stability index (stability.hpp) for planar inextensible rods: the
+// lowest eigenvalues of the Hessian of a discretised total potential energy, projected onto the
+// perturbations the end conditions admit. It shares no code with the conjugate-point count: no
+// Jacobi equations, no canonical coordinates, no isoperimetric correction - the constraints are
+// simply constraints of a finite-dimensional minimisation.
+//
+// Discretisation (N elements of length h = L / N, nodes s_j = j h):
+//   unknowns      the start position r_0 and the node angles theta_0 .. theta_N;
+//   positions     r_i = r_0 + h/2 sum_{k<i} (t(theta_k) + t(theta_k+1)), t = (cos, sin) (trapezoid);
+//   bending       sum_e B(s_e+1/2) / (2 h) (theta_e+1 - theta_e - h u_hat(s_e+1/2))^2 (midpoint);
+//   dead loads    -F_0.r_0 - F_L.r_N - M_0 theta_0 - M_L theta_N (the given end loads);
+//   field         sum_i h c_i W(s_i, r_i) (trapezoid weights c_i): for a uniform field
+//                 -sum_i h c_i f.r_i; for one that depends on position (a soft wall's barrier)
+//                 the lumped potential, whose Hessian adds sum_i (dr_i/dz)^T (-h c_i df/dr)
+//                 (dr_i/dz) to the second variation, r_0 included.
+// Both rules are second order, so equilibria and eigenvalues converge as h^2 (first order with a
+// contact, below).
+//
+// Constraints, read from the case as stability.hpp reads it: imposed positions and rotations are
+// held (e.r_0, e.r_N, theta_0, theta_N at their imposed values); an unknown parameter that is an
+// end load is a Lagrange multiplier, so the displacement conjugate to it is held at the shooting
+// solution's value (its load stays in the energy at the solved value; the constraint's multiplier
+// takes up the O(h^2) difference). Extra conditions (the end slope theta0 of
+// simply_supported.toml) only select the equilibrium and are not imposed.
+//
+// Point contacts (positive force, on a plane or a disc) are bilateral constraints whose contact
+// point slides: the rod's closest approach to the obstacle, the minimum of the quadratic through
+// the gaps of the three nodes around the contact, is held at zero (discrete_stability_contact.hpp).
+// Its multiplier is minus the contact force, and its Hessian brings the sliding term
+// f (dg')^2 / g'' (holding the gap at a node would leave it out: another, wrong count) and, on a
+// disc, the obstacle's curvature. The interpolant's g'' is a second difference across the jump of
+// g''' that the contact force makes, so eigenvalues converge at first order with a contact.
+// Where the energy depends on the start position (a field that depends on position, a contact
+// with a disc), its admissible perturbation, fixed by the held positions as dr_0 = R dtheta,
+// enters the projected form; a start that may translate is then not covered.
+//
+// From the shooting solution sampled at the nodes, Newton solves the discrete KKT system
+// (gradient of the Lagrangian, constraints) with the exact Hessian. The Hessian of the Lagrangian
+// is projected on the null space Z of the constraint Jacobian, and the generalised eigenproblem
+//   Z^T H Z v = mu Z^T M Z v,   M = diag(0, 0, h c_j)  (the trapezoid weight of int dtheta^2 ds)
+// gives eigenvalues mu that approximate those of the continuous second variation with weight
+// int dtheta^2 ds (the Hessian's eigenvalues divided by h, with half weights at the end nodes).
+// Rigid translations that no end holds (zero weight, zero energy) are counted as zero modes and
+// removed first. The index is the number of mu below -zero_tolerance; |mu| <= zero_tolerance
+// are zero modes.
+//
+// The check checks itself (trustworthy = false with the reason in check_message otherwise):
+//   - the KKT residual at N and N/2 elements below kDiscreteStabilityKktTolerance;
+//   - the discrete equilibrium close to the shooting one (kDiscreteStabilityAngleTolerance), and
+//     closer at N than at N/2 (it converges to the shooting solution, not to another one);
+//   - the lowest eigenvalues at N and N/2 agreeing to kDiscreteStabilityAgreement of the sum of
+//     their parts' magnitudes (bending and loads), index and zero modes equal, and every eigenvalue counted with a sign that
+//     the refinement cannot change (|mu_N| > |mu_N - mu_N/2|, three times the Richardson
+//     error estimate, and the same sign at N/2; with a contact, first order, |mu_N| > twice the
+//     change, the error estimate itself);
+//   - each contact pushing in the discrete solve (its multiplier negative) with its closest
+//     approach within one element of its interpolant's middle node.
+// Not covered (index empty, reason given): spatial or extensible rods, natural shear or stretch,
+// extended contacts, contacts with a level-set obstacle, a contact with zero force (weakly
+// active) or where the rod flattens onto the obstacle (g'' = 0), half rods by symmetry, a field
+// that depends on position (or a disc contact) on a rod whose start may translate, an end closed
+// by the continuity of H (a sleeve), unknown parameters that are not end loads, dependent
+// constraints (a straight rod whose chord is held: no perturbation keeps it to first order).
+#pragma once
+
+#include <Eigen/Dense>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kirchhoff/shooting/shooting.hpp"
+
+namespace kirchhoff {
+
+struct DiscreteStability {
+  std::optional<int> index;  // number of negative eigenvalues; empty when not defined (reason)
+  std::string reason;        // why the index is not defined, else empty
+  int zero_modes = 0;        // |mu| <= zero_tolerance, rigid translations included
+  // The lowest eigenvalues mu at N elements (at most kDiscreteStabilityReported), increasing, in
+  // the continuous operator's units (second variation per int dtheta^2 ds: a force, B / L^2),
+  // and the same at N/2 elements.
+  std::vector<double> lowest_eigenvalues, coarse_eigenvalues;
+  double zero_tolerance = 0.0;
+  double kkt_residual = 0.0;       // the larger of the two solves' scaled KKT residuals
+  double angle_deviation = 0.0;    // max_j |theta_j - theta(s_j)| against the shooting solution, at N
+  double coarse_angle_deviation = 0.0;  // the same at N/2
+  int elements = 0;
+  int newton_iterations = 0;  // at N
+  bool trustworthy = false;
+  std::string check_message;  // "passed", or the first self-check that failed
+  bool defined() const { return index.has_value(); }
+};
+
+// Scaled KKT residual: max over the angles of |dL/dtheta_j| / (h F), F = B_max/L^2 + the loads'
+// magnitudes (the equation of node j is a moment balance over a length h, in units of F). Newton
+// ends at round-off, which grows as eps N^2 max|theta| (B/h differences of the angles against a
+// scale of h B/L^2): ~1e-10 at N = 400, ~3e-9 at N = 2000. 1e-8 leaves that margin.
+inline constexpr double kDiscreteStabilityKktTolerance = 1e-8;
+// The discrete angles differ from the shooting solution's by O(h^2): 3e-8 to 1.8e-4 rad on the
+// suite's cases at N = 400 (docs/stability-cross-check.md), four times that at N/2. 1e-2 rad flags
+// another equilibrium or an unresolved one, and the N versus N/2 comparison asks that the
+// difference shrink.
+inline constexpr double kDiscreteStabilityAngleTolerance = 1e-2;
+// An eigenvalue is a sum of a bending part int B dtheta'^2 / int dtheta^2 and a load part, each
+// discretised with a relative error O((k h)^2) for a mode of wave number k (the bending part low
+// by (k h)^2 / 12); between N and N/2 the error changes by three times that. 1 % of the parts'
+// magnitudes admits wave numbers up to ~0.2 / h (80 / L at N = 400): the lowest modes of any
+// resolved equilibrium, while a coarse solve on another equilibrium is caught.
+inline constexpr double kDiscreteStabilityAgreement = 1e-2;
+// Eigenvalues with |mu| <= this times B_max / L^2 are zero modes: exact symmetries (a rod turning
+// about a pin its two ends share, rigid translations) give ~1e-10 here; a mode merely near
+// neutral is not a zero mode of the discrete problem and its sign is decided, or the check fails.
+inline constexpr double kDiscreteStabilityZeroTolerance = 1e-6;
+// How many of the lowest eigenvalues are reported and compared.
+inline constexpr int kDiscreteStabilityReported = 6;
+
+// The discrete index of the equilibrium x of `problem` (x solved) with `elements` elements (even,
+// >= 8) and a second solve with elements / 2. Never throws for an unsupported case: the result
+// says why the index is not defined.
+DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen::VectorXd& x, int elements = 400);
+
+// "index k (N elements, trustworthy)" and the like, for messages.
+std::string describe(const DiscreteStability& result);
+
+}  // namespace kirchhoff

@@ -1,0 +1,46 @@
+#include "kirchhoff/analysis/point_record.hpp"
+
+#include <algorithm>
+
+#include "kirchhoff/analysis/solution.hpp"
+#include "kirchhoff/analysis/stability.hpp"
+
+namespace kirchhoff {
+namespace {
+
+// H is flagged as not flat above this fraction of its scale (the standard).
+constexpr double kFlatH = 1e-9;
+
+}  // namespace
+
+PointRecorder rod_point_recorder(const ContinuationOptions& options) {
+  PointRecorder recorder;
+  if (options.compute_invariants || !options.derived.empty())
+    recorder.describe = [samples = options.samples, derived = options.derived](const ShootingProblem& problem,
+                                                                               ContinuationPoint* point) {
+      ContinuationPoint& p = *point;
+      ShootingResult r;
+      r.x = p.x;
+      r.summary.status = SolverStatus::Converged;
+      r.parameters = problem.parameters_at(p.x);
+      const Parameters at = r.parameters;
+      const Solution s = make_solution(problem, std::move(r), samples, derived);
+      if (!s.result.summary.converged()) p.check_failure = s.result.summary.message;
+      p.derived = s.derived;
+      // Parameters solved for belong on the branch too (e.g. the load of a displacement-controlled run).
+      for (const auto& name : problem.definition().unknown_parameters) p.derived[name] = at.get(name);
+      p.invariants = s.invariants;
+      p.H_flat = !s.invariants.H.applies || s.invariants.H.spread <= kFlatH * std::max(1.0, s.invariants.H.scale);
+    };
+  if (options.compute_stability)
+    recorder.record = [](const ShootingProblem& problem, ContinuationPoint* point) {
+      StabilityOptions only_the_index;
+      only_the_index.symmetric_index_where_contact_acts = false;  // not recorded
+      const StabilityReport stability = analyse_stability(problem, point->x, only_the_index);
+      point->stability_index = stability.index;
+      point->zero_modes = stability.zero_modes;
+    };
+  return recorder;
+}
+
+}  // namespace kirchhoff

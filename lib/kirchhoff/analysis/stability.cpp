@@ -1,0 +1,1063 @@
+// The index of an equilibrium by conjugate points (see stability.hpp for the method).
+#include "kirchhoff/analysis/stability.hpp"
+
+#include "kirchhoff/analysis/detail/stability_free_length.hpp"
+#include "kirchhoff/analysis/detail/stability_symmetric.hpp"
+#include "kirchhoff/contact/self_contact.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <functional>
+#include <limits>
+#include <sstream>
+
+namespace kirchhoff {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Scales making the canonical coordinates dimensionless: lengths by L, forces by B / L^2,
+// moments by B / L. The symplectic form only gains the constant factor L / B.
+struct Scales {
+  double length = 1.0;
+  double bending = 1.0;
+  // The rotation pair's momentum is divided by this as well (a symplectic rescaling u -> u,
+  // p -> p / rate: it changes no crossing nor the inertia of any boundary form). Under loads the
+  // fields oscillate with wavenumber ~ sqrt(|n| / B): scaled so, their eigenphases turn at a
+  // nearly uniform rate ~ 2 rate / L, instead of spending most of a turn within a short stretch
+  // near each conjugate point, where a step could pass a whole turn unseen.
+  double rate = 1.0;
+  // The force's momentum is divided by it too where positions are configuration variables (the
+  // full frame below): the same factor on every momentum keeps the rescaling symplectic.
+  double force_rate = 1.0;
+};
+
+// Canonical coordinates of the rod's configuration (position, then rotation, along the
+// directions the equations admit) and their momenta.
+struct Coordinates {
+  Eigen::MatrixXd position_dirs;  // 3 x kr
+  Eigen::MatrixXd rotation_dirs;  // 3 x kpsi
+  int kr() const { return static_cast<int>(position_dirs.cols()); }
+  int size() const { return kr() + static_cast<int>(rotation_dirs.cols()); }
+};
+
+// A state perturbation dy in the coordinates (u, p_physical) = T dy; the canonical momentum is
+// p = p_physical + G u (G skew: 1/2 m x dpsi on the rotation pair).
+struct CanonicalMap {
+  Eigen::MatrixXd T;
+  Eigen::MatrixXd G;
+};
+
+Eigen::Matrix3d cross_matrix(const Vec3& a) {
+  Eigen::Matrix3d M;
+  M << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  return M;
+}
+
+// dy -> the lab-frame rotation vector dpsi of the frame at state y (whose frame is R): the
+// Jacobian of the orientation error against the frame itself as target.
+Eigen::MatrixXd lab_rotation_jacobian(const RodEquations& eq, const Eigen::VectorXd& y, const Mat3& R) {
+  const Mat3 reference = eq.is_planar() ? planar_reference_frame() : Mat3::Identity();
+  const Eigen::AngleAxisd frame(Mat3(R * reference.transpose()));
+  Eigen::MatrixXd jacobian;
+  eq.orientation_error(y, OrientationTarget{frame.axis(), frame.angle()}, false, &jacobian);
+  return jacobian;
+}
+
+CanonicalMap canonical_map(const RodEquations& eq, const Coordinates& c, const Scales& sc, const Eigen::VectorXd& y,
+                           double s) {
+  const int N = static_cast<int>(y.size()), n = c.size(), kr = c.kr();
+  const RodPoint point = eq.point(y, s);
+  const Eigen::MatrixXd rotation_jacobian = lab_rotation_jacobian(eq, y, point.R);
+  CanonicalMap map;
+  map.T = Eigen::MatrixXd::Zero(2 * n, N);
+  map.T.topRows(kr) = c.position_dirs.transpose() * eq.slot_map(Slot::Position) / sc.length;
+  map.T.middleRows(kr, n - kr) = c.rotation_dirs.transpose() * rotation_jacobian;
+  map.T.middleRows(n, kr) =
+      c.position_dirs.transpose() * eq.slot_map(Slot::Force) * (sc.length * sc.length / (sc.bending * sc.force_rate));
+  map.T.bottomRows(n - kr) =
+      c.rotation_dirs.transpose() * eq.slot_map(Slot::Moment) * (sc.length / (sc.bending * sc.rate));
+  map.G = Eigen::MatrixXd::Zero(n, n);
+  map.G.bottomRightCorner(n - kr, n - kr) =
+      0.5 * (sc.length / (sc.bending * sc.rate)) * c.rotation_dirs.transpose() * cross_matrix(point.m) *
+      c.rotation_dirs;
+  return map;
+}
+
+// Orthonormal basis of the column space of A (columns below `tol` times the largest dropped).
+Eigen::MatrixXd column_basis(const Eigen::MatrixXd& A, double tol = 1e-10) {
+  if (A.cols() == 0 || A.rows() == 0) return Eigen::MatrixXd(A.rows(), 0);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU);
+  int rank = 0;
+  for (int i = 0; i < svd.singularValues().size(); ++i)
+    if (svd.singularValues()[i] > tol) ++rank;
+  return svd.matrixU().leftCols(rank);
+}
+
+// Orthonormal basis of the orthogonal complement of the columns of C in R^n.
+Eigen::MatrixXd complement(const Eigen::MatrixXd& C, int n) {
+  if (C.cols() == 0) return Eigen::MatrixXd::Identity(n, n);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(C, Eigen::ComputeFullU);
+  const int rank = static_cast<int>(column_basis(C).cols());
+  return svd.matrixU().rightCols(n - rank);
+}
+
+// Orthonormal basis of the null space of A (singular values below tol), as columns.
+Eigen::MatrixXd null_space(const Eigen::MatrixXd& A, int cols, double tol) {
+  if (A.rows() == 0) return Eigen::MatrixXd::Identity(cols, cols);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
+  int rank = 0;
+  for (int i = 0; i < svd.singularValues().size(); ++i)
+    if (svd.singularValues()[i] > tol) ++rank;
+  return svd.matrixV().rightCols(cols - rank);
+}
+
+double parameter_step(double value) { return 1e-6 * std::max(1.0, std::abs(value)); }
+
+Vec3 orientation_vector(const OrientationTarget& t) { return t.axis.normalized() * t.angle; }
+
+// How a slot's imposed value changes with parameter `name` (central difference of a closed form).
+Vec3 slot_sensitivity(const SlotCondition& slot, const Parameters& p, const std::string& name) {
+  Parameters plus = p, minus = p;
+  const double h = parameter_step(p.get(name));
+  plus.set(name, p.get(name) + h);
+  minus.set(name, p.get(name) - h);
+  if (slot.slot == Slot::Orientation)
+    return (orientation_vector(slot.orientation(plus)) - orientation_vector(slot.orientation(minus))) / (2 * h);
+  return (slot.value(plus) - slot.value(minus)) / (2 * h);
+}
+
+// The unknown parameters that act as Lagrange multipliers (end loads), or why one does not.
+std::string classify_unknowns(const ShootingProblem& problem, const Parameters& p,
+                              std::vector<std::string>* multipliers) {
+  const ProblemDefinition& d = problem.definition();
+  for (const std::string& name : d.unknown_parameters) {
+    if (is_unfolding_parameter(name)) continue;
+    if (d.model_parameters.count(name) || d.obstacle_parameters.count(name))
+      return "the unknown parameter '" + name + "' changes the rod or an obstacle, not an end load";
+    bool load = false;
+    for (const EndCondition* end : {&d.start, &d.end}) {
+      for (const SlotCondition& slot : end->conditions()) {
+        if (slot.extra) continue;
+        const double change = slot_sensitivity(slot, p, name).norm();
+        if (change == 0.0) continue;
+        if (slot.slot == Slot::Position || slot.slot == Slot::Orientation)
+          return "the unknown parameter '" + name + "' moves an imposed " + to_string(slot.slot);
+        load = true;
+      }
+    }
+    if (!load) return "the unknown parameter '" + name + "' is not an end load";
+    multipliers->push_back(name);
+  }
+  return "";
+}
+
+// The configuration directions an end holds (columns, canonical u coordinates): imposed
+// positions and rotations, and the displacements conjugate to multiplier loads.
+Eigen::MatrixXd held_directions(const RodEquations& eq, const EndCondition& end, const Coordinates& c,
+                                const Parameters& p, const std::vector<std::string>& multipliers) {
+  std::vector<Eigen::VectorXd> columns;
+  auto add = [&](bool position, const Vec3& lab) {
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(c.size());
+    if (position) u.head(c.kr()) = c.position_dirs.transpose() * lab;
+    else u.tail(c.size() - c.kr()) = c.rotation_dirs.transpose() * lab;
+    columns.push_back(u);
+  };
+  for (const SlotCondition& slot : end.conditions()) {
+    if (slot.extra) continue;
+    const Eigen::MatrixXd basis = slot.basis(eq);
+    const bool position = slot.slot == Slot::Position || slot.slot == Slot::Force;
+    if (slot.slot == Slot::Position || slot.slot == Slot::Orientation) {
+      for (int k = 0; k < basis.cols(); ++k) add(position, basis.col(k));
+      continue;
+    }
+    for (const std::string& name : multipliers) {
+      const Eigen::VectorXd along = basis.transpose() * slot_sensitivity(slot, p, name);
+      if (along.norm() > 0) add(position, basis * along.normalized());
+    }
+  }
+  Eigen::MatrixXd C(c.size(), static_cast<int>(columns.size()));
+  for (size_t k = 0; k < columns.size(); ++k) C.col(static_cast<int>(k)) = columns[k];
+  return column_basis(C);
+}
+
+std::string unsupported(const ShootingProblem& problem, const Eigen::VectorXd& x) {
+  const ProblemDefinition& d = problem.definition();
+  const std::vector<Obstacle> obstacles = problem.obstacles(problem.parameters_at(x));
+  for (const PointContact& c : problem.contacts_at(x)) {
+    if (c.extended)
+      return "an extended contact (the rod lying on the obstacle): its second variation is not implemented";
+    if (problem.equations(problem.parameters_at(x))->model().extensible)
+      return "a contact of an extensible rod: not implemented";
+  }
+  if (d.start.is_half_turn_symmetry())
+    return "half of a symmetric rod with the symmetry point at s = 0: only a half-turn end at s = L is "
+           "implemented";
+  if (d.end.is_half_turn_symmetry() && d.end.half_turn_director() == 0)
+    return "half of a symmetric rod whose half-turn end imposes the loop's rotation (balanced by an unknown "
+           "parameter): not implemented";
+  if (d.end.is_half_turn_symmetry() && !problem.contacts_at(x).empty())
+    return "half of a symmetric rod with contacts (hard self-contact): the antisymmetric perturbations of a pair "
+           "contact are not implemented";
+  return "";
+}
+
+double wrap(double angle) { return std::remainder(angle, 2 * kPi); }
+
+// Eigenphases of W = (U + iP)(U - iP)^-1: with the frame made orthonormal, W = X X^T for the
+// unitary X = U + iP.
+Eigen::VectorXd eigenphases(const Eigen::MatrixXd& U_in, const Eigen::MatrixXd& P_in) {
+  const int m = static_cast<int>(U_in.cols());
+  Eigen::MatrixXd Z(2 * m, m);
+  Z << U_in, P_in;
+  const Eigen::MatrixXd Q = Eigen::HouseholderQR<Eigen::MatrixXd>(Z).householderQ() * Eigen::MatrixXd::Identity(2 * m, m);
+  const Eigen::MatrixXd U = Q.topRows(m), P = Q.bottomRows(m);
+  const Eigen::MatrixXcd X = U.cast<std::complex<double>>() + std::complex<double>(0, 1) * P;
+  Eigen::ComplexEigenSolver<Eigen::MatrixXcd> solver(X * X.transpose(), false);
+  Eigen::VectorXd phase(U.cols());
+  for (int j = 0; j < phase.size(); ++j) phase[j] = std::arg(solver.eigenvalues()[j]);
+  return phase;
+}
+
+// The frame of Jacobi fields along the rod, in state coordinates, with its canonical blocks.
+struct Frame {
+  Eigen::VectorXd y;   // the equilibrium state here
+  double s = 0.0;
+  Eigen::MatrixXd dY;  // N x kpsi: state perturbations of the fields
+  Eigen::MatrixXd U, P, P_physical;  // rotation blocks, kpsi x kpsi each; [U; P] orthonormal
+  Eigen::MatrixXd R;                  // position perturbation of the fields (kr x kpsi), slaved
+  // One field per isoperimetric constraint's multiplier: first those starting at s = 0 (the
+  // response to a unit change of the end load along a held chord direction; with the full frame,
+  // of the start's load along a position it holds), then one per point contact, zero up to its
+  // contact, the response to a unit change of its force beyond; with the full frame last one per
+  // position the end holds, identically zero (its load enters through the end's conditions).
+  Eigen::MatrixXd particular, particular_U, particular_P, particular_P_physical, particular_R;
+  // The constraints read before s = L on the frame's fields and on the particular ones: with the
+  // full frame the positions the start holds (at s = 0), then the contacts' nu.dr(s_c) / L,
+  // recorded as each contact is passed.
+  Eigen::MatrixXd recorded_rows_frame, recorded_rows_particular;
+};
+
+// Follows lifted eigenphases, and where they pass odd multiples of pi (a stack per eigenphase:
+// a passage downwards pushes, one back upwards pops, so round-off cancels).
+struct PhaseTrack {
+  Eigen::VectorXd lifted;
+  Eigen::VectorXd lowest;  // running minimum of each lifted phase
+  std::vector<std::vector<std::pair<long, double>>> passages;  // (k of k pi, s) per eigenphase
+  bool reversed = false;  // a genuine passage against the Legendre direction
+  double reversed_at = 0.0;
+};
+
+// How far the eigenphases moved: the largest distance from a lifted phase to its nearest new one.
+double largest_phase_move(const Eigen::VectorXd& phases, const Eigen::VectorXd& lifted) {
+  double largest = 0.0;
+  for (int j = 0; j < lifted.size(); ++j) {
+    double nearest = kPi;
+    for (int k = 0; k < phases.size(); ++k) nearest = std::min(nearest, std::abs(wrap(phases[k] - lifted[j])));
+    largest = std::max(largest, nearest);
+  }
+  return largest;
+}
+
+int odd_multiples_between(double a, double b) {  // odd k with a < k pi < b (a < b)
+  const long lo = static_cast<long>(std::floor((a / kPi - 1) / 2)) + 1;
+  const long hi = static_cast<long>(std::ceil((b / kPi - 1) / 2)) - 1;
+  return static_cast<int>(std::max(0L, hi - lo + 1));
+}
+
+class StabilityAnalysis {
+ public:
+  // `end` replaces the problem's end conditions and `equations` (when not null) its equations: the
+  // antisymmetric half of a half-turn symmetric rod (stability_symmetric.hpp).
+  StabilityAnalysis(const ShootingProblem& problem, const Eigen::VectorXd& x, const StabilityOptions& options,
+                    const EndCondition& end, std::shared_ptr<const RodEquations> equations)
+      : problem_(problem), x_(x), options_(options), end_(end), p_(problem.parameters_at(x)),
+        eq_(equations ? std::move(equations) : problem.equations(p_)) {
+    coords_.position_dirs = eq_->admissible_directions(Slot::Position);
+    coords_.rotation_dirs = eq_->admissible_directions(Slot::Orientation);
+    scales_.length = eq_->model().length;
+    scales_.bending = eq_->model().B[0](0.0);
+    std::vector<double> s(17);
+    for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
+    profile_ = problem_.sample(x_, s);
+    full_ = options_.positions_as_configuration || positions_are_configuration();
+    const int n = coords_.size(), kr = coords_.kr();
+    offset_ = full_ ? 0 : kr;
+    mU_ = full_ ? n : n - kr;
+  }
+
+  // The wavenumber of the Jacobi fields, L sqrt(|n| / B) and L |m| / B at their largest over the
+  // rod (at least 1): sets the momentum's scale and the number of steps.
+  double field_rate() const {
+    const RodModel& model = eq_->model();
+    double stiffness = std::numeric_limits<double>::infinity(), rate = 1.0;
+    for (const RodPoint& q : profile_)
+      for (int k = 0; k < 3; ++k) stiffness = std::min(stiffness, model.B[k](q.s));
+    for (const RodPoint& q : profile_)
+      rate = std::max({rate, scales_.length * std::sqrt(q.n.norm() / stiffness), scales_.length * q.m.norm() / stiffness});
+    // A field stiffness k (|df/dr|) makes the fields oscillate like a beam on a foundation, with
+    // wavenumber (k / B)^(1/4).
+    if (model.field)
+      for (const RodPoint& q : profile_)
+        rate = std::max(rate, scales_.length * std::pow(model.field->force_gradient(q.s, q.r).norm() / stiffness, 0.25));
+    return rate;
+  }
+
+  StabilityReport run();
+
+  // Follow, at every step of the fields' integration, the largest stiffness of the antisymmetric
+  // barrier term of `original`'s half-turn self-contact (stability_symmetric.hpp) along the
+  // equilibrium: the steps are refined where the barrier is stiff (field_rate), and the distance
+  // from the axis is smooth in s, so its minimum is found to ~ its curvature x step^2.
+  void track_barrier(std::shared_ptr<const RodEquations> original) { barrier_eq_ = std::move(original); }
+  double barrier_stiffness() const { return barrier_stiffness_; }
+
+ private:
+  struct Held {
+    Eigen::MatrixXd position;  // kr x a, position coordinates
+    Eigen::MatrixXd rotation;  // kpsi x b, rotation coordinates
+  };
+  Held held_at(const EndCondition& end, const std::vector<std::string>& multipliers) const;
+  bool positions_are_configuration() const;
+  // The configuration directions (the frame's U coordinates) an end holds in the load-controlled
+  // problem: its held rotations; positions are never held there.
+  Eigen::MatrixXd held_configuration(const Held& held) const;
+  Eigen::MatrixXd constraint_directions(const Held& start, const Held& end) const;
+  Frame start_frame(const Held& start, const Eigen::MatrixXd& start_multipliers, int contacts, int end_multipliers) const;
+  std::string pass_contact(Frame* f, const PointContact& contact, int number, PhaseTrack* track, double* shear);
+  void canonical_blocks(Frame* f) const;
+  void orthonormalise(Frame* f) const;
+  Frame flowed(const Frame& f, double s1);
+  void advance(Frame* f, double s1, PhaseTrack* track, int depth);
+  void record(const Eigen::VectorXd& before, double s0, const Eigen::VectorXd& after, double s1, PhaseTrack* track);
+  bool count_interior(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start,
+                      StabilityReport* report) const;
+  Eigen::MatrixXd end_terms(const Frame& f, const Held& end, StabilityReport* report) const;
+  std::string end_moment_reason(const Frame& f, const Held& end) const;
+  bool constraint_correction(const Frame& f, const Held& end, const Eigen::MatrixXd& constraints,
+                             const Eigen::MatrixXd& zero_modes, StabilityReport* report) const;
+  // The shear of the canonical momenta a point quadratic form 1/2 z^T S z of the lab
+  // perturbation z = (dr, dpsi) makes (p += S_c u), in the frame's U coordinates.
+  Eigen::MatrixXd canonical_shear(const Eigen::MatrixXd& lab_S) const;
+
+  const ShootingProblem& problem_;
+  const Eigen::VectorXd& x_;
+  StabilityOptions options_;
+  const EndCondition& end_;
+  Parameters p_;
+  std::shared_ptr<const RodEquations> eq_;
+  Coordinates coords_;
+  Scales scales_;
+  std::vector<RodPoint> profile_;  // the equilibrium at 17 equally spaced points, for the checks above
+  long rhs_ = 0;
+  CarriedSteps steps_;  // the step sizes the fields' integration proposes next (flowed)
+  // The full frame: positions are configuration variables beside the rotation (see
+  // positions_are_configuration); its U block holds (dr / L, dpsi), offset_ = 0. Otherwise the
+  // rotation alone, offset_ = kr. mU_ is the size of U.
+  bool full_ = false;
+  int offset_ = 0, mU_ = 0;
+  // Multipliers whose particular fields start at s = 0 and constraints recorded before L (see Frame).
+  int start_multipliers_ = 0, recorded_before_contacts_ = 0;
+  std::shared_ptr<const RodEquations> barrier_eq_;  // track_barrier
+  double barrier_stiffness_ = 0.0;
+};
+
+StabilityAnalysis::Held StabilityAnalysis::held_at(const EndCondition& end,
+                                                   const std::vector<std::string>& multipliers) const {
+  const Eigen::MatrixXd C = held_directions(*eq_, end, coords_, p_, multipliers);
+  const int kr = coords_.kr(), kpsi = coords_.size() - kr;
+  Held h;
+  h.position = column_basis(C.topRows(kr));
+  h.rotation = column_basis(C.bottomRows(kpsi));
+  return h;
+}
+
+// Whether positions are configuration variables of their own, beside the rotation: where the
+// energy depends on where the rod is, not only on its shape - a field whose force depends on
+// position (a soft wall, a barrier: f = -grad V(r)), or a contact with a curved obstacle, whose
+// second variation holds the obstacle's curvature at the perturbed contact point dr(s_c) - and
+// wherever a point contact is active at all: its force is a multiplier whose change is a load on
+// an interior point, which the end loads of the rotation frame do not balance (the response to it
+// alone is not an equilibrium; D came out unsymmetric), while the full frame has the translations
+// to take it and keeps only the loads that do no work on its zero modes.
+//
+// Why the rotation alone no longer suffices. The load-controlled problem's energy is
+//   E[r0, R] = int W(u, v) + int V(r) - F_L.r(L) + F_0.r(0),   r(s) = r0 + int_0^s R v,
+// so its second variation holds int dr.Hess V dr with dr(s) = dr0 + int_0^s (dpsi x d3 + ...): a
+// non-local term in the rotation, and the translation dr0 costs energy, so the rigid
+// translations are not the zero modes they are without such a field. With (r, R) as the
+// configuration the term is local: the Jacobi fields carry dr, and dn' = -(df/dr) dr (the
+// shooting core's variational equations already linearise the field, so nothing changes there).
+// This is a problem of Lagrange - r' = d3 is a constraint whose multiplier is n, and the
+// Hamiltonian's Hessian in the momenta is B^-1 on dm and zero on dn (inextensible rods): the
+// Legendre condition holds on the strains, as before, not on the position. Morse's index theorem
+// still holds for such problems when they are normal (no perturbation keeps r' = d3 by force
+// alone: here a field with dr = dpsi = dm = 0 must have dn along a straight stretch's axis, which
+// the load-controlled frame, dn(0) = 0, never contains), and a crossing of the Lagrangian frame
+// through det U = 0 has the crossing form dm.B^-1 dm >= 0: the eigenphases of W still pass -1 in
+// one direction only. A crossing with dm = 0 as well would be non-regular; the count refuses any
+// passage the other way, so such a case is reported undefined, never guessed.
+//
+// Why the chord constraint changes. With V depending on r, holding r(0) and r(L) is not the same
+// as holding r(L) - r(0): each held position is a constraint of its own, e.r(0) and e.r(L), whose
+// multiplier is that end's reaction (a force doing work on it). D is then d(held positions) /
+// d(reactions) along the load-controlled equilibria, a k x k matrix with k the positions held at
+// either end; the bordered-Hessian count index = index_dead + n_+(D) + r_Z - k is unchanged (it
+// needs only a quadratic form and linear constraints). Where df/dr = 0 it reduces to the chord
+// count: the translations are then zero modes of the load-controlled problem, r_Z is the rank of
+// the held directions, and the loads doing no work on the translations are the balanced pairs,
+// whose D is the chord's. (The tests check that the two frames agree on every such case.)
+bool StabilityAnalysis::positions_are_configuration() const {
+  const auto& field = eq_->model().field;
+  if (field)
+    for (const RodPoint& q : profile_)
+      if (field->force_gradient(q.s, q.r).norm() > 0) return true;
+  return !problem_.contacts_at(x_).empty();
+}
+
+Eigen::MatrixXd StabilityAnalysis::held_configuration(const Held& held) const {
+  if (!full_) return held.rotation;
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(mU_, held.rotation.cols());
+  out.bottomRows(held.rotation.rows()) = held.rotation;
+  return out;
+}
+
+// Directions along which both ends hold the position: the isoperimetric constraints
+// e.(r(L) - r(0)) = const, whose multipliers are the reactions.
+Eigen::MatrixXd StabilityAnalysis::constraint_directions(const Held& start, const Held& end) const {
+  const int kr = coords_.kr();
+  if (start.position.cols() == 0 || end.position.cols() == 0) return Eigen::MatrixXd(kr, 0);
+  Eigen::MatrixXd both(kr, start.position.cols() + end.position.cols());
+  both << start.position, -end.position;
+  const Eigen::MatrixXd pairs = null_space(both, static_cast<int>(both.cols()), 1e-10);
+  return column_basis(start.position * pairs.topRows(start.position.cols()));
+}
+
+// Jacobi fields of the load-controlled problem meeting the start's conditions: its rotation
+// conditions, dn = 0 (a dead load), and dr = 0 - or, with the full frame, dr free (one field per
+// translation). Then one particular field per multiplier starting at s = 0, with dn(0) given by
+// the columns of start_multipliers (a unit change of the load along a held chord, dn = e_j; with
+// the full frame, of the start's reaction along a position it holds, dn(0) = -e_j, the force on
+// the rod being -n(0)), room for one per contact and, with the full frame, one per position the
+// end holds (zero fields: see Frame).
+Frame StabilityAnalysis::start_frame(const Held& start, const Eigen::MatrixXd& start_multipliers, int contacts,
+                                     int end_multipliers) const {
+  const int n = coords_.size(), kr = coords_.kr();
+  const Eigen::MatrixXd held = held_configuration(start);
+  const Eigen::MatrixXd free = complement(held, mU_);
+  const int starting = static_cast<int>(start_multipliers.cols());
+  Eigen::MatrixXd z = Eigen::MatrixXd::Zero(2 * n, mU_ + starting);
+  z.block(offset_, 0, mU_, free.cols()) = free;
+  z.block(n + offset_, free.cols(), mU_, held.cols()) = held;
+  z.block(n, mU_, kr, starting) = start_multipliers;
+  Frame f;
+  f.s = 0.0;
+  f.y = x_.head(problem_.state_size());
+  const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f.y, 0.0);
+  const Eigen::MatrixXd dY = map.T.completeOrthogonalDecomposition().solve(z);
+  f.dY = dY.leftCols(mU_);
+  const int multipliers = starting + contacts + end_multipliers;
+  f.particular = Eigen::MatrixXd::Zero(dY.rows(), multipliers);
+  f.particular.leftCols(starting) = dY.rightCols(starting);
+  canonical_blocks(&f);
+  // With the full frame, the start's held positions are constraints read here.
+  const int recorded = recorded_before_contacts_ + contacts;
+  f.recorded_rows_frame = Eigen::MatrixXd::Zero(recorded, mU_);
+  f.recorded_rows_particular = Eigen::MatrixXd::Zero(recorded, multipliers);
+  if (recorded_before_contacts_ > 0) {
+    f.recorded_rows_frame.topRows(recorded_before_contacts_) = start.position.transpose() * f.R;
+    f.recorded_rows_particular.topRows(recorded_before_contacts_) = start.position.transpose() * f.particular_R;
+  }
+  return f;
+}
+
+void StabilityAnalysis::canonical_blocks(Frame* f) const {
+  const int n = coords_.size(), kr = coords_.kr();
+  const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f->y, f->s);
+  auto blocks = [&](const Eigen::MatrixXd& dY, Eigen::MatrixXd* U, Eigen::MatrixXd* P, Eigen::MatrixXd* P_phys,
+                    Eigen::MatrixXd* R) {
+    const Eigen::MatrixXd z = map.T * dY;
+    *U = z.middleRows(offset_, mU_);
+    *P_phys = z.middleRows(n + offset_, mU_);
+    *P = *P_phys + map.G.bottomRightCorner(mU_, mU_) * *U;
+    *R = z.topRows(kr);
+  };
+  blocks(f->dY, &f->U, &f->P, &f->P_physical, &f->R);
+  blocks(f->particular, &f->particular_U, &f->particular_P, &f->particular_P_physical, &f->particular_R);
+}
+
+// Keeps the frame's columns orthonormal in (U, P) (the span, a Lagrangian plane, is unchanged).
+void StabilityAnalysis::orthonormalise(Frame* f) const {
+  const int m = static_cast<int>(f->U.cols());
+  Eigen::MatrixXd Z(2 * m, m);
+  Z << f->U, f->P;
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr(Z);
+  const Eigen::MatrixXd R = qr.matrixQR().topRows(m).triangularView<Eigen::Upper>();
+  const Eigen::MatrixXd Rinv = R.inverse();
+  f->dY = f->dY * Rinv;
+  f->U = f->U * Rinv;
+  f->P = f->P * Rinv;
+  f->P_physical = f->P_physical * Rinv;
+  f->R = f->R * Rinv;
+  f->recorded_rows_frame = f->recorded_rows_frame * Rinv;
+}
+
+// Matches new eigenphases to the lifted old ones (nearest on the circle) and lifts them. A phase
+// within 1e-9 of an odd multiple of pi is put on it: a field that stays at a conjugate point (held
+// at s = 0, or abnormal) then never passes it by round-off.
+void StabilityAnalysis::record(const Eigen::VectorXd& before, double s0, const Eigen::VectorXd& phases, double s1,
+                               PhaseTrack* track) {
+  const int m = static_cast<int>(phases.size());
+  std::vector<bool> used(m, false);
+  Eigen::VectorXd lifted(m);
+  for (int j = 0; j < m; ++j) {
+    int best = -1;
+    double best_move = 0.0;
+    for (int k = 0; k < m; ++k) {
+      if (used[k]) continue;
+      const double move = wrap(phases[k] - before[j]);
+      if (best < 0 || std::abs(move) < std::abs(best_move)) best = k, best_move = move;
+    }
+    used[best] = true;
+    lifted[j] = before[j] + best_move;
+    const double off = wrap(lifted[j] - kPi);
+    if (std::abs(off) < 1e-9) lifted[j] -= off;
+  }
+  const double h = 1e-3;  // a passage back needs a move well beyond round-off
+  for (int j = 0; j < m; ++j) {
+    auto& stack = track->passages[j];
+    const double lo = std::min(lifted[j], before[j]), hi = std::max(lifted[j], before[j]);
+    const int passed = odd_multiples_between(lo, hi);
+    const long first = static_cast<long>(std::floor((lo / kPi - 1) / 2)) + 1;  // lowest m of (2m+1) pi passed
+    for (int k = 0; k < passed; ++k) {
+      const long multiple = 2 * (lifted[j] < before[j] ? first + passed - 1 - k : first + k) + 1;
+      if (lifted[j] < before[j]) {
+        // Where: near a passage the phase goes as k pi - 2 atan(c (s - s*)), so tan of half its
+        // offset is close to linear in s and is interpolated.
+        const double ta = std::tan(0.5 * (before[j] - multiple * kPi)), tb = std::tan(0.5 * (lifted[j] - multiple * kPi));
+        stack.emplace_back(multiple, s0 + ta / (ta - tb) * (s1 - s0));
+      }
+      else if (!stack.empty() && stack.back().first == multiple) stack.pop_back();
+    }
+    track->lowest[j] = std::min(track->lowest[j], lifted[j]);
+    if (!track->reversed && odd_multiples_between(track->lowest[j] + h, lifted[j] - h) > 0) {
+      track->reversed = true;
+      track->reversed_at = s1;
+    }
+  }
+  track->lifted = lifted;
+}
+
+// The equilibrium, the frame's fields and the particular fields that have started carried to s1,
+// as one integration continued from the previous step's (steps_): the fields are the directions
+// of the variational equations, so only they are integrated, not the whole of Phi. Particular
+// fields that have not started yet are zero, and stay so.
+Frame StabilityAnalysis::flowed(const Frame& f, double s1) {
+  std::vector<int> started;
+  for (int c = 0; c < f.particular.cols(); ++c)
+    if (!f.particular.col(c).isZero(0.0)) started.push_back(c);
+  const int m = static_cast<int>(f.dY.cols());
+  Eigen::MatrixXd directions(f.dY.rows(), m + static_cast<int>(started.size()));
+  directions.leftCols(m) = f.dY;
+  for (size_t i = 0; i < started.size(); ++i) directions.col(m + static_cast<int>(i)) = f.particular.col(started[i]);
+  const DirectionalFlow flow =
+      eq_->flow_directions(f.y, directions, f.s, s1, problem_.definition().options.integrator, &steps_);
+  rhs_ += flow.rhs_evaluations;
+  Frame next;
+  next.y = flow.y;
+  next.s = s1;
+  next.dY = flow.directions.leftCols(m);
+  next.particular = Eigen::MatrixXd::Zero(f.particular.rows(), f.particular.cols());
+  for (size_t i = 0; i < started.size(); ++i) next.particular.col(started[i]) = flow.directions.col(m + static_cast<int>(i));
+  next.recorded_rows_frame = f.recorded_rows_frame;
+  next.recorded_rows_particular = f.recorded_rows_particular;
+  return next;
+}
+
+void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int depth) {
+  const CarriedSteps before = steps_;
+  Frame next = flowed(*f, s1);
+  canonical_blocks(&next);
+  orthonormalise(&next);
+  const Eigen::VectorXd phases = eigenphases(next.U, next.P);
+  const double largest = largest_phase_move(phases, track->lifted);
+  bool passage = false;
+  for (int j = 0; j < phases.size(); ++j)
+    passage = passage || odd_multiples_between(track->lifted[j] - largest, track->lifted[j] + largest) > 0;
+  // Steps are halved while a phase moves too far, and around a passage until it is located to
+  // passage_resolution (the interpolation below is then exact to its square).
+  const bool locate = passage && s1 - f->s > options_.passage_resolution * scales_.length / scales_.rate;
+  if ((largest > options_.max_phase_step || locate) && depth < options_.max_halvings) {
+    const double mid = 0.5 * (f->s + s1);
+    steps_ = before;  // the halves continue from f, not from the step taken past them
+    advance(f, mid, track, depth + 1);
+    advance(f, s1, track, depth + 1);
+    return;
+  }
+  record(track->lifted, f->s, phases, s1, track);
+  *f = next;
+  if (barrier_eq_)
+    barrier_stiffness_ =
+        std::max(barrier_stiffness_, antisymmetric_barrier_stiffness(*barrier_eq_, {eq_->point(f->y, f->s)}));
+}
+
+// Across a point contact (normal nu, force f > 0, the rod curving away from the obstacle):
+//  - the equilibrium's force jumps by -f nu; in the load-controlled problem the contact force is
+//    a dead load on its material point, so the fields' dn is continuous;
+//  - the contact point slides along the obstacle: to second order the rod stays off it iff the
+//    minimum over s of its gap G(s) = g(r(s)) does. With G(s_c) = G'(s_c) = 0 and G''(s_c) > 0,
+//      min_s G = dG(s_c) + 1/2 d2G(s_c) - (dG'(s_c))^2 / (2 G''(s_c))  (to second order),
+//    and the Lagrangian E - lambda min_s G (lambda = f / |grad g|) gains, per unit |grad g|,
+//      f (nu.dr' + k.dr)^2 / (2 g'') - f dr.K dr / 2,
+//    K = Hess g / |grad g| the obstacle's curvature, k = K d3, nu.dr' = dpsi.(d3 x nu) and
+//    g'' = nu.d3' + d3.K d3 the rate at which the rod curves away from the obstacle (relative
+//    to it). On a plane K = 0: f (nu.dr')^2 / (2 g''). The curvature term is the multiplier
+//    times the constraint's curvature: a convex obstacle (K >= 0) lets a tangential shift open
+//    the gap, which lowers the energy. (Holding the contact at its material point instead leaves
+//    out the sliding term and gives another, wrong count.) For the fields, a point quadratic
+//    form 1/2 z.S z of z = (dr, dpsi) is a jump of the momenta (dn, dm) += S z: a shear
+//    p += S u that leaves U, so no conjugate point; on a curved obstacle it holds dr, which only
+//    the full frame carries;
+//  - nu.dr(s_c) = 0 is one more isoperimetric constraint, its multiplier the change of the force:
+//    its particular field starts here with dn = -nu.
+std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contact, int number, PhaseTrack* track,
+                                            double* shear) {
+  const int n = coords_.size(), kr = coords_.kr();
+  const RodPoint here = eq_->point(f->y, f->s);
+  const Obstacle obstacle = problem_.obstacles(p_)[contact.obstacle];  // obstacles() returns a copy
+  const Vec3 nu = obstacle.normal(here.r);
+  const Mat3 K = obstacle.hessian(here.r) / obstacle.gradient(here.r).norm();
+  const Vec3 d3 = here.R.col(2), curving = here.R * here.u.cross(Vec3::UnitZ());  // d3' of an inextensible rod
+  const double g2 = nu.dot(curving) + d3.dot(K * d3), scale = 1.0 / scales_.length;
+  if (!(contact.force > 1e-10 * scales_.bending / (scales_.length * scales_.length)))
+    return "a contact with zero force (weakly active): the index depends on higher-order terms, not defined here";
+  if (!(g2 > 1e-9 * scale))
+    return "a contact where the rod does not curve away from the obstacle (g'' = 0: it is about to flatten or wrap "
+           "onto it)";
+  if (!full_ && K.norm() > 0) throw std::logic_error("stability: a curved obstacle needs the full frame");
+  const Eigen::VectorXd nu_r = coords_.position_dirs.transpose() * nu;
+  f->recorded_rows_frame.row(recorded_before_contacts_ + number) = nu_r.transpose() * f->R;
+  f->recorded_rows_particular.row(recorded_before_contacts_ + number) = nu_r.transpose() * f->particular_R;
+  // The equilibrium's jump.
+  f->y += eq_->slot_map(Slot::Force).transpose() * (-contact.force * nu);
+  // The point form on z = (dr, dpsi) in the lab: S = (f / g'') a a^T - f diag(K, 0), a = (k, w).
+  Eigen::Matrix<double, 6, 1> a;
+  a << K * d3, d3.cross(nu);
+  Eigen::Matrix<double, 6, 6> S_lab = Eigen::Matrix<double, 6, 6>::Zero();
+  if (options_.contact_sliding) S_lab += (contact.force / g2) * a * a.transpose();
+  S_lab.topLeftCorner<3, 3>() -= contact.force * K;
+  const Eigen::MatrixXd S = canonical_shear(S_lab);
+  *shear = S.norm();
+  // The shear leaves U, so no eigenphase passes -1 through it: each stays in its sheet between
+  // consecutive odd multiples of pi (it may turn almost a whole turn inside it, so it is not
+  // followed by small steps, which could not tell such a turn from a small one back).
+  const Eigen::VectorXd sheared = eigenphases(f->U, f->P + S * f->U);
+  std::vector<bool> used(sheared.size(), false);
+  for (int j = 0; j < track->lifted.size(); ++j) {
+    const double sheet = 2 * kPi * std::round(track->lifted[j] / (2 * kPi));
+    int best = -1;
+    for (int k = 0; k < sheared.size(); ++k)
+      if (!used[k] && (best < 0 || std::abs(wrap(sheared[k] - track->lifted[j])) <
+                                       std::abs(wrap(sheared[best] - track->lifted[j]))))
+        best = k;
+    used[best] = true;
+    track->lifted[j] = sheet + sheared[best];
+    track->lowest[j] = std::min(track->lowest[j], track->lifted[j]);
+  }
+  // The same jump on the fields' state, (dn, dm) += S_lab (dr, dpsi): on the frame and on the
+  // particular fields that have started (they are Jacobi fields of the same system; leaving them
+  // out makes D = dg/dlambda lose its symmetry).
+  Eigen::MatrixXd to_lab(6, f->dY.rows());
+  to_lab << eq_->slot_map(Slot::Position), lab_rotation_jacobian(*eq_, f->y, here.R);
+  Eigen::MatrixXd from_lab(f->dY.rows(), 6);
+  from_lab << eq_->slot_map(Slot::Force).transpose(), eq_->slot_map(Slot::Moment).transpose();
+  const Eigen::MatrixXd jump = from_lab * S_lab * to_lab;
+  f->dY += jump * f->dY;
+  f->particular += jump * f->particular;
+  // The force's particular field.
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * n);
+  z.segment(n, kr) = -nu_r;
+  const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f->y, f->s);
+  f->particular.col(start_multipliers_ + number) = map.T.completeOrthogonalDecomposition().solve(z);
+  canonical_blocks(f);
+  orthonormalise(f);
+  return "";
+}
+
+// z = (dr, dpsi) in the lab is (L position_dirs u_r, rotation_dirs u_psi) in the frame's U
+// coordinates, and the momenta (dn, dm) are scaled by (L^2, L) / (B rate): S_c = L / (B rate)
+// J^T S J with J = diag(L position_dirs, rotation_dirs) - symmetric, as a point form must be.
+// The rotation-only frame keeps the rotation block (S has no position part there).
+Eigen::MatrixXd StabilityAnalysis::canonical_shear(const Eigen::MatrixXd& lab_S) const {
+  const int kr = coords_.kr(), kpsi = coords_.size() - kr;
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(6, coords_.size());
+  J.topLeftCorner(3, kr) = scales_.length * coords_.position_dirs;
+  J.bottomRightCorner(3, kpsi) = coords_.rotation_dirs;
+  const Eigen::MatrixXd S = (scales_.length / (scales_.bending * scales_.rate)) * J.transpose() * lab_S * J;
+  return S.bottomRightCorner(mU_, mU_);
+}
+
+// A dead couple on an end free to turn about two or more axes does work that depends on the path
+// of the rotation (Ziegler): not conservative, and the second variation is not defined. In the
+// canonical coordinates the end's natural conditions then fail to be a Lagrangian plane. The test
+// is relative to the zero tolerance, not round-off: where the couple's work vanishes because the
+// equilibrium makes it so (the antisymmetric half of a half-turn end, free to turn across the axis:
+// the work is m.a, zero to the solve's tolerance, ~1e-9 of |m|), that is what zero means.
+std::string StabilityAnalysis::end_moment_reason(const Frame& f, const Held& end) const {
+  const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f.y, f.s);
+  const Eigen::MatrixXd G = map.G.bottomRightCorner(mU_, mU_);
+  const Eigen::MatrixXd free_rotation = complement(held_configuration(end), mU_);
+  if ((free_rotation.transpose() * G * free_rotation).norm() > options_.zero_tolerance * (1.0 + G.norm()))
+    return "the end's loads are not conservative (a dead couple on an end free to rotate in 3D)";
+  return "";
+}
+
+// Conjugate points in (0, L): net passages of the lifted eigenphases from start to end. Fields
+// with U c = 0 at s = L end exactly on a conjugate point, which is not inside (0, L).
+bool StabilityAnalysis::count_interior(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start,
+                                       StabilityReport* report) const {
+  const int m = static_cast<int>(f.U.cols());
+  Eigen::VectorXd end = track.lifted;
+  const int at_end = m - static_cast<int>(column_basis(f.U, options_.zero_tolerance).cols());
+  std::vector<int> order(m);
+  for (int j = 0; j < m; ++j) order[j] = j;
+  auto distance_to_odd = [&](double t) { return std::abs(wrap(t - kPi)); };
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return distance_to_odd(end[a]) < distance_to_odd(end[b]); });
+  for (int k = 0; k < at_end; ++k) end[order[k]] -= wrap(end[order[k]] - kPi);
+  int interior = 0;
+  for (int j = 0; j < m; ++j) {
+    const double a = std::min(start[j], end[j]) + 1e-9, b = std::max(start[j], end[j]) - 1e-9;
+    const int passed = a < b ? odd_multiples_between(a, b) : 0;
+    interior += end[j] <= start[j] ? passed : -passed;
+  }
+  if (interior < 0) {
+    report->reason = "the conjugate-point count came out negative: the Jacobi system is degenerate";
+    return false;
+  }
+  report->interior_count = interior;
+  // Where: the passages left on the stacks. When round-off made them disagree with the count,
+  // no positions are claimed.
+  for (int j = 0; j < m; ++j)
+    for (const auto& passage : track.passages[j])
+      if (passage.second < scales_.length * (1 - 1e-9)) report->conjugate_points.push_back(passage.second);
+  std::sort(report->conjugate_points.begin(), report->conjugate_points.end());
+  if (static_cast<int>(report->conjugate_points.size()) != interior) report->conjugate_points.clear();
+  return true;
+}
+
+// The count at s = L for the load-controlled problem: negative directions of q(c) = (P c).(U c)
+// over the fields meeting the held rotations, and the fields with U c = 0 whose natural (dead
+// moment) conditions fail, which are negative just before L. Returns the zero modes (fields
+// meeting every condition) as frame coefficients.
+Eigen::MatrixXd StabilityAnalysis::end_terms(const Frame& f, const Held& end, StabilityReport* report) const {
+  const int m = static_cast<int>(f.U.cols());
+  const double tol = options_.zero_tolerance;
+  const Eigen::MatrixXd held = held_configuration(end);
+  const Eigen::MatrixXd free_rotation = complement(held, m);
+  const Eigen::MatrixXd kernel_U = null_space(f.U, m, tol);
+  const Eigen::MatrixXd admissible = null_space(held.transpose() * f.U, m, tol);
+  const Eigen::MatrixXd rest = column_basis(admissible - kernel_U * (kernel_U.transpose() * admissible));
+  const Eigen::MatrixXd q = f.P.transpose() * f.U;
+  const Eigen::MatrixXd q_rest = rest.transpose() * (0.5 * (q + q.transpose())) * rest;
+  int negative = 0;
+  if (q_rest.rows() > 0) {
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(q_rest);
+    for (int i = 0; i < eig.eigenvalues().size(); ++i)
+      if (eig.eigenvalues()[i] < -tol) ++negative;
+  }
+  const Eigen::MatrixXd natural_failure = free_rotation.transpose() * f.P_physical * kernel_U;
+  report->end_count = negative + static_cast<int>(column_basis(natural_failure, tol).cols());
+  Eigen::MatrixXd conditions(held.cols() + free_rotation.cols(), m);
+  conditions << held.transpose() * f.U, free_rotation.transpose() * f.P_physical;
+  return null_space(conditions, m, tol);
+}
+
+// The isoperimetric correction (Maddocks; Manning, Rogers & Maddocks 1998): with the end
+// positions held along k directions, index = index_dead + r_Z + n_+(D) - k, where D = dg/dF is how
+// the chord g = r(L) - r(0) along them moves per unit change of the end load (the multiplier),
+// along the load-controlled equilibria, and r_Z the rank of the chord change along the
+// load-controlled problem's zero modes (D is then taken on the loads that do no work on them).
+// Zero modes of the whole problem: fields meeting every condition, load changes included.
+bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, const Eigen::MatrixXd& constraints,
+                                              const Eigen::MatrixXd& zero_modes, StabilityReport* report) const {
+  const int m = static_cast<int>(f.U.cols());
+  const double tol = options_.zero_tolerance;
+  // Every isoperimetric constraint's value on the frame's fields and on the particular ones, in
+  // the order of the multipliers (Frame::particular): the chord along the held directions at
+  // s = L, then the contacts' nu.dr(s_c); with the full frame the start's held positions, the
+  // contacts, then the end's held positions (`constraints` is then end.position).
+  const int all_constraints = static_cast<int>(f.particular.cols());
+  const int recorded = static_cast<int>(f.recorded_rows_frame.rows()), at_end = static_cast<int>(constraints.cols());
+  Eigen::MatrixXd values(all_constraints, m + all_constraints);
+  values.block(full_ ? recorded : 0, 0, at_end, m + all_constraints) << constraints.transpose() * f.R,
+      constraints.transpose() * f.particular_R;
+  values.block(full_ ? 0 : at_end, 0, recorded, m + all_constraints) << f.recorded_rows_frame,
+      f.recorded_rows_particular;
+  // A constraint that no perturbation changes to first order - the chord of a straight
+  // inextensible rod held at its full length - is degenerate: it holds at second order only
+  // (every perturbation shortens the chord), and its multiplier (the axial force) is
+  // indeterminate though it enters the second variation. The index is then not defined.
+  const Eigen::MatrixXd active = column_basis(values, tol);  // in constraint coordinates
+  if (active.cols() < all_constraints) {
+    report->reason = "a degenerate constraint: a held chord (or contact) that no perturbation changes to first "
+                     "order, as a straight inextensible rod held at its full length; its multiplier is "
+                     "indeterminate";
+    return false;
+  }
+  const Eigen::MatrixXd frame_values = active.transpose() * values.leftCols(m);
+  const Eigen::MatrixXd particular_values = active.transpose() * values.rightCols(all_constraints) * active;
+  // With the full frame, a unit change of the end's reaction along a held position e enters the
+  // end's natural conditions: dn(L) = e (its particular field is zero).
+  Eigen::MatrixXd end_loads = Eigen::MatrixXd::Zero(m, all_constraints);
+  if (full_) end_loads.block(0, all_constraints - at_end, coords_.kr(), at_end) = constraints;
+  const Eigen::MatrixXd particular_U = f.particular_U * active,
+                        particular_P_physical = (f.particular_P_physical - end_loads) * active;
+  const int k = static_cast<int>(active.cols());
+  const Eigen::MatrixXd held = held_configuration(end);
+  const Eigen::MatrixXd free_rotation = complement(held, m);
+  Eigen::MatrixXd conditions(m, m), loads(m, k);
+  conditions << held.transpose() * f.U, free_rotation.transpose() * f.P_physical;
+  loads << held.transpose() * particular_U, free_rotation.transpose() * particular_P_physical;
+  report->zero_modes = 0;
+  int correction = 0;
+  if (k > 0) {
+    const Eigen::MatrixXd c = -conditions.completeOrthogonalDecomposition().solve(loads);
+    const Eigen::MatrixXd chord = frame_values * c + particular_values;  // D, k x k
+
+    const Eigen::MatrixXd chord_zero = frame_values * zero_modes;        // k x z
+    const int r_z = static_cast<int>(column_basis(chord_zero, tol).cols());
+    const Eigen::MatrixXd quiet = null_space(chord_zero.transpose(), k, tol);  // loads doing no work on them
+    // D = C H^-1 C^T is symmetric (reciprocity of the multipliers' responses): 1e-14 of its size
+    // on the cases of the tests once every Jacobi field gets each contact's jump.
+    const Eigen::MatrixXd D_quiet = quiet.transpose() * chord * quiet;
+    const Eigen::MatrixXd D = 0.5 * (D_quiet + D_quiet.transpose());
+    int positive = 0;
+    if (D.rows() > 0) {
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(D);
+      for (int i = 0; i < eig.eigenvalues().size(); ++i)
+        if (eig.eigenvalues()[i] > tol) ++positive;
+    }
+    correction = r_z + positive - k;
+  }
+  Eigen::MatrixXd all(m + k, m + k);
+  all.topLeftCorner(m, m) = conditions;
+  all.topRightCorner(m, k) = loads;
+  all.bottomLeftCorner(k, m) = frame_values;
+  all.bottomRightCorner(k, k) = particular_values;
+  report->zero_modes = static_cast<int>(null_space(all, m + k, tol).cols());
+  report->constraint_count = k;
+  report->constraint_correction = correction;
+  return true;
+}
+
+StabilityReport StabilityAnalysis::run() {
+  StabilityReport report;
+  std::vector<std::string> multipliers;
+  std::string why = unsupported(problem_, x_);
+  if (why.empty()) why = classify_unknowns(problem_, p_, &multipliers);
+  if (!why.empty()) {
+    report.reason = why;
+    return report;
+  }
+  const ProblemDefinition& d = problem_.definition();
+  const Held start = held_at(d.start, multipliers), end = held_at(end_, multipliers);
+  // The isoperimetric constraints read at s = L: the held chord, or with the full frame every
+  // position the end holds (and those the start holds, read at s = 0).
+  const Eigen::MatrixXd constraints = full_ ? end.position : constraint_directions(start, end);
+  const Eigen::MatrixXd start_multipliers = full_ ? Eigen::MatrixXd(-start.position) : constraints;
+  start_multipliers_ = static_cast<int>(start_multipliers.cols());
+  recorded_before_contacts_ = full_ ? static_cast<int>(start.position.cols()) : 0;
+  const std::vector<PointContact> contacts = problem_.contacts_at(x_);
+  scales_.rate = field_rate();
+  if (full_) scales_.force_rate = scales_.rate;
+
+  Frame f = start_frame(start, start_multipliers, static_cast<int>(contacts.size()),
+                        full_ ? static_cast<int>(end.position.cols()) : 0);
+  const int m = static_cast<int>(f.U.cols());
+  const Eigen::MatrixXd lagrange = f.U.transpose() * f.P - f.P.transpose() * f.U;
+  if (lagrange.norm() > 1e-8 * (1.0 + f.U.norm() * f.P.norm())) {
+    report.reason = "the start's loads are not conservative (a dead couple on an end free to rotate in 3D)";
+    return report;
+  }
+  orthonormalise(&f);
+  PhaseTrack track;
+  track.lifted = eigenphases(f.U, f.P);
+  // The fields held at s = 0 start exactly at a conjugate point (U c = 0): their eigenphase is pi,
+  // leaving it in the Legendre direction.
+  const int held_count = static_cast<int>(start.rotation.cols());
+  std::vector<int> order(m);
+  for (int j = 0; j < m; ++j) order[j] = j;
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return std::abs(wrap(track.lifted[a] - kPi)) < std::abs(wrap(track.lifted[b] - kPi)); });
+  for (int k = 0; k < held_count; ++k) track.lifted[order[k]] = kPi;
+  for (int j = 0; j < m; ++j)
+    if (track.lifted[j] < -kPi + 1e-9) track.lifted[j] += 2 * kPi;
+  const Eigen::VectorXd start_phases = track.lifted;
+  track.lowest = start_phases;
+  track.passages.assign(m, {});
+
+  // The rod in pieces between shooting nodes and contacts; the equilibrium is integrated across
+  // them from its start (each contact applies its jump).
+  std::vector<double> breaks = problem_.node_arclengths(x_);
+  for (const PointContact& c : contacts) breaks.push_back(c.s);
+  breaks.push_back(scales_.length);
+  std::sort(breaks.begin(), breaks.end());
+  breaks.erase(std::unique(breaks.begin(), breaks.end(),
+                           [&](double a, double b) { return std::abs(a - b) < 1e-12 * scales_.length; }),
+               breaks.end());
+  const int pieces = static_cast<int>(breaks.size()) - 1;
+  // Enough steps that the eigenphases, turning at ~2 rate / L, move ~0.5 rad per step.
+  const int wanted = std::max(options_.min_steps, static_cast<int>(std::ceil(4.0 * scales_.rate)));
+  const int steps = std::max(2, (wanted + pieces - 1) / pieces);
+  double shear = 0.0;  // of the contact just passed
+  for (int i = 0; i < pieces; ++i) {
+    const double step = (breaks[i + 1] - breaks[i]) / steps;
+    // Past a contact whose shear S is large (the contact near flattening, f / g'' large) the
+    // fields turn on the length L / S: steps grow geometrically from a fraction of it, so no
+    // eigenphase turns a whole turn within one (which a step could not tell from no turn).
+    for (double h = 0.25 * scales_.length / (1.0 + shear); shear > 0 && h < step; h *= 2)
+      advance(&f, breaks[i] + h, &track, 0);
+    shear = 0.0;
+    for (int k = 1; k <= steps; ++k) advance(&f, breaks[i] + step * k, &track, 0);
+    for (size_t c = 0; c < contacts.size(); ++c) {
+      if (std::abs(contacts[c].s - breaks[i + 1]) > 1e-12 * scales_.length) continue;
+      if (std::string why = pass_contact(&f, contacts[c], static_cast<int>(c), &track, &shear); !why.empty()) {
+        report.reason = why;
+        return report;
+      }
+    }
+  }
+  report.rhs_evaluations = rhs_;
+  if (track.reversed) {
+    std::ostringstream reason;
+    reason << "an eigenphase passed against the Legendre direction near s = " << track.reversed_at
+           << ": the Jacobi system is degenerate there and the count is not valid";
+    report.reason = reason.str();
+    return report;
+  }
+  if (!count_interior(f, track, start_phases, &report)) return report;
+  if (std::string why = end_moment_reason(f, end); !why.empty()) {
+    report.reason = why;
+    return report;
+  }
+  const Eigen::MatrixXd zero_modes = end_terms(f, end, &report);
+  report.dead_load_index = report.interior_count + report.end_count;
+  if (!constraint_correction(f, end, constraints, zero_modes, &report)) return report;
+  // Rigid translations along directions neither end holds map equilibria to equilibria (the full
+  // frame carries them, and counts them where they are zero modes).
+  Eigen::MatrixXd held(coords_.kr(), start.position.cols() + end.position.cols());
+  held << start.position, end.position;
+  if (!full_) report.zero_modes += coords_.kr() - static_cast<int>(column_basis(held).cols());
+  report.index = report.dead_load_index + report.constraint_correction;
+  if (*report.index < 0) {
+    report.reason = "the isoperimetric correction exceeds the load-controlled index: degenerate constraints";
+    report.index.reset();
+  }
+  return report;
+}
+
+}  // namespace
+
+namespace {
+
+// The whole rod's index from its two halves (stability_symmetric.hpp): the counts add, and the
+// conjugate points are those of both half problems (half-rod arclengths). Undefined when either is.
+StabilityReport whole_rod(const StabilityReport& symmetric, const StabilityReport& antisymmetric) {
+  for (const auto* part : {&symmetric, &antisymmetric})
+    if (!part->defined()) {
+      StabilityReport out = *part;
+      out.reason = std::string(part == &symmetric ? "symmetric" : "antisymmetric") +
+                   " perturbations of the half-turn symmetric rod: " + part->reason;
+      out.rhs_evaluations = symmetric.rhs_evaluations + antisymmetric.rhs_evaluations;
+      return out;
+    }
+  StabilityReport out;
+  out.index = *symmetric.index + *antisymmetric.index;
+  out.symmetric_index = symmetric.index;
+  out.antisymmetric_index = antisymmetric.index;
+  out.zero_modes = symmetric.zero_modes + antisymmetric.zero_modes;
+  out.conjugate_points = symmetric.conjugate_points;
+  out.conjugate_points.insert(out.conjugate_points.end(), antisymmetric.conjugate_points.begin(),
+                              antisymmetric.conjugate_points.end());
+  std::sort(out.conjugate_points.begin(), out.conjugate_points.end());
+  out.interior_count = symmetric.interior_count + antisymmetric.interior_count;
+  out.end_count = symmetric.end_count + antisymmetric.end_count;
+  out.dead_load_index = symmetric.dead_load_index + antisymmetric.dead_load_index;
+  out.constraint_count = symmetric.constraint_count + antisymmetric.constraint_count;
+  out.constraint_correction = symmetric.constraint_correction + antisymmetric.constraint_correction;
+  out.rhs_evaluations = symmetric.rhs_evaluations + antisymmetric.rhs_evaluations;
+  return out;
+}
+
+// Where the self-contact acts, the whole rod's antisymmetric second variation is not that of the
+// partner pairs (stability_symmetric.hpp): the index is not reported, the symmetric half's when
+// it was computed.
+StabilityReport self_contact_acts(const StabilityReport* symmetric, long rhs_evaluations) {
+  StabilityReport out;
+  out.reason = "the self-contact acts: the whole rod's index needs the antisymmetric perturbations of the "
+               "contact between the strands (their closest points sliding along both), which are not "
+               "implemented";
+  if (!symmetric) return out;
+  out.reason += "; the symmetric perturbations' index is given";
+  out.symmetric_index = symmetric->index;
+  out.rhs_evaluations = symmetric->rhs_evaluations + rhs_evaluations;
+  return out;
+}
+
+// The equilibrium at the shooting nodes, read from the unknowns (no integration).
+std::vector<RodPoint> node_points(const ShootingProblem& problem, const Eigen::VectorXd& x, const RodEquations& eq) {
+  const std::vector<double> s = problem.node_arclengths(x);
+  const int n = problem.state_size();
+  std::vector<RodPoint> nodes;
+  for (int i = 0; i < problem.segments() && i < static_cast<int>(s.size()); ++i)
+    nodes.push_back(eq.point(x.segment(i * n, n), s[i]));
+  return nodes;
+}
+
+}  // namespace
+
+StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::VectorXd& x,
+                                  const StabilityOptions& options) {
+  try {
+    // An unknown that changes the rod (a sleeve's sliding length): reduced on it, or null with why.
+    if (!rod_changing_unknown(problem).empty()) return analyse_free_length_stability(problem, x, options);
+    const EndCondition& end = problem.definition().end;
+    if (!end.is_half_turn_symmetry() || !unsupported(problem, x).empty())
+      return StabilityAnalysis(problem, x, options, end, nullptr).run();
+    // Half of a half-turn symmetric rod: the end as stated holds the symmetric perturbations; the
+    // antisymmetric ones have the complementary conditions and, with self-contact, the pair
+    // energy's other second variation.
+    const auto equations = problem.equations(problem.parameters_at(x));
+    // Acting already at a shooting node (a formed ply), the antisymmetric pass - its steps refined
+    // through the stiff barrier - could only end in the null below: it is not run.
+    const bool acts_at_nodes =
+        antisymmetric_barrier_stiffness(*equations, node_points(problem, x, *equations)) > options.zero_tolerance;
+    if (acts_at_nodes && !options.symmetric_index_where_contact_acts) return self_contact_acts(nullptr, 0);
+    const StabilityReport symmetric = StabilityAnalysis(problem, x, options, end, nullptr).run();
+    if (acts_at_nodes) return self_contact_acts(&symmetric, 0);
+    const EndCondition anti_end = antisymmetric_half_turn_end(end.half_turn_axis());
+    StabilityAnalysis anti(problem, x, options, anti_end, antisymmetric_equations(*equations));
+    anti.track_barrier(equations);
+    const StabilityReport antisymmetric = anti.run();
+    // Below the zero tolerance the term moves no eigenvalue beyond what is called zero anyway.
+    if (anti.barrier_stiffness() > options.zero_tolerance)
+      return self_contact_acts(&symmetric, antisymmetric.rhs_evaluations);
+    return whole_rod(symmetric, antisymmetric);
+  } catch (const IntegrationError& e) {
+    StabilityReport report;
+    report.reason = std::string("the Jacobi fields could not be integrated: ") + e.what();
+    return report;
+  }
+}
+
+std::string describe(const StabilityReport& report) {
+  if (!report.index) return "index undefined: " + report.reason;
+  std::ostringstream out;
+  out << (*report.index == 0 ? "stable" : "unstable (index " + std::to_string(*report.index) + ")");
+  if (report.zero_modes > 0) out << ", " << report.zero_modes << " zero mode" << (report.zero_modes > 1 ? "s" : "");
+  return out.str();
+}
+
+}  // namespace kirchhoff

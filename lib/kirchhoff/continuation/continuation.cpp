@@ -1,0 +1,789 @@
+#include "kirchhoff/continuation/continuation.hpp"
+
+#include <algorithm>
+#include <boost/math/tools/minima.hpp>
+#include <cmath>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+
+#include "kirchhoff/analysis/point_record.hpp"
+#include "kirchhoff/continuation/detail/continuation_detectors.hpp"
+#include "kirchhoff/shooting/detail/jacobian_lu.hpp"
+
+namespace kirchhoff {
+namespace {
+
+// Step growth and shrink factors: the usual choices for predictor-corrector continuation.
+constexpr double kGrow = 1.5, kShrink = 0.5;
+// Secant/Brent location stops when the step interval is this small relative to the step.
+constexpr double kLocateTolerance = 1e-12;
+constexpr int kLocateIterations = 60;
+// Chord iterations continue while each one reduces the residual at least by this factor.
+constexpr double kChordContraction = 0.3;
+// Modified Newton keeps its matrix while each iteration reduces the residual at least by this
+// factor (it converges linearly at that rate, still cheaper than a new matrix when one costs
+// tens of residuals).
+constexpr double kModifiedNewtonContraction = 0.5;
+
+double sign_of(double v) { return v < 0 ? -1.0 : 1.0; }
+
+// Points a march can be resumed from: a special point (fold, branch point, event, end) is found
+// by locating inside a step, and a resumed run finds it again by redoing that step.
+bool resumable_type(PointType t) { return t == PointType::Start || t == PointType::Regular; }
+
+// Obstacles or contacts: the march's looser matrices are not used
+// (ContinuationOptions::march_sensitivity_tol).
+bool has_contact(const ProblemDefinition& d) {
+  return !d.obstacles.empty() || d.moving_obstacles || !d.contacts.empty();
+}
+
+}  // namespace
+
+const char* to_string(PointType type) {
+  switch (type) {
+    case PointType::Start: return "start";
+    case PointType::Regular: return "regular";
+    case PointType::Fold: return "fold";
+    case PointType::BranchPoint: return "branch_point";
+    case PointType::Event: return "event";
+    case PointType::Endpoint: return "endpoint";
+  }
+  return "?";
+}
+
+const char* to_string(StopReason reason) {
+  switch (reason) {
+    case StopReason::ReachedTarget: return "reached_target";
+    case StopReason::MaxPoints: return "max_points";
+    case StopReason::ParameterBounds: return "parameter_bounds";
+    case StopReason::StepTooSmall: return "step_too_small";
+    case StopReason::EventStop: return "event";
+    case StopReason::BranchPointStop: return "branch_point";
+    case StopReason::StartFailed: return "start_failed";
+    case StopReason::Inadmissible: return "inadmissible";
+    case StopReason::TimeLimit: return "time_limit";
+    case StopReason::FoldStop: return "fold";
+  }
+  return "?";
+}
+
+std::string ContinuationOptions::validate() const {
+  if (parameter.empty()) return "no continuation parameter given";
+  if (!(initial_step > 0) || !(min_step > 0) || !(max_step >= min_step)) return "steps must satisfy 0 < min_step <= max_step, initial_step > 0";
+  // Each point keeps its unknowns and derived quantities in memory: 1e7 of them is beyond any
+  // branch and still fits; more is a typo.
+  if (max_points < 1 || max_points > 10000000) return "max_points must be in [1, 1e7]";
+  if (!(parameter_min < parameter_max)) return "parameter_min must be < parameter_max";
+  if (corrector_max_iterations < 1 || !(corrector_tolerance > 0 || std::isnan(corrector_tolerance)))
+    return "corrector settings must be positive";
+  // As a case file's [output] samples (case_file.hpp): 1e5 samples cost ~2 s per point already.
+  if (samples < 2 || samples > 100000) return "samples must be in [2, 100000]";
+  if (!(0 <= grow_iterations && grow_iterations < shrink_iterations))
+    return "grow_iterations must be >= 0 and below shrink_iterations";
+  if (!(march_sensitivity_tol >= 0)) return "march_sensitivity_tol must be >= 0 (0: the problem's own)";
+  if (reuse_jacobian_iterations >= 0 && detect_branch_points)
+    return "reusing Jacobians needs detect_branch_points = false (the test functions need each point's own)";
+  return {};
+}
+
+Continuation::Continuation(const ShootingProblem& problem, ContinuationOptions options)
+    : problem_(problem), options_(std::move(options)) {
+  if (std::string e = options_.validate(); !e.empty()) throw std::invalid_argument(e);
+  if (std::isnan(options_.corrector_tolerance))
+    options_.corrector_tolerance = std::max(1e-10, problem_.definition().options.newton.residual_tolerance);
+  if (!problem_.parameters().contains(options_.parameter))
+    throw std::invalid_argument("continuation parameter '" + options_.parameter + "' is not a parameter of the problem");
+  for (const auto& u : problem_.definition().unknown_parameters)
+    if (u == options_.parameter)
+      throw std::invalid_argument("'" + options_.parameter + "' is solved for (an unknown); continue in another parameter");
+  for (const auto& e : options_.events)
+    if (std::find(options_.derived.begin(), options_.derived.end(), e.quantity) == options_.derived.end())
+      options_.derived.push_back(e.quantity);
+  // The engine knows no rod: what a point records comes from the recorder, by default the rod
+  // layer's (it reads the derived list completed with the events' quantities above).
+  if (!options_.recorder) options_.recorder = rod_point_recorder(options_);
+  n_ = problem_.size();
+  const ProblemDefinition& d = problem_.definition();
+  if (!has_contact(d) &&
+      options_.march_sensitivity_tol > std::max(d.options.integrator.sensitivity_tol, d.options.integrator.abs_tol)) {
+    ProblemDefinition loose = d;
+    loose.options.integrator.sensitivity_tol = options_.march_sensitivity_tol;
+    march_problem_.emplace(std::move(loose));
+  }
+}
+
+Eigen::VectorXd Continuation::join(const Eigen::VectorXd& x, double lambda) const {
+  Eigen::VectorXd z(n_ + 1);
+  z << x, lambda;
+  return z;
+}
+
+bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
+                            bool march) {
+  // A parameter value where no rod can be built (a self-contact radius below zero, reached by a
+  // corrector iterate far off the branch) is a failed evaluation, so the step is shortened as for
+  // any other; it used to end the whole run with the model's exception.
+  try {
+    return evaluate_at(z, F, A, failure, march);
+  } catch (const std::invalid_argument& e) {
+    if (failure) *failure = "no rod at " + options_.parameter + " = " + std::to_string(z[n_]) + ": " + e.what();
+    return false;
+  }
+}
+
+bool Continuation::evaluate_at(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
+                               bool march) {
+  const double lambda = z[n_];
+  const Eigen::VectorXd x = z.head(n_);
+  problem_.set_parameter(options_.parameter, lambda);
+  if (!A) {
+    ++evaluations_.residuals;
+    return problem_.evaluate(x, F, nullptr, failure);
+  }
+  ++evaluations_.matrices;
+  // (Its residual is the same number as problem_'s: the state is integrated at the same tolerance.)
+  ShootingProblem& p = march && march_problem_ ? *march_problem_ : problem_;
+  if (&p != &problem_) p.set_parameter(options_.parameter, lambda);
+  Eigen::VectorXd y_end, F_lambda;
+  if (!p.evaluate_with_end(x, F, A, &y_end, failure)) return false;
+  if (!p.parameter_derivative(x, options_.parameter, &F_lambda, failure, &y_end)) return false;
+  // A column appended in place: the matrices of long rods are tens of megabytes, and realloc
+  // extends such blocks without copying them.
+  A->conservativeResize(n_, n_ + 1);
+  A->col(n_) = F_lambda;
+  return true;
+}
+
+bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
+                           int* iterations, const Eigen::MatrixXd* chord, bool* by_chord, bool march) {
+  Eigen::VectorXd F, G(n_ + 1);
+  Eigen::MatrixXd A;
+  std::string failure;
+  int it = 0;
+  if (chord && chord->rows() == n_) {
+    const JacobianLU lu(*chord, normal);
+    if (lu.reciprocal_condition() > 1e-15) {
+      const Eigen::VectorXd z_start = z;
+      double previous = INFINITY;
+      for (; it <= options_.corrector_max_iterations; ++it) {
+        if (!evaluate(z, &F, nullptr, &failure)) break;
+        G << F, normal.dot(z - z_predicted);
+        const double norm = max_abs_or_nan(G);  // NaN when G holds one (lpNorm would skip it)
+        if (!std::isfinite(norm)) break;
+        if (norm <= options_.corrector_tolerance) {
+          *iterations = it;
+          if (by_chord) *by_chord = true;
+          return true;
+        }
+        // Chord iterations contract linearly; slower than this, full Newton is cheaper.
+        if (norm > kChordContraction * previous) break;
+        previous = norm;
+        z -= lu.solve(G);
+      }
+      if (!z.allFinite()) z = z_start;
+    }
+  }
+  double best = INFINITY, previous = INFINITY;
+  std::optional<JacobianLU> lu;  // the matrix of the current (modified) Newton iteration
+  for (; it <= 2 * options_.corrector_max_iterations; ++it) {
+    if (lu) {
+      if (!evaluate(z, &F, nullptr, &failure)) {
+        last_corrector_failure_ = failure;
+        return false;
+      }
+      G << F, normal.dot(z - z_predicted);
+      if (!(max_abs_or_nan(G) <= kModifiedNewtonContraction * previous)) lu.reset();
+    }
+    if (!lu) {
+      if (!evaluate(z, &F, &A, &failure, march)) {
+        last_corrector_failure_ = failure;
+        return false;
+      }
+      G << F, normal.dot(z - z_predicted);
+    }
+    if (!G.allFinite()) {
+      last_corrector_failure_ = "the residual is not finite";
+      return false;
+    }
+    const double norm = G.lpNorm<Eigen::Infinity>();
+    best = std::min(best, norm);
+    if (norm <= options_.corrector_tolerance) {
+      *iterations = it;
+      return true;
+    }
+    if (!lu) {
+      lu.emplace(A, normal);
+      if (!(lu->reciprocal_condition() > 1e-15)) {
+        std::ostringstream os;
+        os << "singular bordered matrix (reciprocal condition " << lu->reciprocal_condition() << ", residual " << norm
+           << ")";
+        last_corrector_failure_ = os.str();
+        return false;
+      }
+    }
+    z -= lu->solve(G);
+    previous = norm;
+    if (!options_.modified_newton) lu.reset();
+  }
+  std::ostringstream os;
+  os << "no convergence, best residual " << best;
+  last_corrector_failure_ = os.str();
+  return false;
+}
+
+std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous,
+                                                        PointType type, int index, double arclength, int iterations,
+                                                        std::shared_ptr<const Eigen::MatrixXd> reused) {
+  const bool is_reused = reused != nullptr;
+  std::shared_ptr<const Eigen::MatrixXd> A = std::move(reused);
+  if (!A) {
+    Eigen::VectorXd F;
+    Eigen::MatrixXd own;
+    std::string failure;
+    // The march's matrix at the points it can resume from (restore() evaluates the same one).
+    if (!evaluate(z, &F, &own, &failure, resumable_type(type))) return std::nullopt;
+    A = std::make_shared<const Eigen::MatrixXd>(std::move(own));
+  }
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n_ + 1);
+  rhs[n_] = 1.0;
+  Eigen::VectorXd t = JacobianLU(*A, previous).solve(rhs);
+  if (!t.allFinite() || t.norm() == 0.0) return std::nullopt;
+  t.normalize();
+  return make_point(z, t, std::move(A), is_reused, type, index, arclength, iterations);
+}
+
+ContinuationPoint Continuation::make_point(const Eigen::VectorXd& z, const Eigen::VectorXd& t,
+                                           std::shared_ptr<const Eigen::MatrixXd> A, bool reused, PointType type,
+                                           int index, double arclength, int iterations) {
+  ContinuationPoint p;
+  p.index = index;
+  p.x = z.head(n_);
+  p.parameter = z[n_];
+  p.tangent = t;
+  p.type = type;
+  p.arclength = arclength;
+  p.newton_iterations = iterations;
+  p.jacobian_reused = reused;
+  // The determinant and singular values only serve branch-point detection, and the SVD costs
+  // O(n^3) with a large constant: on multiple-shooting problems of several hundred unknowns it
+  // was 95 % of a run.
+  if (options_.detect_branch_points) {
+    Eigen::MatrixXd M(n_ + 1, n_ + 1);
+    M << *A, t.transpose();
+    p.determinant = JacobianLU(M).determinant();
+    const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(M).singularValues();
+    p.smallest_singular = sv[n_] / sv[0];
+    for (int i = 0; i <= n_; ++i) p.small_count += sv[i] / sv[0] < options_.branch_point_tolerance ? 1 : 0;
+  }
+  p.jacobian = std::move(A);
+  return p;
+}
+
+std::optional<ContinuationPoint> Continuation::restore(const ContinuationPoint& saved, bool with_description) {
+  if (saved.x.size() != n_ || saved.tangent.size() != n_ + 1) return std::nullopt;
+  const Eigen::VectorXd z = join(saved.x, saved.parameter);
+  Eigen::VectorXd F;
+  Eigen::MatrixXd A;
+  std::string failure;
+  if (!evaluate(z, &F, &A, &failure, resumable_type(saved.type))) return std::nullopt;
+  // The saved tangent, not one solved for again: bordered by another row (the point's own
+  // tangent instead of its predecessor's) the solve gives the same direction to round-off only.
+  ContinuationPoint p = make_point(z, saved.tangent, std::make_shared<const Eigen::MatrixXd>(std::move(A)), false,
+                                   saved.type, saved.index, saved.arclength, saved.newton_iterations);
+  p.step = saved.step;
+  if (with_description) describe(&p);
+  return p;
+}
+
+void Continuation::describe(ContinuationPoint* point) {
+  if (!options_.recorder->describe) return;
+  problem_.set_parameter(options_.parameter, point->parameter);
+  options_.recorder->describe(problem_, point);
+}
+
+void Continuation::record(ContinuationPoint* point) {
+  if (!options_.recorder->record) return;
+  problem_.set_parameter(options_.parameter, point->parameter);
+  options_.recorder->record(problem_, point);
+}
+
+std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint& from, double h, PointType type) {
+  const Eigen::VectorXd z0 = join(from.x, from.parameter);
+  const Eigen::VectorXd z_pred = z0 + h * from.tangent;
+  Eigen::VectorXd z = z_pred;
+  int iterations = 0;
+  bool by_chord = false;
+  // The march's own steps with its matrices; a located point's correctors (and its matrix, in
+  // point_at) with the problem's own, as its test functions are.
+  const bool march = type == PointType::Regular;
+  if (!correct(z, z_pred, from.tangent, &iterations, from.jacobian.get(), &by_chord, march)) {
+    // Where Newton needs the matrix to more digits than the march's (a stiff self-contact
+    // barrier, where it stalled at a residual of 2e-8), the step is corrected again with the
+    // problem's own before it counts as failed. Its chord iterations on the same matrix from the
+    // same prediction would fail again: Newton at once.
+    if (!march || !march_problem_) return std::nullopt;
+    z = z_pred;
+    if (!correct(z, z_pred, from.tangent, &iterations)) return std::nullopt;
+  }
+  // A corrector that converged quickly on the previous matrix shows that matrix still serves:
+  // the new point keeps it for its tangent and the next chord instead of paying for its own.
+  // (Not a modified-Newton matrix from an iterate of this corrector: tried at L/2R = 200, its
+  // tangents cost three times the run time in harder correctors.)
+  const bool reuse =
+      by_chord && iterations <= options_.reuse_jacobian_iterations && from.jacobian && from.jacobian->rows() == n_;
+  auto point = point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations,
+                        reuse ? from.jacobian : nullptr);
+  if (point) describe(&*point);
+  // A corrected point that is not an admissible solution is a failed step, as a corrector that
+  // did not converge is: the step shrinks, and the run ends saying why at the smallest step.
+  if (point && !point->check_failure.empty()) {
+    last_corrector_failure_ = point->check_failure;
+    return std::nullopt;
+  }
+  return point;
+}
+
+std::optional<ContinuationPoint> Continuation::at_parameter(const ContinuationPoint& located, double value) {
+  const Eigen::VectorXd z0 = join(located.x, located.parameter);
+  Eigen::VectorXd z = join(located.x, value), e = Eigen::VectorXd::Zero(n_ + 1);
+  e[n_] = 1.0;
+  int iterations = 0;
+  if (!correct(z, z, e, &iterations, located.jacobian.get())) return std::nullopt;
+  auto point = point_at(z, located.tangent, located.type, located.index, located.arclength + (z - z0).norm(),
+                        located.newton_iterations);
+  if (point) describe(&*point);
+  if (point && !point->check_failure.empty()) return std::nullopt;
+  return point;
+}
+
+std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& from, double h_max,
+                                                      const std::function<double(const ContinuationPoint&)>& monitor,
+                                                      bool minimise, PointType type) {
+  std::optional<ContinuationPoint> best;
+  if (minimise) {
+    auto f = [&](double h) {
+      auto p = step_from(from, h, type);
+      return p ? monitor(*p) : INFINITY;
+    };
+    const auto [h, value] = boost::math::tools::brent_find_minima(f, 0.0, h_max, 40);
+    (void)value;
+    best = step_from(from, h, type);
+  } else {
+    // Illinois (modified regula falsi) on h: brackets the root and converges superlinearly.
+    double a = 0.0, fa = monitor(from), b = h_max;
+    auto pb = step_from(from, b, type);
+    if (!pb) return std::nullopt;
+    double fb = monitor(*pb);
+    best = pb;
+    int side = 0;
+    for (int it = 0; it < kLocateIterations && std::abs(b - a) > kLocateTolerance * h_max; ++it) {
+      const double c = (a * fb - b * fa) / (fb - fa);
+      auto pc = step_from(from, c, type);
+      if (!pc) break;  // keep the best estimate so far (e.g. at a singular point)
+      const double fc = monitor(*pc);
+      best = pc;
+      if (fc == 0.0) break;
+      if (sign_of(fc) == sign_of(fb)) {
+        b = c;
+        fb = fc;
+        if (side == -1) fa *= 0.5;
+        side = -1;
+      } else {
+        a = c;
+        fa = fc;
+        if (side == +1) fb *= 0.5;
+        side = +1;
+      }
+      if (std::abs(fc) < 1e-15) break;
+    }
+  }
+  if (best) best->type = type;
+  return best;
+}
+
+ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink& sink) {
+  ContinuationResult result;
+  const double lambda0 = problem_.parameters().get(options_.parameter);
+  // Solve at fixed lambda with the damped Newton (and its fallback search) of a single solve,
+  // then orient the tangent towards the target.
+  problem_.set_parameter(options_.parameter, lambda0);
+  const ShootingResult first = solve(problem_, x0);
+  // The continuation works to its own corrector tolerance: a start that stalls below it (a case
+  // asking Newton for 1e-12 at large loads, say) is good enough.
+  if (!first.summary.converged() && !(first.summary.residual_norm <= options_.corrector_tolerance)) {
+    result.reason = StopReason::StartFailed;
+    result.message = "the starting point does not converge at " + options_.parameter + " = " +
+                     std::to_string(lambda0) + ": " + first.summary.brief_report();
+    return result;
+  }
+  Eigen::VectorXd z = join(first.x, lambda0), e = Eigen::VectorXd::Zero(n_ + 1);
+  e[n_] = 1.0;
+  int iterations = 0;
+  const double direction = std::isnan(options_.target) ? sign_of(options_.direction) : sign_of(options_.target - lambda0);
+  std::optional<ContinuationPoint> start;
+  if (correct(z, z, e, &iterations)) start = point_at(z, direction * e, PointType::Start, 0, 0.0, iterations);
+  if (start) describe(&*start);
+  if (!start || !start->check_failure.empty()) {
+    result.reason = StopReason::StartFailed;
+    result.message = "the starting point does not converge at " + options_.parameter + " = " + std::to_string(lambda0) +
+                     (start ? ": " + start->check_failure : "");
+    return result;
+  }
+  start->step = options_.initial_step;
+  MarchState state;
+  state.current = std::move(*start);
+  return march(std::move(state), sink);
+}
+
+ContinuationResult Continuation::resume(const MarchState& saved, const PointSink& sink) {
+  ContinuationResult failed;
+  failed.reason = StopReason::StartFailed;
+  MarchState state = saved;
+  auto current = restore(saved.current, true);
+  if (!current) {
+    failed.message = "cannot resume: the saved point cannot be evaluated (or does not fit this problem)";
+    return failed;
+  }
+  state.current = std::move(*current);
+  // The point before is only looked at for minima of the smallest singular value.
+  if (saved.before && options_.detect_branch_points) {
+    auto before = restore(*saved.before, false);
+    if (!before) {
+      failed.message = "cannot resume: the point before the saved one cannot be evaluated";
+      return failed;
+    }
+    state.before = std::move(*before);
+  } else {
+    state.before.reset();
+  }
+  // The saved point is already reported; the rest go to the sink as they are found, so that a
+  // resumed run killed again keeps what it had computed.
+  ContinuationResult r = march(std::move(state), sink, false);
+  if (!r.points.empty()) r.points.erase(r.points.begin());
+  return r;
+}
+
+ContinuationResult Continuation::resume(const ContinuationPoint& last, const PointSink& sink) {
+  MarchState state;
+  state.current = last;
+  if (!(state.current.step > 0)) state.current.step = options_.initial_step;
+  return resume(state, sink);
+}
+
+Eigen::MatrixXd Continuation::bifurcation_directions(const ContinuationPoint& point, int count) {
+  Eigen::VectorXd F;
+  Eigen::MatrixXd A;
+  std::string failure;
+  if (!evaluate(join(point.x, point.parameter), &F, &A, &failure)) throw std::runtime_error(failure);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
+  // The last count + 1 right singular vectors span the null space (tangent included).
+  Eigen::MatrixXd N = svd.matrixV().rightCols(count + 1);
+  N -= point.tangent * (point.tangent.transpose() * N);
+  Eigen::JacobiSVD<Eigen::MatrixXd> basis(N, Eigen::ComputeThinU);
+  return basis.matrixU().leftCols(count);
+}
+
+ContinuationResult Continuation::run_along(const Eigen::VectorXd& x, double lambda, const Eigen::VectorXd& direction,
+                                           PointType start_type, const PointSink& sink) {
+  ContinuationResult result;
+  const Eigen::VectorXd z_bp = join(x, lambda);
+  const Eigen::VectorXd d = direction.normalized();
+  // The branch point itself: its Jacobian is singular, so it gets no tangent of its own; the
+  // direction we leave along stands in for it.
+  ContinuationPoint origin;
+  origin.x = x;
+  origin.parameter = lambda;
+  origin.tangent = d;
+  origin.type = start_type;
+  describe(&origin);
+  const Eigen::VectorXd z_pred = z_bp + options_.initial_step * d;
+  Eigen::VectorXd z = z_pred;
+  int iterations = 0;
+  std::optional<ContinuationPoint> first;
+  if (correct(z, z_pred, d, &iterations))
+    first = point_at(z, d, PointType::Regular, 1, (z - z_bp).norm(), iterations);
+  if (first) describe(&*first);
+  if (!first) {
+    result.reason = StopReason::StartFailed;
+    result.message = "no solution along the switching direction";
+    return result;
+  }
+  record(&origin);
+  if (sink) sink(origin);
+  first->step = options_.initial_step;
+  MarchState state;
+  state.current = std::move(*first);
+  result = march(std::move(state), sink);
+  result.points.insert(result.points.begin(), origin);
+  return result;
+}
+
+ContinuationResult Continuation::switch_branch(const ContinuationPoint& bp, const PointSink& sink, double sign) {
+  Eigen::VectorXd d = bifurcation_directions(bp, 1).col(0);
+  // Orientation: the first significant component positive for sign = +1 (e.g. theta(0) > 0 on
+  // the buckled Euler column), the mirror branch for sign = -1.
+  for (int i = 0; i < d.size(); ++i)
+    if (std::abs(d[i]) > 1e-8) {
+      d *= sign_of(d[i]) * sign_of(sign);
+      break;
+    }
+  return run_along(bp.x, bp.parameter, d, PointType::BranchPoint, sink);
+}
+
+// The march's working state: MarchState's fields, the result so far and the step size. One step
+// is a candidate point (next_candidate), the detectors' special points inside it (detect), those
+// put on the branch with their actions (take_special), then the candidate itself (advance).
+struct Continuation::Marcher {
+  Marcher(Continuation& engine, const PointSink& point_sink, MarchState state)
+      : c(engine),
+        o(engine.options_),
+        sink(point_sink),
+        current(std::move(state.current)),
+        before(std::move(state.before)),
+        previous_h(state.previous_step),
+        just_reported_branch_point(state.just_reported_branch_point),
+        points_before(state.points - 1),
+        ds(current.step > 0 ? current.step : engine.options_.initial_step) {
+    counters.branch_points_found = state.branch_points_found;
+    result.refused_steps = state.refused_steps;
+  }
+
+  Continuation& c;
+  const ContinuationOptions& o;
+  const PointSink& sink;
+  ContinuationResult result;
+  ContinuationPoint current;
+  std::optional<ContinuationPoint> before;  // the point before `current`, for minima
+  double previous_h;
+  bool just_reported_branch_point;
+  detail::MarchCounters counters;
+  // Points of this march made before `current` (by the run that a resumed one continues): they
+  // count against max_points as if it had not been interrupted.
+  int points_before;
+  double ds;
+  // Only branch points keep their matrix in the branch (for switching); the newest point's moves
+  // on to `current`, for the next corrector's chord. A long branch keeping every one would hold
+  // n^2 doubles per point.
+  std::shared_ptr<const Eigen::MatrixXd> newest_matrix;
+
+  bool has_room() const { return points_before + static_cast<int>(result.points.size()) < o.max_points; }
+
+  ContinuationResult stop(StopReason reason, std::string message = {}) {
+    result.reason = reason;
+    result.message = std::move(message);
+    return std::move(result);
+  }
+
+  // The march's state right after `current` was accepted, for a run to resume from.
+  void report_state() {
+    if (!o.on_resumable || !resumable_type(current.type)) return;
+    MarchState now;
+    now.current = result.points.back();
+    now.before = before;
+    if (now.before) now.before->jacobian.reset();
+    now.previous_step = previous_h;
+    now.just_reported_branch_point = just_reported_branch_point;
+    now.branch_points_found = counters.branch_points_found;
+    now.points = points_before + static_cast<int>(result.points.size());
+    now.refused_steps = result.refused_steps;
+    o.on_resumable(now);
+  }
+
+  void start(bool report) {
+    if (report) c.record(&current);
+    result.points.push_back(current);
+    if (current.type != PointType::BranchPoint) result.points.back().jacobian.reset();
+    if (!report) return;
+    if (sink) sink(current);
+    report_state();
+  }
+
+  // Puts p on the branch: recorded, then reported.
+  void accept(ContinuationPoint p) {
+    p.index = result.points.back().index + 1;
+    p.step = ds;
+    newest_matrix = std::move(p.jacobian);
+    p.jacobian = p.type == PointType::BranchPoint ? newest_matrix : nullptr;
+    c.record(&p);
+    result.points.push_back(std::move(p));
+    if (sink) sink(result.points.back());
+  }
+
+  // A point that kept an older matrix (reuse_jacobian_iterations) gets its own before the step
+  // is shrunk: the stale matrix, not the step, may be what failed the corrector or turned the
+  // tangent, and shrinking alone then crawls (seen at L/2R = 500: steps of 1e-6 for 1,400 points).
+  bool refresh_current() {
+    if (!current.jacobian_reused) return false;
+    auto fresh = c.point_at(c.join(current.x, current.parameter), current.tangent, current.type, current.index,
+                            current.arclength, current.newton_iterations);
+    if (!fresh) return false;
+    fresh->step = current.step;
+    // Same unknowns and parameter: the same description, not computed again.
+    static_cast<PointRecord&>(*fresh) = static_cast<const PointRecord&>(current);
+    current = std::move(*fresh);
+    return true;
+  }
+
+  // The corrected point a step ds ahead, if it is taken: a corrector failure, a turn of the
+  // tangent beyond max_tangent_angle or a refusal of step_check shortens the step instead (none),
+  // down to the minimum step, where the run stops (*stop).
+  std::optional<ContinuationPoint> next_candidate(std::optional<detail::Stop>* stop) {
+    auto candidate = c.step_from(current, ds, PointType::Regular);
+    if (!candidate) {
+      if (refresh_current()) return std::nullopt;
+      ds *= kShrink;
+      if (ds < o.min_step)
+        *stop = {StopReason::StepTooSmall,
+                 "the corrector failed down to the minimum step (last failure: " + c.last_corrector_failure_ + ")"};
+      return std::nullopt;
+    }
+    const double angle = std::acos(std::clamp(current.tangent.dot(candidate->tangent), -1.0, 1.0));
+    if (angle > o.max_tangent_angle && ds > o.min_step) {
+      if (!refresh_current()) ds = std::max(ds * kShrink, o.min_step);
+      return std::nullopt;
+    }
+    const std::string refusal = o.step_check ? o.step_check(current, *candidate) : std::string();
+    if (refusal.empty()) return candidate;
+    ++result.refused_steps;
+    if (ds * kShrink < o.min_step)
+      *stop = {StopReason::Inadmissible, refusal + " (refused down to the minimum step)"};
+    else
+      ds *= kShrink;
+    return std::nullopt;
+  }
+
+  // Every detector on the step current -> candidate, in order; false: one asks for the step
+  // again, shorter.
+  bool detect(const std::vector<std::unique_ptr<detail::Detector>>& detectors, const ContinuationPoint& candidate,
+              std::vector<detail::Detection>* found) {
+    const detail::StepView step{current, candidate, before ? &*before : nullptr, ds, previous_h,
+                                just_reported_branch_point, ds * kShrink >= o.min_step,
+                                [this](const ContinuationPoint& from, double h_max, const detail::TestFunction& test,
+                                       bool minimise, PointType type) {
+                                  return c.locate(from, h_max, test, minimise, type);
+                                },
+                                [this](const ContinuationPoint& located, double value) {
+                                  return c.at_parameter(located, value);
+                                }};
+    for (const auto& d : detectors)
+      if (d->detect(step, found) == detail::Verdict::RetryShorter) return false;
+    return true;
+  }
+
+  // The special points of a step on the branch, in order along it, each acted on by its detector.
+  // A step in which a stopping detector found its point ends the run at its first end point, or
+  // with a stopping event at its first event point (the reason of the last such detection).
+  std::optional<detail::Stop> take_special(std::vector<detail::Detection> found) {
+    std::optional<StopReason> step_stop;
+    for (const auto& d : found)
+      if (d.stop) step_stop = d.stop;
+    const double s0 = current.arclength;
+    std::sort(found.begin(), found.end(), [s0](const detail::Detection& a, const detail::Detection& b) {
+      return a.point.arclength - s0 < b.point.arclength - s0;
+    });
+    just_reported_branch_point = std::any_of(found.begin(), found.end(), [](const detail::Detection& d) {
+      return d.point.type == PointType::BranchPoint;
+    });
+    for (auto& d : found) {
+      accept(d.point);
+      const ContinuationPoint& p = result.points.back();
+      if (auto s = d.detector->act(p, &counters)) return s;
+      if (step_stop && p.type == PointType::Endpoint) return detail::Stop{*step_stop, ""};
+      if (step_stop == StopReason::EventStop && p.type == PointType::Event)
+        return detail::Stop{StopReason::EventStop, "event " + p.event};
+    }
+    return std::nullopt;
+  }
+
+  // The candidate on the branch as the new current point. The next step is decided before the
+  // point is reported, so that a run resumed from it takes the same step as the uninterrupted one.
+  void advance(ContinuationPoint candidate) {
+    const int iterations = candidate.newton_iterations;
+    before = std::move(current);
+    previous_h = ds;
+    if (iterations <= o.grow_iterations) ds = std::min(ds * kGrow, o.max_step);
+    if (iterations >= o.shrink_iterations) ds = std::max(ds * kShrink, o.min_step);
+    accept(std::move(candidate));
+    current = result.points.back();
+    current.jacobian = std::move(newest_matrix);
+    report_state();
+  }
+};
+
+ContinuationResult Continuation::march(MarchState state, const PointSink& sink, bool report_start) {
+  Marcher m(*this, sink, std::move(state));
+  m.start(report_start);
+  const auto detectors = detail::make_detectors(options_, n_);
+  while (m.has_room()) {
+    if (std::chrono::steady_clock::now() >= options_.deadline)
+      return m.stop(StopReason::TimeLimit, "the wall-clock limit was reached");
+    std::optional<detail::Stop> stop;
+    auto candidate = m.next_candidate(&stop);
+    if (stop) return m.stop(stop->first, stop->second);
+    if (!candidate) continue;
+    std::vector<detail::Detection> found;
+    if (!m.detect(detectors, *candidate, &found)) {
+      m.ds *= kShrink;
+      continue;
+    }
+    if (auto s = m.take_special(std::move(found))) return m.stop(s->first, s->second);
+    m.advance(std::move(*candidate));
+  }
+  return m.stop(StopReason::MaxPoints);
+}
+
+SymmetricBranchStart axial_symmetry_branch(Continuation& straight, const ContinuationPoint& bp, double sign) {
+  const ShootingProblem& problem = straight.problem();
+  const Eigen::MatrixXd N = straight.bifurcation_directions(bp, 2);
+  // The phase condition m(0).e2 = 0, linearised: a row on the unknowns at s = 0.
+  const auto eq = problem.equations(problem.parameters());
+  const Eigen::RowVectorXd phase = eq->slot_map(Slot::Moment).row(1);
+  const int n_state = problem.state_size();
+  auto phase_of = [&](const Eigen::VectorXd& v) { return phase.dot(v.head(n_state)); };
+  Eigen::VectorXd d = N.col(0) * phase_of(N.col(1)) - N.col(1) * phase_of(N.col(0));
+  if (d.norm() < 1e-12) d = std::abs(phase_of(N.col(0))) < std::abs(phase_of(N.col(1))) ? N.col(0) : N.col(1);
+  d.normalize();
+  for (int i = 0; i < d.size(); ++i)
+    if (std::abs(d[i]) > 1e-8) {
+      d *= sign_of(d[i]) * sign_of(sign);
+      break;
+    }
+  SymmetricBranchStart start;
+  start.definition = problem.definition();
+  add_axial_phase_condition(start.definition);
+  const int n = problem.size();
+  // The unfolding parameter is the last unknown of the new problem; it starts at 0.
+  start.x = Eigen::VectorXd::Zero(n + 1);
+  start.x.head(n) = bp.x;
+  start.parameter = bp.parameter;
+  start.direction = Eigen::VectorXd::Zero(n + 2);
+  start.direction.head(n) = d.head(n);
+  start.direction[n + 1] = d[n];
+  return start;
+}
+
+ContinuationOptions bifurcating_branch_options(ContinuationOptions options) {
+  options.target = NAN;
+  options.direction = 1.0;
+  return options;
+}
+
+ContinuationResult follow_bifurcating_branch(Continuation& run, const ContinuationPoint& bp,
+                                             ContinuationOptions options, double side,
+                                             const BranchSinkFactory& sink_for) {
+  options = bifurcating_branch_options(std::move(options));
+  if (bp.multiplicity == 2 && run.problem().definition().kind == RodKind::Spatial) {
+    const SymmetricBranchStart start = axial_symmetry_branch(run, bp, side);
+    const ShootingProblem switched(start.definition);
+    Continuation next(switched, options);
+    return next.run_along(start.x, start.parameter, start.direction, PointType::BranchPoint,
+                          sink_for(switched, true));
+  }
+  ShootingProblem at_bp = run.problem();
+  at_bp.set_parameter(options.parameter, bp.parameter);
+  Continuation next(at_bp, options);
+  return next.switch_branch(bp, sink_for(at_bp, false), side);
+}
+
+}  // namespace kirchhoff

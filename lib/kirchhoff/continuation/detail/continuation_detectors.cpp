@@ -1,0 +1,186 @@
+#include "kirchhoff/continuation/detail/continuation_detectors.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace kirchhoff::detail {
+namespace {
+
+// The located end point of a run with a target is accepted this close to it (relative).
+constexpr double kTargetTolerance = 1e-9;
+
+// A sign change between a and b (a = 0 exactly is where the last point was located: none).
+bool crossed(double a, double b) { return std::isfinite(a) && std::isfinite(b) && (a < 0) != (b < 0) && a != 0.0; }
+
+// A detector whose test value changes sign inside the step: located by the secant method on h.
+class SignChange : public Detector {
+ public:
+  Verdict detect(const StepView& step, std::vector<Detection>* found) const override {
+    const TestFunction test = [this](const ContinuationPoint& p) { return value(p); };
+    if (!crossed(value(step.current), value(step.candidate))) return Verdict::Nothing;
+    auto p = step.locate(step.current, step.h, test, false, type());
+    if (!p) return Verdict::Nothing;
+    if (!close_enough(*p) && step.can_shrink) return Verdict::RetryShorter;
+    refine(step, &*p);
+    finish(&*p);
+    found->push_back({std::move(*p), stop(), this});
+    return Verdict::Found;
+  }
+
+ protected:
+  virtual double value(const ContinuationPoint& p) const = 0;
+  virtual PointType type() const = 0;
+  virtual std::optional<StopReason> stop() const { return std::nullopt; }
+  // False: the located point missed (a corrector failed inside the step) and the step is retried
+  // shorter while it can be.
+  virtual bool close_enough(const ContinuationPoint&) const { return true; }
+  // The located point made exact where the test function allows it (the parameter's value).
+  virtual void refine(const StepView&, ContinuationPoint*) const {}
+  virtual void finish(ContinuationPoint*) const {}
+};
+
+// The parameter reaching a value: the target, or a bound.
+class ParameterValue : public SignChange {
+ public:
+  ParameterValue(double value, StopReason reason) : value_(value), reason_(reason) {}
+
+ protected:
+  double value(const ContinuationPoint& p) const override { return p.parameter - value_; }
+  PointType type() const override { return PointType::Endpoint; }
+  std::optional<StopReason> stop() const override { return reason_; }
+  // A corrector that failed inside the step leaves the location short of the target (or the whole
+  // step's point, beyond it): retried with a shorter step rather than stopped off the target.
+  bool close_enough(const ContinuationPoint& p) const override { return reason_ != StopReason::ReachedTarget || near(p); }
+  // The secant leaves the parameter within round-off of the value, on whichever side; corrected
+  // again at the value itself, the end lies on it (a run started from it sets exactly that value).
+  // Kept as located if that corrector fails.
+  void refine(const StepView& step, ContinuationPoint* p) const override {
+    if (p->parameter == value_ || !near(*p)) return;
+    if (auto pinned = step.pin(*p, value_)) *p = std::move(*pinned);
+  }
+
+ private:
+  bool near(const ContinuationPoint& p) const {
+    return std::abs(p.parameter - value_) <= kTargetTolerance * std::max(1.0, std::abs(value_));
+  }
+  double value_;
+  StopReason reason_;
+};
+
+class Fold : public SignChange {
+ public:
+  Fold(int n, bool stops, std::string parameter) : n_(n), stops_(stops), parameter_(std::move(parameter)) {}
+  std::optional<Stop> act(const ContinuationPoint& p, MarchCounters*) const override {
+    if (!stops_) return std::nullopt;
+    return Stop{StopReason::FoldStop, "fold at " + parameter_ + " = " + std::to_string(p.parameter)};
+  }
+
+ protected:
+  double value(const ContinuationPoint& p) const override { return p.tangent[n_]; }
+  PointType type() const override { return PointType::Fold; }
+
+ private:
+  int n_;
+  bool stops_;
+  std::string parameter_;
+};
+
+// Both branch-point detectors count what they find against stop_at_branch_point.
+std::optional<Stop> count_branch_point(int stop_at, MarchCounters* counters) {
+  ++counters->branch_points_found;
+  if (stop_at > 0 && counters->branch_points_found >= stop_at)
+    return Stop{StopReason::BranchPointStop, "branch point " + std::to_string(counters->branch_points_found)};
+  return std::nullopt;
+}
+
+class SimpleBranchPoint : public SignChange {
+ public:
+  explicit SimpleBranchPoint(int stop_at) : stop_at_(stop_at) {}
+  std::optional<Stop> act(const ContinuationPoint&, MarchCounters* counters) const override {
+    return count_branch_point(stop_at_, counters);
+  }
+
+ protected:
+  double value(const ContinuationPoint& p) const override { return p.determinant; }
+  PointType type() const override { return PointType::BranchPoint; }
+  void finish(ContinuationPoint* p) const override { p->multiplicity = std::max(1, p->small_count); }
+
+ private:
+  int stop_at_;
+};
+
+// Branch points that keep the determinant's sign (even multiplicity): a local minimum of the
+// smallest singular value over the last two steps that is, once located, tiny. Skipped where the
+// determinant found one in this step, and right after a branch point was reported (the minimum
+// is that point again).
+class EvenBranchPoint : public Detector {
+ public:
+  EvenBranchPoint(int stop_at, double tolerance) : stop_at_(stop_at), tolerance_(tolerance) {}
+  Verdict detect(const StepView& step, std::vector<Detection>* found) const override {
+    const bool simple = std::any_of(found->begin(), found->end(),
+                                    [](const Detection& d) { return d.point.type == PointType::BranchPoint; });
+    if (simple || !step.before || step.just_reported_branch_point ||
+        !(step.current.smallest_singular < step.before->smallest_singular &&
+          step.current.smallest_singular < step.candidate.smallest_singular))
+      return Verdict::Nothing;
+    auto p = step.locate(*step.before, step.previous_h + step.h,
+                         [](const ContinuationPoint& q) { return q.smallest_singular; }, true,
+                         PointType::BranchPoint);
+    if (!p || !(p->smallest_singular < tolerance_)) return Verdict::Nothing;
+    p->multiplicity = std::max(1, p->small_count);
+    // It may lie just behind `current` (already recorded): points are in detection order.
+    found->push_back({std::move(*p), std::nullopt, this});
+    return Verdict::Found;
+  }
+  std::optional<Stop> act(const ContinuationPoint&, MarchCounters* counters) const override {
+    return count_branch_point(stop_at_, counters);
+  }
+
+ private:
+  int stop_at_;
+  double tolerance_;
+};
+
+// A derived quantity crossing a value (the recorder's `derived`; NaN where it has none).
+class Event : public SignChange {
+ public:
+  Event(ContinuationEvent event, int index) : event_(std::move(event)), index_(index) {}
+
+ protected:
+  double value(const ContinuationPoint& p) const override {
+    const auto it = p.derived.find(event_.quantity);
+    return it == p.derived.end() ? NAN : it->second - event_.value;
+  }
+  PointType type() const override { return PointType::Event; }
+  std::optional<StopReason> stop() const override {
+    return event_.stop ? std::optional<StopReason>(StopReason::EventStop) : std::nullopt;
+  }
+  void finish(ContinuationPoint* p) const override {
+    p->event = event_.label.empty() ? event_.quantity + "=" + std::to_string(event_.value) : event_.label;
+    p->event_index = index_;
+  }
+
+ private:
+  ContinuationEvent event_;
+  int index_;
+};
+
+}  // namespace
+
+std::optional<Stop> Detector::act(const ContinuationPoint&, MarchCounters*) const { return std::nullopt; }
+
+std::vector<std::unique_ptr<Detector>> make_detectors(const ContinuationOptions& o, int n) {
+  std::vector<std::unique_ptr<Detector>> d;
+  if (!std::isnan(o.target)) d.push_back(std::make_unique<ParameterValue>(o.target, StopReason::ReachedTarget));
+  for (double bound : {o.parameter_min, o.parameter_max})
+    if (std::isfinite(bound)) d.push_back(std::make_unique<ParameterValue>(bound, StopReason::ParameterBounds));
+  if (o.detect_folds) d.push_back(std::make_unique<Fold>(n, o.stop_at_fold, o.parameter));
+  if (o.detect_branch_points) {
+    d.push_back(std::make_unique<SimpleBranchPoint>(o.stop_at_branch_point));
+    d.push_back(std::make_unique<EvenBranchPoint>(o.stop_at_branch_point, o.branch_point_tolerance));
+  }
+  for (size_t k = 0; k < o.events.size(); ++k) d.push_back(std::make_unique<Event>(o.events[k], static_cast<int>(k)));
+  return d;
+}
+
+}  // namespace kirchhoff::detail

@@ -1,0 +1,258 @@
+// Internal: the odeint plumbing shared by the spatial and planar equations. A right-hand side
+// is any object with `template <class T> void operator()(const T* y, T* dyds, double s) const`,
+// evaluated on double for the state and on Dual<N> for the variational equations.
+#pragma once
+
+#include <array>
+#include <boost/numeric/odeint.hpp>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "kirchhoff/equations/detail/dual.hpp"
+#include "kirchhoff/equations/integrator.hpp"
+
+namespace kirchhoff::detail {
+
+namespace odeint = boost::numeric::odeint;
+
+// Arclength marching with an odeint controlled stepper. We drive try_step ourselves (rather
+// than integrate_adaptive) to cap the number of steps and to land exactly on s1. The first trial
+// step is *ds (when it is finite and points from s0 to s1, else opt.initial_step of the span); on
+// return *ds is the step the controller proposes next, a step cut short to land on s1 not
+// shrinking it: handed to the next adjacent interval, it continues the same integration.
+template <class State, class System>
+long march_carrying(State& x, double s0, double s1, const System& system, const IntegratorOptions& opt, double* ds_io) {
+  const double span = s1 - s0;
+  if (span == 0.0) return 0;
+  double s = s0;
+  double ds = std::isfinite(*ds_io) && *ds_io * span > 0 ? *ds_io : opt.initial_step * span;
+  long steps = 0;
+  auto advance = [&](auto stepper) {
+    while ((span > 0) ? (s < s1) : (s > s1)) {
+      const double planned = ds;
+      const bool cut = (span > 0) ? (s + ds > s1) : (s + ds < s1);
+      if (cut) ds = s1 - s;
+      const bool accepted = stepper.try_step(system, x, s, ds) == odeint::success;
+      if (accepted) ++steps;
+      *ds_io = accepted && cut && std::abs(planned) > std::abs(ds) ? planned : ds;
+      // A step meant to land on s1 can stop an ulp short of it (s + (s1 - s) rounds): the sliver
+      // left is below round-off, not a step to take (taking it read as a step-size underflow).
+      if (std::abs(s1 - s) <= 1e-14 * std::abs(span)) break;
+      if (steps + 1 > opt.max_steps) throw IntegrationError("more than max_steps integration steps");
+      if (!std::isfinite(ds) || std::abs(ds) < 1e-14 * std::abs(span))
+        throw IntegrationError("step size underflow near s = " + std::to_string(s));
+    }
+  };
+  if (opt.stepper == IntegratorOptions::Stepper::Dopri5)
+    advance(odeint::make_controlled(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_dopri5<State>()));
+  else
+    advance(odeint::make_controlled(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_fehlberg78<State>()));
+  for (double v : x)
+    if (!std::isfinite(v)) throw IntegrationError("non-finite state");
+  return steps;
+}
+
+// One interval on its own: the first trial step is opt.initial_step of it.
+template <class State, class System>
+long march(State& x, double s0, double s1, const System& system, const IntegratorOptions& opt) {
+  double ds = opt.initial_step * (s1 - s0);
+  return march_carrying(x, s0, s1, system, opt, &ds);
+}
+
+// The right-hand side on the state followed by K directions (an N x K block, row-major): one
+// evaluation on Dual<K> seeded with the directions gives their derivatives (df/dy) directions.
+template <int N, int K, class Rhs>
+struct DualSystem {
+  using State = std::array<double, N + N * K>;
+  const Rhs& rhs;
+  long* evaluations;
+  void operator()(const State& y, State& dy, double s) const {
+    ++*evaluations;
+    std::array<Dual<K>, N> yd, dyd;
+    for (int i = 0; i < N; ++i) {
+      yd[i].v = y[i];
+      for (int j = 0; j < K; ++j) yd[i].d[j] = y[N + i * K + j];
+    }
+    rhs(yd.data(), dyd.data(), s);
+    for (int i = 0; i < N; ++i) {
+      dy[i] = dyd[i].v;
+      for (int j = 0; j < K; ++j) dy[N + i * K + j] = dyd[i].d[j];
+    }
+  }
+};
+
+// Integrates the state alone.
+template <int N, class Rhs>
+SegmentFlow flow_state(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                       const IntegratorOptions& opt) {
+  using State = std::array<double, N>;
+  State x;
+  for (int i = 0; i < N; ++i) x[i] = y0[i];
+  long evaluations = 0;
+  auto system = [&](const State& y, State& dy, double s) {
+    ++evaluations;
+    rhs(y.data(), dy.data(), s);
+  };
+  SegmentFlow out;
+  out.steps = march(x, s0, s1, system, opt);
+  out.y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
+  out.rhs_evaluations = evaluations;
+  return out;
+}
+
+// Integrates the state together with the variational equations Phi' = (df/dy) Phi, Phi(s0) = I,
+// by evaluating the right-hand side on Dual<K> seeded with K of the N columns of Phi (the others
+// may be known in closed form by the caller): cheaper by about (N/K)^2 in the derivative
+// arithmetic. Returns Phi restricted to those columns (N x K) in out.Phi.
+template <int N, int K, class Rhs>
+SegmentFlow flow_with_partial_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                            const IntegratorOptions& opt, const std::array<int, K>& seeds);
+
+// Phi at opt.sensitivity_tol, the state at the state's own tolerance (IntegratorOptions).
+template <int N, int K, class Rhs>
+SegmentFlow flow_with_loose_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                          const IntegratorOptions& opt, const std::array<int, K>& seeds) {
+  IntegratorOptions loose = opt;
+  loose.abs_tol = loose.rel_tol = opt.sensitivity_tol;
+  loose.sensitivity_tol = 0.0;
+  SegmentFlow out = flow_with_partial_sensitivities<N, K>(rhs, y0, s0, s1, loose, seeds);
+  const SegmentFlow state = flow_state<N>(rhs, y0, s0, s1, opt);
+  out.y = state.y;
+  out.steps += state.steps;
+  out.rhs_evaluations += state.rhs_evaluations;
+  return out;
+}
+
+template <int N, int K, class Rhs>
+SegmentFlow flow_with_partial_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                            const IntegratorOptions& opt, const std::array<int, K>& seeds) {
+  if (opt.sensitivity_tol > opt.abs_tol)  // (abs_tol > 0, so 0 keeps the one pass)
+    return flow_with_loose_sensitivities<N, K>(rhs, y0, s0, s1, opt, seeds);
+  using State = typename DualSystem<N, K, Rhs>::State;  // y, then the N x K block row-major
+  State x{};
+  for (int i = 0; i < N; ++i) x[i] = y0[i];
+  for (int j = 0; j < K; ++j) x[N + seeds[j] * K + j] = 1.0;
+  long evaluations = 0;
+  const DualSystem<N, K, Rhs> system{rhs, &evaluations};
+  SegmentFlow out;
+  out.steps = march(x, s0, s1, system, opt);
+  out.y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
+  out.Phi = Eigen::Map<const Eigen::Matrix<double, N, K, Eigen::RowMajor>>(x.data() + N);
+  out.rhs_evaluations = evaluations;
+  return out;
+}
+
+// All N directions seeded: the full state-transition matrix.
+template <int N, class Rhs>
+SegmentFlow flow_with_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                    const IntegratorOptions& opt) {
+  std::array<int, N> all;
+  for (int i = 0; i < N; ++i) all[i] = i;
+  return flow_with_partial_sensitivities<N, N>(rhs, y0, s0, s1, opt, all);
+}
+
+// The state and the columns of `directions` (at most K; fewer are padded with zero columns, which
+// stay zero) carried from s0 to s1, continuing from the step sizes in *carried and leaving there
+// those proposed next. With opt.sensitivity_tol looser than abs_tol, as flow_with_loose_sensitivities:
+// the directions at sensitivity_tol, the state at its own tolerance in a pass of its own.
+template <int N, int K, class Rhs>
+DirectionalFlow flow_directions(const Rhs& rhs, const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions,
+                                double s0, double s1, const IntegratorOptions& opt, CarriedSteps* carried) {
+  const bool loose = opt.sensitivity_tol > opt.abs_tol;
+  IntegratorOptions dual_opt = opt;
+  if (loose) dual_opt.abs_tol = dual_opt.rel_tol = opt.sensitivity_tol;
+  using State = typename DualSystem<N, K, Rhs>::State;
+  const int k = static_cast<int>(directions.cols());
+  State x{};
+  for (int i = 0; i < N; ++i) {
+    x[i] = y0[i];
+    for (int j = 0; j < k; ++j) x[N + i * K + j] = directions(i, j);
+  }
+  DirectionalFlow out;
+  const DualSystem<N, K, Rhs> system{rhs, &out.rhs_evaluations};
+  out.steps = march_carrying(x, s0, s1, system, dual_opt, &carried->directions);
+  out.y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
+  // (A single column is stored alike either way; Eigen refuses a row-major column vector.)
+  constexpr int kLayout = K == 1 ? Eigen::ColMajor : Eigen::RowMajor;
+  out.directions = Eigen::Map<const Eigen::Matrix<double, N, K, kLayout>>(x.data() + N).leftCols(k);
+  if (!loose) return out;
+  std::array<double, N> state;
+  for (int i = 0; i < N; ++i) state[i] = y0[i];
+  auto state_system = [&](const std::array<double, N>& y, std::array<double, N>& dy, double s) {
+    ++out.rhs_evaluations;
+    rhs(y.data(), dy.data(), s);
+  };
+  out.steps += march_carrying(state, s0, s1, state_system, opt, &carried->state);
+  out.y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(state.data());
+  return out;
+}
+
+// flow_directions with K the first of Ks (ascending) that holds `count` columns; false when none does.
+template <int N, int K, int... More, class Rhs>
+bool flow_directions_fitting(const Rhs& rhs, const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions,
+                             double s0, double s1, const IntegratorOptions& opt, CarriedSteps* carried,
+                             DirectionalFlow* out) {
+  if (directions.cols() <= K) {
+    *out = flow_directions<N, K>(rhs, y0, directions, s0, s1, opt, carried);
+    return true;
+  }
+  if constexpr (sizeof...(More) > 0)
+    return flow_directions_fitting<N, More...>(rhs, y0, directions, s0, s1, opt, carried, out);
+  else
+    return false;
+}
+
+// The directions' flow for RodEquations::flow_directions. The state-transition matrix has unit
+// columns off `seeds` (the state entries nothing depends on), so fewer directions than seeds are
+// carried themselves, and more through Phi's seeded columns: Phi directions. Ks (ascending, the
+// last at least seeds.size()) are the numbers of dual directions compiled.
+template <int N, int... Ks, class Rhs>
+DirectionalFlow flow_directions_through_seeds(const Rhs& rhs, const Eigen::VectorXd& y0,
+                                              const Eigen::MatrixXd& directions, const std::vector<int>& seeds,
+                                              double s0, double s1, const IntegratorOptions& opt,
+                                              CarriedSteps* carried) {
+  DirectionalFlow out;
+  if (directions.cols() < static_cast<Eigen::Index>(seeds.size()) &&
+      flow_directions_fitting<N, Ks...>(rhs, y0, directions, s0, s1, opt, carried, &out))
+    return out;
+  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(N, static_cast<Eigen::Index>(seeds.size()));
+  for (size_t j = 0; j < seeds.size(); ++j) unit(seeds[j], static_cast<Eigen::Index>(j)) = 1.0;
+  if (!flow_directions_fitting<N, Ks...>(rhs, y0, unit, s0, s1, opt, carried, &out))
+    throw std::logic_error("flow_directions_through_seeds: no dual size holds the seeds");
+  Eigen::MatrixXd Phi = Eigen::MatrixXd::Identity(N, N);
+  for (size_t j = 0; j < seeds.size(); ++j) Phi.col(seeds[j]) = out.directions.col(static_cast<Eigen::Index>(j));
+  out.directions = Phi * directions;
+  return out;
+}
+
+// States at the requested arclengths (sorted; repeated values allowed). Both steppers step onto
+// each sample point, so profiles keep the integration's accuracy. (Dopri5's dense output is not
+// used: odeint's integrate_times interpolates a sample equal to the start before the first step,
+// from the stepper's uninitialised previous state, and gave NaN there.)
+template <int N, class Rhs>
+std::vector<Eigen::VectorXd> sample_states(const Rhs& rhs, const Eigen::VectorXd& y0,
+                                           const std::vector<double>& s_values,
+                                           const IntegratorOptions& opt) {
+  using State = std::array<double, N>;
+  State x;
+  for (int i = 0; i < N; ++i) x[i] = y0[i];
+  std::vector<Eigen::VectorXd> out;
+  if (s_values.empty()) return out;
+  auto system = [&](const State& y, State& dy, double s) { rhs(y.data(), dy.data(), s); };
+  auto observer = [&](const State& y, double) {
+    out.push_back(Eigen::Map<const Eigen::Matrix<double, N, 1>>(y.data()));
+  };
+  const double span = s_values.back() - s_values.front();
+  const double ds = opt.initial_step * (span > 0 ? span : 1.0);
+  if (opt.stepper == IntegratorOptions::Stepper::Dopri5) {
+    auto stepper = odeint::make_controlled(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_dopri5<State>());
+    odeint::integrate_times(stepper, system, x, s_values.begin(), s_values.end(), ds, observer);
+  } else {
+    auto stepper = odeint::make_controlled(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_fehlberg78<State>());
+    odeint::integrate_times(stepper, system, x, s_values.begin(), s_values.end(), ds, observer);
+  }
+  return out;
+}
+
+}  // namespace kirchhoff::detail

@@ -1,0 +1,179 @@
+// The planar Elastica/Reissner rod: the 3D equations restricted to motions in the (x, y) plane
+// with d2 = e_z, d3 = (cos theta, sin theta, 0), d1 = (-sin theta, cos theta, 0) (section 7 of the
+// reference paper). Then u = (0, theta', 0), the moment is m e_z, and the 3D equations reduce to
+//   r' = v1 d1 + v3 d3,  theta' = u_hat2 + m / B2,  n' = -f_ext,  m' = (n x r') . e_z,
+// which for an inextensible rod is EI theta'' = n_x sin theta - n_y cos theta (eq. 52).
+// It reads the same RodModel as SpatialEquations (B2, u_hat2, A1, A3, v_hat1, v_hat3, the field),
+// so there is one physics and two state layouts; a test checks both give the same rod to 1e-10.
+//
+// State layout (6): x, y, theta, n_x, n_y, m. theta tracks whole turns by itself.
+#include <cmath>
+
+#include "kirchhoff/equations/detail/field_eval.hpp"
+#include "kirchhoff/equations/detail/integrator_impl.hpp"
+#include "kirchhoff/equations/rod_equations.hpp"
+
+namespace kirchhoff {
+namespace {
+
+constexpr int kStateSize = 6;
+enum Index { kX = 0, kY = 1, kTheta = 2, kNx = 3, kNy = 4, kMoment = 5 };
+
+class PlanarEquations final : public RodEquations {
+ public:
+  explicit PlanarEquations(RodModel model) : model_(std::move(model)) {}
+
+  int state_size() const override { return kStateSize; }
+  const RodModel& model() const override { return model_; }
+  bool is_planar() const override { return true; }
+
+  template <class T>
+  void rhs(const T* y, T* dy, double s) const {
+    using std::cos;
+    using std::sin;
+    const T c = cos(y[kTheta]), sn = sin(y[kTheta]);
+    T v1 = T(model_.v_hat[0](s)), v3 = T(model_.v_hat[2](s));
+    if (model_.extensible) {
+      const T n1 = -y[kNx] * sn + y[kNy] * c;
+      const T n3 = y[kNx] * c + y[kNy] * sn;
+      v1 = v1 + n1 * (1.0 / model_.A[0](s));
+      v3 = v3 + n3 * (1.0 / model_.A[2](s));
+    }
+    const T dx = -v1 * sn + v3 * c;
+    const T dyy = v1 * c + v3 * sn;
+    dy[kX] = dx;
+    dy[kY] = dyy;
+    dy[kTheta] = model_.u_hat[1](s) + y[kMoment] * (1.0 / model_.B[1](s));
+    if (model_.field) {
+      const T r[3] = {y[kX], y[kY], T(0.0)};
+      T f[3];
+      detail::field_force(*model_.field, s, r, f);
+      dy[kNx] = -f[0];
+      dy[kNy] = -f[1];
+    } else {
+      dy[kNx] = T(0.0);
+      dy[kNy] = T(0.0);
+    }
+    dy[kMoment] = y[kNx] * dyy - y[kNy] * dx;
+  }
+
+  SegmentFlow flow(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities,
+                   const IntegratorOptions& options) const override {
+    auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
+    if (!sensitivities) return detail::flow_state<kStateSize>(f, y0, s0, s1, options);
+    if (model_.field) return detail::flow_with_sensitivities<kStateSize>(f, y0, s0, s1, options);
+    // Without a field nothing depends on x(s0), y(s0): their columns of Phi are unit vectors.
+    constexpr std::array<int, 4> kSeeds{kTheta, kNx, kNy, kMoment};
+    SegmentFlow partial = detail::flow_with_partial_sensitivities<kStateSize, 4>(f, y0, s0, s1, options, kSeeds);
+    Eigen::MatrixXd Phi = Eigen::MatrixXd::Zero(kStateSize, kStateSize);
+    for (int j = 0; j < 4; ++j) Phi.col(kSeeds[j]) = partial.Phi.col(j);
+    Phi(kX, kX) = 1.0;
+    Phi(kY, kY) = 1.0;
+    partial.Phi = std::move(Phi);
+    return partial;
+  }
+
+  DirectionalFlow flow_directions(const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions, double s0, double s1,
+                                  const IntegratorOptions& options, CarriedSteps* carried) const override {
+    auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
+    // The seeds of flow(): all of them with a field, else those x(s0), y(s0) do not enter.
+    static const std::vector<int> kAll{kX, kY, kTheta, kNx, kNy, kMoment};
+    static const std::vector<int> kSeeds{kTheta, kNx, kNy, kMoment};
+    return detail::flow_directions_through_seeds<kStateSize, 1, 2, 3, 4, 5, 6>(
+        f, y0, directions, model_.field ? kAll : kSeeds, s0, s1, options, carried);
+  }
+
+  std::vector<Eigen::VectorXd> sample(const Eigen::VectorXd& y0, const std::vector<double>& s,
+                                      const IntegratorOptions& options) const override {
+    auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
+    return detail::sample_states<kStateSize>(f, y0, s, options);
+  }
+
+  Eigen::VectorXd derivative(const Eigen::VectorXd& y, double s) const override {
+    Eigen::VectorXd dy(kStateSize);
+    rhs(y.data(), dy.data(), s);
+    return dy;
+  }
+
+  RodPoint point(const Eigen::VectorXd& y, double s) const override {
+    RodPoint p;
+    p.s = s;
+    p.r = Vec3(y[kX], y[kY], 0.0);
+    const double theta = y[kTheta], c = std::cos(theta), sn = std::sin(theta);
+    p.R.col(0) = Vec3(-sn, c, 0.0);
+    p.R.col(1) = Vec3::UnitZ();
+    p.R.col(2) = Vec3(c, sn, 0.0);
+    p.n = Vec3(y[kNx], y[kNy], 0.0);
+    p.m = Vec3(0.0, 0.0, y[kMoment]);
+    p.u = Vec3(model_.u_hat[0](s), model_.u_hat[1](s) + y[kMoment] / model_.B[1](s), model_.u_hat[2](s));
+    const Vec3 n_body = p.R.transpose() * p.n;
+    p.v = Vec3(model_.v_hat[0](s), model_.v_hat[1](s), model_.v_hat[2](s));
+    if (model_.extensible) p.v += Vec3(n_body[0] / model_.A[0](s), 0.0, n_body[2] / model_.A[2](s));
+    p.turn_angle = theta;
+    return p;
+  }
+
+  int turn_angle_index() const override { return kTheta; }
+
+  Eigen::VectorXd state(const RodPoint& p) const override {
+    Eigen::VectorXd y(kStateSize);
+    y << p.r.x(), p.r.y(), std::atan2(p.R(1, 2), p.R(0, 2)), p.n.x(), p.n.y(), p.m.z();
+    return y;
+  }
+
+  Eigen::MatrixXd slot_map(Slot slot) const override {
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(3, kStateSize);
+    switch (slot) {
+      case Slot::Position: M(0, kX) = 1; M(1, kY) = 1; break;
+      case Slot::Force: M(0, kNx) = 1; M(1, kNy) = 1; break;
+      case Slot::Moment: M(2, kMoment) = 1; break;
+      case Slot::Orientation: M(2, kTheta) = 1; break;
+    }
+    return M;
+  }
+
+  // In the plane every admissible target is a rotation about e_z, and theta - angle is the exact
+  // rotation error, turns included.
+  Vec3 orientation_error(const Eigen::VectorXd& y, const OrientationTarget& target, bool,
+                         Eigen::MatrixXd* jacobian) const override {
+    const double sign = target.axis.z() < 0 ? -1.0 : 1.0;
+    if (jacobian) {
+      jacobian->setZero(3, kStateSize);
+      (*jacobian)(2, kTheta) = 1.0;
+    }
+    return Vec3(0.0, 0.0, y[kTheta] - sign * target.angle);
+  }
+
+  Eigen::VectorXd gauge_residual(const Eigen::VectorXd&, Eigen::MatrixXd* jacobian) const override {
+    if (jacobian) jacobian->resize(0, kStateSize);
+    return Eigen::VectorXd(0);
+  }
+
+  Eigen::MatrixXd admissible_directions(Slot slot) const override {
+    if (slot == Slot::Orientation || slot == Slot::Moment) return Vec3::UnitZ();
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(3, 2);
+    E(0, 0) = 1.0;
+    E(1, 1) = 1.0;
+    return E;
+  }
+
+ private:
+  RodModel model_;
+};
+
+}  // namespace
+
+Mat3 planar_reference_frame() {
+  Mat3 R;
+  R.col(0) = Vec3::UnitY();
+  R.col(1) = Vec3::UnitZ();
+  R.col(2) = Vec3::UnitX();
+  return R;
+}
+
+std::shared_ptr<const RodEquations> make_planar_equations(RodModel model) {
+  model.validate();
+  return std::make_shared<PlanarEquations>(std::move(model));
+}
+
+}  // namespace kirchhoff

@@ -1,0 +1,135 @@
+#include "kirchhoff/jobs/case_solve.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "kirchhoff/analysis/discrete_seed.hpp"
+
+namespace kirchhoff {
+namespace {
+
+constexpr const char* kDirectHint =
+    "; a direct solve (--direct, or direct=True in Python) starts Newton from the guess at the requested values "
+    "instead, and reaches whichever equilibrium attracts it";
+
+bool solved_for(const ProblemDefinition& d, const std::string& name) {
+  return std::find(d.unknown_parameters.begin(), d.unknown_parameters.end(), name) != d.unknown_parameters.end();
+}
+
+// Whether a parameter only says where Newton starts: solved for (its value is a guess), or used
+// by the [guess] alone.
+bool only_a_guess(const Case& c, const std::string& name) {
+  return solved_for(c.definition, name) || !c.problem_parameters.count(name);
+}
+
+// The case at its file's values, keeping the overrides of parameters only its [guess] uses: they
+// choose the equilibrium the homotopy starts from (the straight column, the S-shaped mode).
+// Guesses of solved-for parameters are guesses at the requested values, which the path carries
+// there itself: the start is the case's own solve.
+Case case_at_file_values(const Case& c) {
+  ParameterOverrides guesses;
+  for (const auto& [name, value] : c.overrides)
+    if (!solved_for(c.definition, name) && !c.problem_parameters.count(name)) guesses.emplace_back(name, value);
+  Case start = reload_case(c, guesses);
+  // The solver settings as the case was given them (a wall-clock limit, command-line settings).
+  start.definition.options = c.definition.options;
+  return start;
+}
+
+CaseSolve by_homotopy(const Case& c, std::vector<ParameterChange> changes, HomotopyOptions options) {
+  CaseSolve out;
+  out.path.method = "homotopy";
+  out.path.changes = changes;
+  const Case start = case_at_file_values(c);
+  DefinitionSolve at_start = solve_definition(start.definition, start.start_guess);
+  if (!at_start.result.summary.converged()) {
+    // Newton's own status: what failed is a solve, the one the path would start from.
+    out.failure = to_string(at_start.result.summary.status);
+    out.solved.result.summary = at_start.result.summary;
+    out.message = "not converged: the case's own solve at its file's values, where the homotopy to the requested "
+                  "values starts: " + at_start.result.summary.brief_report() + kDirectHint;
+    return out;
+  }
+  HomotopyResult h =
+      follow_homotopy(at_start.problem->definition(), at_start.result.x, changes, options);
+  if (h.stop != "reached" && h.stop != "not_converged") {
+    out.failure = h.stop;
+    out.message = h.message + kDirectHint;
+    // No iterate at the requested values was evaluated: no residual there to report.
+    out.solved.result.summary.residual_norm = INFINITY;
+    out.path.homotopy = std::move(h);
+    return out;
+  }
+  out.solved.problem = std::make_unique<ShootingProblem>(h.definition);
+  out.solved.result = std::move(h.result);
+  for (const auto& line : at_start.contact_log) out.solved.contact_log.push_back("start: " + line);
+  for (const auto& line : h.contact_changes) out.solved.contact_log.push_back("homotopy: " + line);
+  out.path.homotopy = std::move(h);
+  return out;
+}
+
+// The equilibrium reached, by the seed, the homotopy or directly (the options' choice).
+CaseSolve reach_equilibrium(const Case& c, const CaseSolveOptions& options) {
+  if (options.seed.ipopt) {
+    CaseSolve out;
+    out.path.method = "ipopt_seed";
+    DiscreteSeed seed;
+    out.solved = as_definition_solve(
+        solve_from_discrete_seed(c.definition, options.seed.segments, options.seed.amplitude, &seed));
+    out.path.seed_summary = seed.summary;
+    return out;
+  }
+  std::vector<ParameterChange> changes = homotopy_changes(c);
+  if (!options.direct && !changes.empty()) {
+    HomotopyOptions homotopy = options.homotopy;
+    homotopy.deadline = std::min(homotopy.deadline, c.definition.options.newton.deadline);
+    return by_homotopy(c, std::move(changes), homotopy);
+  }
+  CaseSolve out;
+  out.path.method = "direct";
+  out.solved = solve_definition(c.definition, c.start_guess);
+  return out;
+}
+
+// What is reported of a converged equilibrium: its solution, checked as it is made, then (unless
+// the checks failed) its stability.
+void analyse(const Case& c, const CaseSolveOptions& options, CaseSolve* out) {
+  const ShootingProblem& problem = *out->solved.problem;
+  if (options.solution) {
+    out->solution = make_solution(problem, out->solved.result, options.samples > 0 ? options.samples : c.samples,
+                                  c.derived);
+    if (!out->solution->result.summary.converged()) return;
+  }
+  const Eigen::VectorXd& x = out->solved.result.x;
+  if (options.stability) out->stability = analyse_stability(problem, x);
+  if (options.stability_check) out->stability_check = discrete_stability(problem, x);
+}
+
+}  // namespace
+
+std::vector<ParameterChange> homotopy_changes(const Case& c) {
+  std::vector<ParameterChange> changes;
+  for (const auto& override_pair : c.overrides) {
+    // Named copies: clang's C++17 (the fuzzer build) refuses a lambda capturing a structured binding.
+    const std::string& name = override_pair.first;
+    const double value = override_pair.second;
+    if (only_a_guess(c, name) || !c.file_parameters.contains(name)) continue;
+    const double from = c.file_parameters.get(name);
+    if (from == value) continue;
+    const auto same = std::find_if(changes.begin(), changes.end(), [&](const auto& k) { return k.name == name; });
+    if (same != changes.end()) same->to = value;  // the last --set of a name wins, as in load_case
+    else changes.push_back({name, from, value});
+  }
+  // A name set twice, back to its file value, is no change.
+  changes.erase(std::remove_if(changes.begin(), changes.end(), [](const auto& k) { return k.from == k.to; }),
+                changes.end());
+  return changes;
+}
+
+CaseSolve solve_case(const Case& c, const CaseSolveOptions& options) {
+  CaseSolve out = reach_equilibrium(c, options);
+  if (out.failure.empty() && out.solved.result.summary.converged()) analyse(c, options, &out);
+  return out;
+}
+
+}  // namespace kirchhoff

@@ -1,0 +1,105 @@
+#include "kirchhoff/jobs/continue_outputs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "kirchhoff/analysis/solution.hpp"
+
+namespace kirchhoff {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool same_contacts(const std::vector<PointContact>& a, const std::vector<PointContact>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const PointContact& x, const PointContact& y) {
+    return x.obstacle == y.obstacle && x.s == y.s && x.force == y.force && x.extended == y.extended &&
+           x.s_end == y.s_end && x.force_end == y.force_end;
+  });
+}
+
+}  // namespace
+
+void BranchCsvSink::begin(const std::string& parameter, const std::vector<std::string>& columns,
+                          int resumed_after_row) {
+  columns_ = columns;
+  const bool append = resumed_after_row >= 0;
+  if (append) truncate_csv(path_, resumed_after_row);
+  out_.open(path_, append ? std::ios::app : std::ios::trunc);
+  if (!out_) throw std::runtime_error("cannot write " + path_.string());
+  out_ << std::setprecision(15);
+  if (!append) {
+    out_ << "index,branch," << parameter << ",arclength";
+    for (const auto& d : columns_) out_ << ',' << d;
+    out_ << ",H_spread,m3_spread,n_dot_m_spread,H_flat,type,multiplicity,event,newton_iterations,stability_index,"
+            "zero_modes\n";
+    out_.flush();
+  }
+}
+
+void BranchCsvSink::point(const RunPoint& rp) {
+  const ContinuationPoint& p = *rp.point;
+  out_ << rp.row << ',' << rp.branch << ',' << p.parameter << ',' << p.arclength;
+  for (const auto& d : columns_) {
+    const auto it = p.derived.find(d);
+    out_ << ',' << (it != p.derived.end() ? it->second : NAN);
+  }
+  const auto& inv = p.invariants;
+  // + 0.0 prints a zero spread as 0, not -0.
+  out_ << ',' << inv.H.relative_spread() + 0.0 << ',' << inv.m3.relative_spread() + 0.0 << ','
+       << inv.n_dot_m.relative_spread() + 0.0 << ',' << (p.H_flat ? 1 : 0) << ',' << to_string(p.type) << ','
+       << p.multiplicity << ',' << p.event << ',' << p.newton_iterations << ',';
+  // Empty where the index is not defined (or not computed): never a guessed number.
+  if (p.stability_index) out_ << *p.stability_index;
+  out_ << ',' << p.zero_modes << '\n';
+  out_.flush();
+}
+
+void StateFileSink::save(const RunState& s) {
+  save_state(path_, s);
+  last_ = std::chrono::steady_clock::now();
+  ++saves_;
+}
+
+void StateFileSink::state(const RunState& s, bool) {
+  if (saves_ == 0 || std::chrono::steady_clock::now() - last_ >= interval_) save(s);
+}
+
+void StateFileSink::finish(const RunState* s) {
+  if (s && s->has_march) save(*s);  // with the last row written
+}
+
+ProfileSink::ProfileSink(const Case& c, std::string parameter, fs::path dir, int samples)
+    : case_(c), parameter_(std::move(parameter)), dir_(std::move(dir)), samples_(samples) {
+  fs::create_directories(dir_);
+}
+
+void ProfileSink::point(const RunPoint& rp) {
+  const ShootingProblem* problem = rp.problem;
+  if (!problem && rp.contacts) {
+    // A contact run's leg: the case with the leg's active set (built again when it changes).
+    if (!leg_problem_ || !same_contacts(*rp.contacts, leg_contacts_)) {
+      ProblemDefinition d = case_.definition;
+      d.contacts = leg_contacts_ = *rp.contacts;
+      leg_problem_ = std::make_unique<ShootingProblem>(d);
+    }
+    problem = leg_problem_.get();
+  }
+  if (!problem) return;
+  const ContinuationPoint& p = *rp.point;
+  ShootingProblem copy = *problem;
+  copy.set_parameter(parameter_, p.parameter);
+  ShootingResult r;
+  r.x = p.x;
+  r.parameters = copy.parameters_at(p.x);
+  const Solution s = make_solution(copy, r, samples_, {});
+  std::ostringstream name;
+  name << "point_" << std::setw(5) << std::setfill('0') << rp.row << ".csv";
+  write_profile_csv((dir_ / name.str()).string(), copy.equations(r.parameters)->model(), s.profile,
+                    copy.definition().kind);
+}
+
+}  // namespace kirchhoff

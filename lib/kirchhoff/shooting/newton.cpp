@@ -1,0 +1,271 @@
+#include "kirchhoff/shooting/newton.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <nlopt.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "kirchhoff/shooting/detail/jacobian_lu.hpp"
+
+namespace kirchhoff {
+
+const char* to_string(SolverStatus status) {
+  switch (status) {
+    case SolverStatus::Converged: return "converged";
+    case SolverStatus::MaxIterations: return "max_iterations";
+    case SolverStatus::SingularJacobian: return "singular_jacobian";
+    case SolverStatus::IntegrationFailed: return "integration_failed";
+    case SolverStatus::LineSearchFailed: return "line_search_failed";
+    case SolverStatus::UnfoldingNotZero: return "unfolding_not_zero";
+    case SolverStatus::NotFinite: return "not_finite";
+    case SolverStatus::CheckFailed: return "check_failed";
+    case SolverStatus::TimeLimit: return "time_limit";
+  }
+  return "unknown";
+}
+
+std::string NewtonOptions::validate() const {
+  if (max_iterations < 1) return "max_iterations must be >= 1";
+  if (!(residual_tolerance > 0)) return "residual_tolerance must be > 0";
+  if (!(finite_difference_step > 0)) return "finite_difference_step must be > 0";
+  if (max_backtracks < 0) return "max_backtracks must be >= 0";
+  if (!(max_seconds >= 0 && max_seconds <= 1e9)) return "max_seconds must be in [0, 1e9] (0: no limit)";
+  return {};
+}
+
+std::string NewtonSummary::brief_report() const {
+  std::ostringstream os;
+  os << to_string(status) << " after " << iterations << " iterations, residual " << residual_norm;
+  if (used_fallback_search) os << " (starting point from NLopt search)";
+  if (!message.empty()) os << ": " << message;
+  return os.str();
+}
+
+double max_abs_or_nan(const Eigen::VectorXd& v) {
+  if (!v.allFinite()) return NAN;
+  return v.size() == 0 ? 0.0 : v.lpNorm<Eigen::Infinity>();
+}
+
+std::chrono::steady_clock::time_point deadline_after(double seconds) {
+  using Clock = std::chrono::steady_clock;
+  if (!(seconds >= 0 && seconds <= 1e9)) throw std::invalid_argument("the time limit must be in [0, 1e9] seconds");
+  if (seconds == 0) return Clock::time_point::max();
+  return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+}
+
+namespace {
+
+// Wall-clock deadline of a solve: the earlier of its own limit (none when 0) and the options'
+// deadline.
+class Deadline {
+ public:
+  explicit Deadline(const NewtonOptions& options)
+      : end_(options.max_seconds > 0 ? std::min(options.deadline, deadline_after(options.max_seconds))
+                                     : options.deadline) {}
+  bool limited() const { return end_ != std::chrono::steady_clock::time_point::max(); }
+  bool passed() const { return limited() && std::chrono::steady_clock::now() >= end_; }
+  double remaining_seconds() const {
+    return std::max(1e-3, std::chrono::duration<double>(end_ - std::chrono::steady_clock::now()).count());
+  }
+
+ private:
+  std::chrono::steady_clock::time_point end_;
+};
+
+}  // namespace
+
+bool finite_difference_jacobian(const NonlinearSystem& system, const Eigen::VectorXd& x, double step,
+                                Eigen::MatrixXd* J) {
+  const int n = system.size();
+  J->resize(n, n);
+  Eigen::VectorXd xp = x, Fp, Fm;
+  std::string failure;
+  for (int j = 0; j < n; ++j) {
+    const double h = step * (1.0 + std::abs(x[j]));
+    xp[j] = x[j] + h;
+    if (!system.evaluate(xp, &Fp, nullptr, &failure)) return false;
+    xp[j] = x[j] - h;
+    if (!system.evaluate(xp, &Fm, nullptr, &failure)) return false;
+    xp[j] = x[j];
+    J->col(j) = (Fp - Fm) / (2.0 * h);
+  }
+  return true;
+}
+
+namespace {
+
+NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options,
+                           const Deadline& deadline) {
+  NewtonSummary summary;
+  Eigen::VectorXd F, F_trial;
+  Eigen::MatrixXd J;
+  std::string failure;
+  bool not_finite = false;  // the last failed evaluation returned NaN or inf (not an integrator failure)
+  auto evaluate = [&](const Eigen::VectorXd& at, Eigen::VectorXd* f, Eigen::MatrixXd* jac) {
+    ++summary.evaluations;
+    not_finite = false;
+    bool ok = false;
+    if (jac && options.finite_difference_jacobian)
+      ok = system.evaluate(at, f, nullptr, &failure) &&
+           finite_difference_jacobian(system, at, options.finite_difference_step, jac);
+    else
+      ok = system.evaluate(at, f, jac, &failure);
+    if (!ok) return false;
+    // A NaN or inf is never a residual: it is reported, never compared with the tolerance.
+    if (!f->allFinite() || (jac && !jac->allFinite())) {
+      not_finite = true;
+      failure = std::string("the ") + (f->allFinite() ? "Jacobian" : "residual") + " holds NaN or inf";
+      return false;
+    }
+    return true;
+  };
+  auto fail = [&](double norm) {
+    summary.status = not_finite ? SolverStatus::NotFinite : SolverStatus::IntegrationFailed;
+    summary.residual_norm = norm;
+    summary.message = failure;
+    return summary;
+  };
+
+  // F alone first: a converged guess (or iterate) never pays for a Jacobian.
+  if (!evaluate(x, &F, nullptr)) return fail(INFINITY);
+  double norm = max_abs_or_nan(F);
+  summary.residual_norm = norm;
+  for (int it = 0; it < options.max_iterations; ++it) {
+    if (norm <= options.residual_tolerance) {
+      summary.status = SolverStatus::Converged;
+      return summary;
+    }
+    if (deadline.passed()) {
+      summary.status = SolverStatus::TimeLimit;
+      summary.message = "the wall-clock limit was reached";
+      return summary;
+    }
+    if (!evaluate(x, &F, &J)) return fail(norm);
+    const JacobianLU lu(J);
+    const double rcond = lu.reciprocal_condition();
+    if (!(rcond > options.singular_rcond)) {
+      summary.status = SolverStatus::SingularJacobian;
+      summary.message = "reciprocal condition number " + std::to_string(rcond);
+      return summary;
+    }
+    const Eigen::VectorXd dx = -lu.solve(F);
+    // Backtracking on |F|_2: accept the first step length that decreases it (sufficient
+    // decrease with the usual 1e-4 slope fraction). A trial whose residual is NaN or inf fails
+    // evaluate and is backed away from.
+    const double merit = F.squaredNorm();
+    double alpha = 1.0;
+    bool accepted = false;
+    Eigen::VectorXd x_trial;
+    for (int k = 0; k <= options.max_backtracks && !deadline.passed(); ++k, alpha *= 0.5) {
+      x_trial = x + alpha * dx;
+      if (evaluate(x_trial, &F_trial, nullptr) && F_trial.squaredNorm() <= (1.0 - 1e-4 * alpha) * merit) {
+        accepted = true;
+        break;
+      }
+    }
+    ++summary.iterations;
+    if (!accepted) {
+      const bool timed_out = deadline.passed();  // once: status and message must agree
+      summary.status = timed_out ? SolverStatus::TimeLimit : SolverStatus::LineSearchFailed;
+      summary.message =
+          timed_out ? "the wall-clock limit was reached in the line search" : "no step length decreased the residual";
+      return summary;
+    }
+    x = x_trial;
+    F = F_trial;
+    norm = max_abs_or_nan(F);
+    summary.residual_norm = norm;
+    summary.history.push_back(norm);
+    const bool stalled = alpha * dx.lpNorm<Eigen::Infinity>() <=
+                         options.step_tolerance * (1.0 + x.lpNorm<Eigen::Infinity>());
+    if (stalled && norm <= 1e3 * options.residual_tolerance) {
+      summary.status = SolverStatus::Converged;
+      summary.message = "step at round-off";
+      return summary;
+    }
+  }
+  summary.status = norm <= options.residual_tolerance ? SolverStatus::Converged : SolverStatus::MaxIterations;
+  return summary;
+}
+
+}  // namespace
+
+NewtonSummary newton_solve(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options) {
+  return newton_until(system, x, options, Deadline(options));
+}
+
+namespace {
+
+struct SearchContext {
+  const NonlinearSystem* system;
+  long evaluations = 0;
+};
+
+// Objective |F|^2 / 2 with gradient J^T F; an unevaluable point is a large value, so the
+// search backs away from regions where the integrator fails.
+double least_squares_objective(unsigned n, const double* x, double* grad, void* data) {
+  auto* ctx = static_cast<SearchContext*>(data);
+  ++ctx->evaluations;
+  Eigen::Map<const Eigen::VectorXd> xv(x, n);
+  Eigen::VectorXd F;
+  Eigen::MatrixXd J;
+  std::string failure;
+  if (!ctx->system->evaluate(xv, &F, grad ? &J : nullptr, &failure) || !F.allFinite() ||
+      (grad && !J.allFinite())) {
+    if (grad) std::fill(grad, grad + n, 0.0);
+    return 1e300;
+  }
+  if (grad) Eigen::Map<Eigen::VectorXd>(grad, n) = J.transpose() * F;
+  return 0.5 * F.squaredNorm();
+}
+
+}  // namespace
+
+NewtonSummary solve_with_fallback(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options) {
+  const Eigen::VectorXd guess = x;
+  const Deadline deadline(options);
+  NewtonSummary summary = newton_until(system, x, options, deadline);
+  if (summary.converged() || !options.fallback_search || deadline.passed()) return summary;
+
+  SearchContext ctx{&system};
+  nlopt::opt search(nlopt::LD_LBFGS, static_cast<unsigned>(system.size()));
+  search.set_min_objective(least_squares_objective, &ctx);
+  search.set_maxeval(options.fallback_evaluations);
+  search.set_ftol_abs(0.5 * options.residual_tolerance * options.residual_tolerance);
+  if (deadline.limited()) search.set_maxtime(deadline.remaining_seconds());
+  std::vector<double> start(guess.data(), guess.data() + guess.size());
+  double value = 0.0;  // NLopt's objective at its end (unused: the residual there is recomputed)
+  try {
+    search.optimize(start, value);
+  } catch (const std::exception&) {
+    // NLopt stops with roundoff_limited or similar: the point reached is still a candidate.
+  }
+  Eigen::VectorXd candidate = Eigen::Map<Eigen::VectorXd>(start.data(), start.size());
+  const Eigen::VectorXd searched = candidate;
+  NewtonSummary second = newton_until(system, candidate, options, deadline);
+  second.used_fallback_search = true;
+  second.evaluations += summary.evaluations + ctx.evaluations;
+  if (second.converged()) {
+    x = candidate;
+    return second;
+  }
+  // Neither start converged: the better one is returned, saying what both tried.
+  Eigen::VectorXd F_searched;
+  std::string failure;
+  const double reached = system.evaluate(searched, &F_searched, nullptr, &failure) ? max_abs_or_nan(F_searched) : NAN;
+  std::ostringstream tried;
+  tried << "tried 2 starts: Newton from the guess (" << to_string(summary.status) << " after " << summary.iterations
+        << " iterations, residual " << summary.residual_norm << "), then from the point an NLopt least-squares search "
+        << "reached in " << ctx.evaluations << " evaluations (residual " << reached << " there; Newton: "
+        << to_string(second.status) << " after " << second.iterations << " iterations, residual "
+        << second.residual_norm << "); best residual " << std::min(summary.residual_norm, second.residual_norm)
+        << " against the tolerance " << options.residual_tolerance;
+  NewtonSummary& best = second.residual_norm < summary.residual_norm ? second : summary;
+  if (&best == &second) x = candidate;
+  best.evaluations = second.evaluations;
+  best.message = best.message.empty() ? tried.str() : best.message + "; " + tried.str();
+  return best;
+}
+
+}  // namespace kirchhoff

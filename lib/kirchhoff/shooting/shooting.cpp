@@ -1,0 +1,621 @@
+#include "kirchhoff/shooting/shooting.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <functional>
+#include <optional>
+#include <stdexcept>
+#include <thread>
+
+#include "kirchhoff/equations/detail/rod_on_cylinder.hpp"
+#include "kirchhoff/shooting/detail/contact_conditions.hpp"
+#include "kirchhoff/shooting/detail/jacobian_lu.hpp"
+#include "kirchhoff/shooting/verification.hpp"
+
+namespace kirchhoff {
+
+using detail::Breakpoint;
+using detail::DiscWrap;
+using detail::SegmentSpan;
+using detail::breakpoints;
+using detail::disc_wrap;
+using detail::point_contact_terms;
+using detail::segment_spans;
+using detail::support_of;
+
+namespace {
+
+// Central-difference step for parameter columns, relative to 1 + |p|: the truncation error
+// ~h^2 and round-off ~eps/h balance near 1e-6 for the smooth closed-form targets.
+constexpr double kParameterStep = 1e-6;
+
+struct ConditionRows {
+  std::vector<double> values;
+  std::vector<Eigen::RowVectorXd> jacobian;
+};
+
+}  // namespace
+
+std::string ShootingOptions::validate() const {
+  if (segments < 1) return "segments must be >= 1";
+  if (threads < 0) return "threads must be >= 0 (0: the hardware concurrency)";
+  if (std::string e = integrator.validate(); !e.empty()) return e;
+  return newton.validate();
+}
+
+std::string IntegratorOptions::validate() const {
+  if (!(abs_tol > 0) || !(rel_tol >= 0)) return "integrator tolerances must be > 0";
+  if (!(sensitivity_tol >= 0)) return "sensitivity_tol must be >= 0 (0: the state's tolerances)";
+  if (!(initial_step > 0) || initial_step > 1) return "initial_step must be in (0, 1]";
+  if (max_steps < 1) return "max_steps must be >= 1";
+  return {};
+}
+
+ShootingProblem::ShootingProblem(ProblemDefinition definition) : definition_(std::move(definition)) {
+  if (std::string e = definition_.options.validate(); !e.empty()) throw std::invalid_argument(e);
+  if (!definition_.model) throw std::invalid_argument("no rod model given");
+  adopt_dependent_parameters();
+  const auto eq = equations(definition_.parameters);
+  state_size_ = eq->state_size();
+  if (std::string e = definition_.start.check(*eq); !e.empty()) throw std::invalid_argument("start: " + e);
+  if (std::string e = definition_.end.check(*eq); !e.empty()) throw std::invalid_argument("end: " + e);
+  for (const auto& name : definition_.unknown_parameters) {
+    const int i = definition_.parameters.index_of(name);
+    if (i < 0) throw std::invalid_argument("unknown parameter '" + name + "' is not among the parameters");
+    unknown_index_.push_back(i);
+  }
+  const int extras = definition_.start.extra_count() + definition_.end.extra_count();
+  if (extras != static_cast<int>(unknown_index_.size()))
+    throw std::invalid_argument(std::to_string(extras) + " extra condition(s) but " +
+                                std::to_string(unknown_index_.size()) +
+                                " unknown parameter(s): each unknown parameter needs exactly one extra condition");
+  // Count residual rows once, at the guess, to make sure the system is square.
+  std::vector<double> rows;
+  const Eigen::VectorXd y = eq->state(RodPoint{});
+  residual_count_ = static_cast<int>(eq->gauge_residual(y, nullptr).size());
+  gauge_count_ = residual_count_;
+  definition_.start.append_residuals(*eq, true, y, definition_.parameters, &rows, nullptr);
+  start_condition_count_ = static_cast<int>(rows.size());
+  definition_.end.append_residuals(*eq, false, y, definition_.parameters, &rows, nullptr);
+  residual_count_ += static_cast<int>(rows.size()) + (segments() - 1) * state_size_;
+  if (!definition_.contacts.empty()) {
+    for (const auto& c : definition_.contacts)
+      if (c.obstacle < 0 || c.obstacle >= static_cast<int>(definition_.obstacles.size()))
+        throw std::invalid_argument("contact on obstacle " + std::to_string(c.obstacle) + ", which does not exist");
+    for (const auto& c : definition_.contacts) residual_count_ += c.unknowns();
+  }
+  // Moving obstacles decide: `obstacles` is kept as their value at the current parameters.
+  if (definition_.moving_obstacles) definition_.obstacles = definition_.moving_obstacles(definition_.parameters);
+  for (const auto& c : definition_.contacts) {
+    if (!c.extended) continue;
+    if (std::string e = extended_contact_unsupported(*eq, definition_.obstacles[c.obstacle]); !e.empty())
+      throw std::invalid_argument(e);
+    // Each way of shooting through a wrap is written once: the closed-form planar ones through a
+    // single segment, the spatial rod on a cylinder as a piece of multiple shooting.
+    if (eq->is_planar() && segments() > 1)
+      throw std::invalid_argument("solver: extended contacts of planar rods need single shooting (segments = 1)");
+    if (!eq->is_planar() && segments() == 1)
+      throw std::invalid_argument(
+          "solver: a spatial rod lying on a cylinder is shot piece by piece: set segments to at least the number of "
+          "pieces the contacts cut the rod into");
+  }
+  if (!definition_.contacts.empty() && segments() > 1) set_piece_segments();
+  if (residual_count_ != size())
+    throw std::invalid_argument("boundary conditions give " + std::to_string(residual_count_) +
+                                " equations for " + std::to_string(size()) + " unknowns");
+}
+
+int ShootingProblem::size() const {
+  int n = segments() * state_size_ + static_cast<int>(unknown_index_.size());
+  for (const auto& c : definition_.contacts) n += c.unknowns();
+  return n;
+}
+
+void ShootingProblem::adopt_dependent_parameters() {
+  const auto& dependents = definition_.dependent_parameters;
+  for (const auto& name : definition_.unknown_parameters)
+    if (find_dependent(dependents, name))
+      throw std::invalid_argument("unknown parameter '" + name + "' is computed from other parameters");
+  // Later rules may use earlier ones: walking backwards reaches every parameter a chain uses.
+  for (auto d = dependents.rbegin(); d != dependents.rend(); ++d) {
+    for (auto* depends : {&definition_.model_parameters, &definition_.obstacle_parameters})
+      if (depends->count(d->name)) depends->insert(d->uses.begin(), d->uses.end());
+  }
+  complete(&definition_.parameters, dependents);
+  if (definition_.moving_obstacles) definition_.obstacles = definition_.moving_obstacles(definition_.parameters);
+}
+
+Parameters ShootingProblem::completed(Parameters p) const {
+  complete(&p, definition_.dependent_parameters);
+  return p;
+}
+
+std::vector<Obstacle> ShootingProblem::obstacles(const Parameters& p) const {
+  if (!definition_.moving_obstacles) return definition_.obstacles;
+  return definition_.dependent_parameters.empty() ? definition_.moving_obstacles(p)
+                                                  : definition_.moving_obstacles(completed(p));
+}
+
+std::shared_ptr<const RodEquations> ShootingProblem::build_equations(const Parameters& p) const {
+  RodModel model = definition_.model(p);
+  return definition_.kind == RodKind::Planar ? make_planar_equations(std::move(model))
+                                             : make_spatial_equations(std::move(model));
+}
+
+std::shared_ptr<const RodEquations> ShootingProblem::equations(const Parameters& given) const {
+  // Callers that changed a parameter by hand may pass values whose dependents are stale.
+  Parameters recomputed;
+  if (!definition_.dependent_parameters.empty()) recomputed = completed(given);
+  const Parameters& p = definition_.dependent_parameters.empty() ? given : recomputed;
+  std::vector<double> key;
+  for (const auto& name : definition_.model_parameters)
+    if (p.contains(name)) key.push_back(p.get(name));
+  if (!cached_equations_ || key != cached_model_values_) {
+    cached_equations_ = build_equations(p);
+    cached_model_values_ = key;
+    worker_equations_.clear();
+  }
+  return cached_equations_;
+}
+
+namespace {
+
+// The machine's hardware concurrency, read once per process: std::thread::hardware_concurrency()
+// reads /sys/devices/system/cpu/online on every call, and asked at every evaluation it was 15 % of
+// a planar branch's CPU time, in the kernel.
+int hardware_threads() {
+  static const int threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  return threads;
+}
+
+}  // namespace
+
+void ShootingProblem::for_each_segment(const Parameters& p, const std::function<void(int, const RodEquations&)>& work,
+                                       bool parallel) const {
+  const auto eq = equations(p);
+  const int M = segments();
+  if (!parallel || M < 8) {
+    // Serially, on this thread: no threads, no error slots (an exception reaches the caller as is).
+    for (int i = 0; i < M; ++i) work(i, *eq);
+    return;
+  }
+  const int requested = definition_.options.threads > 0 ? definition_.options.threads : hardware_threads();
+  const int workers = std::clamp(requested, 1, M / 4);
+  while (static_cast<int>(worker_equations_.size()) < workers - 1) worker_equations_.push_back(build_equations(p));
+  // Worker w takes the segments w, w + workers, ... (neighbouring segments cost alike).
+  std::vector<std::exception_ptr> errors(workers);
+  auto run = [&](int w) {
+    const RodEquations& equations = w == 0 ? *eq : *worker_equations_[w - 1];
+    try {
+      for (int i = w; i < M; i += workers) work(i, equations);
+    } catch (...) {
+      errors[w] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int w = 1; w < workers; ++w) threads.emplace_back(run, w);
+  run(0);
+  for (auto& t : threads) t.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+bool ShootingProblem::integrate_segments(const Eigen::VectorXd& x, const Parameters& p, bool sensitivities,
+                                         std::vector<SegmentFlow>* flows, std::string* failure) const {
+  const int n = state_size_, M = segments();
+  const double L = length(p);
+  flows->assign(M, SegmentFlow{});
+  try {
+    for_each_segment(p, [&](int i, const RodEquations& equations) {
+      (*flows)[i] = equations.flow(x.segment(i * n, n), L * i / M, L * (i + 1) / M, sensitivities,
+                                   definition_.options.integrator);
+    });
+  } catch (const IntegrationError& e) {
+    if (failure) *failure = e.what();
+    return false;
+  }
+  for (const auto& flow : *flows) rhs_evaluations_ += flow.rhs_evaluations;
+  return true;
+}
+
+Parameters ShootingProblem::parameters_at(const Eigen::VectorXd& x) const {
+  Parameters p = definition_.parameters;
+  const int offset = segments() * state_size_;
+  for (size_t j = 0; j < unknown_index_.size(); ++j) p.value_at(unknown_index_[j]) = x[offset + j];
+  complete(&p, definition_.dependent_parameters);
+  return p;
+}
+
+void ShootingProblem::set_parameter(const std::string& name, double value) {
+  if (find_dependent(definition_.dependent_parameters, name))
+    throw std::invalid_argument("parameter '" + name + "' is computed from other parameters: set those instead");
+  definition_.parameters.set(name, value);
+  complete(&definition_.parameters, definition_.dependent_parameters);
+  if (definition_.moving_obstacles && definition_.obstacle_parameters.count(name))
+    definition_.obstacles = definition_.moving_obstacles(definition_.parameters);
+}
+
+bool ShootingProblem::moves_beyond_conditions(int unknown) const {
+  const std::string& name = definition_.parameters.names()[unknown_index_[unknown]];
+  return definition_.model_parameters.count(name) > 0 || definition_.obstacle_parameters.count(name) > 0;
+}
+
+bool ShootingProblem::evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
+                               std::string* failure) const {
+  Eigen::VectorXd y_end;
+  return evaluate_with_end(x, F, J, &y_end, failure);
+}
+
+bool ShootingProblem::parameter_derivative(const Eigen::VectorXd& x, const std::string& name, Eigen::VectorXd* dF,
+                                           std::string* failure, const Eigen::VectorXd* y_end) const {
+  const double value = definition_.parameters.get(name);
+  const double h = kParameterStep * (1.0 + std::abs(value));
+  if (find_dependent(definition_.dependent_parameters, name))
+    throw std::invalid_argument("parameter '" + name + "' is computed from other parameters");
+  Parameters plus = parameters_at(x), minus = plus;
+  plus.set(name, value + h);
+  minus.set(name, value - h);
+  complete(&plus, definition_.dependent_parameters);
+  complete(&minus, definition_.dependent_parameters);
+  if (definition_.model_parameters.count(name) || definition_.obstacle_parameters.count(name)) {
+    Eigen::VectorXd Fp, Fm;
+    if (!residual(x, plus, &Fp, nullptr, failure) || !residual(x, minus, &Fm, nullptr, failure)) return false;
+    *dF = (Fp - Fm) / (2.0 * h);
+    return true;
+  }
+  Eigen::VectorXd end_state;
+  if (!y_end) {
+    Eigen::VectorXd F;
+    if (!residual(x, parameters_at(x), &F, nullptr, failure, &end_state)) return false;
+    y_end = &end_state;
+  }
+  const Eigen::VectorXd y0 = x.head(state_size_);
+  const Eigen::VectorXd column = (condition_rows(y0, *y_end, plus) - condition_rows(y0, *y_end, minus)) / (2.0 * h);
+  dF->setZero(residual_count_);
+  place_condition_rows(column, dF);
+  return true;
+}
+
+void ShootingProblem::place_condition_rows(const Eigen::VectorXd& rows, Eigen::VectorXd* column) const {
+  // Start rows follow the gauge rows; end rows are the last ones (contact rows lie between).
+  column->segment(gauge_count_, start_condition_count_) = rows.head(start_condition_count_);
+  column->tail(rows.size() - start_condition_count_) = rows.tail(rows.size() - start_condition_count_);
+}
+
+bool ShootingProblem::evaluate_with_end(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
+                                        Eigen::VectorXd* y_end_out, std::string* failure) const {
+  const Parameters p = parameters_at(x);
+  Eigen::VectorXd& y_end = *y_end_out;
+  if (!residual(x, p, F, J, failure, &y_end)) return false;
+  if (!J) return true;
+  // Parameter columns by central differences (see the header for why this is accurate enough).
+  // A parameter that only enters the boundary conditions moves only their rows, which are
+  // closed-form in the end states: no re-integration is needed for it.
+  const int offset = segments() * state_size_;
+  const Eigen::VectorXd y0 = x.head(state_size_);
+  for (size_t j = 0; j < unknown_index_.size(); ++j) {
+    const double h = kParameterStep * (1.0 + std::abs(x[offset + j]));
+    Eigen::VectorXd xp = x, xm = x, Fp, Fm;
+    xp[offset + j] += h;
+    xm[offset + j] -= h;
+    if (moves_beyond_conditions(static_cast<int>(j))) {
+      if (!residual(xp, parameters_at(xp), &Fp, nullptr, failure)) return false;
+      if (!residual(xm, parameters_at(xm), &Fm, nullptr, failure)) return false;
+      J->col(offset + j) = (Fp - Fm) / (2.0 * h);
+    } else {
+      const Eigen::VectorXd rows =
+          (condition_rows(y0, y_end, parameters_at(xp)) - condition_rows(y0, y_end, parameters_at(xm))) / (2.0 * h);
+      Eigen::VectorXd column = Eigen::VectorXd::Zero(residual_count_);
+      place_condition_rows(rows, &column);
+      J->col(offset + j) = column;
+    }
+  }
+  return true;
+}
+
+Eigen::VectorXd ShootingProblem::condition_rows(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end,
+                                                const Parameters& p) const {
+  const auto eq = equations(p);
+  std::vector<double> rows;
+  definition_.start.append_residuals(*eq, true, y0, p, &rows, nullptr);
+  definition_.end.append_residuals(*eq, false, y_end, p, &rows, nullptr);
+  return Eigen::Map<Eigen::VectorXd>(rows.data(), static_cast<Eigen::Index>(rows.size()));
+}
+
+int ShootingProblem::start_rows(const RodEquations& eq, const Eigen::VectorXd& y0, const Parameters& p,
+                                Eigen::VectorXd* F, Eigen::MatrixXd* J) const {
+  const int n = state_size_;
+  F->resize(residual_count_);
+  if (J) J->setZero(residual_count_, size());
+  Eigen::MatrixXd Jg;
+  const Eigen::VectorXd g = eq.gauge_residual(y0, J ? &Jg : nullptr);
+  F->head(g.size()) = g;
+  if (J) J->block(0, 0, g.size(), n) = Jg;
+  int row = static_cast<int>(g.size());
+  ConditionRows start;
+  definition_.start.append_residuals(eq, true, y0, p, &start.values, J ? &start.jacobian : nullptr);
+  for (size_t k = 0; k < start.values.size(); ++k, ++row) {
+    (*F)[row] = start.values[k];
+    if (J) J->block(row, 0, 1, n) = start.jacobian[k];
+  }
+  return row;
+}
+
+void ShootingProblem::end_rows(const RodEquations& eq, const Eigen::VectorXd& y_end, const Parameters& p,
+                               const Eigen::MatrixXd* S, Eigen::VectorXd* F, Eigen::MatrixXd* J, int row) const {
+  ConditionRows end;
+  definition_.end.append_residuals(eq, false, y_end, p, &end.values, J ? &end.jacobian : nullptr);
+  for (size_t k = 0; k < end.values.size(); ++k, ++row) {
+    (*F)[row] = end.values[k];
+    if (J) J->row(row) = end.jacobian[k] * *S;
+  }
+}
+
+bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
+                               Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const {
+  // A Newton or corrector iterate may take a parameter outside the model's domain (a slenderness
+  // whose radius is <= 0): that point cannot be evaluated, like one that cannot be integrated.
+  std::shared_ptr<const RodEquations> eq;
+  try {
+    eq = equations(p);
+  } catch (const std::invalid_argument& e) {
+    if (failure) *failure = std::string("the rod model is not defined there: ") + e.what();
+    return false;
+  }
+  if (!definition_.contacts.empty())
+    return segments() > 1 ? residual_pieces(x, p, F, J, failure, y_end)
+                          : residual_with_contacts(x, p, F, J, failure, y_end);
+  const int n = state_size_, M = segments();
+  const Eigen::VectorXd y0 = x.head(n);
+  int row = start_rows(*eq, y0, p, F, J);
+
+  std::vector<SegmentFlow> flows;
+  if (!integrate_segments(x, p, J != nullptr, &flows, failure)) return false;
+  for (int i = 0; i + 1 < M; ++i) {
+    F->segment(row, n) = flows[i].y - x.segment((i + 1) * n, n);
+    if (J) {
+      J->block(row, i * n, n, n) = flows[i].Phi;
+      J->block(row, (i + 1) * n, n, n) = -Eigen::MatrixXd::Identity(n, n);
+    }
+    row += n;
+  }
+  const SegmentFlow& last = flows.back();
+
+  if (y_end) *y_end = last.y;
+  ConditionRows end;
+  definition_.end.append_residuals(*eq, false, last.y, p, &end.values, J ? &end.jacobian : nullptr);
+  for (size_t k = 0; k < end.values.size(); ++k, ++row) {
+    (*F)[row] = end.values[k];
+    if (J) J->block(row, (M - 1) * n, 1, n) = end.jacobian[k] * last.Phi;
+  }
+  return true;
+}
+
+std::vector<double> ShootingProblem::node_arclengths(const Eigen::VectorXd& x) const {
+  const double L = length(parameters_at(x));
+  std::vector<double> out;
+  if (piece_segments_.empty()) {
+    for (int i = 0; i < segments(); ++i) out.push_back(L * i / segments());
+    return out;
+  }
+  for (const auto& span : segment_spans(breakpoints(contacts_at(x), contact_columns()), piece_segments_, L))
+    out.push_back(span.s0);
+  return out;
+}
+
+Eigen::VectorXd ShootingProblem::unknowns_from(const std::vector<RodPoint>& nodes) const {
+  if (static_cast<int>(nodes.size()) != segments())
+    throw std::invalid_argument("unknowns_from: one point per segment needed");
+  const auto eq = equations(definition_.parameters);
+  Eigen::VectorXd x = unknowns_without_states();
+  // The turn angle counts whole turns along the rod; at s = 0 the gauge wants it in (-pi, pi].
+  const int turns = eq->turn_angle_index();
+  const double offset = eq->state(nodes.front())[turns] - nodes.front().turn_angle;
+  for (int i = 0; i < segments(); ++i) {
+    Eigen::VectorXd y = eq->state(nodes[i]);
+    y[turns] = nodes[i].turn_angle + offset;
+    x.segment(i * state_size_, state_size_) = y;
+  }
+  return x;
+}
+
+Eigen::VectorXd ShootingProblem::unknowns_without_states() const {
+  const int n = state_size_, M = segments();
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(size());
+  for (size_t j = 0; j < unknown_index_.size(); ++j)
+    x[M * n + j] = definition_.parameters.values()[unknown_index_[j]];
+  for (size_t k = 0; k < definition_.contacts.size(); ++k) {
+    const auto& c = definition_.contacts[k];
+    const int column = contact_column(k);
+    x[column] = c.s;
+    x[column + 1] = c.force;
+    if (c.extended) {
+      x[column + 2] = c.s_end;
+      x[column + 3] = c.force_end;
+    }
+  }
+  return x;
+}
+
+Eigen::VectorXd ShootingProblem::initial_unknowns(const RodPoint& start_guess) const {
+  const auto eq = equations(definition_.parameters);
+  RodPoint p0 = start_guess;
+  definition_.start.impose_on(*eq, true, definition_.parameters, &p0);
+  const int n = state_size_, M = segments();
+  Eigen::VectorXd x = unknowns_without_states();
+  Eigen::VectorXd y = eq->state(p0);
+  if (piece_segments_.empty()) {
+    const double L = eq->model().length;
+    for (int i = 0; i < M; ++i) {
+      x.segment(i * n, n) = y;
+      if (i + 1 < M) y = eq->flow(y, L * i / M, L * (i + 1) / M, false, definition_.options.integrator).y;
+    }
+    return x;
+  }
+  // Piece by piece, each jump applied with its guessed force.
+  const auto points = breakpoints(definition_.contacts, contact_columns());
+  const auto spans = segment_spans(points, piece_segments_, eq->model().length);
+  const auto on_piece = piece_equations(x, definition_.parameters);
+  const auto obstacles_here = obstacles(definition_.parameters);
+  const Eigen::MatrixXd force = eq->slot_map(Slot::Force);
+  for (int i = 0; i < M; ++i) {
+    x.segment(i * n, n) = y;
+    if (i + 1 == M) break;
+    const RodEquations& e = on_piece[spans[i].piece] ? *on_piece[spans[i].piece] : *eq;
+    y = e.flow(y, spans[i].s0, spans[i].s1, false, definition_.options.integrator).y;
+    if (spans[i + 1].piece == spans[i].piece) continue;
+    const Breakpoint& b = points[spans[i].piece];
+    const Obstacle& o = obstacles_here[b.obstacle];
+    const Vec3 normal = b.kind == Breakpoint::Point ? point_contact_terms(*eq, o, y, b.s, false).here.normal
+                                                    : cylinder_normal(support_of(o), y);
+    y -= b.force * force.transpose() * normal;
+  }
+  return x;
+}
+
+std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const std::vector<double>& s) const {
+  const Parameters p = parameters_at(x);
+  const auto eq = equations(p);
+  const int n = state_size_, M = segments();
+  const double L = eq->model().length;
+  std::vector<RodPoint> out;
+  out.reserve(s.size());
+  size_t k = 0;
+  if (!definition_.contacts.empty() && piece_segments_.empty()) {
+    // Piece by piece between breakpoints, applying the jump of n at each.
+    const auto points = breakpoints(contacts_at(x), contact_columns());
+    const std::vector<Obstacle> obstacles_here = obstacles(p);
+    const Eigen::MatrixXd force = eq->slot_map(Slot::Force);
+    Eigen::VectorXd y = x.head(n);
+    double s0 = 0.0;
+    std::optional<DiscWrap> wrap;  // set when [s0, next breakpoint] lies on a disc
+    for (size_t c = 0; c <= points.size(); ++c) {
+      const bool last = c == points.size();
+      const double s1 = last ? L : points[c].s;
+      std::vector<double> local{s0};
+      // The last piece takes every remaining point: an arclength computed as L * i / n can exceed
+      // L by an ulp.
+      while (k < s.size() && (s[k] < s1 || last)) local.push_back(std::min(s[k++], s1));
+      if (wrap) {
+        for (size_t j = 1; j < local.size(); ++j) out.push_back(eq->point(wrap->advance(*eq, y, local[j] - s0), local[j]));
+        y = wrap->advance(*eq, y, s1 - s0);
+        wrap.reset();
+      } else {
+        if (local.size() > 1) {
+          const auto states = eq->sample(y, local, definition_.options.integrator);
+          for (size_t j = 1; j < states.size(); ++j) out.push_back(eq->point(states[j], local[j]));
+        }
+        if (!last) y = eq->flow(y, s0, s1, false, definition_.options.integrator).y;
+      }
+      if (last) break;
+      const Obstacle& o = obstacles_here[points[c].obstacle];
+      const Eigen::MatrixXd position = eq->slot_map(Slot::Position);
+      const Vec3 tangent = position * eq->derivative(y, s1);
+      const Vec3 normal = o.contact_conditions(position * y, tangent).normal;
+      if (points[c].kind == Breakpoint::ExtendedStart && !o.is_flat()) wrap = disc_wrap(o, tangent, normal);
+      y -= points[c].force * force.transpose() * normal;
+      s0 = s1;
+    }
+    return out;
+  }
+  // Each segment samples the arclengths in it, from its own start state (with contacts, on the
+  // equations of its piece: a node after a breakpoint holds the state after the jump).
+  std::vector<SegmentSpan> spans;
+  std::vector<std::shared_ptr<const RodEquations>> on_piece{nullptr};
+  if (piece_segments_.empty()) {
+    for (int i = 0; i < M; ++i) {
+      SegmentSpan span;
+      span.s0 = L * i / M;
+      span.s1 = L * (i + 1) / M;
+      spans.push_back(span);
+    }
+  } else {
+    spans = segment_spans(breakpoints(contacts_at(x), contact_columns()), piece_segments_, L);
+    on_piece = piece_equations(x, p);
+  }
+  std::vector<std::vector<double>> local(M);
+  for (int i = 0; i < M; ++i) {
+    local[i] = {spans[i].s0};
+    while (k < s.size() && (s[k] < spans[i].s1 || i + 1 == M)) local[i].push_back(std::min(s[k++], spans[i].s1));
+  }
+  std::vector<std::vector<RodPoint>> points(M);
+  for_each_segment(p, [&](int i, const RodEquations& own) {
+    if (local[i].size() == 1) return;
+    const RodEquations& equations = on_piece[spans[i].piece] ? *on_piece[spans[i].piece] : own;
+    const auto states = equations.sample(x.segment(i * n, n), local[i], definition_.options.integrator);
+    for (size_t j = 1; j < states.size(); ++j) points[i].push_back(equations.point(states[j], local[i][j]));
+  }, s.size() >= 64);
+  for (auto& segment : points) out.insert(out.end(), segment.begin(), segment.end());
+  return out;
+}
+
+std::string extended_contact_unsupported(const RodEquations& equations, const Obstacle& obstacle) {
+  if (!equations.is_planar()) {
+    if (obstacle.shape() != Obstacle::Shape::Cylinder)
+      return "a spatial rod lying on " + obstacle.describe() +
+             " is not implemented: of the obstacles, only cylinders are modelled for spatial rods";
+    return rod_on_cylinder_unsupported(equations.model());
+  }
+  if (obstacle.is_flat()) return "";
+  const std::string what = "wrapping around " + obstacle.describe();
+  if (obstacle.shape() != Obstacle::Shape::Cylinder || std::abs(std::abs(obstacle.direction().z()) - 1.0) > 1e-12)
+    return what + " is not implemented: of the curved obstacles, only discs (cylinders along e_z) are modelled";
+  const RodModel& model = equations.model();
+  if (model.extensible || !model.is_uniform() || model.field)
+    return what + " is modelled for uniform, inextensible rods without an external field (its closed form); "
+                  "not implemented for this rod";
+  return "";
+}
+
+void add_axial_phase_condition(ProblemDefinition& d) {
+  if (d.kind != RodKind::Spatial) throw std::invalid_argument("the axial phase condition is for spatial rods");
+  const std::string name = kUnfoldingParameter;
+  d.parameters.set(name, 0.0);
+  d.model = [inner = d.model, name](const Parameters& p) {
+    RodModel m = inner(p);
+    m.symmetry_unfolding = p.get(name);
+    return m;
+  };
+  d.model_parameters.insert(name);
+  SlotCondition phase;
+  phase.slot = Slot::Moment;
+  phase.directions = Directions::AlongAxis;
+  phase.axis = Vec3::UnitY();
+  phase.value = constant(Vec3::Zero());
+  phase.extra = true;
+  d.start.add(phase);
+  d.unknown_parameters.push_back(name);
+}
+
+void limit_wall_clock(ShootingOptions& options, double seconds) { options.newton.deadline = deadline_after(seconds); }
+
+ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) {
+  ShootingResult result;
+  result.x = x0;
+  result.summary = solve_with_fallback(problem, result.x, problem.definition().options.newton);
+  result.parameters = problem.parameters_at(result.x);
+  if (result.summary.converged()) mark_check_failure(&result, unknowns_failure(problem, result));
+  if (result.summary.converged()) mark_check_failure(&result, zero_iteration_failure(problem, result));
+  if (!result.summary.converged() || !result.parameters.contains(kUnfoldingParameter)) return result;
+  if (std::abs(result.parameters.get(kUnfoldingParameter)) > kUnfoldingTolerance) {
+    result.summary.status = SolverStatus::UnfoldingNotZero;
+    result.summary.message = "unfolding = " + std::to_string(result.parameters.get(kUnfoldingParameter)) +
+                             ": not an equilibrium (on the straight rod the axial phase condition is degenerate)";
+    return result;
+  }
+  // A guess that is already a straight solution converges in zero iterations; the phase
+  // condition is degenerate there, which shows as a singular Jacobian.
+  Eigen::VectorXd F;
+  Eigen::MatrixXd J;
+  std::string failure;
+  if (problem.evaluate(result.x, &F, &J, &failure) &&
+      !(JacobianLU(J).reciprocal_condition() > problem.definition().options.newton.singular_rcond * 1e3)) {
+    result.summary.status = SolverStatus::SingularJacobian;
+    result.summary.message =
+        "the axial phase condition is degenerate here (a straight rod): solve it without the phase condition";
+  }
+  return result;
+}
+
+}  // namespace kirchhoff

@@ -1,0 +1,107 @@
+#include "kirchhoff/shooting/verification.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace kirchhoff {
+namespace {
+
+bool finite(const RodPoint& p) {
+  return std::isfinite(p.s) && p.r.allFinite() && p.R.allFinite() && p.n.allFinite() && p.m.allFinite() &&
+         p.u.allFinite() && p.v.allFinite() && std::isfinite(p.turn_angle);
+}
+
+std::string at(double s) {
+  std::ostringstream os;
+  os.precision(6);
+  os << " at s = " << s;
+  return os.str();
+}
+
+// J^-1 F with J equilibrated by rows and columns first (LAPACK's dgeequ idea): a case in units far
+// from 1 has Jacobian entries spread over hundreds of orders of magnitude (a rod of length 1e-100:
+// d y(L) / d P ~ L^3), which an unscaled solve reads as rank deficiency. NaN when the equilibrated
+// matrix is still singular (rcond below 1e-12), where no correction can be told. Partial pivoting:
+// after the equilibration the rows are of one size; on 1300 unknowns (a plectoneme at L/2R = 500)
+// its blocked factorisation takes 0.5 s against full pivoting's 5-6 s (same rcond), and this runs
+// on every solve that starts converged.
+Eigen::VectorXd equilibrated_newton_correction(const Eigen::MatrixXd& J, const Eigen::VectorXd& F) {
+  const auto power_of_two_inverse = [](double m) { return m > 0.0 ? std::exp2(-std::ilogb(m)) : 1.0; };
+  Eigen::VectorXd rows(J.rows()), columns(J.cols());
+  for (int i = 0; i < J.rows(); ++i) rows[i] = power_of_two_inverse(J.row(i).lpNorm<Eigen::Infinity>());
+  const Eigen::MatrixXd row_scaled = rows.asDiagonal() * J;
+  for (int j = 0; j < J.cols(); ++j) columns[j] = power_of_two_inverse(row_scaled.col(j).lpNorm<Eigen::Infinity>());
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(row_scaled * columns.asDiagonal());
+  if (!(lu.rcond() > 1e-12)) return Eigen::VectorXd::Constant(F.size(), std::nan(""));
+  return columns.asDiagonal() * lu.solve(rows.asDiagonal() * F);
+}
+
+}  // namespace
+
+std::string unknowns_failure(const ShootingProblem& problem, const ShootingResult& result) {
+  if (!result.x.allFinite()) return "the unknowns hold NaN or inf";
+  const Parameters& p = result.parameters;
+  for (int i = 0; i < p.size(); ++i)
+    if (!std::isfinite(p.values()[i])) return "parameter '" + p.names()[i] + "' is not finite";
+  Eigen::VectorXd F;
+  std::string failure;
+  if (!problem.evaluate(result.x, &F, nullptr, &failure))
+    return "the residual cannot be evaluated again at the solution: " + failure;
+  const double norm = max_abs_or_nan(F);
+  if (!std::isfinite(norm)) return "the residual recomputed at the solution holds NaN or inf";
+  // Newton accepts a step that stopped moving at round-off with |F| up to 1e3 times the
+  // tolerance (NewtonOptions::step_tolerance); anything beyond is not a converged residual.
+  const double tolerance = problem.definition().options.newton.residual_tolerance;
+  const double allowed = result.summary.message == "step at round-off" ? 1e3 * tolerance : tolerance;
+  if (!(norm <= allowed)) {
+    std::ostringstream os;
+    os << "the residual recomputed at the solution is " << norm << ", above the tolerance " << allowed;
+    return os.str();
+  }
+  return {};
+}
+
+std::string zero_iteration_failure(const ShootingProblem& problem, const ShootingResult& result) {
+  if (result.summary.iterations > 0) return {};
+  Eigen::VectorXd F;
+  Eigen::MatrixXd J;
+  std::string failure;
+  if (!problem.evaluate(result.x, &F, &J, &failure) || !J.allFinite()) return {};  // unknowns_failure's job
+  const Eigen::VectorXd correction = equilibrated_newton_correction(J, F);
+  if (!correction.allFinite()) return {};  // singular even when equilibrated: a branch point, say
+  const double size = 1.0 + result.x.lpNorm<Eigen::Infinity>();
+  const double step = correction.lpNorm<Eigen::Infinity>();
+  if (step <= kGuessCorrectionTolerance * size) return {};
+  std::ostringstream os;
+  os << "the guess meets the residual tolerance as it is (residual " << max_abs_or_nan(F)
+     << ", 0 iterations), but one Newton correction from it moves the unknowns by " << step << " against their size "
+     << size - 1.0 << ": the absolute tolerance is not meaningful at this case's scale; give lengths, "
+     << "stiffnesses and loads in units that make them of order 1";
+  return os.str();
+}
+
+std::string profile_failure(const RodModel& model, const std::vector<RodPoint>& profile) {
+  for (const RodPoint& p : profile)
+    if (!finite(p)) return "the solution's profile holds NaN or inf" + at(p.s);
+  if (!model.field) return {};
+  for (const RodPoint& p : profile) {
+    const double gap = model.field->gap(p.s, p.r);
+    // NaN: the field models no wall. A gap <= 0 is on or beyond the wall, where W_ext is
+    // infinite or changes sign: outside the potential's domain.
+    if (!std::isnan(gap) && !(gap > 0.0)) {
+      std::ostringstream os;
+      os << "the rod is on or beyond its soft wall" << at(p.s) << " (gap " << gap
+         << "), outside the domain of the barrier potential";
+      return os.str();
+    }
+  }
+  return {};
+}
+
+void mark_check_failure(ShootingResult* result, const std::string& failure) {
+  if (failure.empty() || !result->summary.converged()) return;
+  result->summary.status = SolverStatus::CheckFailed;
+  result->summary.message = failure;
+}
+
+}  // namespace kirchhoff
