@@ -490,5 +490,55 @@ TEST(Recorder, DescribesEachPointOnceAndRecordsEveryPointOnTheBranch) {
   }
 }
 
+// The options come in groups that check themselves; ContinuationOptions reports the first group's
+// complaint, then the rule between groups (reused Jacobians need branch-point detection off). Each
+// case below breaks one rule only, so a group that missed it would let validate() return "".
+TEST(ContinuationOptions, EachGroupValidatesItself) {
+  ContinuationOptions good;
+  good.parameter = "P";
+  ASSERT_EQ(good.validate(), "");
+  EXPECT_EQ(static_cast<const ContinuationRange&>(good).validate(), "");
+  EXPECT_EQ(static_cast<const StepControl&>(good).validate(), "");
+  EXPECT_EQ(static_cast<const CorrectorOptions&>(good).validate(), "");
+  EXPECT_EQ(static_cast<const DetectionOptions&>(good).validate(), "");
+  EXPECT_EQ(static_cast<const RecordOptions&>(good).validate(), "");
+
+  const auto broken = [&](auto&& change) {
+    ContinuationOptions o = good;
+    change(o);
+    return o;
+  };
+  const ContinuationOptions no_parameter = broken([](ContinuationOptions& o) { o.parameter.clear(); });
+  EXPECT_NE(static_cast<const ContinuationRange&>(no_parameter).validate(), "");
+  const ContinuationOptions steps = broken([](ContinuationOptions& o) { o.max_step = o.min_step / 2; });
+  EXPECT_NE(static_cast<const StepControl&>(steps).validate(), "");
+  const ContinuationOptions corrector = broken([](ContinuationOptions& o) { o.corrector_max_iterations = 0; });
+  EXPECT_NE(static_cast<const CorrectorOptions&>(corrector).validate(), "");
+  const ContinuationOptions detection = broken([](ContinuationOptions& o) { o.branch_point_tolerance = 2.0; });
+  EXPECT_NE(static_cast<const DetectionOptions&>(detection).validate(), "");
+  const ContinuationOptions unnamed_event = broken([](ContinuationOptions& o) { o.events = {{"", 1.0, true, ""}}; });
+  EXPECT_NE(static_cast<const DetectionOptions&>(unnamed_event).validate(), "");
+  const ContinuationOptions record = broken([](ContinuationOptions& o) { o.samples = 1; });
+  EXPECT_NE(static_cast<const RecordOptions&>(record).validate(), "");
+  for (const ContinuationOptions* o : {&no_parameter, &steps, &corrector, &detection, &unnamed_event, &record})
+    EXPECT_NE(o->validate(), "");
+  EXPECT_EQ(steps.validate(), static_cast<const StepControl&>(steps).validate());
+
+  ContinuationOptions reuse = broken([](ContinuationOptions& o) { o.reuse_jacobian_iterations = 2; });
+  EXPECT_NE(reuse.validate().find("detect_branch_points"), std::string::npos);
+  reuse.detect_branch_points = false;
+  EXPECT_EQ(reuse.validate(), "");
+
+  // A group handed on whole: what it sets is what the run gets.
+  StepControl step;
+  step.max_step = 2.0;
+  step.initial_step = 0.1;
+  ContinuationOptions run = good;
+  static_cast<StepControl&>(run) = step;
+  EXPECT_EQ(run.max_step, 2.0);
+  EXPECT_EQ(run.initial_step, 0.1);
+  EXPECT_EQ(run.parameter, "P");
+}
+
 }  // namespace
 }  // namespace kirchhoff

@@ -68,20 +68,50 @@ const char* to_string(StopReason reason) {
   return "?";
 }
 
-std::string ContinuationOptions::validate() const {
+std::string ContinuationRange::validate() const {
   if (parameter.empty()) return "no continuation parameter given";
-  if (!(initial_step > 0) || !(min_step > 0) || !(max_step >= min_step)) return "steps must satisfy 0 < min_step <= max_step, initial_step > 0";
   // Each point keeps its unknowns and derived quantities in memory: 1e7 of them is beyond any
   // branch and still fits; more is a typo.
   if (max_points < 1 || max_points > 10000000) return "max_points must be in [1, 1e7]";
   if (!(parameter_min < parameter_max)) return "parameter_min must be < parameter_max";
-  if (corrector_max_iterations < 1 || !(corrector_tolerance > 0 || std::isnan(corrector_tolerance)))
-    return "corrector settings must be positive";
-  // As a case file's [output] samples (case_file.hpp): 1e5 samples cost ~2 s per point already.
-  if (samples < 2 || samples > 100000) return "samples must be in [2, 100000]";
+  return {};
+}
+
+std::string StepControl::validate() const {
+  if (!(initial_step > 0) || !(min_step > 0) || !(max_step >= min_step)) return "steps must satisfy 0 < min_step <= max_step, initial_step > 0";
   if (!(0 <= grow_iterations && grow_iterations < shrink_iterations))
     return "grow_iterations must be >= 0 and below shrink_iterations";
+  return {};
+}
+
+std::string CorrectorOptions::validate() const {
+  if (corrector_max_iterations < 1 || !(corrector_tolerance > 0 || std::isnan(corrector_tolerance)))
+    return "corrector settings must be positive";
   if (!(march_sensitivity_tol >= 0)) return "march_sensitivity_tol must be >= 0 (0: the problem's own)";
+  return {};
+}
+
+std::string DetectionOptions::validate() const {
+  // A relative singular value: 1 or more would call every point a branch point.
+  if (!(branch_point_tolerance > 0 && branch_point_tolerance < 1)) return "branch_point_tolerance must be in (0, 1)";
+  if (stop_at_branch_point < 0) return "stop_at_branch_point must be >= 0 (0: never stop at one)";
+  // (An event's value may be NaN: a contact leg resumed from a state that recorded none arms an
+  // event that never fires.)
+  for (const ContinuationEvent& e : events)
+    if (e.quantity.empty()) return "an event needs a quantity";
+  return {};
+}
+
+std::string RecordOptions::validate() const {
+  // As a case file's [output] samples (case_file.hpp): 1e5 samples cost ~2 s per point already.
+  if (samples < 2 || samples > 100000) return "samples must be in [2, 100000]";
+  return {};
+}
+
+std::string ContinuationOptions::validate() const {
+  for (const std::string& group : {ContinuationRange::validate(), StepControl::validate(), CorrectorOptions::validate(),
+                                   DetectionOptions::validate(), RecordOptions::validate()})
+    if (!group.empty()) return group;
   if (reuse_jacobian_iterations >= 0 && detect_branch_points)
     return "reusing Jacobians needs detect_branch_points = false (the test functions need each point's own)";
   return {};

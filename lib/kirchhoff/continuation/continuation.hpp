@@ -56,21 +56,32 @@ struct PointRecorder {
   std::function<void(const ShootingProblem& problem, ContinuationPoint* point)> record;
 };
 
-struct ContinuationOptions {
+// The options of a run, in groups (Ceres's Solver::Options and BifurcationKit's ContParams are the
+// models): each group says what it controls and checks itself (validate(): "" or what is wrong);
+// ContinuationOptions derives from all of them, so a run's options are still set field by field
+// (options.max_step = 1) and a group can be handed on whole (StepControl& step = options).
+
+// Where a run goes and when it stops for reasons of its own.
+struct ContinuationRange {
   std::string parameter;                                      // the continued parameter
   double target = std::numeric_limits<double>::quiet_NaN();   // stop on reaching it (NaN: no target)
   double direction = 1.0;           // initial direction of lambda (+1/-1), used when there is no target
-  double initial_step = 0.05;       // pseudo-arclength step
-  double min_step = 1e-7;           // below this the run stops (step_too_small)
-  double max_step = 0.5;
-  double max_tangent_angle = 0.35;  // rad; a step turning the tangent more is retried shorter
+  double parameter_min = -std::numeric_limits<double>::infinity();
+  double parameter_max = std::numeric_limits<double>::infinity();
   int max_points = 500;
   // No step starts after this instant (a command's wall-clock limit; every point before it is
   // reported and resumable). Stop reason time_limit.
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
-  double parameter_min = -std::numeric_limits<double>::infinity();
-  double parameter_max = std::numeric_limits<double>::infinity();
-  int corrector_max_iterations = 8;
+
+  std::string validate() const;
+};
+
+// The pseudo-arclength step and how it adapts.
+struct StepControl {
+  double initial_step = 0.05;       // pseudo-arclength step
+  double min_step = 1e-7;           // below this the run stops (step_too_small)
+  double max_step = 0.5;
+  double max_tangent_angle = 0.35;  // rad; a step turning the tangent more is retried shorter
   // A corrector that needed at most grow_iterations lets the step grow, at least
   // shrink_iterations shrink it (chord iterations contract linearly, so a good step takes three
   // or four). Where a point's Jacobian and derived quantities cost many residual evaluations
@@ -78,6 +89,14 @@ struct ContinuationOptions {
   // branch: raise both.
   int grow_iterations = 4;
   int shrink_iterations = 7;
+
+  std::string validate() const;
+};
+
+// The corrector: chord (or modified Newton) iterations on the bordered system, and the matrices
+// they use.
+struct CorrectorOptions {
+  int corrector_max_iterations = 8;
   // A point whose corrector converged by at most this many chord iterations on the previous
   // point's matrix keeps that matrix (for its tangent and the next chord) instead of evaluating
   // its own - the variational equations are most of a point's cost on long multiple-shooting
@@ -101,6 +120,12 @@ struct ContinuationOptions {
   // On max |F| and |arclength condition|; NaN: 1e-10, or the problem's Newton residual tolerance
   // (a case's [solver] tolerance) when that is looser - rods with large forces need it.
   double corrector_tolerance = std::numeric_limits<double>::quiet_NaN();
+
+  std::string validate() const;
+};
+
+// The special points a run looks for, and which of them stop it.
+struct DetectionOptions {
   bool detect_folds = true;
   bool detect_branch_points = true;
   // Located branch point: smallest singular value of the bordered matrix below this times the
@@ -110,12 +135,26 @@ struct ContinuationOptions {
   std::vector<ContinuationEvent> events;
   int stop_at_branch_point = 0;       // > 0: stop once this many branch points have been found
   bool stop_at_fold = false;          // stop at the first fold (a homotopy that must not turn back)
+
+  std::string validate() const;
+};
+
+// What a run records at each point: the recorder, and the rod layer's default recorder's settings.
+struct RecordOptions {
   std::vector<std::string> derived;   // computed at every point (and available to events)
   int samples = 101;                  // profile points for invariants and derived quantities
   bool compute_invariants = true;     // false skips sampling (derived from events need it)
   // The stability index of every point (stability.hpp): about one Jacobian's worth of
   // integration per point. Folds and branch points then show the exchange of stability.
   bool compute_stability = false;
+  // What is recorded at each point; nullopt: the rod layer's default from compute_invariants,
+  // samples, derived and compute_stability above (rod_point_recorder, point_record.hpp).
+  std::optional<PointRecorder> recorder;
+
+  std::string validate() const;
+};
+
+struct ContinuationOptions : ContinuationRange, StepControl, CorrectorOptions, DetectionOptions, RecordOptions {
   // A check of each step that a converged corrector cannot make (that the rod did not pass
   // through itself: SelfPassageGuard): a non-empty answer refuses the step, which is retried
   // shorter; refused at the minimum step, the run stops as Inadmissible with that answer.
@@ -125,10 +164,8 @@ struct ContinuationOptions {
   // same steps as the uninterrupted run (see MarchState). Contact continuations report through
   // their own ContactStateSink instead (it adds the leg's state) and replace this one.
   std::function<void(const MarchState&)> on_resumable;
-  // What is recorded at each point; nullopt: the rod layer's default from compute_invariants,
-  // samples, derived and compute_stability above (rod_point_recorder, point_record.hpp).
-  std::optional<PointRecorder> recorder;
 
+  // Every group's validate(), then the rules between groups.
   std::string validate() const;
 };
 
