@@ -270,6 +270,8 @@ py::dict stability_dict(const StabilityReport& st, const DiscreteStability& disc
     check["trustworthy"] = discrete.trustworthy;
     check["check"] = discrete.check_message;
     check["agrees"] = discrete.trustworthy && st.index && *st.index == *discrete.index;
+    if (!discrete.sliding_length.empty() && std::isfinite(discrete.reduced_curvature))
+      check["reduced_energy_curvature"] = discrete.reduced_curvature;
     d["cross_check"] = check;
   }
   d["method"] = st.method;

@@ -2,6 +2,7 @@
 #include "kirchhoff/analysis/discrete_stability.hpp"
 
 #include "kirchhoff/analysis/detail/discrete_stability_contact.hpp"
+#include "kirchhoff/analysis/detail/stability_free_length.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -43,6 +44,11 @@ struct Reading {
   Vec2 start_force = Vec2::Zero(), end_force = Vec2::Zero();  // dead loads applied at the ends
   double start_moment = 0.0, end_moment = 0.0;
   std::vector<Constraint> constraints;
+  // A sliding length (stability_free_length.hpp): the rod's length ell is an unknown of the
+  // energy, which gains the part inside the sleeve, H_in ell (read_sliding_length). Empty name:
+  // the length is given.
+  std::string sliding;
+  double inside_hamiltonian = 0.0;
 };
 
 std::string format(double v) {
@@ -66,9 +72,11 @@ Vec3 slot_rate(const SlotCondition& slot, const Parameters& p, const std::string
 }
 
 // The unknown parameters that are end loads (Lagrange multipliers), or why one is not.
-std::string multiplier_loads(const ShootingProblem& problem, const Parameters& p, std::vector<std::string>* loads) {
+std::string multiplier_loads(const ShootingProblem& problem, const Parameters& p, const std::string& sliding,
+                             std::vector<std::string>* loads) {
   const ProblemDefinition& d = problem.definition();
   for (const std::string& name : d.unknown_parameters) {
+    if (name == sliding) continue;  // a degree of freedom of the energy, not a load
     if (d.model_parameters.count(name) || d.obstacle_parameters.count(name))
       return "the unknown parameter '" + name + "' changes the rod or an obstacle, not an end load";
     bool load = false;
@@ -115,14 +123,56 @@ std::string not_covered(const ShootingProblem& problem, const Eigen::VectorXd& x
     if (!model.v_hat[i].is_constant() || model.v_hat[i](0.0) != (i == 2 ? 1.0 : 0.0))
       return "natural shear or stretch (v_hat is not (0, 0, 1)): not modelled by the discrete check";
   if (std::string why = contacts_not_covered(problem, x, model); !why.empty()) return why;
-  for (const EndCondition* end : {&d.start, &d.end}) {
+  for (const EndCondition* end : {&d.start, &d.end})
     if (end->is_half_turn_symmetry()) return "half of a symmetric rod: the discrete check needs the whole rod";
-    int extra_slots = 0;
-    for (const SlotCondition& slot : end->conditions()) extra_slots += slot.extra ? 1 : 0;
-    if (end->extra_count() > extra_slots)
-      return "an end closed by the continuity of H (a sleeve): its sliding length is not modelled";
-  }
   return "";
+}
+
+// An end closed by the continuity of H is a sleeve's exit, and the unknown that balances it the
+// length ell outside the sleeve, if stability_free_length's classification says so (one such
+// unknown and no other, a uniform rod without a field, H at one end only). The part inside the
+// sleeve is straight along the exit's fixed tangent t (the exit is clamped: checked in
+// exit_is_clamped) and carries no bending energy; the sleeve's frictionless reactions are normal
+// to it, so its axial force is constant, n.t = H_in, the value the H condition names (H = n.t on
+// a straight part). Its inner end, at distance L_total - ell from the exit, carries a dead load
+// F; its potential -F.r changes with ell as F.t ell at an exit at s = L (the inner end lies
+// beyond it, n = F there) and as -F.t ell at an exit at s = 0 (the inner end before it, n = -F):
+// H_in ell either way, up to a constant. So the whole energy is the outside rod's plus H_in ell.
+// That needs H_in to be a constant: an H condition whose value changes with ell does not describe
+// a dead load on a straight part, and the inside energy is then not known.
+std::string read_sliding_length(const ShootingProblem& problem, const Eigen::VectorXd& x, Reading* out) {
+  const ProblemDefinition& d = problem.definition();
+  const bool exit_at_start = has_hamiltonian_condition(d.start);
+  if (!exit_at_start && !has_hamiltonian_condition(d.end)) return "";
+  const std::string name = rod_changing_unknown(problem);
+  if (name.empty())
+    return "an end closed by the continuity of H (a sleeve) without an unknown length of rod to balance it: no "
+           "energy is known whose stationarity the H condition is";
+  if (std::string why = sliding_length_reason(problem, x, name); !why.empty())
+    return "a sleeve whose sliding length is not covered: " + why;
+  if (!problem.contacts_at(x).empty())
+    return "a contact on a rod with a sliding length: not modelled by the discrete check";
+  const auto& value = (exit_at_start ? d.start : d.end).hamiltonian_condition();
+  const Parameters p = problem.parameters_at(x);
+  Parameters moved = p;
+  moved.set(name, p.get(name) * (1 + 1e-3) + 1e-3);
+  out->inside_hamiltonian = value(p);
+  if (value(problem.completed(moved)) != out->inside_hamiltonian)
+    return "the H that the sleeve's exit is held to changes with the sliding length '" + name +
+           "': not the constant H of a straight part under a dead load, so the part inside has no known energy";
+  out->sliding = name;
+  return "";
+}
+
+// The sleeve's exit holds the rod's position and direction (both position components and the
+// angle), so that the part inside is straight along a fixed line.
+bool exit_is_clamped(const Reading& reading, bool exit_at_start) {
+  int positions = 0, angles = 0;
+  for (const Constraint& c : reading.constraints) {
+    positions += c.kind == (exit_at_start ? Held::StartPosition : Held::EndPosition) ? 1 : 0;
+    angles += c.kind == (exit_at_start ? Held::StartAngle : Held::EndAngle) ? 1 : 0;
+  }
+  return positions == 2 && angles == 1;
 }
 
 // Reads one end's conditions: dead loads into `force`/`moment`, held quantities into constraints.
@@ -175,11 +225,13 @@ void read_end(const RodEquations& eq, const EndCondition& end, bool at_start, co
   }
 }
 
-// The discretised rod at N elements: energy, constraints and their derivatives.
+// The discretised rod at N elements: energy, constraints and their derivatives. With a sliding
+// length the last unknown is ell, and the element length h = ell / N follows it (step(z)).
 class DiscreteRod {
  public:
   DiscreteRod(const RodModel& model, const Reading& reading, const std::vector<RodPoint>& nodes)
-      : N_(static_cast<int>(nodes.size()) - 1), h_(model.length / N_), reading_(reading), field_(model.field.get()) {
+      : N_(static_cast<int>(nodes.size()) - 1), h_(model.length / N_), reading_(reading), field_(model.field.get()),
+        sliding_(!reading.sliding.empty()) {
     for (const RodPoint& q : nodes) {
       arclengths_.push_back(q.s);
       if (field_ && field_->force_gradient(q.s, q.r).norm() > 0) position_dependent_ = true;
@@ -212,10 +264,14 @@ class DiscreteRod {
   }
 
   int elements() const { return N_; }
-  int unknowns() const { return N_ + 3; }  // r_0 (2), theta_0..theta_N
+  int unknowns() const { return N_ + 3 + (sliding_ ? 1 : 0); }  // r_0 (2), theta_0..theta_N, [ell]
   int constraints() const { return static_cast<int>(reading_.constraints.size()); }
   const Constraint& constraint(int k) const { return reading_.constraints[k]; }
-  double h() const { return h_; }
+  bool sliding() const { return sliding_; }
+  int length_index() const { return N_ + 3; }  // ell's place among the unknowns, when it slides
+  // The element length at z: ell / N with a sliding length, else L / N. (The constructor's lumped
+  // uniform field uses L / N: read_sliding_length refuses a field with a sliding length.)
+  double step(const Eigen::VectorXd& z) const { return sliding_ ? z[length_index()] / N_ : h_; }
   double weight(int i) const { return (i == 0 || i == N_) ? 0.5 : 1.0; }
   double stiffness_scale() const { return stiffness_scale_; }
   static int angle(int j) { return 2 + j; }
@@ -223,7 +279,7 @@ class DiscreteRod {
 
   Vec2 end_position(const Eigen::VectorXd& z) const {
     Vec2 r = z.head<2>();
-    for (int j = 0; j <= N_; ++j) r += h_ * weight(j) * tangent(z[angle(j)]);
+    for (int j = 0; j <= N_; ++j) r += step(z) * weight(j) * tangent(z[angle(j)]);
     return r;
   }
 
@@ -232,7 +288,7 @@ class DiscreteRod {
     const std::vector<Vec2> r = positions(z);
     const int i = contact_node_[k];
     const Obstacle& o = *constraint(k).obstacle;
-    return closest_approach(o.gap(lift(r[i - 1])), o.gap(lift(r[i])), o.gap(lift(r[i + 1])), h_);
+    return closest_approach(o.gap(lift(r[i - 1])), o.gap(lift(r[i])), o.gap(lift(r[i + 1])), step(z));
   }
 
   Eigen::VectorXd constraint_values(const Eigen::VectorXd& z) const {
@@ -253,11 +309,14 @@ class DiscreteRod {
 
   Eigen::MatrixXd constraint_jacobian(const Eigen::VectorXd& z) const {
     Eigen::MatrixXd J = Eigen::MatrixXd::Zero(constraints(), unknowns());
+    const Vec2 end = end_position(z);
     for (int k = 0; k < constraints(); ++k) {
       const Constraint& c = reading_.constraints[k];
       switch (c.kind) {
         case Held::EndPosition:
-          for (int j = 0; j <= N_; ++j) J(k, angle(j)) = h_ * weight(j) * c.direction.dot(normal(z[angle(j)]));
+          for (int j = 0; j <= N_; ++j) J(k, angle(j)) = step(z) * weight(j) * c.direction.dot(normal(z[angle(j)]));
+          // r_N - r_0 is proportional to ell at fixed angles.
+          if (sliding_) J(k, length_index()) = c.direction.dot(end - z.head<2>()) / z[length_index()];
           [[fallthrough]];
         case Held::StartPosition: J.block<1, 2>(k, 0) = c.direction.transpose(); break;
         case Held::StartAngle: J(k, angle(0)) = 1.0; break;
@@ -304,11 +363,24 @@ class DiscreteRod {
     (*gradient)[angle(0)] -= reading_.start_moment;
     (*gradient)[angle(N_)] -= reading_.end_moment;
     if (hessian) hessian->setZero(unknowns(), unknowns());
+    const double h = step(z);
     for (int j = 0; j <= N_; ++j) {
       const double theta = z[angle(j)];
       const Vec2 G = beyond[j + 1] + (j >= 1 ? beyond[j] : Vec2::Zero());
-      (*gradient)[angle(j)] -= 0.5 * h_ * normal(theta).dot(G);
-      if (hessian) (*hessian)(angle(j), angle(j)) += 0.5 * h_ * tangent(theta).dot(G);
+      (*gradient)[angle(j)] -= 0.5 * h * normal(theta).dot(G);
+      if (hessian) (*hessian)(angle(j), angle(j)) += 0.5 * h * tangent(theta).dot(G);
+      // The loads' potential -sum P_i.r_i is linear in ell at fixed angles (r_i - r_0 scales with
+      // it), so its ell derivatives are the angle terms over ell; d/dr_0 does not depend on ell.
+      if (hessian && sliding_) {
+        const double cross = -0.5 * h * normal(theta).dot(G) / z[length_index()];
+        (*hessian)(angle(j), length_index()) += cross;
+        (*hessian)(length_index(), angle(j)) += cross;
+      }
+    }
+    if (sliding_) {
+      double work = 0.0;  // sum P_i.(r_i - r_0)
+      for (int i = 0; i <= N_; ++i) work += force[i].dot(r[i] - r.front());
+      (*gradient)[length_index()] += reading_.inside_hamiltonian - work / z[length_index()];
     }
     if (hessian && position_dependent_) add_field_stiffness(z, hessian);
     if (hessian)
@@ -340,7 +412,9 @@ class DiscreteRod {
     lagrangian(z, lambda, &gradient, nullptr);
     const double F = residual_scale(lambda);
     double worst = gradient.head<2>().cwiseAbs().maxCoeff() / F;
-    worst = std::max(worst, gradient.tail(N_ + 1).cwiseAbs().maxCoeff() / (h_ * F));
+    worst = std::max(worst, gradient.segment(angle(0), N_ + 1).cwiseAbs().maxCoeff() / (step(z) * F));
+    // The length's equation is a force balance along the sleeve (energy per length), like r_0's.
+    if (sliding_) worst = std::max(worst, std::abs(gradient[length_index()]) / F);
     const Eigen::VectorXd g = constraint_values(z);
     for (int k = 0; k < constraints(); ++k)
       worst = std::max(worst, std::abs(g[k]) / (angular(reading_.constraints[k]) ? 1.0 : N_ * h_));
@@ -356,7 +430,8 @@ class DiscreteRod {
   std::vector<Vec2> positions(const Eigen::VectorXd& z) const {
     std::vector<Vec2> r(N_ + 1);
     r[0] = z.head<2>();
-    for (int i = 1; i <= N_; ++i) r[i] = r[i - 1] + 0.5 * h_ * (tangent(z[angle(i - 1)]) + tangent(z[angle(i)]));
+    const double h = step(z);
+    for (int i = 1; i <= N_; ++i) r[i] = r[i - 1] + 0.5 * h * (tangent(z[angle(i - 1)]) + tangent(z[angle(i)]));
     return r;
   }
 
@@ -364,7 +439,7 @@ class DiscreteRod {
   Eigen::MatrixXd node_jacobian(int i, const Eigen::VectorXd& z) const {
     Eigen::MatrixXd D = Eigen::MatrixXd::Zero(2, unknowns());
     D.leftCols(2).setIdentity();
-    for (int j = 0; j <= i; ++j) D.col(angle(j)) = 0.5 * h_ * a(i, j) * normal(z[angle(j)]);
+    for (int j = 0; j <= i; ++j) D.col(angle(j)) = 0.5 * step(z) * a(i, j) * normal(z[angle(j)]);
     return D;
   }
   static double a(int i, int j) { return (j < i ? 1.0 : 0.0) + (j >= 1 && j <= i ? 1.0 : 0.0); }
@@ -376,7 +451,8 @@ class DiscreteRod {
     std::vector<Vec2> force = nodal_;
     if (!position_dependent_) return force;
     const std::vector<Vec2> r = positions(z);
-    for (int i = 0; i <= N_; ++i) force[i] += h_ * weight(i) * field_->force(arclengths_[i], lift(r[i])).head<2>();
+    const double h = step(z);
+    for (int i = 0; i <= N_; ++i) force[i] += h * weight(i) * field_->force(arclengths_[i], lift(r[i])).head<2>();
     return force;
   }
 
@@ -390,12 +466,12 @@ class DiscreteRod {
     std::vector<Eigen::Matrix2d> K(N_ + 1), S(N_ + 2, Eigen::Matrix2d::Zero());
     for (int i = 0; i <= N_; ++i) {
       const Eigen::Matrix2d g = field_->force_gradient(arclengths_[i], lift(r[i])).topLeftCorner<2, 2>();
-      K[i] = -h_ * weight(i) * 0.5 * (g + g.transpose());
+      K[i] = -step(z) * weight(i) * 0.5 * (g + g.transpose());
     }
     for (int m = N_; m >= 0; --m) S[m] = S[m + 1] + K[m];
     auto beyond = [](int j) { return j >= 1 ? 2.0 : 1.0; };  // a_ij for every i > j
     std::vector<Vec2> n(N_ + 1);
-    for (int j = 0; j <= N_; ++j) n[j] = 0.5 * h_ * normal(z[angle(j)]);
+    for (int j = 0; j <= N_; ++j) n[j] = 0.5 * step(z) * normal(z[angle(j)]);
     hessian->topLeftCorner<2, 2>() += S[0];
     for (int k = 0; k <= N_; ++k) {
       // r_0 with theta_k: sum_{i >= k} a_ik K_i n_k.
@@ -428,17 +504,31 @@ class DiscreteRod {
     *hessian -= (lambda / c.curvature) * u * u.transpose();
   }
 
+  // B / (2 h) (d - h u_hat)^2 per element, d = theta_e+1 - theta_e. With a sliding length, h =
+  // ell / N: the element's energy B d^2 / (2 h) - B d u_hat + B h u_hat^2 / 2 has dh derivative
+  // -B d^2 / (2 h^2) + B u_hat^2 / 2, d dh derivative -B d / h^2 and second dh derivative
+  // B d^2 / h^3 (B and u_hat do not depend on s: read_sliding_length asks for a uniform rod).
   void add_bending(const Eigen::VectorXd& z, Eigen::VectorXd* gradient, Eigen::MatrixXd* hessian) const {
+    const double h = step(z), dh = 1.0 / N_;  // dh / d ell
     for (int e = 0; e < N_; ++e) {
-      const double k = bending_[e] / h_;
-      const double moment = k * (z[angle(e + 1)] - z[angle(e)] - h_ * natural_[e]);  // B (theta' - u_hat)
+      const double k = bending_[e] / h, d = z[angle(e + 1)] - z[angle(e)];
+      const double moment = k * (d - h * natural_[e]);  // B (theta' - u_hat)
       (*gradient)[angle(e + 1)] += moment;
       (*gradient)[angle(e)] -= moment;
+      if (sliding_)
+        (*gradient)[length_index()] += dh * bending_[e] * (natural_[e] * natural_[e] - d * d / (h * h)) / 2;
       if (!hessian) continue;
       (*hessian)(angle(e), angle(e)) += k;
       (*hessian)(angle(e + 1), angle(e + 1)) += k;
       (*hessian)(angle(e), angle(e + 1)) -= k;
       (*hessian)(angle(e + 1), angle(e)) -= k;
+      if (!sliding_) continue;
+      const double cross = -dh * bending_[e] * d / (h * h);  // d^2 / d ell d theta_e+1
+      (*hessian)(angle(e + 1), length_index()) += cross;
+      (*hessian)(length_index(), angle(e + 1)) += cross;
+      (*hessian)(angle(e), length_index()) -= cross;
+      (*hessian)(length_index(), angle(e)) -= cross;
+      (*hessian)(length_index(), length_index()) += dh * dh * bending_[e] * d * d / (h * h * h);
     }
   }
 
@@ -452,6 +542,7 @@ class DiscreteRod {
   std::vector<Vec2> nodal_;                // dead loads and lumped uniform-field forces
   std::vector<int> contact_node_;          // per constraint: a contact's middle node, else -1
   double stiffness_scale_ = 1.0, load_scale_ = 0.0;
+  bool sliding_ = false;  // ell is the last unknown
 };
 
 // One discrete solve and its spectrum.
@@ -466,6 +557,13 @@ struct Spectrum {
   std::vector<double> bending;
   std::string contact_problem;  // a contact whose discrete solve is not the shooting one's, else ""
   bool contacts = false;        // the eigenvalues converge at first order only (see self_check)
+  // With a sliding length: the sliding direction's own second variation when it was negative (it
+  // adds one to the index beside the eigenvalues), why it could not be eliminated (else ""), the
+  // discrete d^2 E*/d ell^2, and |ell - ell_shooting| / ell.
+  int massless_negative = 0;
+  std::string sliding_problem;
+  double reduced_curvature = NAN;
+  double length_deviation = 0.0;
 };
 
 // Starting values: the shooting solution at the nodes, multipliers by least squares.
@@ -474,6 +572,7 @@ void starting_point(const DiscreteRod& rod, const std::vector<RodPoint>& nodes, 
   z->resize(rod.unknowns());
   z->head<2>() = nodes.front().r.head<2>();
   for (int j = 0; j <= rod.elements(); ++j) (*z)[DiscreteRod::angle(j)] = nodes[j].turn_angle;
+  if (rod.sliding()) (*z)[rod.length_index()] = nodes.back().s - nodes.front().s;
   Eigen::VectorXd gradient;
   rod.lagrangian(*z, Eigen::VectorXd::Zero(rod.constraints()), &gradient, nullptr);
   const Eigen::MatrixXd Jt = rod.constraint_jacobian(*z).transpose();
@@ -526,58 +625,120 @@ void refine(const DiscreteRod& rod, Eigen::VectorXd* z, Eigen::VectorXd* lambda,
 }
 
 // The Hessian of the Lagrangian on the admissible perturbations, with the weight M = diag(h c_j)
-// of int dtheta^2. The start position r_0 enters the energy linearly, so it drops out: of the
-// constraints J_r dr_0 + J_theta dtheta = 0, those combinations free of r_0 (U^T J_r = 0) restrict
-// dtheta, the rest fix dr_0, and directions of r_0 that no constraint sees are rigid translations.
-// In y = M^1/2 dtheta the problem is the compression of A = M^-1/2 H M^-1/2 onto the complement of
+// of int dtheta^2. The massless unknowns m - the start position r_0 and, with a sliding length,
+// ell - carry no weight. Of the constraints J_m dm + J_theta dtheta = 0, the combinations free of
+// m (U2^T J_m = 0) restrict dtheta (rows C), and the rest fix dm = R dtheta + N alpha: R the
+// least-squares solution, N the null space of J_m, massless directions with dtheta = 0. Those with
+// d ell = 0 are rigid translations that no end holds (zero weight, zero energy: the energy depends
+// on r_0 only linearly, unless a field or a curved contact makes it depend on position, which
+// discrete_stability() refuses where r_0 is free). With a sliding length N may hold one direction
+// with d ell != 0: the rod sliding at a fixed shape (r_0 following where the constraints ask). It
+// has no weight, so it has no eigenvalue of its own; its second variation a (2 E_bend / ell^2 for
+// a uniform rod, since at fixed angles the bending energy goes as 1 / ell and the loads' potential
+// is linear in ell) is eliminated by the Schur complement Q - q q^T / a, which pairs each dtheta
+// with the d ell that makes the energy stationary. By Sylvester's law of inertia and its
+// additivity over a Schur complement (Haynsworth), the form on (dtheta, alpha) has as many
+// negative eigenvalues as the complement on dtheta plus (a < 0): the index is read from the
+// complement's eigenvalues in the weight int dtheta^2, in the same units as without a sliding
+// length. (a = 0, a straight rod, would leave the elimination undefined: sliding_problem.)
+// In y = M^1/2 dtheta the problem is the compression of A = M^-1/2 Q M^-1/2 onto the complement of
 // the constraint rows V; it is computed as the spectrum of P A P + sigma V V^T (P = I - V V^T)
 // with sigma above every eigenvalue of A, so the c constrained directions sit at the top.
 void spectrum(const DiscreteRod& rod, const Eigen::VectorXd& z, const Eigen::VectorXd& lambda, bool modes,
               Spectrum* out) {
-  const int n = rod.elements() + 1;
+  const int n = rod.elements() + 1, first = DiscreteRod::angle(0);
   Eigen::VectorXd gradient;
   Eigen::MatrixXd H;
   rod.lagrangian(z, lambda, &gradient, &H);
   const Eigen::MatrixXd J = rod.constraint_jacobian(z);
   Eigen::VectorXd root_mass(n);
-  for (int j = 0; j < n; ++j) root_mass[j] = std::sqrt(rod.h() * rod.weight(j));
-  Eigen::MatrixXd C(0, n);
-  out->translations = 2;
-  // dr_0 = R dtheta on the admissible perturbations where the constraints fix r_0 (rank 2).
-  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(2, n);
-  if (J.rows() > 0) {
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J.leftCols(2), Eigen::ComputeFullU);
-    int rank = 0;  // J_r's entries are unit directions or gap gradients: singular values are 0 or O(1)
-    for (int i = 0; i < svd.singularValues().size(); ++i) rank += svd.singularValues()[i] > 1e-10 ? 1 : 0;
-    out->translations = 2 - rank;
-    C = svd.matrixU().rightCols(J.rows() - rank).transpose() * J.rightCols(n);
-    if (rank == 2) {
-      const Eigen::MatrixXd U1 = svd.matrixU().leftCols(2);
-      R = -(U1.transpose() * J.leftCols(2)).inverse() * (U1.transpose() * J.rightCols(n));
-    }
+  for (int j = 0; j < n; ++j) root_mass[j] = std::sqrt(rod.step(z) * rod.weight(j));
+  std::vector<int> massless = {0, 1};
+  if (rod.sliding()) massless.push_back(rod.length_index());
+  const int k = static_cast<int>(massless.size());
+  Eigen::MatrixXd J_m(J.rows(), k), H_mm(k, k), H_ma(k, n);
+  for (int a = 0; a < k; ++a) {
+    J_m.col(a) = J.col(massless[a]);
+    H_ma.row(a) = H.row(massless[a]).segment(first, n);
+    for (int b = 0; b < k; ++b) H_mm(a, b) = H(massless[a], massless[b]);
   }
-  // Where the energy depends on r_0 (a field that depends on position, a contact with a disc),
-  // the admissible dr_0 = R dtheta enters the form; otherwise H's r_0 blocks vanish and this is
-  // H_theta,theta itself. (discrete_stability() refuses such a case when r_0 is not fixed.)
-  const Eigen::MatrixXd H_angles = H.bottomRightCorner(n, n) + R.transpose() * H.topRightCorner(2, n) +
-                                   H.bottomLeftCorner(n, 2) * R + R.transpose() * H.topLeftCorner<2, 2>() * R;
+  const Eigen::MatrixXd J_a = J.middleCols(first, n);
+  Eigen::MatrixXd C(0, n), R = Eigen::MatrixXd::Zero(k, n), null_m = Eigen::MatrixXd::Identity(k, k);
+  if (J.rows() > 0) {
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J_m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    // J_m's entries are unit directions, gap gradients or chord components over ell: its singular
+    // values are 0 (to round-off) or O(1).
+    int rank = 0;
+    for (int i = 0; i < svd.singularValues().size(); ++i) rank += svd.singularValues()[i] > 1e-10 ? 1 : 0;
+    C = svd.matrixU().rightCols(J.rows() - rank).transpose() * J_a;
+    R = -svd.matrixV().leftCols(rank) * svd.singularValues().head(rank).cwiseInverse().asDiagonal() *
+        svd.matrixU().leftCols(rank).transpose() * J_a;
+    null_m = svd.matrixV().rightCols(k - rank);
+  }
+  // The sliding direction (along ell's components of the null space) and the rigid ones.
+  Eigen::VectorXd slide;
+  Eigen::MatrixXd rigid = null_m;
+  if (rod.sliding() && null_m.cols() > 0 && null_m.row(k - 1).norm() > 1e-10) {
+    const int c = static_cast<int>(null_m.cols());
+    // An orthonormal basis of the null space's coefficients whose first column is along ell's
+    // components: the others have d ell = 0.
+    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(null_m.row(k - 1).transpose());
+    const Eigen::MatrixXd basis = qr.householderQ() * Eigen::MatrixXd::Identity(c, c);
+    slide = null_m * basis.col(0);
+    rigid = null_m * basis.rightCols(c - 1);
+  }
+  out->translations = static_cast<int>(rigid.cols());
+  Eigen::MatrixXd Q =
+      H.block(first, first, n, n) + R.transpose() * H_ma + H_ma.transpose() * R + R.transpose() * H_mm * R;
+  if (slide.size() > 0) {
+    const double a = slide.dot(H_mm * slide);
+    const Eigen::VectorXd q = (H_ma.transpose() + R.transpose() * H_mm) * slide;
+    // a has the units of B / L^3; the zero modes' tolerance in those units.
+    if (std::abs(a) <= kDiscreteStabilityZeroTolerance * rod.stiffness_scale() / z[rod.length_index()]) {
+      out->sliding_problem = "sliding the rod at a fixed shape does not change its energy to second order (a "
+                             "straight rod): the sliding length cannot be eliminated, the index is not defined here";
+      return;
+    }
+    Q -= q * q.transpose() / a;
+    out->massless_negative = a < 0 ? 1 : 0;
+  }
   const Eigen::MatrixXd scaled_rows = root_mass.cwiseInverse().asDiagonal() * C.transpose();  // n x c
   const Eigen::MatrixXd V = Eigen::HouseholderQR<Eigen::MatrixXd>(scaled_rows).householderQ() *
                             Eigen::MatrixXd::Identity(n, C.rows());
   const Eigen::VectorXd inverse_root = root_mass.cwiseInverse();
-  const Eigen::MatrixXd A = inverse_root.asDiagonal() * H_angles * inverse_root.asDiagonal();
+  const Eigen::MatrixXd A = inverse_root.asDiagonal() * Q * inverse_root.asDiagonal();
   const double sigma = 2 * A.cwiseAbs().rowwise().sum().maxCoeff() + 1;  // twice Gershgorin's bound
   const Eigen::MatrixXd AV = A * V, VAV = V.transpose() * AV;
   const Eigen::MatrixXd projected =
       A - AV * V.transpose() - V * AV.transpose() + V * (VAV + sigma * Eigen::MatrixXd::Identity(V.cols(), V.cols())) * V.transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(projected, modes ? Eigen::ComputeEigenvectors : Eigen::EigenvaluesOnly);
-  const int k = n - static_cast<int>(V.cols());
-  out->eigenvalues.assign(eig.eigenvalues().data(), eig.eigenvalues().data() + k);
+  const int count = n - static_cast<int>(V.cols());
+  out->eigenvalues.assign(eig.eigenvalues().data(), eig.eigenvalues().data() + count);
   if (!modes) return;
-  const Eigen::MatrixXd K = rod.bending_hessian().bottomRightCorner(n, n);  // r_0 does not bend
-  const Eigen::MatrixXd modes_of_unit_weight = inverse_root.asDiagonal() * eig.eigenvectors().leftCols(k);
+  const Eigen::MatrixXd K = rod.bending_hessian().block(first, first, n, n);  // r_0 does not bend
+  const Eigen::MatrixXd modes_of_unit_weight = inverse_root.asDiagonal() * eig.eigenvectors().leftCols(count);
   const Eigen::VectorXd bending = (modes_of_unit_weight.transpose() * K * modes_of_unit_weight).diagonal();
-  out->bending.assign(bending.data(), bending.data() + k);
+  out->bending.assign(bending.data(), bending.data() + count);
+}
+
+// The discrete counterpart of stability_free_length's S = d^2 E*/d ell^2, E* the energy along the
+// equilibria at fixed length: with K = [H_zz J_z^T; J_z 0] the fixed-length KKT matrix and
+// b = [H_z,ell; J_ell] its ell column, (dz, dlambda)/d ell = -K^-1 b and
+//   S_d = H_ell,ell - b^T K^-1 b.
+// NaN where K is singular (the fixed-length problem has a zero mode or a free translation).
+double reduced_curvature(const DiscreteRod& rod, const Eigen::VectorXd& z, const Eigen::VectorXd& lambda) {
+  Eigen::VectorXd gradient;
+  Eigen::MatrixXd H;
+  rod.lagrangian(z, lambda, &gradient, &H);
+  const Eigen::MatrixXd J = rod.constraint_jacobian(z);
+  const int n = rod.length_index(), m = rod.constraints();  // ell is the last unknown
+  Eigen::MatrixXd K(n + m, n + m);
+  K << H.topLeftCorner(n, n), J.leftCols(n).transpose(), J.leftCols(n), Eigen::MatrixXd::Zero(m, m);
+  Eigen::VectorXd b(n + m);
+  b << H.col(n).head(n), J.col(n);
+  const Eigen::FullPivLU<Eigen::MatrixXd> lu(K);
+  if (!lu.isInvertible()) return NAN;
+  return H(n, n) - b.dot(lu.solve(b));
 }
 
 // Each contact of the discrete solve pushes (its multiplier is minus its force) and its closest
@@ -590,7 +751,7 @@ std::string contact_problem(const DiscreteRod& rod, const Eigen::VectorXd& z, co
     const std::string which = "the contact at s = " + format(rod.constraint(k).s);
     if (!(-lambda[k] > 0))
       return which + " pulls in the discrete solve (force " + format(-lambda[k]) + "): not the shooting equilibrium";
-    if (!(std::abs(c.offset) <= rod.h() && c.curvature > 0))
+    if (!(std::abs(c.offset) <= rod.step(z) && c.curvature > 0))
       return which + " has moved off its interpolant's nodes in the discrete solve: not the shooting equilibrium";
   }
   return "";
@@ -605,7 +766,11 @@ Spectrum solve_and_analyse(const RodModel& model, const Reading& reading, const 
   starting_point(rod, nodes, &z, &lambda);
   const Eigen::VectorXd start = z;
   refine(rod, &z, &lambda, &out);
-  out.angle_deviation = (z - start).tail(rod.elements() + 1).cwiseAbs().maxCoeff();
+  out.angle_deviation = (z - start).segment(DiscreteRod::angle(0), rod.elements() + 1).cwiseAbs().maxCoeff();
+  if (rod.sliding()) {
+    out.length_deviation = std::abs(z[rod.length_index()] / start[rod.length_index()] - 1);
+    out.reduced_curvature = reduced_curvature(rod, z, lambda);
+  }
   out.contact_problem = contact_problem(rod, z, lambda);
   for (int k = 0; k < rod.constraints(); ++k) out.contacts = out.contacts || rod.constraint(k).kind == Held::Contact;
   spectrum(rod, z, lambda, modes, &out);
@@ -665,6 +830,7 @@ struct Counts {
 Counts count(const Spectrum& s, double zero_tolerance) {
   Counts c;
   c.zero = s.translations;
+  c.index = s.massless_negative;
   for (double mu : s.eigenvalues) {
     if (mu < -zero_tolerance) ++c.index;
     else if (mu <= zero_tolerance) ++c.zero;
@@ -686,12 +852,20 @@ std::string self_check(const Spectrum& fine, const Spectrum& coarse, double zero
   if (fine.angle_deviation > 1e-9 && !(fine.angle_deviation < coarse.angle_deviation))
     return "the discrete equilibrium does not approach the shooting one as the elements halve (" +
            format(coarse.angle_deviation) + " rad, then " + format(fine.angle_deviation) + ")";
+  // A sliding length's relative difference is held to the angles' tolerance (both O(h^2)).
+  if (!(fine.length_deviation <= kDiscreteStabilityAngleTolerance))
+    return "the discrete sliding length is " + format(fine.length_deviation) +
+           " of itself from the shooting one: another equilibrium, or the discretisation does not resolve it";
+  if (fine.length_deviation > 1e-9 && !(fine.length_deviation < coarse.length_deviation))
+    return "the discrete sliding length does not approach the shooting one as the elements halve (" +
+           format(coarse.length_deviation) + ", then " + format(fine.length_deviation) + " of itself)";
   const Counts a = count(fine, zero_tolerance), b = count(coarse, zero_tolerance);
   if (a.index != b.index || a.zero != b.zero)
     return "N and N/2 elements disagree: index " + std::to_string(a.index) + " / " + std::to_string(b.index) +
            ", zero modes " + std::to_string(a.zero) + " / " + std::to_string(b.zero);
   // The reported eigenvalues, and every one up to the first above the index and zero modes.
-  const size_t wanted = std::max(kDiscreteStabilityReported, a.index + a.zero - fine.translations + 1);
+  const size_t wanted =
+      std::max(kDiscreteStabilityReported, a.index - fine.massless_negative + a.zero - fine.translations + 1);
   // Second order, the error at N is a third of the change; with a contact the sliding term's
   // g'' is a second difference across the jump of g''' that the contact force makes, so the
   // eigenvalues converge at first order (measured: the antisymmetric modes at wall.toml's
@@ -725,18 +899,25 @@ DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen
   const Parameters p = problem.parameters_at(x);
   const std::shared_ptr<const RodEquations> eq = problem.equations(p);
   const RodModel& model = eq->model();
+  Reading reading;
   out.reason = not_covered(problem, x, model);
+  if (out.reason.empty()) out.reason = read_sliding_length(problem, x, &reading);
   std::vector<std::string> multipliers;
-  if (out.reason.empty()) out.reason = multiplier_loads(problem, p, &multipliers);
+  if (out.reason.empty()) out.reason = multiplier_loads(problem, p, reading.sliding, &multipliers);
   if (!out.reason.empty()) return out;
+  out.sliding_length = reading.sliding;
 
   std::vector<double> s(elements + 1);
   for (int j = 0; j <= elements; ++j) s[j] = model.length * j / elements;
   const std::vector<RodPoint> nodes = problem.sample(x, s);
-  Reading reading;
   const ProblemDefinition& d = problem.definition();
   read_end(*eq, d.start, true, nodes.front(), p, multipliers, &reading);
   read_end(*eq, d.end, false, nodes.back(), p, multipliers, &reading);
+  if (!reading.sliding.empty() && !exit_is_clamped(reading, has_hamiltonian_condition(d.start))) {
+    out.reason = "the sleeve's exit does not hold the rod's position and direction: the part inside is not "
+                 "straight along a fixed line, and its energy is not known";
+    return out;
+  }
   read_contacts(problem, x, &reading);
   if (DiscreteRod(model, reading, nodes).position_dependent() || curved_contact(reading)) {
     if (!start_position_fixed(DiscreteRod(model, reading, nodes), nodes)) {
@@ -757,6 +938,11 @@ DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen
   // eigenvectors give them at an eighth of the cost of the fine one's.
   const Spectrum fine = solve_and_analyse(model, reading, nodes, false);
   const Spectrum coarse = solve_and_analyse(model, reading, coarse_nodes, true);
+  for (const Spectrum* spectrum : {&fine, &coarse})
+    if (!spectrum->sliding_problem.empty()) {
+      out.reason = spectrum->sliding_problem;
+      return out;
+    }
   const double scale = DiscreteRod(model, reading, nodes).stiffness_scale();
   out.zero_tolerance = kDiscreteStabilityZeroTolerance * scale;
   const Counts counts = count(fine, out.zero_tolerance);
@@ -769,6 +955,10 @@ DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen
   out.kkt_residual = std::max(fine.kkt_residual, coarse.kkt_residual);
   out.angle_deviation = fine.angle_deviation;
   out.coarse_angle_deviation = coarse.angle_deviation;
+  out.length_deviation = fine.length_deviation;
+  out.coarse_length_deviation = coarse.length_deviation;
+  out.reduced_curvature = fine.reduced_curvature;
+  out.coarse_reduced_curvature = coarse.reduced_curvature;
   out.newton_iterations = fine.iterations;
   out.check_message = self_check(fine, coarse, out.zero_tolerance);
   out.trustworthy = out.check_message.empty();

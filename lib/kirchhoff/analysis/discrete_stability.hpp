@@ -34,6 +34,18 @@
 // with a disc), its admissible perturbation, fixed by the held positions as dr_0 = R dtheta,
 // enters the projected form; a start that may translate is then not covered.
 //
+// A sliding length (the rod's length ell outside a frictionless sleeve, an unknown balanced by the
+// continuity of H at the sleeve's exit, as stability_free_length.hpp classifies it) is an unknown
+// of the energy too: h = ell / N, and the energy gains the part inside the sleeve, straight along
+// the clamped exit's tangent under the axial force H_in that the H condition names: H_in ell up to
+// a constant (its inner end's dead load moves by -/+ d ell along the sleeve). The stationarity in
+// ell is then the H condition. ell has no weight in int dtheta^2: where the constraints leave a
+// direction that slides the rod at fixed angles, it is eliminated by a Schur complement (the
+// second variation of that direction, 2 E_bend / ell^2, is positive for a bent rod), and by the
+// inertia additivity of Schur complements the index is the complement's count (spectrum() in the
+// .cpp). The discrete d^2 E*/d ell^2 along its fixed-length equilibria (reduced_curvature)
+// converges to stability_free_length's S at second order.
+//
 // From the shooting solution sampled at the nodes, Newton solves the discrete KKT system
 // (gradient of the Lagrangian, constraints) with the exact Hessian. The Hessian of the Lagrangian
 // is projected on the null space Z of the constraint Jacobian, and the generalised eigenproblem
@@ -47,7 +59,8 @@
 // The check checks itself (trustworthy = false with the reason in check_message otherwise):
 //   - the KKT residual at N and N/2 elements below kDiscreteStabilityKktTolerance;
 //   - the discrete equilibrium close to the shooting one (kDiscreteStabilityAngleTolerance), and
-//     closer at N than at N/2 (it converges to the shooting solution, not to another one);
+//     closer at N than at N/2 (it converges to the shooting solution, not to another one); a
+//     sliding length's relative difference likewise;
 //   - the lowest eigenvalues at N and N/2 agreeing to kDiscreteStabilityAgreement of the sum of
 //     their parts' magnitudes (bending and loads), index and zero modes equal, and every eigenvalue counted with a sign that
 //     the refinement cannot change (|mu_N| > |mu_N - mu_N/2|, three times the Richardson
@@ -58,12 +71,19 @@
 // Not covered (index empty, reason given): spatial or extensible rods, natural shear or stretch,
 // extended contacts, contacts with a level-set obstacle, a contact with zero force (weakly
 // active) or where the rod flattens onto the obstacle (g'' = 0), half rods by symmetry, a field
-// that depends on position (or a disc contact) on a rod whose start may translate, an end closed
-// by the continuity of H (a sleeve), unknown parameters that are not end loads, dependent
-// constraints (a straight rod whose chord is held: no perturbation keeps it to first order).
+// that depends on position (or a disc contact) on a rod whose start may translate, unknown
+// parameters that are neither end loads nor a sliding length, dependent constraints (a straight
+// rod whose chord is held: no perturbation keeps it to first order). Of sleeves: what
+// stability_free_length refuses (a field, a non-uniform rod, other unknowns beside the length, a
+// length that changes the rod's properties or is not closed by H at exactly one end), an H
+// condition without a sliding length to balance it, an H value that changes with ell (not a dead
+// load on a straight part: the inside part's energy is unknown), an exit that does not hold the
+// rod's position and direction, a contact on a sliding rod, and a straight sliding rod (sliding at
+// fixed shape costs no energy: the elimination is not defined).
 #pragma once
 
 #include <Eigen/Dense>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -84,6 +104,12 @@ struct DiscreteStability {
   double kkt_residual = 0.0;       // the larger of the two solves' scaled KKT residuals
   double angle_deviation = 0.0;    // max_j |theta_j - theta(s_j)| against the shooting solution, at N
   double coarse_angle_deviation = 0.0;  // the same at N/2
+  // With a sliding length (its name, else empty): |ell - ell(shooting)| / ell at N and N/2, and
+  // the discrete energy's d^2 E*/d ell^2 along its fixed-length equilibria at N and N/2, the
+  // counterpart of stability_free_length's S (NaN where the fixed-length problem is singular).
+  std::string sliding_length;
+  double length_deviation = 0.0, coarse_length_deviation = 0.0;
+  double reduced_curvature = NAN, coarse_reduced_curvature = NAN;
   int elements = 0;
   int newton_iterations = 0;  // at N
   bool trustworthy = false;

@@ -70,6 +70,9 @@ nlohmann::json stability_json(const StabilityReport& st, const DiscreteStability
                         {"trustworthy", discrete->trustworthy},
                         {"check", discrete->check_message},
                         {"agrees", discrete->trustworthy && st.index && *st.index == *discrete->index}};
+    // With a sliding length: the discrete d^2 E*/d ell^2, beside the conjugate points' S below.
+    if (!discrete->sliding_length.empty() && std::isfinite(discrete->reduced_curvature))
+      j["cross_check"]["reduced_energy_curvature"] = discrete->reduced_curvature;
   }
   j["method"] = st.method;
   if (st.reduced_energy_curvature) {

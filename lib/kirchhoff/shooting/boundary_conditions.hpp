@@ -83,6 +83,8 @@ class EndCondition {
   // sleeve: H is continuous across the exit (sections 6.3, 7.3), and inside the straight sleeve
   // it is the inner tension (e.g. -P for a rod pushed by P, 0 for an unloaded end: eq. 55, Fig. 8).
   EndCondition& impose_hamiltonian(std::function<double(const Parameters&)> value);
+  // The value of the H condition imposed by impose_hamiltonian, empty when there is none.
+  const std::function<double(const Parameters&)>& hamiltonian_condition() const { return hamiltonian_; }
 
   const std::vector<SlotCondition>& conditions() const { return conditions_; }
   // The half-turn symmetry this end imposes without a turn of its own (half_turn_symmetry without

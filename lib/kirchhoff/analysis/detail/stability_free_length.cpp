@@ -9,14 +9,6 @@ namespace {
 
 constexpr const char* kMethod = "conjugate_points+reduced_energy";
 
-int extra_slot_count(const EndCondition& end) {
-  return static_cast<int>(std::count_if(end.conditions().begin(), end.conditions().end(),
-                                         [](const SlotCondition& c) { return c.extra; }));
-}
-
-// Whether the end carries an H condition (the only extra condition that is not a slot).
-bool has_hamiltonian_condition(const EndCondition& end) { return end.extra_count() > extra_slot_count(end); }
-
 // The end as stated without its H condition: the same slot conditions, added again.
 EndCondition without_hamiltonian(const EndCondition& end) {
   EndCondition stripped;
@@ -135,6 +127,17 @@ FreeLengthStability undefined(FreeLengthStability out, const std::string& reason
 
 }  // namespace
 
+bool has_hamiltonian_condition(const EndCondition& end) { return static_cast<bool>(end.hamiltonian_condition()); }
+
+std::string sliding_length_reason(const ShootingProblem& problem, const Eigen::VectorXd& x, const std::string& name) {
+  if (std::string why = unsupported_reason(problem, name); !why.empty()) return why;
+  try {
+    return energy_slope_reason(problem, x, name);
+  } catch (const std::exception& e) {
+    return std::string("the rod could not be built at a nearby length: ") + e.what();
+  }
+}
+
 std::string rod_changing_unknown(const ShootingProblem& problem) {
   const ProblemDefinition& d = problem.definition();
   for (const std::string& name : d.unknown_parameters) {
@@ -166,16 +169,12 @@ FreeLengthStability analyse_free_length(const ShootingProblem& problem, const Ei
   out.reduced_curvature = out.curvature_scale = NAN;
   out.parameter = rod_changing_unknown(problem);
   if (out.parameter.empty()) return undefined(out, "no unknown parameter changes the rod: not a sliding length");
+  if (std::string why = sliding_length_reason(problem, x, out.parameter); !why.empty()) return undefined(out, why);
   FixedLengthProblem fixed;
   try {
     fixed = fixed_length_problem(problem, x, out.parameter);
   } catch (const std::exception& e) {
     return undefined(out, e.what());
-  }
-  try {
-    if (std::string why = energy_slope_reason(problem, x, out.parameter); !why.empty()) return undefined(out, why);
-  } catch (const std::exception& e) {
-    return undefined(out, std::string("the rod could not be built at a nearby length: ") + e.what());
   }
   const std::string held = "with the length '" + out.parameter + "' held: ";
   out.fixed_length = analyse_stability(*fixed.problem, fixed.x, options);

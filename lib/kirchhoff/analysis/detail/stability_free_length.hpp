@@ -63,6 +63,14 @@ struct FreeLengthStability {
 // analyse_stability covers the problem).
 std::string rod_changing_unknown(const ShootingProblem& problem);
 
+// Why the unknown `name` (rod_changing_unknown's) is not a sliding length this reduction covers,
+// "" when it is: the classification both stability analyses use (this one and the discretised
+// energy's, discrete_stability.hpp), with the reasons listed above.
+std::string sliding_length_reason(const ShootingProblem& problem, const Eigen::VectorXd& x, const std::string& name);
+
+// Whether the end carries an H condition (impose_hamiltonian): the sleeve's exit of a sliding length.
+bool has_hamiltonian_condition(const EndCondition& end);
+
 // The problem with the sliding length `name` given at its value in x and its H condition dropped,
 // and x without that unknown: what E*(ell) is the energy of. Throws std::invalid_argument with the
 // reason when it cannot be built.
