@@ -34,9 +34,7 @@ PointRecorder rod_point_recorder(const ContinuationOptions& options) {
     };
   if (options.compute_stability)
     recorder.record = [](const ShootingProblem& problem, ContinuationPoint* point) {
-      StabilityOptions only_the_index;
-      only_the_index.symmetric_index_where_contact_acts = false;  // not recorded
-      const StabilityReport stability = analyse_stability(problem, point->x, only_the_index);
+      const StabilityReport stability = analyse_stability(problem, point->x);
       point->stability_index = stability.index;
       point->zero_modes = stability.zero_modes;
     };

@@ -307,12 +307,11 @@ class StabilityAnalysis {
 
   StabilityReport run();
 
-  // Follow, at every step of the fields' integration, the largest stiffness of the antisymmetric
-  // barrier term of `original`'s half-turn self-contact (stability_symmetric.hpp) along the
-  // equilibrium: the steps are refined where the barrier is stiff (field_rate), and the distance
-  // from the axis is smooth in s, so its minimum is found to ~ its curvature x step^2.
+  // Check, at every step of the fields' integration, that the sliding partners of `original`'s
+  // half-turn self-contact are defined where it acts (sliding_reason, stability_symmetric.hpp):
+  // the steps are refined where the barrier is stiff (field_rate).
   void track_barrier(std::shared_ptr<const RodEquations> original) { barrier_eq_ = std::move(original); }
-  double barrier_stiffness() const { return barrier_stiffness_; }
+  const std::string& sliding_reason() const { return sliding_reason_; }
 
  private:
   struct Held {
@@ -361,7 +360,7 @@ class StabilityAnalysis {
   // Multipliers whose particular fields start at s = 0 and constraints recorded before L (see Frame).
   int start_multipliers_ = 0, recorded_before_contacts_ = 0;
   std::shared_ptr<const RodEquations> barrier_eq_;  // track_barrier
-  double barrier_stiffness_ = 0.0;
+  std::string sliding_reason_;  // track_barrier: the first point where the sliding partners are not defined
 };
 
 StabilityAnalysis::Held StabilityAnalysis::held_at(const EndCondition& end,
@@ -598,9 +597,8 @@ void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int dept
   }
   record(track->lifted, f->s, phases, s1, track);
   *f = next;
-  if (barrier_eq_)
-    barrier_stiffness_ =
-        std::max(barrier_stiffness_, antisymmetric_barrier_stiffness(*barrier_eq_, {eq_->point(f->y, f->s)}));
+  if (barrier_eq_ && sliding_reason_.empty())
+    sliding_reason_ = kirchhoff::sliding_reason(*barrier_eq_, eq_->point(f->y, f->s), options_.zero_tolerance);
 }
 
 // Across a point contact (normal nu, force f > 0, the rod curving away from the obstacle):
@@ -991,29 +989,14 @@ StabilityReport whole_rod(const StabilityReport& symmetric, const StabilityRepor
   return out;
 }
 
-// Where the self-contact acts, the whole rod's antisymmetric second variation is not that of the
-// partner pairs (stability_symmetric.hpp): the index is not reported, the symmetric half's when
-// it was computed.
-StabilityReport self_contact_acts(const StabilityReport* symmetric, long rhs_evaluations) {
+// Where the sliding contact partners are not defined (stability_symmetric.hpp), the whole rod's
+// index is not; the symmetric half's is given.
+StabilityReport sliding_undefined(const std::string& reason, const StabilityReport& symmetric, long rhs_evaluations) {
   StabilityReport out;
-  out.reason = "the self-contact acts: the whole rod's index needs the antisymmetric perturbations of the "
-               "contact between the strands (their closest points sliding along both), which are not "
-               "implemented";
-  if (!symmetric) return out;
-  out.reason += "; the symmetric perturbations' index is given";
-  out.symmetric_index = symmetric->index;
-  out.rhs_evaluations = symmetric->rhs_evaluations + rhs_evaluations;
+  out.reason = reason + "; the symmetric perturbations' index is given";
+  out.symmetric_index = symmetric.index;
+  out.rhs_evaluations = symmetric.rhs_evaluations + rhs_evaluations;
   return out;
-}
-
-// The equilibrium at the shooting nodes, read from the unknowns (no integration).
-std::vector<RodPoint> node_points(const ShootingProblem& problem, const Eigen::VectorXd& x, const RodEquations& eq) {
-  const std::vector<double> s = problem.node_arclengths(x);
-  const int n = problem.state_size();
-  std::vector<RodPoint> nodes;
-  for (int i = 0; i < problem.segments() && i < static_cast<int>(s.size()); ++i)
-    nodes.push_back(eq.point(x.segment(i * n, n), s[i]));
-  return nodes;
 }
 
 }  // namespace
@@ -1030,20 +1013,13 @@ StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::V
     // antisymmetric ones have the complementary conditions and, with self-contact, the pair
     // energy's other second variation.
     const auto equations = problem.equations(problem.parameters_at(x));
-    // Acting already at a shooting node (a formed ply), the antisymmetric pass - its steps refined
-    // through the stiff barrier - could only end in the null below: it is not run.
-    const bool acts_at_nodes =
-        antisymmetric_barrier_stiffness(*equations, node_points(problem, x, *equations)) > options.zero_tolerance;
-    if (acts_at_nodes && !options.symmetric_index_where_contact_acts) return self_contact_acts(nullptr, 0);
     const StabilityReport symmetric = StabilityAnalysis(problem, x, options, end, nullptr).run();
-    if (acts_at_nodes) return self_contact_acts(&symmetric, 0);
     const EndCondition anti_end = antisymmetric_half_turn_end(end.half_turn_axis());
     StabilityAnalysis anti(problem, x, options, anti_end, antisymmetric_equations(*equations));
     anti.track_barrier(equations);
     const StabilityReport antisymmetric = anti.run();
-    // Below the zero tolerance the term moves no eigenvalue beyond what is called zero anyway.
-    if (anti.barrier_stiffness() > options.zero_tolerance)
-      return self_contact_acts(&symmetric, antisymmetric.rhs_evaluations);
+    if (!anti.sliding_reason().empty())
+      return sliding_undefined(anti.sliding_reason(), symmetric, antisymmetric.rhs_evaluations);
     return whole_rod(symmetric, antisymmetric);
   } catch (const IntegrationError& e) {
     StabilityReport report;

@@ -99,11 +99,6 @@ struct StabilityOptions {
   // (position-dependent fields, contacts with curved obstacles); forcing it elsewhere only checks
   // that the two frames count alike (tests).
   bool positions_as_configuration = false;
-  // On half of a half-turn symmetric rod whose self-contact acts at a shooting node (where the
-  // whole rod's index is not defined), still compute the symmetric half's index
-  // (StabilityReport::symmetric_index). Continuation records only the index, and skips it: through
-  // a formed ply it costs several times the rest of the point.
-  bool symmetric_index_where_contact_acts = true;
 };
 
 struct StabilityReport {
@@ -118,8 +113,8 @@ struct StabilityReport {
   int constraint_correction = 0;         // index - dead_load_index
   // Half of a half-turn symmetric rod (a `half_turn` end): the counts above are the whole rod's,
   // the sums of the symmetric and antisymmetric halves, whose indices are these (empty otherwise).
-  // Where the whole rod's index is not defined, symmetric_index may still be (the self-contact
-  // acting: stability_symmetric.hpp).
+  // Where the whole rod's index is not defined, symmetric_index may still be (the self-contact's
+  // sliding partners not defined: stability_symmetric.hpp).
   std::optional<int> symmetric_index, antisymmetric_index;
   std::string method = "conjugate_points";
   // A sliding length among the unknowns (stability_free_length.hpp, method

@@ -42,7 +42,8 @@ Eigen::Vector4d quaternion_from_rotation(const Mat3& R) {
 class SpatialEquations final : public RodEquations {
  public:
   explicit SpatialEquations(RodModel model, std::optional<CylinderSupport> support = std::nullopt)
-      : model_(std::move(model)), support_(std::move(support)) {}
+      : model_(std::move(model)), support_(std::move(support)),
+        tangent_stiffness_(model_.field && !support_ && model_.field->has_tangent_stiffness()) {}
 
   int state_size() const override { return kStateSize; }
   const RodModel& model() const override { return model_; }
@@ -88,6 +89,13 @@ class SpatialEquations final : public RodEquations {
     dy[kM] = n[1] * dr[2] - n[2] * dr[1];
     dy[kM + 1] = n[2] * dr[0] - n[0] * dr[2];
     dy[kM + 2] = n[0] * dr[1] - n[1] * dr[0];
+    if (tangent_stiffness_) {
+      // Only the linearisation changes (a stability analysis' term, rod_model.hpp): d3' = R (u x e3).
+      const T* d3[3] = {&R[0][2], &R[1][2], &R[2][2]};
+      double d3_prime[3];
+      for (int i = 0; i < 3; ++i) d3_prime[i] = value(R[i][0] * u[1] - R[i][1] * u[0]);
+      detail::add_tangent_stiffness(*model_.field, s, y + kR, d3, d3_prime, dy + kN, dy + kM);
+    }
     if (model_.symmetry_unfolding != 0.0) {
       const double mu = model_.symmetry_unfolding;
       dy[kM] = dy[kM] + mu * R[0][2];
@@ -250,6 +258,7 @@ class SpatialEquations final : public RodEquations {
  private:
   RodModel model_;
   std::optional<CylinderSupport> support_;  // set: the rod lies on this cylinder
+  bool tangent_stiffness_ = false;           // the field has a tangent stiffness (rod_model.hpp)
 };
 
 }  // namespace

@@ -48,6 +48,16 @@ Mat3 FieldSum::force_gradient(double s, const Vec3& r) const {
   return total;
 }
 
+bool FieldSum::has_tangent_stiffness() const {
+  for (const auto& f : fields_)
+    if (f->has_tangent_stiffness()) return true;
+  return false;
+}
+void FieldSum::add_tangent_stiffness(double s, const Vec3& r, const Vec3& d3, const Vec3& d3_prime,
+                                     Eigen::Matrix<double, 6, 6>* S) const {
+  for (const auto& f : fields_) f->add_tangent_stiffness(s, r, d3, d3_prime, S);
+}
+
 double FieldSum::gap(double s, const Vec3& r) const {
   double smallest = std::numeric_limits<double>::quiet_NaN();
   for (const auto& f : fields_) {

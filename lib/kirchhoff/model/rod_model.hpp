@@ -50,6 +50,15 @@ class ExternalField {
   virtual Mat3 force_gradient(double s, const Vec3& r) const = 0;
   // Distance to the obstacle the field models (soft walls); NaN when it models none.
   virtual double gap(double, const Vec3&) const { return std::numeric_limits<double>::quiet_NaN(); }
+  // A term of the second variation that depends on the tangent d3 = r' as well as on r, for fields
+  // that exist only in a stability analysis (the sliding contact partners of a half-turn
+  // self-contact, analysis/detail/stability_symmetric.hpp): adds to S (6 x 6, symmetric, on
+  // z = (dr, dd3)) the field's part of d2E/de2 = z.S z beyond dr.Hess W dr. It has no first
+  // variation, so the equilibrium equations do not change; their linearisation gains
+  // dn' += S_rr dr + S_rt dd3 and dm' += d3 x (S_tr dr + S_tt dd3) (the spatial equations only).
+  virtual bool has_tangent_stiffness() const { return false; }
+  virtual void add_tangent_stiffness(double /*s*/, const Vec3& /*r*/, const Vec3& /*d3*/, const Vec3& /*d3_prime*/,
+                                     Eigen::Matrix<double, 6, 6>* /*S*/) const {}
 };
 
 // Weight per unit length w acting along -up: W_ext = w r.up (section 3.1, rho S g r.e_z).
@@ -89,6 +98,9 @@ class FieldSum final : public ExternalField {
   Vec3 force(double s, const Vec3& r) const override;
   Mat3 force_gradient(double s, const Vec3& r) const override;
   double gap(double s, const Vec3& r) const override;  // the smallest of the fields' gaps
+  bool has_tangent_stiffness() const override;
+  void add_tangent_stiffness(double s, const Vec3& r, const Vec3& d3, const Vec3& d3_prime,
+                             Eigen::Matrix<double, 6, 6>* S) const override;
   const std::vector<std::shared_ptr<const ExternalField>>& fields() const { return fields_; }
 
  private:

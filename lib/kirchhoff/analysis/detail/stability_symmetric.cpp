@@ -5,13 +5,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace kirchhoff {
+
+double shift_curvature(const Vec3& axis, const Vec3& radial, const Vec3& d3, const Vec3& d3_prime) {
+  const double alpha = axis.dot(d3);
+  return alpha * alpha + radial.dot(d3_prime);
+}
+
 namespace {
 
-// The half-turn self-contact as the antisymmetric perturbations see it: the same force on the
-// equilibrium, the force gradient of the pair energy on dr(L - s) = -Q dr(s), which is
-// (f.d) / rho^2 a a^T (stability_symmetric.hpp).
+// The half-turn self-contact as the antisymmetric perturbations see it (stability_symmetric.hpp):
+// the same force on the equilibrium; the pair energy's second variation with the partners held,
+// as a force gradient (f.d) / rho^2 a a^T, and the partners' sliding as a tangent stiffness
+// k v v^T on (dr, dd3), v = (alpha a, d), k = (f.d) / (rho^2 kappa).
 class AntisymmetricPairBarrier final : public ExternalField {
  public:
   explicit AntisymmetricPairBarrier(std::shared_ptr<const HalfTurnSelfContact> barrier)
@@ -26,6 +34,19 @@ class AntisymmetricPairBarrier final : public ExternalField {
     return (f.dot(d) / d.squaredNorm()) * g.axis * g.axis.transpose();
   }
   double gap(double s, const Vec3& r) const override { return barrier_->gap(s, r); }
+  bool has_tangent_stiffness() const override { return true; }
+  void add_tangent_stiffness(double s, const Vec3& r, const Vec3& d3, const Vec3& d3_prime,
+                             Eigen::Matrix<double, 6, 6>* S) const override {
+    const Vec3 f = barrier_->force(s, r);
+    if (f.isZero(0.0)) return;
+    const HalfTurnGeometry& g = barrier_->geometry();
+    const Vec3 d = g.radial(r);
+    const double kappa = shift_curvature(g.axis, d, d3, d3_prime);
+    if (!(kappa > 0)) return;  // not a minimum along the shift: stability.cpp reports it (sliding_reason)
+    Eigen::Matrix<double, 6, 1> v;
+    v << g.axis.dot(d3) * g.axis, d;
+    *S += (f.dot(d) / (d.squaredNorm() * kappa)) * v * v.transpose();
+  }
 
  private:
   std::shared_ptr<const HalfTurnSelfContact> barrier_;
@@ -72,6 +93,22 @@ double antisymmetric_barrier_stiffness(const RodEquations& eq, const std::vector
     largest = std::max(largest, std::abs(barrier->force(q.s, q.r).dot(d)) / d.squaredNorm());
   }
   return largest * std::pow(model.length, 4) / model.B[0](0.0);
+}
+
+std::string sliding_reason(const RodEquations& eq, const RodPoint& q, double zero_tolerance) {
+  const HalfTurnSelfContact* barrier = find_half_turn_self_contact(eq.model());
+  if (!barrier || !(antisymmetric_barrier_stiffness(eq, {q}) > zero_tolerance)) return "";
+  if (eq.is_planar())
+    return "the self-contact acts on a planar rod: the sliding contact partners of its antisymmetric perturbations "
+           "are implemented in the spatial equations only";
+  const Vec3 d3 = q.R.col(2), d3_prime = q.R * q.u.cross(Vec3::UnitZ());
+  const double kappa = shift_curvature(barrier->geometry().axis, barrier->geometry().radial(q.r), d3, d3_prime);
+  if (kappa > 0) return "";
+  std::ostringstream out;
+  out << "the self-contact acts where the strands' distance is not a minimum along their relative shift "
+         "(alpha^2 + d.r'' = "
+      << kappa << " at s = " << q.s << "): the sliding partners are not defined there";
+  return out.str();
 }
 
 }  // namespace kirchhoff

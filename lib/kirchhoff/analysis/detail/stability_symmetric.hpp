@@ -35,23 +35,55 @@
 //   symmetric:     dd = (I - Q) dr = 2 (I - a a^T) dr: w [phi'' e e^T + phi' / rho (I - a a^T -
 //                  e e^T)], twice the half rod's Hess W - the field the case has, unchanged;
 //   antisymmetric: dd = (I + Q) dr = 2 a (a.dr), along a, across d: only phi' enters, and the
-//                  pair's second variation is int_0^l w phi' / rho (a.dr)^2, i.e. the half
-//                  problem's field Hessian is H = w phi' / rho a a^T (phi' < 0: sliding the strands
-//                  past each other along the axis lengthens d at second order and lowers the
-//                  repulsion). As a force gradient df/dr = -H = (f.d_r) / rho^2 a a^T, with f the
-//                  barrier's force and d_r the radial vector (f = -w phi' d_r / rho).
-// Where the barrier acts this is the second variation of the partner-pair energy above, but not
-// of the whole rod's self-contact: the case defines its energy on symmetric configurations only,
-// and pairing s with L - s for ever is one extension of it, not the physical one. Antisymmetric
-// perturbations slide the strands past each other; the pair of closest points then moves along
-// both strands (as a point contact slides along its obstacle, stability.hpp), and a contact
-// between strands lying along each other does not open, whereas the fixed partners separate and
-// the term above lowers the energy by ~ contact pressure / R x (a.dr)^2. Along plectoneme.toml's
-// branch it made every equilibrium past the end loop's closing unstable in one antisymmetric
-// direction (and the crossings non-monotone at some), against what the rod literature finds for
-// the ply under end-rotation control. So where the barrier acts the whole rod's index is not
-// reported (the symmetric half's is); the field above is what the antisymmetric half uses where
-// it does not act, to round-off (tested against finite differences of the pair energy).
+//                  pair's second variation with the partners held is int_0^l w phi' / rho (a.dr)^2,
+//                  a field Hessian H = w phi' / rho a a^T (phi' < 0: it lowers the energy).
+// Holding the partners is one extension of the case's energy, which is defined on symmetric
+// configurations only, and not the physical one for antisymmetric perturbations: they slide the
+// strands past each other, and a contact between strands lying along each other does not open
+// when they slide; held partners separate. Computed so, every equilibrium of plectoneme.toml past
+// the end loop's closing had an antisymmetric negative direction.
+//
+// The sliding partners. The energy of a real contact depends on where the strands are, not on
+// which material points face each other: E_pair = int_0^L w phi(D / 2 - R), D the distance of a
+// cross-section to the other strand. Two such distances:
+//   closest point:  D_c(s) = min_t |r(s) - r(t)|;
+//   common shift:   D(sigma) = min_u |r(sigma + u) - r(L - sigma + u)| (u near 0).
+// Both are unchanged when one strand slides along itself (for D: sliding strand 2 by tau turns
+// D(sigma) into D(sigma + tau / 2), and the integral over sigma stays, where w is 1). On a
+// symmetric configuration the common shift's minimum is at u = 0 exactly (with F(u) = |r(sigma + u)
+// - r(L - sigma + u)|^2, F_u(0) = 2 d.(r'(s) - r'(L - s)) = 2 d.(I + Q) r' = 4 (a.r') d.a = 0), so
+// D = |d| = 2 rho: E_pair is the case's energy on symmetric configurations and the solved
+// equilibrium is its critical point. The closest point is L - s only where rho' = 0
+// (d.r'(L - s) = -(rho^2)'), so D_c < 2 rho where the distance to the axis varies: it is not an
+// extension of the case's energy, and the solved equilibrium is not its critical point (by
+// ~ w phi' rho rho'^2). The common shift is the one used. Its second variation for
+// z = dr, antisymmetric (z(L - s) = -Q z(s), z'(L - s) = Q z'(s)), at u(e) minimising F(u, e):
+//   d2(min_u F)/de2 = F_ee - F_ue^2 / F_uu                           (F_u = 0 at e = 0)
+//   F_ee = 2 |z(s) - z(L - s)|^2 = 8 (a.z)^2
+//   F_ue = 2 [(r'(s) - r'(L - s)).(z(s) - z(L - s)) + d.(z'(s) - z'(L - s))]
+//        = 2 [2 alpha a.2 a (a.z) + 2 rho_vec.2 z'] = 8 (alpha a.z + rho_vec.z')
+//   F_uu = 2 |r'(s) - r'(L - s)|^2 + 2 d.(r''(s) - r''(L - s)) = 8 (alpha^2 + rho_vec.r'') = 8 kappa
+// with alpha = a.r', rho_vec = d / 2 the radial vector, r'(L - s) = -Q r', r''(L - s) = Q r''.
+// (Symmetric z keep the configuration symmetric, u = 0 and D = |d|: F_ue = 0, that half is
+// unchanged, and the halves stay uncoupled.) D' = d.dd / D = 0 (dd along a), so D'' = d2F / (2 D)
+// and the pair's second variation is
+//   int_0^L w phi' D'' / 2 = 2 int_0^l w phi' / rho [(a.z)^2 - (alpha a.z + rho_vec.z')^2 / kappa],
+// i.e. on the half rod z.H z (H above, the partners held) plus the sliding term
+//   k (alpha a.z + rho_vec.z')^2,   k = -w phi' / (rho kappa) = (f.d_r) / (rho^2 kappa) > 0,
+// a multiplier times (a contact-point shift)^2 / (the distance's curvature along the shift), as
+// f (nu.dr')^2 / (2 g'') for a point contact (stability.cpp). It does not cancel H: on a uniform ply
+// (a helix of pitch angle theta about a, rho' = 0) with z = a, alpha = cos theta, rho_vec.r'' =
+// -sin^2 theta, kappa = cos 2 theta, and the sum is w phi' / rho (1 - cos^2 theta / cos 2 theta)
+// = -w phi' / rho sin^2 theta / cos 2 theta > 0: sliding the strands along the axis turns the
+// double helix's phase and brings them closer, which costs energy. The closest point's second
+// variation (F_tt = 2 (1 - d.r''(t)) = 2 (1 + 2 rho_vec.r'')) has 1 + 2 rho_vec.r'' in place of kappa:
+// they differ by (rho^2)'' / 2, zero on a uniform ply. z' = dr' = dd3 = dpsi x d3 is a rotation, so
+// the term couples positions and rotations: it is given to the fields as the field's tangent
+// stiffness k v v^T on (dr, dd3), v = (alpha a, rho_vec) (rod_model.hpp). It vanishes on rigid
+// motions (F_ue = 0 for z = omega x r, and for translations), so the isotropic rod's turn about the
+// clamps' axis stays a zero mode. kappa > 0 is needed (u = 0 a minimum, not a saddle): where the
+// barrier acts with kappa <= 0 the index is not reported (sliding_reason). Tested against finite
+// differences of E_pair with D found by minimisation on a solved ply (stability_symmetric_test).
 // One-body fields invariant under Q (gravity along a, none in the cases) keep their Hessian on both
 // halves: (Q dr).Hess V(Q r) (Q dr) = dr.Hess V(r) dr.
 #pragma once
@@ -70,10 +102,20 @@ namespace kirchhoff {
 // directions do).
 EndCondition antisymmetric_half_turn_end(const Vec3& axis);
 
-// The rod's equations with the half-turn self-contact's force gradient replaced by the
-// antisymmetric one (above); the equilibrium's force is unchanged. Null when the rod has no
+// The rod's equations with the half-turn self-contact's second variation replaced by the
+// antisymmetric one with sliding partners (above: H as force gradient, the sliding term as tangent
+// stiffness); the equilibrium's force is unchanged. Null when the rod has no
 // half-turn self-contact (its own equations then serve both halves).
 std::shared_ptr<const RodEquations> antisymmetric_equations(const RodEquations& eq);
+
+// kappa = alpha^2 + d.r'' (alpha = a.d3, d the radial vector): the curvature of the strands'
+// squared distance along their relative shift, / 8 (above). The sliding term needs kappa > 0.
+double shift_curvature(const Vec3& axis, const Vec3& radial, const Vec3& d3, const Vec3& d3_prime);
+
+// Why the sliding partners are not defined at the equilibrium's point q of the rod with equations
+// `eq` (its own, with the half-turn self-contact): the barrier acts there (its stiffness as below
+// above zero_tolerance) and kappa <= 0, or the rod is planar. Empty otherwise.
+std::string sliding_reason(const RodEquations& eq, const RodPoint& q, double zero_tolerance);
 
 // The largest stiffness of the antisymmetric barrier term, |w phi'| / rho (above), over the
 // equilibrium's samples, in units of B / L^4 (B the first bending stiffness at s = 0, L the half
