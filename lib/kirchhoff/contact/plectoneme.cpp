@@ -292,38 +292,40 @@ PlectonemeMeasures measure_plectoneme(const ShootingProblem& problem, const Eige
   return m;
 }
 
-const std::vector<std::pair<std::string, std::string>>& plectoneme_quantities() {
-  static const std::vector<std::pair<std::string, std::string>> names = {
-      {"T_ext", "plectoneme: tension n.d3 at the clamp (the end pull T_ext of Fig. 10)"},
-      {"m3", "plectoneme: twisting moment m.d3 at the clamp"},
-      {"helix_angle", "plectoneme: mean angle (rad) between d3 and the axis over the central half of the contact region"},
-      {"helix_radius", "plectoneme: mean distance to the axis over the central half of the contact region (R + gap)"},
-      {"contact_pressure", "plectoneme: mean self-contact force per length over the central half of the contact region"},
-      {"contact_start", "plectoneme: arclength where the contact region starts (half rod)"},
-      {"contact_end", "plectoneme: arclength where the contact region ends (half rod)"},
-      {"H_A", "plectoneme: H in the middle of the contact region (eq. 60)"},
-      {"H_B", "plectoneme: H at the clamped end (eq. 59)"},
-      {"self_distance", "plectoneme: smallest distance between non-neighbouring cross-sections / 2R (>= 1)"},
-      {"loop_clearance", "plectoneme: smallest gap / range where the contact is switched off (H drifts by ~exp(-it^2))"},
-      {"ply_clearance", "plectoneme, hard contact: smallest (rho - R)/R between the ply's contacts (< 0: a new contact)"},
+const std::vector<PlectonemeQuantity>& plectoneme_quantities() {
+  using M = PlectonemeMeasures;
+  static const std::vector<PlectonemeQuantity> table = {
+      {"T_ext", "plectoneme: tension n.d3 at the clamp (the end pull T_ext of Fig. 10)", &M::T_ext},
+      {"m3", "plectoneme: twisting moment m.d3 at the clamp", &M::m3},
+      {"helix_angle",
+       "plectoneme: mean angle (rad) between d3 and the axis over the central half of the contact region (NaN "
+       "without one)",
+       &M::helix_angle},
+      {"helix_radius",
+       "plectoneme: mean distance to the axis over the central half of the contact region (R + gap; NaN without one)",
+       &M::helix_radius},
+      {"contact_pressure",
+       "plectoneme: mean self-contact force per length over the central half of the contact region (NaN without "
+       "one)",
+       &M::contact_pressure},
+      {"contact_start", "plectoneme: arclength where the contact region starts (half rod; NaN without one)",
+       &M::contact_start},
+      {"contact_end", "plectoneme: arclength where the contact region ends (half rod; NaN without one)",
+       &M::contact_end},
+      {"H_A", "plectoneme: H in the middle of the contact region (eq. 60; NaN without one)", &M::H_A},
+      {"H_B", "plectoneme: H at the clamped end (eq. 59)", &M::H_B},
+      {"self_distance", "plectoneme: smallest distance between non-neighbouring cross-sections / 2R (>= 1)",
+       &M::self_distance},
+      {"loop_clearance",
+       "plectoneme: smallest gap / range where the contact is switched off (H drifts by ~exp(-it^2); NaN with hard "
+       "contact)",
+       &M::loop_clearance},
+      {"ply_clearance",
+       "plectoneme, hard contact: smallest (rho - R)/R between the ply's contacts (< 0: a new contact; NaN with the "
+       "barrier or without such a gap)",
+       &M::ply_clearance},
   };
-  return names;
-}
-
-double plectoneme_quantity(const PlectonemeMeasures& m, const std::string& name) {
-  if (name == "T_ext") return m.T_ext;
-  if (name == "m3") return m.m3;
-  if (name == "helix_angle") return m.helix_angle;
-  if (name == "helix_radius") return m.helix_radius;
-  if (name == "contact_pressure") return m.contact_pressure;
-  if (name == "contact_start") return m.contact_start;
-  if (name == "contact_end") return m.contact_end;
-  if (name == "H_A") return m.H_A;
-  if (name == "H_B") return m.H_B;
-  if (name == "self_distance") return m.self_distance;
-  if (name == "loop_clearance") return m.loop_clearance;
-  if (name == "ply_clearance") return m.ply_clearance;
-  throw std::invalid_argument("unknown plectoneme quantity '" + name + "'");
+  return table;
 }
 
 }  // namespace kirchhoff

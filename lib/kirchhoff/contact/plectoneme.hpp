@@ -97,8 +97,13 @@ constexpr double kSelfDistanceSlack = 1e-9;
 PlectonemeMeasures measure_plectoneme(const ShootingProblem& problem, const Eigen::VectorXd& x,
                                       const std::vector<RodPoint>& profile);
 
-// The derived quantities measure_plectoneme provides, by name, with their meaning.
-const std::vector<std::pair<std::string, std::string>>& plectoneme_quantities();
-double plectoneme_quantity(const PlectonemeMeasures& m, const std::string& name);
+// The derived quantities measure_plectoneme provides: name, meaning, and the measure it reads (one
+// table, so that a name cannot lack its value or its meaning).
+struct PlectonemeQuantity {
+  std::string name;
+  std::string meaning;
+  double PlectonemeMeasures::*value;
+};
+const std::vector<PlectonemeQuantity>& plectoneme_quantities();
 
 }  // namespace kirchhoff

@@ -663,9 +663,9 @@ std::vector<std::string> read_derived(const Reader& reader, const Value& v, cons
       reader.fail(v, "output.derived", "'" + name + "' is not a derived quantity (known: " + join(names) + ")");
     }
   const bool self_contact = Reader::find(root, "rod") && Reader::find(*Reader::find(root, "rod"), "self_contact");
-  for (const auto& [name, meaning] : plectoneme_quantities())
-    if (!self_contact && std::find(derived.begin(), derived.end(), name) != derived.end())
-      reader.fail(v, "output.derived", "'" + name + "' is a plectoneme quantity: it needs [rod.self_contact]");
+  for (const auto& q : plectoneme_quantities())
+    if (!self_contact && std::find(derived.begin(), derived.end(), q.name) != derived.end())
+      reader.fail(v, "output.derived", "'" + q.name + "' is a plectoneme quantity: it needs [rod.self_contact]");
   return derived;
 }
 
