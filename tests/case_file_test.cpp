@@ -226,7 +226,7 @@ TEST_F(CaseFileTest, StiffnessIsArray) {
 
 TEST_F(CaseFileTest, SegmentsIsFloat) {
   const std::string text = replaced(kBase, "unknowns = [\"P\"]", "unknowns = [\"P\"]\nsegments = 1.5");
-  expect_refused(text, "solver.segments", {"must be an integer", "floating"}, line_of(text, "segments"));
+  expect_refused(text, "solver.segments", {"must be an integer", "got a float"}, line_of(text, "segments"));
 }
 
 TEST_F(CaseFileTest, UnknownsIsString) {
@@ -670,10 +670,10 @@ TEST_F(CaseFileTest, BadSolverOverridesAreRefusedAsInTheFile) {
   };
   const std::string tolerance = message("tolerance", "1");
   EXPECT_THAT(tolerance, HasSubstr(path + ": --solver tolerance=1: key 'solver.tolerance': must be in (0, 0.01]"));
-  EXPECT_THAT(message("tolerance", "small"), HasSubstr("key 'solver.tolerance': must be a number, got string"));
+  EXPECT_THAT(message("tolerance", "small"), HasSubstr("key 'solver.tolerance': must be a number, got a string"));
   EXPECT_THAT(message("tolernace", "1e-9"), HasSubstr("--solver tolernace=1e-9: key 'solver.tolernace': unknown key"));
   EXPECT_THAT(message("stepper", "rk4"), HasSubstr("key 'solver.stepper': 'rk4' is not 'rk78' or 'dopri5'"));
-  EXPECT_THAT(message("segments", "1.5"), HasSubstr("key 'solver.segments': must be an integer"));
+  EXPECT_THAT(message("segments", "1.5"), HasSubstr("key 'solver.segments': must be an integer, got a float"));
   EXPECT_THAT(message("unknowns", "P"), HasSubstr("key 'solver.unknowns': must be an array of strings"));
   EXPECT_THAT(message("max_iterations", "0"), HasSubstr("must be in [1, 10000]"));
 }

@@ -86,5 +86,39 @@ TEST(SweepFile, ErrorsNameFileLineKeyAndReason) {
   EXPECT_EQ(error_of("case = [\n").rfind("bad.toml: TOML syntax error: ", 0), 0u);
 }
 
+// Sweep files are read by the case files' reader (toml_reader.hpp): numbers, integers and types
+// are refused in the case files' words, with values shown to 15 digits.
+TEST(SweepFile, ValuesAreRefusedInTheCaseFilesWords) {
+  const std::string job = head() + "[[jobs]]\nkind = \"solve\"\n";
+  EXPECT_EQ(error_of(job + "grid = { theta0 = inf }\n"),
+            "bad.toml:4: key 'jobs[1].grid.theta0': must be a finite number, got inf");
+  EXPECT_EQ(error_of(job + "grid = { theta0 = [0.1, 1.2345678901234567e300] }\n"),
+            "bad.toml:4: key 'jobs[1].grid.theta0[1]': must have a magnitude <= 1e+100 (so that the equations' "
+            "products do not overflow), got 1.23456789012346e+300");
+  EXPECT_EQ(error_of(job + "grid = { theta0 = { from = 1, to = 2, count = 2.5 } }\n"),
+            "bad.toml:4: key 'jobs[1].grid.theta0.count': must be an integer, got a float");
+  EXPECT_EQ(error_of(job + "grid = { theta0 = { from = 1, to = 2, count = 0 } }\n"),
+            "bad.toml:4: key 'jobs[1].grid.theta0.count': must be in [1, 1000000], got 0");
+  EXPECT_EQ(error_of(job + "profiles = 1\n"),
+            "bad.toml:4: key 'jobs[1].profiles': must be true or false, got an integer");
+  EXPECT_EQ(error_of(job + "grid = 3\n"),
+            "bad.toml:4: key 'jobs[1].grid': must be a table NAME = values, got an integer");
+}
+
+// The fingerprint (which a resumed sweep compares) and the [solver] texts handed to the case loader
+// keep 17 digits, so that 0.1 and the next double are told apart and read back exactly.
+TEST(SweepFile, FingerprintsAndSolverTextsKeepSeventeenDigits) {
+  const std::string text = head() + "solver = { tolerance = 1e-11 }\n[[jobs]]\nkind = \"solve\"\n" +
+                           "grid = { theta0 = [0.1, 0.10000000000000002] }\n";
+  const SweepSpec spec = load_sweep_text(text, "sweep.toml");
+  ASSERT_EQ(spec.jobs.size(), 2u);
+  EXPECT_EQ(spec.jobs[0].fingerprint(), "solve case=" + kCases + "/simply_supported.toml theta0=0.10000000000000001 "
+                                        "set: solver: tolerance=9.9999999999999994e-12 direct=0 max_seconds=120 "
+                                        "max_equilibria=16 profiles=1");
+  EXPECT_NE(spec.jobs[0].fingerprint(), spec.jobs[1].fingerprint());
+  ASSERT_EQ(spec.jobs[0].solver.size(), 1u);
+  EXPECT_EQ(spec.jobs[0].solver[0].second, "9.9999999999999994e-12");
+}
+
 }  // namespace
 }  // namespace kirchhoff

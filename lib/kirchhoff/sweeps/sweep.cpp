@@ -12,6 +12,7 @@
 #include <toml.hpp>
 
 #include "kirchhoff/jobs/detail/toml_nesting.hpp"
+#include "kirchhoff/jobs/detail/toml_reader.hpp"
 
 namespace kirchhoff {
 
@@ -28,6 +29,7 @@ const char* to_string(SweepJobKind kind) {
 namespace {
 
 using Value = toml::value;
+using toml_reading::type_name;
 
 // Ranges hold at most this many points: a larger count is a typo (a 1e6-job sweep is kMaxJobs).
 constexpr long kMaxRangeCount = 1000000;
@@ -44,23 +46,14 @@ double default_cost(SweepJobKind kind) {
   return 1.0;
 }
 
-std::string shown(double v) {
+// A value as text that reads back to the same double (17 significant digits, where messages
+// show 15): the fingerprint tells values apart by it, and a [solver] number reaches the case
+// loader as this text.
+std::string exact_text(double v) {
   std::ostringstream os;
-  os.precision(17);  // round-trip: the fingerprint tells values apart
+  os.precision(17);
   os << v;
   return os.str();
-}
-
-std::string type_name(const Value& v) {
-  switch (v.type()) {
-    case toml::value_t::boolean: return "a boolean";
-    case toml::value_t::integer: return "an integer";
-    case toml::value_t::floating: return "a float";
-    case toml::value_t::string: return "a string";
-    case toml::value_t::array: return "an array";
-    case toml::value_t::table: return "a table";
-    default: return "a date or time";
-  }
 }
 
 // Entries of a table in the order of the file (toml11 keeps a table's keys unordered): the
@@ -75,65 +68,12 @@ std::vector<std::pair<std::string, const Value*>> in_file_order(const toml::tabl
   return entries;
 }
 
-// Turns every problem into a SweepError naming the file, the line, the key and the reason.
-class Reader {
+// Reads the sweep file's keys, turning every problem into a SweepError naming the file, the line,
+// the key and the reason, in the case files' words (toml_reader.hpp); adds what only sweep files
+// hold: a parameter's values (a number, a list or a range), overrides and [solver] keys.
+class Reader : public toml_reading::KeyReader<SweepError> {
  public:
-  explicit Reader(std::string path) : path_(std::move(path)) {}
-
-  [[noreturn]] void fail(const Value& v, const std::string& key, const std::string& reason) const {
-    std::ostringstream os;
-    os << path_;
-    if (const auto line = v.location().line(); line > 0) os << ":" << line;
-    os << ": key '" << key << "': " << reason;
-    throw SweepError(os.str());
-  }
-  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
-    throw SweepError(path_ + ": key '" + key + "': " + reason);
-  }
-
-  void allow_keys(const Value& table, const std::string& name, const std::set<std::string>& allowed) const {
-    if (!table.is_table()) fail(table, name, "must be a table, got " + type_name(table));
-    for (const auto& entry : table.as_table())
-      if (!allowed.count(entry.first)) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail(entry.second, qualified(name, entry.first), "unknown key (expected one of: " + list + ")");
-      }
-  }
-
-  static std::string qualified(const std::string& table, const std::string& key) {
-    return table.empty() ? key : table + "." + key;
-  }
-  static const Value* find(const Value& table, const std::string& key) {
-    const auto& t = table.as_table();
-    const auto it = t.find(key);
-    return it == t.end() ? nullptr : &it->second;
-  }
-
-  double number(const Value& v, const std::string& key) const {
-    double x = 0.0;
-    if (v.is_floating()) x = v.as_floating();
-    else if (v.is_integer()) x = static_cast<double>(v.as_integer());
-    else fail(v, key, "must be a number, got " + type_name(v));
-    if (!std::isfinite(x) || std::abs(x) > case_limits::kMaxMagnitude)
-      fail(v, key, "must be a finite number with magnitude <= 1e+100, got " + shown(x));
-    return x;
-  }
-  long integer(const Value& v, const std::string& key, long low, long high) const {
-    if (!v.is_integer()) fail(v, key, "must be an integer, got " + type_name(v));
-    const auto x = v.as_integer();
-    if (x < low || x > high)
-      fail(v, key, "must be in [" + std::to_string(low) + ", " + std::to_string(high) + "], got " + std::to_string(x));
-    return static_cast<long>(x);
-  }
-  bool boolean(const Value& v, const std::string& key) const {
-    if (!v.is_boolean()) fail(v, key, "must be true or false, got " + type_name(v));
-    return v.as_boolean();
-  }
-  std::string string(const Value& v, const std::string& key) const {
-    if (!v.is_string()) fail(v, key, "must be a string, got " + type_name(v));
-    return v.as_string().str;
-  }
+  using KeyReader::KeyReader;
 
   // A parameter's values: a number, an array of numbers, or a range
   // { from, to, count [, log = true] } (count points, both ends included; log: evenly spaced in
@@ -190,15 +130,10 @@ class Reader {
     for (const auto& [name, value] : in_file_order(v.as_table())) {
       if (value->is_string()) out.emplace_back(name, value->as_string().str);
       else if (value->is_boolean()) out.emplace_back(name, value->as_boolean() ? "true" : "false");
-      else out.emplace_back(name, shown(number(*value, key + "." + name)));
+      else out.emplace_back(name, exact_text(number(*value, key + "." + name)));
     }
     return out;
   }
-
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
 };
 
 SweepJobKind parse_kind(const Reader& r, const Value& v, const std::string& key) {
@@ -277,19 +212,20 @@ std::string resolve(const std::string& sweep_path, const std::string& case_path)
 std::string SweepJob::fingerprint() const {
   std::ostringstream os;
   os << to_string(kind) << " case=" << case_name;
-  for (const auto& [name, value] : values) os << " " << name << "=" << shown(value);
+  for (const auto& [name, value] : values) os << " " << name << "=" << exact_text(value);
   os << " set:";
-  for (const auto& [name, value] : set) os << " " << name << "=" << shown(value);
+  for (const auto& [name, value] : set) os << " " << name << "=" << exact_text(value);
   os << " solver:";
   for (const auto& [name, value] : solver) os << " " << name << "=" << value;
-  os << " direct=" << direct << " max_seconds=" << shown(max_seconds) << " max_equilibria=" << max_equilibria
+  os << " direct=" << direct << " max_seconds=" << exact_text(max_seconds) << " max_equilibria=" << max_equilibria
      << " profiles=" << profiles;
   if (kind == SweepJobKind::Continue)
-    os << " param=" << param << " to=" << shown(to) << " max_points=" << max_points << " step=" << shown(step)
-       << " min_step=" << shown(min_step) << " max_step=" << shown(max_step) << " branch_points=" << branch_points
-       << " stability=" << stability;
+    os << " param=" << param << " to=" << exact_text(to) << " max_points=" << max_points
+       << " step=" << exact_text(step) << " min_step=" << exact_text(min_step) << " max_step=" << exact_text(max_step)
+       << " branch_points=" << branch_points << " stability=" << stability;
   if (kind == SweepJobKind::Plectonemes)
-    os << " from_ply=" << shown(from_ply) << " from_ply_turns=" << shown(from_ply_turns) << " hard_from=" << shown(hard_from);
+    os << " from_ply=" << exact_text(from_ply) << " from_ply_turns=" << exact_text(from_ply_turns)
+       << " hard_from=" << exact_text(hard_from);
   return os.str();
 }
 
@@ -427,7 +363,7 @@ void read_job_options(const Reader& r, Group* g) {
   }
   if (const Value* v = Reader::find(g->table, "max_equilibria")) {
     if (job.kind != SweepJobKind::Equilibria) r.fail(*v, key + ".max_equilibria", "only equilibria jobs take it");
-    job.max_equilibria = static_cast<int>(r.integer(*v, key + ".max_equilibria", 1, 1000));
+    job.max_equilibria = r.integer(*v, key + ".max_equilibria", 1, 1000);
   }
   if (const Value* v = Reader::find(g->table, "profiles")) job.profiles = r.boolean(*v, key + ".profiles");
 }
@@ -462,7 +398,7 @@ void read_continue_keys(const Reader& r, Group* g) {
   job.param = r.string(*param, key + ".param");
   if (const Value* v = Reader::find(g->table, "to")) job.to = r.number(*v, key + ".to");
   if (const Value* v = Reader::find(g->table, "max_points"))
-    job.max_points = static_cast<int>(r.integer(*v, key + ".max_points", 1, 1000000));
+    job.max_points = r.integer(*v, key + ".max_points", 1, 1000000);
   for (auto [k, field] :
        {std::pair<const char*, double*>{"step", &job.step}, {"min_step", &job.min_step}, {"max_step", &job.max_step}})
     if (const Value* v = Reader::find(g->table, k)) {
