@@ -74,6 +74,7 @@
 #include "kirchhoff/analysis/analytic.hpp"
 #include "kirchhoff/analysis/solution.hpp"
 #include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/continuation/rod_continuation.hpp"
 #include "kirchhoff/jobs/case_file.hpp"
 #include "kirchhoff/shooting/shooting.hpp"
 

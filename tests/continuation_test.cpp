@@ -6,6 +6,7 @@
 #include "kirchhoff/analysis/analytic.hpp"
 #include "kirchhoff/analysis/point_record.hpp"
 #include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/continuation/rod_continuation.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {
@@ -457,12 +458,12 @@ TEST(Recorder, DescribesEachPointOnceAndRecordsEveryPointOnTheBranch) {
   const PointRecorder rod = rod_point_recorder(b);
   int described = 0, recorded = 0;
   PointRecorder counting;
-  counting.describe = [&](const ShootingProblem& problem, ContinuationPoint* p) {
+  counting.describe = [&](ParameterisedSystem& system, ContinuationPoint* p) {
     ++described;
-    rod.describe(problem, p);
+    rod.describe(system, p);
     p->derived["describe_calls"] += 1.0;
   };
-  counting.record = [&](const ShootingProblem&, ContinuationPoint* p) {
+  counting.record = [&](ParameterisedSystem&, ContinuationPoint* p) {
     ++recorded;
     p->derived["record_calls"] += 1.0;
   };

@@ -14,6 +14,7 @@
 #include "kirchhoff/analysis/analytic.hpp"
 #include "kirchhoff/analysis/discrete_stability.hpp"
 #include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/continuation/rod_continuation.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {

@@ -4,6 +4,7 @@
 
 #include "kirchhoff/analysis/solution.hpp"
 #include "kirchhoff/analysis/stability.hpp"
+#include "kirchhoff/continuation/shooting_system.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -16,9 +17,10 @@ constexpr double kFlatH = 1e-9;
 PointRecorder rod_point_recorder(const ContinuationOptions& options) {
   PointRecorder recorder;
   if (options.compute_invariants || !options.derived.empty())
-    recorder.describe = [samples = options.samples, derived = options.derived](const ShootingProblem& problem,
+    recorder.describe = [samples = options.samples, derived = options.derived](ParameterisedSystem& system,
                                                                                ContinuationPoint* point) {
       ContinuationPoint& p = *point;
+      const ShootingProblem& problem = shooting_problem_at(system, p.parameter);
       ShootingResult r;
       r.x = p.x;
       r.summary.status = SolverStatus::Converged;
@@ -33,8 +35,8 @@ PointRecorder rod_point_recorder(const ContinuationOptions& options) {
       p.H_flat = !s.invariants.H.applies || s.invariants.H.spread <= kFlatH * std::max(1.0, s.invariants.H.scale);
     };
   if (options.compute_stability)
-    recorder.record = [](const ShootingProblem& problem, ContinuationPoint* point) {
-      const StabilityReport stability = analyse_stability(problem, point->x);
+    recorder.record = [](ParameterisedSystem& system, ContinuationPoint* point) {
+      const StabilityReport stability = analyse_stability(shooting_problem_at(system, point->parameter), point->x);
       point->stability_index = stability.index;
       point->zero_modes = stability.zero_modes;
     };

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/continuation/rod_continuation.hpp"
 #include "kirchhoff/shooting/shooting.hpp"
 
 namespace kirchhoff {

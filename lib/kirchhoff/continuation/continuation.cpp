@@ -3,13 +3,14 @@
 #include <algorithm>
 #include <boost/math/tools/minima.hpp>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
 
-#include "kirchhoff/analysis/point_record.hpp"
 #include "kirchhoff/continuation/detail/continuation_detectors.hpp"
 #include "kirchhoff/shooting/detail/jacobian_lu.hpp"
+#include "kirchhoff/shooting/newton.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -31,12 +32,6 @@ double sign_of(double v) { return v < 0 ? -1.0 : 1.0; }
 // Points a march can be resumed from: a special point (fold, branch point, event, end) is found
 // by locating inside a step, and a resumed run finds it again by redoing that step.
 bool resumable_type(PointType t) { return t == PointType::Start || t == PointType::Regular; }
-
-// Obstacles or contacts: the march's looser matrices are not used
-// (ContinuationOptions::march_sensitivity_tol).
-bool has_contact(const ProblemDefinition& d) {
-  return !d.obstacles.empty() || d.moving_obstacles || !d.contacts.empty();
-}
 
 }  // namespace
 
@@ -117,30 +112,21 @@ std::string ContinuationOptions::validate() const {
   return {};
 }
 
-Continuation::Continuation(const ShootingProblem& problem, ContinuationOptions options)
-    : problem_(problem), options_(std::move(options)) {
+Continuation::Continuation(std::unique_ptr<ParameterisedSystem> system, ContinuationOptions options)
+    : system_(std::move(system)), options_(std::move(options)) {
+  if (!system_) throw std::invalid_argument("no system to continue");
   if (std::string e = options_.validate(); !e.empty()) throw std::invalid_argument(e);
-  if (std::isnan(options_.corrector_tolerance))
-    options_.corrector_tolerance = std::max(1e-10, problem_.definition().options.newton.residual_tolerance);
-  if (!problem_.parameters().contains(options_.parameter))
-    throw std::invalid_argument("continuation parameter '" + options_.parameter + "' is not a parameter of the problem");
-  for (const auto& u : problem_.definition().unknown_parameters)
-    if (u == options_.parameter)
-      throw std::invalid_argument("'" + options_.parameter + "' is solved for (an unknown); continue in another parameter");
+  configure();
+  if (!options_.recorder) options_.recorder = PointRecorder{};
+}
+
+void Continuation::configure() {
+  if (std::isnan(options_.corrector_tolerance)) options_.corrector_tolerance = system_->default_corrector_tolerance();
+  // Events read their quantities among the derived ones the recorder fills.
   for (const auto& e : options_.events)
     if (std::find(options_.derived.begin(), options_.derived.end(), e.quantity) == options_.derived.end())
       options_.derived.push_back(e.quantity);
-  // The engine knows no rod: what a point records comes from the recorder, by default the rod
-  // layer's (it reads the derived list completed with the events' quantities above).
-  if (!options_.recorder) options_.recorder = rod_point_recorder(options_);
-  n_ = problem_.size();
-  const ProblemDefinition& d = problem_.definition();
-  if (!has_contact(d) &&
-      options_.march_sensitivity_tol > std::max(d.options.integrator.sensitivity_tol, d.options.integrator.abs_tol)) {
-    ProblemDefinition loose = d;
-    loose.options.integrator.sensitivity_tol = options_.march_sensitivity_tol;
-    march_problem_.emplace(std::move(loose));
-  }
+  n_ = system_->size();
 }
 
 Eigen::VectorXd Continuation::join(const Eigen::VectorXd& x, double lambda) const {
@@ -151,38 +137,14 @@ Eigen::VectorXd Continuation::join(const Eigen::VectorXd& x, double lambda) cons
 
 bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
                             bool march) {
-  // A parameter value where no rod can be built (a self-contact radius below zero, reached by a
-  // corrector iterate far off the branch) is a failed evaluation, so the step is shortened as for
-  // any other; it used to end the whole run with the model's exception.
-  try {
-    return evaluate_at(z, F, A, failure, march);
-  } catch (const std::invalid_argument& e) {
-    if (failure) *failure = "no rod at " + options_.parameter + " = " + std::to_string(z[n_]) + ": " + e.what();
-    return false;
-  }
-}
-
-bool Continuation::evaluate_at(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
-                               bool march) {
   const double lambda = z[n_];
   const Eigen::VectorXd x = z.head(n_);
-  problem_.set_parameter(options_.parameter, lambda);
   if (!A) {
     ++evaluations_.residuals;
-    return problem_.evaluate(x, F, nullptr, failure);
+    return system_->residual(x, lambda, F, failure);
   }
   ++evaluations_.matrices;
-  // (Its residual is the same number as problem_'s: the state is integrated at the same tolerance.)
-  ShootingProblem& p = march && march_problem_ ? *march_problem_ : problem_;
-  if (&p != &problem_) p.set_parameter(options_.parameter, lambda);
-  Eigen::VectorXd y_end, F_lambda;
-  if (!p.evaluate_with_end(x, F, A, &y_end, failure)) return false;
-  if (!p.parameter_derivative(x, options_.parameter, &F_lambda, failure, &y_end)) return false;
-  // A column appended in place: the matrices of long rods are tens of megabytes, and realloc
-  // extends such blocks without copying them.
-  A->conservativeResize(n_, n_ + 1);
-  A->col(n_) = F_lambda;
-  return true;
+  return system_->matrix(x, lambda, F, A, failure, march);
 }
 
 bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
@@ -277,7 +239,14 @@ std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z
   }
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n_ + 1);
   rhs[n_] = 1.0;
-  Eigen::VectorXd t = JacobianLU(*A, previous).solve(rhs);
+  const JacobianLU lu(*A, previous);
+  Eigen::VectorXd t = lu.solve(rhs);
+  // A located branch point whose bordered matrix is singular to round-off (a pitchfork whose test
+  // function is linear in lambda: the secant lands on its zero exactly) has no tangent of its own;
+  // the branch followed goes on along the step's. Rods' located branch points stay well above
+  // that (their smallest singular value ~1e-12 of the largest).
+  if (type == PointType::BranchPoint && !(lu.reciprocal_condition() > std::numeric_limits<double>::epsilon()))
+    t = previous;
   if (!t.allFinite() || t.norm() == 0.0) return std::nullopt;
   t.normalize();
   return make_point(z, t, std::move(A), is_reused, type, index, arclength, iterations);
@@ -327,15 +296,11 @@ std::optional<ContinuationPoint> Continuation::restore(const ContinuationPoint& 
 }
 
 void Continuation::describe(ContinuationPoint* point) {
-  if (!options_.recorder->describe) return;
-  problem_.set_parameter(options_.parameter, point->parameter);
-  options_.recorder->describe(problem_, point);
+  if (options_.recorder->describe) options_.recorder->describe(*system_, point);
 }
 
 void Continuation::record(ContinuationPoint* point) {
-  if (!options_.recorder->record) return;
-  problem_.set_parameter(options_.parameter, point->parameter);
-  options_.recorder->record(problem_, point);
+  if (options_.recorder->record) options_.recorder->record(*system_, point);
 }
 
 std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint& from, double h, PointType type) {
@@ -352,7 +317,7 @@ std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint
     // barrier, where it stalled at a residual of 2e-8), the step is corrected again with the
     // problem's own before it counts as failed. Its chord iterations on the same matrix from the
     // same prediction would fail again: Newton at once.
-    if (!march || !march_problem_) return std::nullopt;
+    if (!march || !system_->has_approximate_matrices()) return std::nullopt;
     z = z_pred;
     if (!correct(z, z_pred, from.tangent, &iterations)) return std::nullopt;
   }
@@ -434,17 +399,14 @@ std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& f
 
 ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink& sink) {
   ContinuationResult result;
-  const double lambda0 = problem_.parameters().get(options_.parameter);
-  // Solve at fixed lambda with the damped Newton (and its fallback search) of a single solve,
-  // then orient the tangent towards the target.
-  problem_.set_parameter(options_.parameter, lambda0);
-  const ShootingResult first = solve(problem_, x0);
-  // The continuation works to its own corrector tolerance: a start that stalls below it (a case
-  // asking Newton for 1e-12 at large loads, say) is good enough.
-  if (!first.summary.converged() && !(first.summary.residual_norm <= options_.corrector_tolerance)) {
+  const double lambda0 = system_->parameter();
+  // Corrected at fixed lambda by the system's own solve (a rod's: the damped Newton and fallback
+  // search of a single solve), then the tangent oriented towards the target.
+  const FixedParameterSolve first = system_->solve_at(x0, lambda0, options_.corrector_tolerance);
+  if (!first.converged) {
     result.reason = StopReason::StartFailed;
     result.message = "the starting point does not converge at " + options_.parameter + " = " +
-                     std::to_string(lambda0) + ": " + first.summary.brief_report();
+                     std::to_string(lambda0) + ": " + first.report;
     return result;
   }
   Eigen::VectorXd z = join(first.x, lambda0), e = Eigen::VectorXd::Zero(n_ + 1);
@@ -761,59 +723,6 @@ ContinuationResult Continuation::march(MarchState state, const PointSink& sink, 
     m.advance(std::move(*candidate));
   }
   return m.stop(StopReason::MaxPoints);
-}
-
-SymmetricBranchStart axial_symmetry_branch(Continuation& straight, const ContinuationPoint& bp, double sign) {
-  const ShootingProblem& problem = straight.problem();
-  const Eigen::MatrixXd N = straight.bifurcation_directions(bp, 2);
-  // The phase condition m(0).e2 = 0, linearised: a row on the unknowns at s = 0.
-  const auto eq = problem.equations(problem.parameters());
-  const Eigen::RowVectorXd phase = eq->slot_map(Slot::Moment).row(1);
-  const int n_state = problem.state_size();
-  auto phase_of = [&](const Eigen::VectorXd& v) { return phase.dot(v.head(n_state)); };
-  Eigen::VectorXd d = N.col(0) * phase_of(N.col(1)) - N.col(1) * phase_of(N.col(0));
-  if (d.norm() < 1e-12) d = std::abs(phase_of(N.col(0))) < std::abs(phase_of(N.col(1))) ? N.col(0) : N.col(1);
-  d.normalize();
-  for (int i = 0; i < d.size(); ++i)
-    if (std::abs(d[i]) > 1e-8) {
-      d *= sign_of(d[i]) * sign_of(sign);
-      break;
-    }
-  SymmetricBranchStart start;
-  start.definition = problem.definition();
-  add_axial_phase_condition(start.definition);
-  const int n = problem.size();
-  // The unfolding parameter is the last unknown of the new problem; it starts at 0.
-  start.x = Eigen::VectorXd::Zero(n + 1);
-  start.x.head(n) = bp.x;
-  start.parameter = bp.parameter;
-  start.direction = Eigen::VectorXd::Zero(n + 2);
-  start.direction.head(n) = d.head(n);
-  start.direction[n + 1] = d[n];
-  return start;
-}
-
-ContinuationOptions bifurcating_branch_options(ContinuationOptions options) {
-  options.target = NAN;
-  options.direction = 1.0;
-  return options;
-}
-
-ContinuationResult follow_bifurcating_branch(Continuation& run, const ContinuationPoint& bp,
-                                             ContinuationOptions options, double side,
-                                             const BranchSinkFactory& sink_for) {
-  options = bifurcating_branch_options(std::move(options));
-  if (bp.multiplicity == 2 && run.problem().definition().kind == RodKind::Spatial) {
-    const SymmetricBranchStart start = axial_symmetry_branch(run, bp, side);
-    const ShootingProblem switched(start.definition);
-    Continuation next(switched, options);
-    return next.run_along(start.x, start.parameter, start.direction, PointType::BranchPoint,
-                          sink_for(switched, true));
-  }
-  ShootingProblem at_bp = run.problem();
-  at_bp.set_parameter(options.parameter, bp.parameter);
-  Continuation next(at_bp, options);
-  return next.switch_branch(bp, sink_for(at_bp, false), side);
 }
 
 }  // namespace kirchhoff

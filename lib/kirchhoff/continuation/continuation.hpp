@@ -1,8 +1,10 @@
-// Pseudo-arclength continuation of shooting problems in one named parameter, with fold and
+// Pseudo-arclength continuation of a parameterised system F(x, lambda) = 0
+// (parameterised_system.hpp; a rod's shooting problem is one, shooting_system.hpp), with fold and
 // branch-point detection and location, branch switching, events and resumable runs.
 //
 // The branch is a curve z(sigma) = (x, lambda) of solutions of F(x; lambda) = 0, where x are the
-// shooting unknowns and lambda the continued parameter. Each step predicts along the tangent t,
+// system's unknowns (a rod's shooting unknowns) and lambda the continued parameter. Each step
+// predicts along the tangent t,
 // then corrects with Newton on the bordered system
 //     [ F_x  F_lambda ] dz = -[ F                  ]
 //     [      t^T      ]      [ t.(z - z_predicted) ],
@@ -25,8 +27,8 @@
 #include <string>
 #include <vector>
 
+#include "kirchhoff/continuation/parameterised_system.hpp"
 #include "kirchhoff/equations/invariants.hpp"
-#include "kirchhoff/shooting/shooting.hpp"
 
 namespace kirchhoff {
 
@@ -40,20 +42,21 @@ struct ContinuationEvent {
 
 struct ContinuationPoint;
 struct MarchState;
+class ShootingProblem;
 
 // What a run records of a point besides its unknowns, parameter, tangent and counts, supplied by
 // the layer that knows what the unknowns mean (BifurcationKit's record_from_solution is the
-// model; point_record.hpp is the rod layer's). The engine sets the problem's continued parameter
-// to the point's before each call and interprets only `derived` (events read their quantities
-// there) and `check_failure` (non-empty: the corrected point is not a solution, the step is
-// refused) of what the hooks fill.
+// model; point_record.hpp is the rod layer's). The hooks get the system followed (a rod's reads its
+// problem at the point's parameter through shooting_problem_at) and the point; the engine
+// interprets only `derived` (events read their quantities there) and `check_failure` (non-empty:
+// the corrected point is not a solution, the step is refused) of what they fill.
 struct PointRecorder {
   // At most once per corrected point, before the engine tests it (events, admissibility); a
   // point whose matrix is re-evaluated keeps what it was given. Empty: nothing is described.
-  std::function<void(const ShootingProblem& problem, ContinuationPoint* point)> describe;
+  std::function<void(ParameterisedSystem& system, ContinuationPoint* point)> describe;
   // Once per point put on the branch (the start, regular and special points reported), after
   // `describe`: what only the branch's points need (e.g. their stability). Empty: nothing.
-  std::function<void(const ShootingProblem& problem, ContinuationPoint* point)> record;
+  std::function<void(ParameterisedSystem& system, ContinuationPoint* point)> record;
 };
 
 // The options of a run, in groups (Ceres's Solver::Options and BifurcationKit's ContParams are the
@@ -253,7 +256,12 @@ using PointSink = std::function<void(const ContinuationPoint&)>;
 
 class Continuation {
  public:
-  // The problem is copied; its value of options.parameter is the starting one.
+  // Any system F(x, lambda) = 0, starting at its parameter(). Without a recorder in the options
+  // its points carry what the engine computes (x, parameter, tangent, test functions) only.
+  Continuation(std::unique_ptr<ParameterisedSystem> system, ContinuationOptions options);
+  // A rod's shooting problem (a ShootingSystem; the problem is copied, its value of
+  // options.parameter is the starting one). Without a recorder in the options its points are
+  // described by the rod layer's (rod_point_recorder). Defined in rod_continuation.cpp.
   Continuation(const ShootingProblem& problem, ContinuationOptions options);
 
   // Starts from unknowns x0 (corrected at fixed lambda first).
@@ -281,7 +289,9 @@ class Continuation {
   // Null vectors of [F_x F_lambda] at a point, orthonormal, orthogonal to its tangent.
   Eigen::MatrixXd bifurcation_directions(const ContinuationPoint& point, int count);
 
-  const ShootingProblem& problem() const { return problem_; }
+  // The rod's shooting problem followed; throws std::logic_error for a system of another kind.
+  const ShootingProblem& problem() const;
+  const ParameterisedSystem& system() const { return *system_; }
   const ContinuationOptions& options() const { return options_; }
   // Evaluations of F alone and of F with its matrix [F_x F_lambda] (the variational equations)
   // so far: the cost of a branch on long rods, where a matrix costs tens of residuals.
@@ -292,11 +302,10 @@ class Continuation {
   const EvaluationCount& evaluations() const { return evaluations_; }
 
  private:
-  // With `march` the matrix comes from march_problem_ when there is one (march_sensitivity_tol).
+  // F at z = (x, lambda), with A = [F_x F_lambda] when A is given; with `march` the matrix may be
+  // the system's approximate one (march_sensitivity_tol).
   bool evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
                 bool march = false);
-  bool evaluate_at(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
-                   bool march);
   // Newton on [F; normal.(z - z_predicted)] = 0. With `chord` (the Jacobian at a nearby point)
   // it first iterates with that fixed matrix, one integration without sensitivities per
   // iteration, and turns to (modified, with options_.modified_newton) Newton only if those
@@ -336,42 +345,15 @@ class Continuation {
   // tolerance of it. Empty if that corrector fails.
   std::optional<ContinuationPoint> at_parameter(const ContinuationPoint& located, double value);
   Eigen::VectorXd join(const Eigen::VectorXd& x, double lambda) const;
+  // What both constructors do once the system is there: the corrector's default tolerance, the
+  // events' quantities among the derived ones, the size.
+  void configure();
 
-  ShootingProblem problem_;
-  // The problem with its variational equations at march_sensitivity_tol, for the march's matrices;
-  // empty where that does not apply (see ContinuationOptions).
-  std::optional<ShootingProblem> march_problem_;
+  std::unique_ptr<ParameterisedSystem> system_;
   ContinuationOptions options_;
-  int n_ = 0;  // number of shooting unknowns
+  int n_ = 0;  // number of unknowns x
   EvaluationCount evaluations_;
   std::string last_corrector_failure_;  // why the last failed corrector failed, for the stop message
 };
-
-// Branch switching at the double branch point of an isotropic twisted rod (the straight rod's
-// first bifurcation, where the buckling modes form a circle). The bifurcating branch is followed
-// in the same problem with add_axial_phase_condition; this gives that problem, the branch point
-// in its unknowns (unfolding = 0) and the buckling direction satisfying the phase condition,
-// ready for Continuation::run_along.
-struct SymmetricBranchStart {
-  ProblemDefinition definition;  // with the phase condition
-  Eigen::VectorXd x;             // unknowns at the branch point
-  double parameter = 0.0;
-  Eigen::VectorXd direction;     // (dx, dlambda), unit
-};
-SymmetricBranchStart axial_symmetry_branch(Continuation& straight, const ContinuationPoint& branch_point,
-                                           double sign = 1.0);
-
-// Follows the branch bifurcating at `branch_point`, found by `run`: along the null vector of
-// [F_x F_lambda] at a simple branch point, or, at the double branch point of a spatial rod, in the
-// problem with the axial phase condition (axial_symmetry_branch). The run has no target (it stops
-// on the options' events, bounds or point count). `sink_for` gives the sink for the new branch's
-// points from the problem they belong to and whether the phase condition was added.
-// The options the bifurcating branch is followed with (no target; it stops on the events,
-// bounds or point count): also those a run resumed on that branch must use.
-ContinuationOptions bifurcating_branch_options(ContinuationOptions options);
-using BranchSinkFactory = std::function<PointSink(const ShootingProblem&, bool with_phase_condition)>;
-ContinuationResult follow_bifurcating_branch(Continuation& run, const ContinuationPoint& branch_point,
-                                             ContinuationOptions options, double side,
-                                             const BranchSinkFactory& sink_for);
 
 }  // namespace kirchhoff

@@ -8,6 +8,7 @@
 #include "kirchhoff/analysis/stability.hpp"
 #include "kirchhoff/contact/self_passage.hpp"
 #include "kirchhoff/equations/integrator.hpp"
+#include "kirchhoff/continuation/rod_continuation.hpp"
 #include "kirchhoff/jobs/deflated_continuation.hpp"
 
 namespace kirchhoff {

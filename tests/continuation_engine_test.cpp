@@ -1,0 +1,178 @@
+// The continuation engine on systems that are not rods (ParameterisedSystem): its folds, branch
+// points, switching, events and resume on algebraic problems whose branches are known in closed
+// form, so that nothing of the shooting layer stands between the engine and the check.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+#include "kirchhoff/continuation/continuation.hpp"
+
+namespace kirchhoff {
+namespace {
+
+// F(x, lambda) for one unknown, with its two partial derivatives.
+class ScalarSystem : public ParameterisedSystem {
+ public:
+  explicit ScalarSystem(double lambda0) : lambda0_(lambda0) {}
+  int size() const override { return 1; }
+  double parameter() const override { return lambda0_; }
+  bool residual(const Eigen::VectorXd& x, double lambda, Eigen::VectorXd* F, std::string*) override {
+    *F = Eigen::VectorXd::Constant(1, f(x[0], lambda));
+    return true;
+  }
+  bool matrix(const Eigen::VectorXd& x, double lambda, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
+              bool) override {
+    residual(x, lambda, F, failure);
+    A->resize(1, 2);
+    (*A) << f_x(x[0], lambda), f_lambda(x[0], lambda);
+    return true;
+  }
+
+ protected:
+  virtual double f(double x, double lambda) const = 0;
+  virtual double f_x(double x, double lambda) const = 0;
+  virtual double f_lambda(double x, double lambda) const = 0;
+
+ private:
+  double lambda0_;
+};
+
+// x^2 + lambda^2 = 1: one closed branch with folds at lambda = +1 and -1 (where x = 0).
+class Circle final : public ScalarSystem {
+ public:
+  using ScalarSystem::ScalarSystem;
+
+ private:
+  double f(double x, double l) const override { return x * x + l * l - 1.0; }
+  double f_x(double x, double) const override { return 2.0 * x; }
+  double f_lambda(double, double l) const override { return 2.0 * l; }
+};
+
+// x (lambda - x^2) = 0: the trivial branch x = 0 and the parabola x^2 = lambda cross at a simple
+// branch point at the origin (the pitchfork's normal form).
+class Pitchfork final : public ScalarSystem {
+ public:
+  using ScalarSystem::ScalarSystem;
+
+ private:
+  double f(double x, double l) const override { return x * (l - x * x); }
+  double f_x(double x, double l) const override { return l - 3.0 * x * x; }
+  double f_lambda(double x, double) const override { return x; }
+};
+
+ContinuationOptions options_for(const char* parameter) {
+  ContinuationOptions o;
+  o.parameter = parameter;
+  o.initial_step = 0.05;
+  o.max_step = 0.1;
+  return o;
+}
+
+const Eigen::VectorXd kNearOne = Eigen::VectorXd::Constant(1, 0.9);
+
+// The corrector's tolerance is on max |F|: every point lies on its branch to it (1e-10, the
+// engine's default for a system that names none).
+constexpr double kOnBranch = 1e-10;
+
+TEST(ContinuationEngine, FollowsACircleThroughBothFolds) {
+  ContinuationOptions o = options_for("lambda");
+  o.max_points = 100;  // one turn is 2 pi of arclength, at most 0.1 per step: ~63 points
+  Continuation run(std::make_unique<Circle>(0.0), o);
+  const ContinuationResult r = run.run(kNearOne);
+  ASSERT_EQ(r.reason, StopReason::MaxPoints) << r.message;
+  std::vector<double> folds;
+  for (const auto& p : r.points) {
+    EXPECT_LE(std::abs(p.x[0] * p.x[0] + p.parameter * p.parameter - 1.0), kOnBranch) << "point " << p.index;
+    if (p.type == PointType::Fold) folds.push_back(p.parameter);
+  }
+  // Along +lambda from (x, lambda) = (1, 0): the fold at lambda = 1, then the one at -1. A fold is
+  // located where the tangent's lambda component vanishes, i.e. x = 0 to the location's tolerance
+  // t; lambda = sqrt(1 - x^2) is then 1 to t^2 / 2.
+  ASSERT_GE(folds.size(), 2u);
+  EXPECT_NEAR(folds[0], 1.0, 1e-9);
+  EXPECT_NEAR(folds[1], -1.0, 1e-9);
+  // Nothing of a rod is recorded: there is no recorder.
+  EXPECT_TRUE(r.points.front().derived.empty());
+  EXPECT_THROW(run.problem(), std::logic_error);
+}
+
+TEST(ContinuationEngine, FindsThePitchforkAndSwitchesOntoTheParabola) {
+  ContinuationOptions o = options_for("lambda");
+  o.target = 1.0;
+  o.stop_at_branch_point = 1;
+  Continuation trivial(std::make_unique<Pitchfork>(-1.0), o);
+  const ContinuationResult r = trivial.run(Eigen::VectorXd::Constant(1, 0.1));
+  ASSERT_EQ(r.reason, StopReason::BranchPointStop) << r.message;
+  const ContinuationPoint& bp = r.points.back();
+  ASSERT_EQ(bp.type, PointType::BranchPoint);
+  // On the trivial branch the bordered matrix [lambda 0; 0 1] has the determinant lambda: located
+  // by the secant to its zero, it stops within the corrector's tolerance of the origin.
+  EXPECT_NEAR(bp.parameter, 0.0, 1e-9);
+  EXPECT_NEAR(bp.x[0], 0.0, 1e-12);
+  EXPECT_EQ(bp.multiplicity, 1);
+
+  // Switching: [F_x F_lambda] vanishes at the origin, so the direction is the one orthogonal to the
+  // trivial branch's tangent, dx, with a positive first component: the upper half x = +sqrt(lambda).
+  // An event on x, recorded by a recorder of this system, stops it at x = 0.5, lambda = 0.25.
+  ContinuationOptions b = options_for("lambda");
+  b.events = {{"x", 0.5, true, ""}};
+  PointRecorder recorder;
+  recorder.describe = [](ParameterisedSystem&, ContinuationPoint* p) { p->derived["x"] = p->x[0]; };
+  b.recorder = recorder;
+  Continuation parabola(std::make_unique<Pitchfork>(bp.parameter), b);
+  const ContinuationResult s = parabola.switch_branch(bp);
+  ASSERT_EQ(s.reason, StopReason::EventStop) << s.message;
+  for (size_t i = 1; i < s.points.size(); ++i) {
+    const ContinuationPoint& p = s.points[i];
+    EXPECT_GT(p.x[0], 0.0) << "point " << p.index;
+    // |F| = x |lambda - x^2| <= tolerance, and x is O(0.1-1) here.
+    EXPECT_NEAR(p.parameter, p.x[0] * p.x[0], 1e-8) << "point " << p.index;
+  }
+  EXPECT_EQ(s.points.back().type, PointType::Event);
+  EXPECT_NEAR(s.points.back().x[0], 0.5, 1e-9);
+  EXPECT_NEAR(s.points.back().parameter, 0.25, 1e-8);
+}
+
+// A march resumed from its state at one of its points takes the same steps as the uninterrupted
+// one, bit for bit (MarchState), for any system.
+TEST(ContinuationEngine, ResumedMarchRepeatsTheUninterruptedOne) {
+  ContinuationOptions o = options_for("lambda");
+  o.max_points = 40;
+  std::vector<MarchState> states;
+  o.on_resumable = [&](const MarchState& s) { states.push_back(s); };
+  Continuation whole(std::make_unique<Circle>(0.0), o);
+  const ContinuationResult r = whole.run(kNearOne);
+  ASSERT_GE(states.size(), 10u);
+  const MarchState middle = states[8];
+
+  ContinuationOptions quiet = o;
+  quiet.on_resumable = nullptr;
+  Continuation resumed(std::make_unique<Circle>(0.0), quiet);
+  const ContinuationResult rest = resumed.resume(middle);
+  // The resumed run's points are those after `middle.current` in the whole run.
+  size_t k = 0;
+  while (k < r.points.size() && r.points[k].index != middle.current.index) ++k;
+  ASSERT_LT(k, r.points.size());
+  ASSERT_EQ(rest.points.size(), r.points.size() - k - 1);
+  for (size_t i = 0; i < rest.points.size(); ++i) {
+    const ContinuationPoint& a = r.points[k + 1 + i];
+    const ContinuationPoint& b = rest.points[i];
+    EXPECT_EQ(a.type, b.type);
+    EXPECT_EQ(a.parameter, b.parameter) << "point " << a.index;
+    EXPECT_EQ(a.x[0], b.x[0]) << "point " << a.index;
+  }
+}
+
+TEST(ContinuationEngine, RefusesNoSystemAndAStartThatDoesNotConverge) {
+  EXPECT_THROW(Continuation(std::unique_ptr<ParameterisedSystem>{}, options_for("lambda")), std::invalid_argument);
+  // No real x solves x^2 + lambda^2 = 1 at lambda = 2: Newton's iterates wander, and the run says so.
+  Continuation outside(std::make_unique<Circle>(2.0), options_for("lambda"));
+  const ContinuationResult r = outside.run(kNearOne);
+  EXPECT_EQ(r.reason, StopReason::StartFailed);
+  EXPECT_NE(r.message.find("does not converge at lambda = 2"), std::string::npos) << r.message;
+}
+
+}  // namespace
+}  // namespace kirchhoff
