@@ -16,44 +16,6 @@
 namespace kirchhoff {
 namespace {
 
-// The two-sleeve rod of stability_free_length_test.cpp: it leaves the first sleeve at the origin
-// at angle theta1 and enters the second at (D, 0) at angle -theta2, both parts inside straight and
-// unloaded; equilibria at ell = 1.1132 (index 0) and 1.9572 (index 1).
-constexpr const char* kSlingCase = R"(
-title = "A rod between two sliding sleeves"
-model = "planar"
-
-[parameters]
-theta1 = 0.5
-theta2 = 1.0
-D = 1.0
-EI = 1.0
-ell = 1.2
-m_guess = 1.0
-
-[rod]
-length = "ell"
-B = "EI"
-
-[start]
-type = "clamped"
-position = [0, 0]
-orientation = { axis = [0, 0, 1], angle = "theta1" }
-
-[end]
-type = "clamped"
-position = ["D", 0]
-orientation = { axis = [0, 0, 1], angle = "-theta2" }
-extra_hamiltonian = 0.0
-
-[solver]
-unknowns = ["ell"]
-
-[guess]
-force = [-1, 0]
-moment = [0, 0, "m_guess"]
-)";
-
 struct Solved {
   std::string name;
   std::unique_ptr<ShootingProblem> problem;
@@ -87,8 +49,8 @@ std::vector<Solved> sliding_cases() {
   std::vector<Solved> out;
   out.push_back(solve_text("sleeve.toml", testing::case_text("sleeve.toml")));
   out.push_back(solve_text("arm_scale.toml", testing::case_text("arm_scale.toml")));
-  out.push_back(solve_text("sling, ell = 1.1132", kSlingCase, {{"ell", 1.2}}));
-  out.push_back(solve_text("sling, ell = 1.9572", kSlingCase, {{"ell", 3.0}, {"m_guess", 4.0}}));
+  out.push_back(solve_text("sling, ell = 1.1132", testing::kTwoSleeveRodCase, {{"ell", 1.2}}));
+  out.push_back(solve_text("sling, ell = 1.9572", testing::kTwoSleeveRodCase, {{"ell", 3.0}, {"m_guess", 4.0}}));
   out.push_back(solve_text("pinned sleeve", pinned_sleeve_text(), {{"P", 40.0}, {"P_prime", 45.0}}));
   return out;
 }

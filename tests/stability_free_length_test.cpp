@@ -14,44 +14,6 @@
 namespace kirchhoff {
 namespace {
 
-// A rod between two frictionless sleeves (an "elastica sling", Cazzolli & Dal Corso 2024): it
-// leaves the first at the origin at angle theta1 and enters the second at (D, 0) at angle -theta2;
-// both parts inside are straight and unloaded (H = 0 there), so the length outside, ell, slides.
-constexpr const char* kSlingCase = R"(
-title = "A rod between two sliding sleeves"
-model = "planar"
-
-[parameters]
-theta1 = 0.5
-theta2 = 1.0
-D = 1.0
-EI = 1.0
-ell = 1.2
-m_guess = 1.0
-
-[rod]
-length = "ell"
-B = "EI"
-
-[start]
-type = "clamped"
-position = [0, 0]
-orientation = { axis = [0, 0, 1], angle = "theta1" }
-
-[end]
-type = "clamped"
-position = ["D", 0]
-orientation = { axis = [0, 0, 1], angle = "-theta2" }
-extra_hamiltonian = 0.0
-
-[solver]
-unknowns = ["ell"]
-
-[guess]
-force = [-1, 0]
-moment = [0, 0, "m_guess"]
-)";
-
 struct Sliding {
   Case c;
   std::unique_ptr<ShootingProblem> problem;
@@ -84,7 +46,7 @@ Sliding arm_scale(const ParameterOverrides& overrides = {}) {
   return solve_sliding(load_case(testing::case_path("arm_scale.toml"), overrides), 0.0);
 }
 Sliding sling(const ParameterOverrides& overrides) {
-  return solve_sliding(load_case_text(kSlingCase, testing::case_path("sling.toml"), overrides), 0.0);
+  return solve_sliding(load_case_text(testing::kTwoSleeveRodCase, testing::case_path("sling.toml"), overrides), 0.0);
 }
 
 double length_of(const Sliding& s) { return s.problem->parameters_at(s.x).get("ell"); }
@@ -185,8 +147,8 @@ TEST(FreeLength, SlingHasAStableAndAnUnstableEquilibriumAtTheSameSleeves) {
 }
 
 // The two equilibria of the two-sleeve rod meet at a fold as the first sleeve turns: `kirchhoff
-// continue` of kSlingCase in theta1 (theta2 = 1) locates it at theta1 = 1.96768195, ell =
-// 2.10198316 (its fold detector: the parameter component of the branch's tangent changing sign,
+// continue` of testing::kTwoSleeveRodCase in theta1 (theta2 = 1) locates it at theta1 =
+// 1.96768195, ell = 2.10198316 (its fold detector: the parameter component of the branch's tangent changing sign,
 // bisected - the whole problem's Jacobian, not this analysis). Just before it (theta1 = 1.96768)
 // the two equilibria are stable and index 1, with S of opposite signs and small (2e-3 of its
 // scale, against 1 away from the fold), and S interpolated linearly between them vanishes at the

@@ -24,6 +24,46 @@ inline std::string case_text(const std::string& name) {
   return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
 }
 
+// A rod between two frictionless sleeves (an "elastica sling", Cazzolli & Dal Corso 2024): it
+// leaves the first at the origin at angle theta1 and enters the second at (D, 0) at angle -theta2;
+// both parts inside are straight and unloaded (H = 0 there), so the length outside, ell, slides.
+// Equilibria at ell = 1.1132 (index 0) and 1.9572 (index 1). Used by the sliding-length stability
+// tests and their discretised-energy check.
+inline constexpr const char* kTwoSleeveRodCase = R"(
+title = "A rod between two sliding sleeves"
+model = "planar"
+
+[parameters]
+theta1 = 0.5
+theta2 = 1.0
+D = 1.0
+EI = 1.0
+ell = 1.2
+m_guess = 1.0
+
+[rod]
+length = "ell"
+B = "EI"
+
+[start]
+type = "clamped"
+position = [0, 0]
+orientation = { axis = [0, 0, 1], angle = "theta1" }
+
+[end]
+type = "clamped"
+position = ["D", 0]
+orientation = { axis = [0, 0, 1], angle = "-theta2" }
+extra_hamiltonian = 0.0
+
+[solver]
+unknowns = ["ell"]
+
+[guess]
+force = [-1, 0]
+moment = [0, 0, "m_guess"]
+)";
+
 // wall.toml with a guess next to its asymmetric point contact far from mid-span (s = 0.454754,
 // f = 49.1106 at Delta = 0.0307, found by `equilibria`); load it with {{"Delta", 0.0307},
 // {"P_guess", 131.24}, {"m_guess", 1.213}}.

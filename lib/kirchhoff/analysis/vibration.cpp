@@ -11,13 +11,14 @@
 #include <stdexcept>
 
 #include "kirchhoff/equations/detail/integrator_impl.hpp"
+#include "kirchhoff/equations/detail/planar_state.hpp"
 
 namespace kirchhoff {
 namespace {
 
-// Planar state layout, shared with planar_equations.cpp.
-enum Index { kX = 0, kY = 1, kTheta = 2, kNx = 3, kNy = 4, kMoment = 5 };
-constexpr int kState = 6;
+// The state layout (planar_state.hpp).
+using detail::kPlanarStateSize, detail::kX, detail::kY, detail::kTheta, detail::kNx, detail::kNy, detail::kMoment;
+constexpr int kState = kPlanarStateSize;
 // At most three perturbations start from each end (six unknowns, three conditions per end).
 constexpr int kColumns = 3;
 

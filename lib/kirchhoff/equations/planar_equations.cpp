@@ -11,13 +11,15 @@
 
 #include "kirchhoff/equations/detail/field_eval.hpp"
 #include "kirchhoff/equations/detail/integrator_impl.hpp"
+#include "kirchhoff/equations/detail/planar_state.hpp"
 #include "kirchhoff/equations/rod_equations.hpp"
 
 namespace kirchhoff {
 namespace {
 
-constexpr int kStateSize = 6;
-enum Index { kX = 0, kY = 1, kTheta = 2, kNx = 3, kNy = 4, kMoment = 5 };
+// The state layout (planar_state.hpp).
+using detail::kPlanarStateSize, detail::kX, detail::kY, detail::kTheta, detail::kNx, detail::kNy, detail::kMoment;
+constexpr int kStateSize = kPlanarStateSize;
 
 class PlanarEquations final : public RodEquations {
  public:
