@@ -126,7 +126,7 @@ TEST(DiscreteStabilitySleeve, ReducedCurvatureConvergesToTheConjugatePointMethod
 // What stays uncovered says why, never a count: an H condition whose value changes with the
 // length (not the constant H of a straight part under a dead load: the part inside has no known
 // energy), a sleeve's exit that does not hold the rod's direction (sleeve.toml with its exit
-// pinned: the conjugate points give it an index, the discrete check does not guess one), and a
+// pinned: neither method guesses an index, stability_free_length_test), and a
 // field acting on the sliding rod (stability_free_length's own classification refuses it).
 TEST(DiscreteStabilitySleeve, UncoveredSleevesSayWhy) {
   struct Uncovered {

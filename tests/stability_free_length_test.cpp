@@ -4,6 +4,7 @@
 // against the discretised energy, and a case with a stable and an unstable sliding equilibrium.
 #include <cmath>
 #include <memory>
+#include <tuple>
 
 #include "kirchhoff/analysis/detail/stability_free_length.hpp"
 #include "kirchhoff/analysis/discrete_stability.hpp"
@@ -317,6 +318,26 @@ TEST(FreeLength, NullWhereTheLengthDoesNotSlide) {
   const StabilityReport stiff = analyse_free_length_stability(*scaled.problem, scaled.x);
   EXPECT_FALSE(stiff.defined());
   EXPECT_NE(stiff.reason.find("not only its length"), std::string::npos) << stiff.reason;
+
+  // The part inside the sleeve without a known energy: an H condition whose value changes with
+  // the length (not the constant H of a straight part under a dead load), and a sleeve free to
+  // turn (its exit pinned: the part inside and its load turn with it). Both solve; neither gets a
+  // count, from this analysis or from the discretised energy (discrete_stability_sleeve_test).
+  std::string moving_H = testing::case_text("arm_scale.toml");
+  moving_H.replace(moving_H.find("extra_hamiltonian = 0.0"), 23, "extra_hamiltonian = \"0.05*ell\"");
+  std::string pinned_exit = testing::case_text("sleeve.toml");
+  pinned_exit.replace(pinned_exit.find("type = \"clamped\""), 16, "type = \"pinned\"");
+  for (const auto& [name, text, reason] :
+       {std::tuple<std::string, std::string, std::string>{"arm_scale.toml", moving_H, "changes with the sliding length"},
+        {"sleeve.toml", pinned_exit, "does not hold the rod's position and direction"}}) {
+    const Case uncovered = load_case_text(text, testing::case_path(name));
+    const ShootingProblem p(uncovered.definition);
+    const ShootingResult solved = solve(p, p.initial_unknowns(uncovered.start_guess));
+    ASSERT_TRUE(solved.summary.converged()) << name << ": " << solved.summary.brief_report();
+    const StabilityReport whole = analyse_stability(p, solved.x);
+    EXPECT_FALSE(whole.defined()) << name;
+    EXPECT_NE(whole.reason.find(reason), std::string::npos) << whole.reason;
+  }
 
   const auto column = testing::solve_case("euler_column.toml");
   const StabilityReport none = analyse_free_length_stability(*column.problem, column.solution.result.x);

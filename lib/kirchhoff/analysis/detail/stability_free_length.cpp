@@ -70,6 +70,42 @@ std::string energy_slope_reason(const ShootingProblem& problem, const Eigen::Vec
   return "";
 }
 
+// How many independent directions of `slot` the end holds (the rank of its conditions' bases).
+int held_directions(const EndCondition& end, const RodEquations& eq, Slot slot) {
+  Eigen::MatrixXd held(3, 0);
+  for (const SlotCondition& c : end.conditions()) {
+    if (c.slot != slot || c.extra) continue;
+    const Eigen::MatrixXd b = c.basis(eq);
+    held.conservativeResize(3, held.cols() + b.cols());
+    held.rightCols(b.cols()) = b;
+  }
+  return held.cols() == 0 ? 0 : static_cast<int>(Eigen::FullPivLU<Eigen::MatrixXd>(held).rank());
+}
+
+// Why the part inside the sleeve has no known energy, "" when it has: H_inside ell (up to a
+// constant) is its energy when it is straight along the exit's fixed tangent under the constant
+// axial force H_inside that the H condition names, with a dead load at its inner end. That needs
+// the named H not to change with ell, and the exit to hold the rod's position and direction (a
+// sleeve free to turn carries the inside part and its load with it: another energy, which the
+// case does not describe).
+std::string sleeve_reason(const ShootingProblem& problem, const Eigen::VectorXd& x, const std::string& name) {
+  const ProblemDefinition& d = problem.definition();
+  const EndCondition& exit = has_hamiltonian_condition(d.start) ? d.start : d.end;
+  const Parameters p = problem.parameters_at(x);
+  Parameters moved = p;
+  moved.set(name, p.get(name) * (1 + 1e-3) + 1e-3);
+  const auto& inside_H = exit.hamiltonian_condition();
+  if (inside_H(problem.completed(moved)) != inside_H(p))
+    return "the H that the sleeve's exit is held to changes with the sliding length '" + name +
+           "': not the constant H of a straight part under a dead load, so the part inside has no known energy";
+  const auto equations = problem.equations(p);
+  for (Slot slot : {Slot::Position, Slot::Orientation})
+    if (held_directions(exit, *equations, slot) < equations->admissible_directions(slot).cols())
+      return "the sleeve's exit does not hold the rod's position and direction: the part inside is not straight "
+             "along a fixed line, and its energy is not known";
+  return "";
+}
+
 // Row k of `full` whose removal, with column `column`, leaves `fixed`: the H row. -1 when none
 // does (the two problems do not differ by that row and column alone).
 int hamiltonian_row(const Eigen::MatrixXd& full, const Eigen::MatrixXd& fixed, int column) {
@@ -132,7 +168,8 @@ bool has_hamiltonian_condition(const EndCondition& end) { return static_cast<boo
 std::string sliding_length_reason(const ShootingProblem& problem, const Eigen::VectorXd& x, const std::string& name) {
   if (std::string why = unsupported_reason(problem, name); !why.empty()) return why;
   try {
-    return energy_slope_reason(problem, x, name);
+    if (std::string why = energy_slope_reason(problem, x, name); !why.empty()) return why;
+    return sleeve_reason(problem, x, name);
   } catch (const std::exception& e) {
     return std::string("the rod could not be built at a nearby length: ") + e.what();
   }

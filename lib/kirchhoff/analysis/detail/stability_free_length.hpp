@@ -30,7 +30,10 @@
 // (then it is not a sliding length), a length that changes the rod's properties besides its
 // length, a rod whose properties vary along it or that feels an external field (dE_outside/d ell
 // = -H needs a Lagrangian without explicit s, and a field would act on the part inside the sleeve
-// too, which the case does not describe), half-turn symmetric half rods, a fixed-length problem
+// too, which the case does not describe), an H condition whose value changes with ell or an exit
+// that does not hold the rod's position and direction (the part inside then has no known energy:
+// it is H_inside ell only for a straight part along a fixed line under a constant axial force),
+// half-turn symmetric half rods, a fixed-length problem
 // with a zero mode (Q singular: the reduction is not defined) or whose own index is undefined.
 #pragma once
 
