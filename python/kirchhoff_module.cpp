@@ -1150,6 +1150,11 @@ T_ext = EI/(2 R^2) sin^4 theta (1 + 2/cos 2theta).)doc");
 }
 
 }  // namespace
+
+namespace kirchhoff {
+void bind_system_continuation(py::module_& m);  // system_continuation.cpp
+}
+
 PYBIND11_MODULE(kirchhoff, m) {
   m.doc() = R"doc(Elastic-rod equilibria by shooting and pseudo-arclength continuation.
 
@@ -1173,6 +1178,7 @@ prints; a solve that does not converge returns a Solution whose status says why.
   bind_case(m);
   bind_jobs(m);
   bind_reference(m);
+  kirchhoff::bind_system_continuation(m);
 
   m.attr("__version__") = KIRCHHOFF_VERSION;
 }

@@ -819,5 +819,82 @@ class EquilibriaTest(unittest.TestCase):
             kirchhoff.load_case(case_path("euler_column.toml")).continue_("P", to=60, deflate=True, switch_at_bp=1)
 
 
+class SystemContinuationTest(unittest.TestCase):
+    """kirchhoff.continue_system: the engine on systems given as Python functions."""
+
+    def test_circle_folds(self):
+        # F = (x1 - x2, x1^2 + lam^2 - 1): a circle in (x1, lam), folds at lam = +1 and -1. The
+        # corrector holds |F| <= 1e-10 at every point; the folds are located where the tangent's
+        # lambda component vanishes, x1 = 0 to the location's tolerance t, so |lam| = 1 to t^2 / 2.
+        F = lambda x, lam: [x[0] - x[1], x[0] ** 2 + lam ** 2 - 1]
+        J = lambda x, lam: [[1.0, -1.0, 0.0], [2 * x[0], 0.0, 2 * lam]]
+        b = kirchhoff.continue_system(F, J, [0.9, 0.9], 0.0, max_points=100, max_step=0.1)
+        p = b["points"]
+        self.assertEqual(b["reason"], "max_points")
+        np.testing.assert_allclose(p["x"][:, 0] ** 2 + p["parameter"] ** 2, 1.0, atol=1e-10)
+        folds = [lam for lam, t in zip(p["parameter"], p["type"]) if t == "fold"]
+        self.assertGreaterEqual(len(folds), 2)
+        self.assertAlmostEqual(folds[0], 1.0, delta=1e-9)
+        self.assertAlmostEqual(folds[1], -1.0, delta=1e-9)
+
+    def test_pitchfork_switch_and_event(self):
+        # x (lam - x^2) = 0: the trivial branch from lam = -1, its branch point at the origin, then
+        # the parabola x = +sqrt(lam) to the event x0 = 0.5 (lam = 0.25).
+        F = lambda x, lam: [x[0] * (lam - x[0] ** 2)]
+        J = lambda x, lam: [[lam - 3 * x[0] ** 2, x[0]]]
+        b = kirchhoff.continue_system(F, J, [0.1], -1.0, to=1.0, switch_at_bp=1, events={"x0": 0.5})
+        p = b["points"]
+        self.assertTrue(b["switched"])
+        self.assertEqual(b["reason"], "event")
+        bp = list(p["type"]).index("branch_point")
+        self.assertAlmostEqual(p["parameter"][bp], 0.0, delta=1e-9)
+        after = p["branch"] == 1
+        np.testing.assert_allclose(p["parameter"][after], p["x"][after, 0] ** 2, atol=1e-8)
+        self.assertAlmostEqual(p["x"][-1, 0], 0.5, delta=1e-9)
+        self.assertAlmostEqual(p["parameter"][-1], 0.25, delta=1e-8)
+
+    def test_bratu_fold_converges_to_the_critical_value(self):
+        # u'' + lam exp(u) = 0, u(0) = u(1) = 0, by central differences on N interior points: the
+        # fold of the discrete problem converges at second order in h to the continuous one,
+        # lam_c = 3.513830719 (the root of the closed form lam = 8 t^2 / cosh(t/4)^2's maximum).
+        # Richardson's extrapolation of N = 20 and 40 (h = 1/21, 1/41) removes the h^2 term; what
+        # is left is O(h1^2 h2^2) = 1.3e-6 times a coefficient of order one (measured: 7.6e-7).
+        def fold(N):
+            h = 1.0 / (N + 1)
+            def F(u, lam):
+                v = np.concatenate(([0.0], u, [0.0]))
+                return (v[:-2] - 2 * v[1:-1] + v[2:]) / h ** 2 + lam * np.exp(u)
+            def J(u, lam):
+                A = np.zeros((N, N + 1))
+                A[np.arange(N), np.arange(N)] = -2 / h ** 2 + lam * np.exp(u)
+                A[np.arange(N - 1), np.arange(1, N)] = 1 / h ** 2
+                A[np.arange(1, N), np.arange(N - 1)] = 1 / h ** 2
+                A[:, N] = np.exp(u)
+                return A
+            b = kirchhoff.continue_system(F, J, np.zeros(N), 0.0, to=5.0, max_step=0.5, max_points=200)
+            folds = [lam for lam, t in zip(b["points"]["parameter"], b["points"]["type"]) if t == "fold"]
+            self.assertEqual(len(folds), 1, b["message"])
+            return folds[0]
+        l20, l40 = fold(20), fold(40)
+        self.assertLess(l20, l40)  # the error is -c h^2: both below lam_c, the finer closer
+        h20, h40 = 1 / 21, 1 / 41
+        extrapolated = (h20 ** 2 * l40 - h40 ** 2 * l20) / (h20 ** 2 - h40 ** 2)
+        self.assertAlmostEqual(extrapolated, 3.513830719, delta=1e-5)
+
+    def test_bad_systems_say_why(self):
+        F = lambda x, lam: [x[0] - lam]
+        wrong_shape = lambda x, lam: [[1.0]]
+        b = kirchhoff.continue_system(F, wrong_shape, [0.0], 0.0, to=1.0)
+        self.assertEqual(b["reason"], "start_failed")
+        self.assertIn("J returned a 1 x 1 matrix", b["message"])
+
+        def raises(x, lam):
+            raise RuntimeError("no F here")
+        with self.assertRaisesRegex(RuntimeError, "no F here"):
+            kirchhoff.continue_system(raises, wrong_shape, [0.0], 0.0)
+        with self.assertRaisesRegex(ValueError, "components of x"):
+            kirchhoff.continue_system(F, wrong_shape, [0.0], 0.0, events={"y": 1.0})
+
+
 if __name__ == "__main__":
     unittest.main()
