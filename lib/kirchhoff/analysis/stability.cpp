@@ -7,6 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 #include <functional>
@@ -207,17 +208,28 @@ std::string unsupported(const ShootingProblem& problem, const Eigen::VectorXd& x
 double wrap(double angle) { return std::remainder(angle, 2 * kPi); }
 
 // Eigenphases of W = (U + iP)(U - iP)^-1: with the frame made orthonormal, W = X X^T for the
-// unitary X = U + iP.
+// unitary X = U + iP. One field (the planar rod's rotation frame): W = (u + ip)^2 / (u^2 + p^2),
+// whose phase is 2 atan2(p, u). The matrices are at most 12 x 6 (the full frame of a spatial rod):
+// fixed-capacity storage, no allocation at each of the index's steps.
 Eigen::VectorXd eigenphases(const Eigen::MatrixXd& U_in, const Eigen::MatrixXd& P_in) {
   const int m = static_cast<int>(U_in.cols());
-  Eigen::MatrixXd Z(2 * m, m);
+  Eigen::VectorXd phase(m);
+  if (m == 0) return phase;
+  if (m == 1) {
+    phase[0] = wrap(2 * std::atan2(P_in(0, 0), U_in(0, 0)));
+    return phase;
+  }
+  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 6>;
+  using SmallComplex = Eigen::Matrix<std::complex<double>, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+  Small Z(2 * m, m);
   Z << U_in, P_in;
-  const Eigen::MatrixXd Q = Eigen::HouseholderQR<Eigen::MatrixXd>(Z).householderQ() * Eigen::MatrixXd::Identity(2 * m, m);
-  const Eigen::MatrixXd U = Q.topRows(m), P = Q.bottomRows(m);
-  const Eigen::MatrixXcd X = U.cast<std::complex<double>>() + std::complex<double>(0, 1) * P;
-  Eigen::ComplexEigenSolver<Eigen::MatrixXcd> solver(X * X.transpose(), false);
-  Eigen::VectorXd phase(U.cols());
-  for (int j = 0; j < phase.size(); ++j) phase[j] = std::arg(solver.eigenvalues()[j]);
+  Eigen::HouseholderQR<Small> qr(Z);
+  Small Q = Small::Identity(2 * m, m);
+  Q.applyOnTheLeft(qr.householderQ());
+  const SmallComplex X = Q.topRows(m).cast<std::complex<double>>() + std::complex<double>(0, 1) * Q.bottomRows(m);
+  const SmallComplex W = X * X.transpose();
+  Eigen::ComplexEigenSolver<SmallComplex> solver(W, false);
+  for (int j = 0; j < m; ++j) phase[j] = std::arg(solver.eigenvalues()[j]);
   return phase;
 }
 
@@ -249,17 +261,6 @@ struct PhaseTrack {
   bool reversed = false;  // a genuine passage against the Legendre direction
   double reversed_at = 0.0;
 };
-
-// How far the eigenphases moved: the largest distance from a lifted phase to its nearest new one.
-double largest_phase_move(const Eigen::VectorXd& phases, const Eigen::VectorXd& lifted) {
-  double largest = 0.0;
-  for (int j = 0; j < lifted.size(); ++j) {
-    double nearest = kPi;
-    for (int k = 0; k < phases.size(); ++k) nearest = std::min(nearest, std::abs(wrap(phases[k] - lifted[j])));
-    largest = std::max(largest, nearest);
-  }
-  return largest;
-}
 
 int odd_multiples_between(double a, double b) {  // odd k with a < k pi < b (a < b)
   const long lo = static_cast<long>(std::floor((a / kPi - 1) / 2)) + 1;
@@ -326,11 +327,15 @@ class StabilityAnalysis {
   Eigen::MatrixXd constraint_directions(const Held& start, const Held& end) const;
   Frame start_frame(const Held& start, const Eigen::MatrixXd& start_multipliers, int contacts, int end_multipliers) const;
   std::string pass_contact(Frame* f, const PointContact& contact, int number, PhaseTrack* track, double* shear);
+  const CanonicalMap& map_at(const Eigen::VectorXd& y, double s) const;
   void canonical_blocks(Frame* f) const;
   void orthonormalise(Frame* f) const;
-  Frame flowed(const Frame& f, double s1);
+  void flowed(const Frame& f, double s1, CarriedSteps* steps, bool frame_only, Frame* next);
+  void march(Frame* f, double end, double longest, PhaseTrack* track);
   void advance(Frame* f, double s1, PhaseTrack* track, int depth);
-  void record(const Eigen::VectorXd& before, double s0, const Eigen::VectorXd& after, double s1, PhaseTrack* track);
+  void record(const Frame& f, const Eigen::VectorXd& after, double s1, PhaseTrack* track);
+  double locate_passage(const Frame& f, const Eigen::VectorXd& before, int j, long multiple, double s1, double ta,
+                        double tb);
   bool count_interior(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start,
                       StabilityReport* report) const;
   Eigen::MatrixXd end_terms(const Frame& f, const Held& end, StabilityReport* report) const;
@@ -352,6 +357,14 @@ class StabilityAnalysis {
   std::vector<RodPoint> profile_;  // the equilibrium at 17 equally spaced points, for the checks above
   long rhs_ = 0;
   CarriedSteps steps_;  // the step sizes the fields' integration proposes next (flowed)
+  // Workspaces kept across the index's steps (no allocation at each): the map (map_at), the
+  // canonical coordinates of the fields (canonical_blocks), the frame a step arrives at (advance)
+  // and the trial frames of locate_passage.
+  mutable CanonicalMap map_;
+  mutable bool map_known_ = false, map_has_G_ = true;
+  mutable Eigen::MatrixXd z_, z_particular_;
+  Frame arriving_, trial_;
+  Eigen::MatrixXd directions_;  // the fields handed to the integration (flowed)
   // The full frame: positions are configuration variables beside the rotation (see
   // positions_are_configuration); its U block holds (dr / L, dpsi), offset_ = 0. Otherwise the
   // rotation alone, offset_ = kr. mU_ is the size of U.
@@ -472,44 +485,59 @@ Frame StabilityAnalysis::start_frame(const Held& start, const Eigen::MatrixXd& s
   return f;
 }
 
+// The canonical map at the frame's point. A planar rod's is the same everywhere (its rotation is
+// the state's angle, and G = 1/2 e_z.(m x e_z) = 0): computed once.
+const CanonicalMap& StabilityAnalysis::map_at(const Eigen::VectorXd& y, double s) const {
+  if (eq_->is_planar() && map_known_) return map_;
+  map_ = canonical_map(*eq_, coords_, scales_, y, s);
+  map_known_ = true;
+  map_has_G_ = !map_.G.isZero(0.0) || !eq_->is_planar();
+  return map_;
+}
+
 void StabilityAnalysis::canonical_blocks(Frame* f) const {
   const int n = coords_.size(), kr = coords_.kr();
-  const CanonicalMap map = canonical_map(*eq_, coords_, scales_, f->y, f->s);
-  auto blocks = [&](const Eigen::MatrixXd& dY, Eigen::MatrixXd* U, Eigen::MatrixXd* P, Eigen::MatrixXd* P_phys,
-                    Eigen::MatrixXd* R) {
-    const Eigen::MatrixXd z = map.T * dY;
-    *U = z.middleRows(offset_, mU_);
-    *P_phys = z.middleRows(n + offset_, mU_);
-    *P = *P_phys + map.G.bottomRightCorner(mU_, mU_) * *U;
-    *R = z.topRows(kr);
+  const CanonicalMap& map = map_at(f->y, f->s);
+  auto blocks = [&](const Eigen::MatrixXd& dY, Eigen::MatrixXd* z, Eigen::MatrixXd* U, Eigen::MatrixXd* P,
+                    Eigen::MatrixXd* P_phys, Eigen::MatrixXd* R) {
+    z->noalias() = map.T * dY;
+    *U = z->middleRows(offset_, mU_);
+    *P_phys = z->middleRows(n + offset_, mU_);
+    *P = *P_phys;
+    if (map_has_G_) P->noalias() += map.G.bottomRightCorner(mU_, mU_) * *U;
+    *R = z->topRows(kr);
   };
-  blocks(f->dY, &f->U, &f->P, &f->P_physical, &f->R);
-  blocks(f->particular, &f->particular_U, &f->particular_P, &f->particular_P_physical, &f->particular_R);
+  blocks(f->dY, &z_, &f->U, &f->P, &f->P_physical, &f->R);
+  blocks(f->particular, &z_particular_, &f->particular_U, &f->particular_P, &f->particular_P_physical,
+         &f->particular_R);
 }
 
-// Keeps the frame's columns orthonormal in (U, P) (the span, a Lagrangian plane, is unchanged).
+// Keeps the frame's columns orthonormal in (U, P) (the span, a Lagrangian plane, is unchanged):
+// the columns times R^-1 of the QR factorisation of [U; P] (one field: divided by its norm).
 void StabilityAnalysis::orthonormalise(Frame* f) const {
   const int m = static_cast<int>(f->U.cols());
-  Eigen::MatrixXd Z(2 * m, m);
+  if (m == 0) return;
+  auto apply = [&](auto&& divide) {
+    for (Eigen::MatrixXd* X : {&f->dY, &f->U, &f->P, &f->P_physical, &f->R, &f->recorded_rows_frame})
+      if (X->size() > 0) divide(*X);
+  };
+  if (m == 1) {
+    const double norm = std::hypot(f->U(0, 0), f->P(0, 0));
+    apply([&](Eigen::MatrixXd& X) { X /= norm; });
+    return;
+  }
+  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 6>;
+  Small Z(2 * m, m);
   Z << f->U, f->P;
-  Eigen::HouseholderQR<Eigen::MatrixXd> qr(Z);
-  const Eigen::MatrixXd R = qr.matrixQR().topRows(m).triangularView<Eigen::Upper>();
-  const Eigen::MatrixXd Rinv = R.inverse();
-  f->dY = f->dY * Rinv;
-  f->U = f->U * Rinv;
-  f->P = f->P * Rinv;
-  f->P_physical = f->P_physical * Rinv;
-  f->R = f->R * Rinv;
-  f->recorded_rows_frame = f->recorded_rows_frame * Rinv;
+  const Eigen::HouseholderQR<Small> qr(Z);
+  const Small R = qr.matrixQR().topRows(m);
+  apply([&](Eigen::MatrixXd& X) { R.triangularView<Eigen::Upper>().solveInPlace<Eigen::OnTheRight>(X); });
 }
 
-// Matches new eigenphases to the lifted old ones (nearest on the circle) and lifts them. A phase
-// within 1e-9 of an odd multiple of pi is put on it: a field that stays at a conjugate point (held
-// at s = 0, or abnormal) then never passes it by round-off.
-void StabilityAnalysis::record(const Eigen::VectorXd& before, double s0, const Eigen::VectorXd& phases, double s1,
-                               PhaseTrack* track) {
+// New eigenphases matched to the lifted old ones (nearest on the circle) and lifted.
+Eigen::VectorXd lift(const Eigen::VectorXd& before, const Eigen::VectorXd& phases) {
   const int m = static_cast<int>(phases.size());
-  std::vector<bool> used(m, false);
+  std::array<bool, 12> used{};
   Eigen::VectorXd lifted(m);
   for (int j = 0; j < m; ++j) {
     int best = -1;
@@ -521,6 +549,19 @@ void StabilityAnalysis::record(const Eigen::VectorXd& before, double s0, const E
     }
     used[best] = true;
     lifted[j] = before[j] + best_move;
+  }
+  return lifted;
+}
+
+// Records the step from f (phases track->lifted) to s1 (phases `phases`): lifts them (lift), and a
+// phase within 1e-9 of an odd multiple of pi is put on it: a field that stays at a conjugate point
+// (held at s = 0, or abnormal) then never passes it by round-off. Passages downwards are located
+// (locate_passage) and pushed, passages back upwards pop.
+void StabilityAnalysis::record(const Frame& f, const Eigen::VectorXd& phases, double s1, PhaseTrack* track) {
+  const Eigen::VectorXd before = track->lifted;
+  const int m = static_cast<int>(phases.size());
+  Eigen::VectorXd lifted = lift(before, phases);
+  for (int j = 0; j < m; ++j) {
     const double off = wrap(lifted[j] - kPi);
     if (std::abs(off) < 1e-9) lifted[j] -= off;
   }
@@ -533,10 +574,8 @@ void StabilityAnalysis::record(const Eigen::VectorXd& before, double s0, const E
     for (int k = 0; k < passed; ++k) {
       const long multiple = 2 * (lifted[j] < before[j] ? first + passed - 1 - k : first + k) + 1;
       if (lifted[j] < before[j]) {
-        // Where: near a passage the phase goes as k pi - 2 atan(c (s - s*)), so tan of half its
-        // offset is close to linear in s and is interpolated.
         const double ta = std::tan(0.5 * (before[j] - multiple * kPi)), tb = std::tan(0.5 * (lifted[j] - multiple * kPi));
-        stack.emplace_back(multiple, s0 + ta / (ta - tb) * (s1 - s0));
+        stack.emplace_back(multiple, locate_passage(f, before, j, multiple, s1, ta, tb));
       }
       else if (!stack.empty() && stack.back().first == multiple) stack.pop_back();
     }
@@ -549,54 +588,108 @@ void StabilityAnalysis::record(const Eigen::VectorXd& before, double s0, const E
   track->lifted = lifted;
 }
 
-// The equilibrium, the frame's fields and the particular fields that have started carried to s1,
-// as one integration continued from the previous step's (steps_): the fields are the directions
-// of the variational equations, so only they are integrated, not the whole of Phi. Particular
-// fields that have not started yet are zero, and stay so.
-Frame StabilityAnalysis::flowed(const Frame& f, double s1) {
-  std::vector<int> started;
-  for (int c = 0; c < f.particular.cols(); ++c)
-    if (!f.particular.col(c).isZero(0.0)) started.push_back(c);
-  const int m = static_cast<int>(f.dY.cols());
-  Eigen::MatrixXd directions(f.dY.rows(), m + static_cast<int>(started.size()));
-  directions.leftCols(m) = f.dY;
-  for (size_t i = 0; i < started.size(); ++i) directions.col(m + static_cast<int>(i)) = f.particular.col(started[i]);
-  const DirectionalFlow flow =
-      eq_->flow_directions(f.y, directions, f.s, s1, problem_.definition().options.integrator, &steps_);
-  rhs_ += flow.rhs_evaluations;
-  Frame next;
-  next.y = flow.y;
-  next.s = s1;
-  next.dY = flow.directions.leftCols(m);
-  next.particular = Eigen::MatrixXd::Zero(f.particular.rows(), f.particular.cols());
-  for (size_t i = 0; i < started.size(); ++i) next.particular.col(started[i]) = flow.directions.col(m + static_cast<int>(i));
-  next.recorded_rows_frame = f.recorded_rows_frame;
-  next.recorded_rows_particular = f.recorded_rows_particular;
-  return next;
+// Where eigenphase j (lifted `before` at f.s) passes multiple * pi within (f.s, s1): near a passage
+// the phase goes as k pi - 2 atan(c (s - s*)), so t(s) = tan of half its offset is close to linear
+// in s, from ta > 0 at f.s to tb < 0 at s1. Regula falsi on t (the Illinois variant, so that an
+// end kept twice does not stall it), each t from the frame carried from f to the trial point, until
+// the estimate moves less than passage_tolerance: the position is then exact to the fields'
+// integration, not to a step's interpolation. The trial frames are not kept (the march goes on
+// from s1).
+double StabilityAnalysis::locate_passage(const Frame& f, const Eigen::VectorXd& before, int j, long multiple,
+                                         double s1, double ta, double tb) {
+  const double tolerance = options_.passage_tolerance * scales_.length;
+  double a = f.s, b = s1, estimate = a + ta / (ta - tb) * (b - a);
+  int kept = 0;  // the end the last step kept: +1 a, -1 b
+  for (int i = 0; i < options_.max_locating_steps && b - a > tolerance; ++i) {
+    CarriedSteps steps{estimate - f.s, estimate - f.s};  // one integration step to the trial point
+    flowed(f, estimate, &steps, true, &trial_);
+    canonical_blocks(&trial_);
+    orthonormalise(&trial_);
+    const double t = std::tan(0.5 * (lift(before, eigenphases(trial_.U, trial_.P))[j] - multiple * kPi));
+    if (t > 0) {
+      a = estimate, ta = t;
+      if (kept == -1) tb *= 0.5;  // b kept twice
+      kept = -1;
+    } else {
+      b = estimate, tb = t;
+      if (kept == 1) ta *= 0.5;
+      kept = 1;
+    }
+    const double next = a + ta / (ta - tb) * (b - a);
+    const bool converged = std::abs(next - estimate) < tolerance || t == 0.0;
+    estimate = t == 0.0 ? estimate : next;
+    if (converged) break;
+  }
+  return estimate;
 }
 
+// The equilibrium, the frame's fields and the particular fields that have started carried to s1,
+// as one integration continued from the previous step's (*steps): the fields are the directions
+// of the variational equations, so only they are integrated, not the whole of Phi. Particular
+// fields that have not started yet are zero, and stay so; frame_only leaves all of them behind
+// (the trial frames of locate_passage need U and P alone).
+void StabilityAnalysis::flowed(const Frame& f, double s1, CarriedSteps* steps, bool frame_only, Frame* next) {
+  std::array<int, 16> started;
+  int count = 0;
+  for (int c = 0; !frame_only && c < f.particular.cols(); ++c)
+    if (!f.particular.col(c).isZero(0.0)) {
+      if (count == static_cast<int>(started.size())) throw std::logic_error("stability: more than 16 multipliers");
+      started[count++] = c;
+    }
+  const int m = static_cast<int>(f.dY.cols());
+  directions_.resize(f.dY.rows(), m + count);
+  directions_.leftCols(m) = f.dY;
+  for (int i = 0; i < count; ++i) directions_.col(m + i) = f.particular.col(started[i]);
+  DirectionalFlow flow =
+      eq_->flow_directions(f.y, directions_, f.s, s1, problem_.definition().options.integrator, steps);
+  rhs_ += flow.rhs_evaluations;
+  next->y.swap(flow.y);
+  next->s = s1;
+  next->dY = flow.directions.leftCols(m);
+  next->particular.setZero(f.particular.rows(), frame_only ? 0 : f.particular.cols());
+  for (int i = 0; i < count; ++i) next->particular.col(started[i]) = flow.directions.col(m + i);
+  if (frame_only) return;
+  next->recorded_rows_frame = f.recorded_rows_frame;
+  next->recorded_rows_particular = f.recorded_rows_particular;
+}
+
+// Marches the frame to `end` (a shooting node, a contact or L) as one adaptive integration
+// observed at the end of each of its own steps: each observation step is the step the
+// integrator proposes (steps_), so none is cut short to land on a grid and its right-hand sides
+// are those of the integration alone. At most `longest`, so that no eigenphase turns by pi
+// between two observations unseen (see run); the last steps are evened out to land on `end`.
+void StabilityAnalysis::march(Frame* f, double end, double longest, PhaseTrack* track) {
+  const double sliver = 1e-12 * scales_.length;
+  while (end - f->s > sliver) {
+    double h = longest;
+    if (steps_.directions > 0) h = std::min(h, steps_.directions);
+    const double left = end - f->s;
+    advance(f, left <= h ? end : f->s + left / std::ceil(left / h), track, 0);
+  }
+}
+
+// One observation step, halved while an eigenphase moves more than max_phase_step over it as
+// record() pairs them (so that it pairs none wrongly, nor misses a turn).
 void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int depth) {
   const CarriedSteps before = steps_;
-  Frame next = flowed(*f, s1);
+  Frame& next = arriving_;
+  flowed(*f, s1, &steps_, false, &next);
   canonical_blocks(&next);
   orthonormalise(&next);
   const Eigen::VectorXd phases = eigenphases(next.U, next.P);
-  const double largest = largest_phase_move(phases, track->lifted);
-  bool passage = false;
-  for (int j = 0; j < phases.size(); ++j)
-    passage = passage || odd_multiples_between(track->lifted[j] - largest, track->lifted[j] + largest) > 0;
-  // Steps are halved while a phase moves too far, and around a passage until it is located to
-  // passage_resolution (the interpolation below is then exact to its square).
-  const bool locate = passage && s1 - f->s > options_.passage_resolution * scales_.length / scales_.rate;
-  if ((largest > options_.max_phase_step || locate) && depth < options_.max_halvings) {
+  // The moves of the phases as record() pairs them: where two phases come close, a long step can
+  // pair them wrongly though each lies near some new phase.
+  const double largest =
+      phases.size() == 0 ? 0.0 : (lift(track->lifted, phases) - track->lifted).cwiseAbs().maxCoeff();
+  if (largest > options_.max_phase_step && depth < options_.max_halvings) {
     const double mid = 0.5 * (f->s + s1);
     steps_ = before;  // the halves continue from f, not from the step taken past them
     advance(f, mid, track, depth + 1);
     advance(f, s1, track, depth + 1);
     return;
   }
-  record(track->lifted, f->s, phases, s1, track);
-  *f = next;
+  record(*f, phases, s1, track);
+  std::swap(*f, next);  // (next keeps f's storage for the following step)
   if (barrier_eq_ && sliding_reason_.empty())
     sliding_reason_ = kirchhoff::sliding_reason(*barrier_eq_, eq_->point(f->y, f->s), options_.zero_tolerance);
 }
@@ -906,19 +999,20 @@ StabilityReport StabilityAnalysis::run() {
                            [&](double a, double b) { return std::abs(a - b) < 1e-12 * scales_.length; }),
                breaks.end());
   const int pieces = static_cast<int>(breaks.size()) - 1;
-  // Enough steps that the eigenphases, turning at ~2 rate / L, move ~0.5 rad per step.
+  // Steps no longer than these, so that the eigenphases, turning at ~2 rate / L, move ~0.5 rad
+  // per step at most (march takes the integrator's own steps below that).
   const int wanted = std::max(options_.min_steps, static_cast<int>(std::ceil(4.0 * scales_.rate)));
   const int steps = std::max(2, (wanted + pieces - 1) / pieces);
   double shear = 0.0;  // of the contact just passed
   for (int i = 0; i < pieces; ++i) {
-    const double step = (breaks[i + 1] - breaks[i]) / steps;
+    const double longest = (breaks[i + 1] - breaks[i]) / steps;
     // Past a contact whose shear S is large (the contact near flattening, f / g'' large) the
     // fields turn on the length L / S: steps grow geometrically from a fraction of it, so no
     // eigenphase turns a whole turn within one (which a step could not tell from no turn).
-    for (double h = 0.25 * scales_.length / (1.0 + shear); shear > 0 && h < step; h *= 2)
+    for (double h = 0.25 * scales_.length / (1.0 + shear); shear > 0 && h < longest; h *= 2)
       advance(&f, breaks[i] + h, &track, 0);
     shear = 0.0;
-    for (int k = 1; k <= steps; ++k) advance(&f, breaks[i] + step * k, &track, 0);
+    march(&f, breaks[i + 1], longest, &track);
     for (size_t c = 0; c < contacts.size(); ++c) {
       if (std::abs(contacts[c].s - breaks[i + 1]) > 1e-12 * scales_.length) continue;
       if (std::string why = pass_contact(&f, contacts[c], static_cast<int>(c), &track, &shear); !why.empty()) {

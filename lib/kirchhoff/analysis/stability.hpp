@@ -74,17 +74,19 @@
 namespace kirchhoff {
 
 struct StabilityOptions {
-  // Sub-intervals along the whole rod at least (two per shooting segment at least); each is
-  // halved while an eigenphase of W moves more than max_phase_step over it, so passages are
-  // never missed nor paired wrongly. Too few (2 on the column at P = 200, whose phases turn
-  // through 9 pi) let a phase turn by more than pi unseen: 16 leaves a factor 4 on the cases
-  // of the tests.
+  // Sub-intervals along the whole rod at least (two per shooting segment at least): the
+  // eigenphases are observed at the end of each step of the fields' integration, and steps are
+  // no longer than these; each is halved while an eigenphase of W moves more than
+  // max_phase_step over it, so passages are never missed nor paired wrongly. Too few (2 on the
+  // column at P = 200, whose phases turn through 9 pi) let a phase turn by more than pi unseen:
+  // 16 leaves a factor 4 on the cases of the tests.
   int min_steps = 16;
   double max_phase_step = 0.5;  // rad
-  // Steps holding a conjugate point are halved down to this fraction of L (divided by the fields'
-  // wavenumber L sqrt(|n| / B) under large loads), so its position is found to ~1e-5 L (the
-  // interpolation of tan(phase / 2) is exact to second order in the step).
-  double passage_resolution = 1e-2;
+  // Conjugate points are located to this fraction of L (regula falsi on the phase from the
+  // step that holds the passage; 1e-7 leaves a factor 100 on the tests' 1e-5), in at most
+  // max_locating_steps trial integrations each.
+  double passage_tolerance = 1e-7;
+  int max_locating_steps = 20;
   int max_halvings = 16;
   // Singular values (of the orthonormal frame's blocks, dimensionless) and eigenvalues of the
   // boundary form below this are zero: a conjugate point exactly at L, a zero mode. The frame is
