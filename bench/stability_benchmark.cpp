@@ -85,6 +85,8 @@ int main(int argc, char** argv) {
       {"clamped-clamped, S mode", "clamped_clamped.toml", {{"s_mode", 1.0}}},
       {"twisted rod, straight, phi = 12", "twisted_clamped.toml", {{"phi", 12.0}}},
       {"heavy cantilever (gravity)", "heavy_cantilever.toml", {}},
+      {"wall, point contact (full frame)", "wall.toml", {}},
+      {"soft wall (barrier field, full frame)", "soft_wall.toml", {}},
   };
   std::printf("median CPU time of %d runs; F+J = one residual and variational Jacobian at the solution\n", runs);
   std::printf("%-44s %10s %10s %7s %9s %9s %6s  %s\n", "equilibrium", "F+J [us]", "index [us]", "ratio",
