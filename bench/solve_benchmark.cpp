@@ -5,7 +5,9 @@
 //       at phi = 11.58 (guess m_lateral = -1.7, n_lateral = 3.4, axial phase condition).
 // Each is solved from the case's own guess and from a converged solution perturbed by ~1e-2
 // (relative, with a unit floor), which is what a continuation step sees. Variants: single vs
-// multiple shooting (4 segments, Elastica) and variational vs finite-difference Jacobian.
+// multiple shooting (4 segments, Elastica) and the Newton steps' matrices: variational with the
+// variational equations at NewtonOptions::step_matrix_tolerance (the default), variational
+// exact (step_matrix_tolerance = 0), finite-difference.
 //
 // Two modes:
 //   solve_benchmark [--benchmark_...]    Google Benchmark; counters per solve: rhs_evals
@@ -43,6 +45,7 @@
 #include <time.h>
 
 #include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/shooting/detail/jacobian_lu.hpp"
 #include "kirchhoff/shooting/shooting.hpp"
 
 namespace {
@@ -62,7 +65,16 @@ constexpr double kSpatialGoalUs = 1000.0;
 constexpr double kPerturbation = 1e-2;
 
 enum class Guess { Case, Perturbed };
-enum class Jacobian { Variational, FiniteDifference };
+enum class Jacobian { Variational, ExactVariational, FiniteDifference };
+
+const char* jacobian_name(Jacobian j) {
+  switch (j) {
+    case Jacobian::Variational: return "variational";
+    case Jacobian::ExactVariational: return "exact_variational";
+    case Jacobian::FiniteDifference: return "fd_jacobian";
+  }
+  return "?";
+}
 
 struct CaseSpec {
   std::string label;
@@ -91,7 +103,7 @@ struct Scenario {
 
   std::string setup_key() const {
     return spec->label + "/" + (segments == 1 ? "single" : "multiple" + std::to_string(segments)) + "/" +
-           (jacobian == Jacobian::Variational ? "variational" : "fd_jacobian");
+           jacobian_name(jacobian);
   }
   std::string name() const {
     return setup_key() + "/" + (guess == Guess::Case ? "case_guess" : "perturbed_guess");
@@ -104,6 +116,7 @@ std::vector<Scenario> scenarios() {
   for (const CaseSpec& spec : case_specs())
     for (Guess guess : {Guess::Case, Guess::Perturbed}) {
       out.push_back({&spec, 1, Jacobian::Variational, guess});
+      out.push_back({&spec, 1, Jacobian::ExactVariational, guess});
       out.push_back({&spec, 1, Jacobian::FiniteDifference, guess});
       if (spec.planar) out.push_back({&spec, 4, Jacobian::Variational, guess});
     }
@@ -143,6 +156,7 @@ Prepared& prepared(const Scenario& sc) {
     ProblemDefinition d = p.c.definition;
     d.options.segments = sc.segments;
     d.options.newton.finite_difference_jacobian = sc.jacobian == Jacobian::FiniteDifference;
+    if (sc.jacobian == Jacobian::ExactVariational) d.options.newton.step_matrix_tolerance = 0.0;
     p.problem = std::make_unique<ShootingProblem>(std::move(d));
     p.case_guess = p.problem->initial_unknowns(p.c.start_guess);
     const ShootingResult r = solve(*p.problem, p.case_guess);
@@ -293,6 +307,10 @@ void jacobian_breakdown(const CaseSpec& spec, int reps) {
   std::string failure;
   const auto f_only = time_call(problem, reps, [&] { problem.evaluate(x, &F, nullptr, &failure); });
   const auto f_var = time_call(problem, reps, [&] { problem.evaluate(x, &F, &J, &failure); });
+  const double step_tol = problem.definition().options.newton.step_matrix_tolerance;
+  Eigen::MatrixXd J_step;
+  const auto f_step = time_call(problem, reps, [&] { problem.evaluate_for_step(x, &F, &J_step, step_tol, &failure); });
+  const double step_diff = (J_step - J).lpNorm<Eigen::Infinity>() / std::max(1.0, J.lpNorm<Eigen::Infinity>());
   const auto f_fd = time_call(problem, reps, [&] {
     problem.evaluate(x, &F, nullptr, &failure);
     finite_difference_jacobian(problem, x, problem.definition().options.newton.finite_difference_step, &Jfd);
@@ -322,6 +340,11 @@ void jacobian_breakdown(const CaseSpec& spec, int reps) {
               "F twice each: ~%.0f rhs, ~%.1f us)\n",
               f_var.first, f_var.second, n_model_params, 2.0 * n_model_params * f_only.second,
               2.0 * n_model_params * f_only.first);
+  std::printf("    F + J step matrix     %9.1f us %7.0f rhs  (variational equations at %.0e%s), |J_step - J| %.1e, "
+              "rcond(J) %.1e\n",
+              f_step.first, f_step.second, step_tol,
+              problem.has_step_matrices(step_tol) ? "" : ": not offered, the exact matrix", step_diff,
+              JacobianLU(J).reciprocal_condition());
   // Unknown parameters the rod model depends on (the axial phase condition's "unfolding"):
   // every change of their value rebuilds the equations (single-entry cache), which happens
   // twice per Jacobian for the parameter column and again back at x.
@@ -372,6 +395,17 @@ int run_summary(int runs_planar, int runs_3d) {
                 notes.c_str());
     std::fflush(stdout);
   }
+
+  std::printf("\nStep matrices / exact matrices (NewtonOptions::step_matrix_tolerance; same process, single shooting):\n");
+  for (const CaseSpec& spec : case_specs())
+    for (Guess g : {Guess::Case, Guess::Perturbed}) {
+      const Stats& v = results[Scenario{&spec, 1, Jacobian::Variational, g}.name()];
+      const Stats& e = results[Scenario{&spec, 1, Jacobian::ExactVariational, g}.name()];
+      if (!v.ok || !e.ok) continue;
+      std::printf("  %-28s %-16s time %.2f (%.1f / %.1f us)  rhs %.2f (%.0f / %.0f)  its %.2f / %.2f\n",
+                  spec.label.c_str(), g == Guess::Case ? "case_guess" : "perturbed_guess", v.median_us / e.median_us,
+                  v.median_us, e.median_us, v.rhs / e.rhs, v.rhs, e.rhs, v.iterations, e.iterations);
+    }
 
   std::printf("\nVariational / finite-difference Jacobian (same process, single shooting):\n");
   for (const CaseSpec& spec : case_specs())

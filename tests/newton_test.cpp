@@ -58,5 +58,173 @@ TEST(Summary, MaxIterationsIsReportedWithTheBestResidual) {
   EXPECT_TRUE(std::isfinite(s.residual_norm));
 }
 
+// A toy system F = (x0^2 - 2, eps (x1 - x0)) (condition number ~ 1 / eps) whose step matrices
+// are the exact J times `scale`, and which counts the calls of each entry point.
+class ScaledStepMatrices final : public NonlinearSystem {
+ public:
+  explicit ScaledStepMatrices(double scale, double eps = 1.0) : scale_(scale), eps_(eps) {}
+  int size() const override { return 2; }
+  bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, std::string*) const override {
+    *F = Eigen::Vector2d(x[0] * x[0] - 2.0, eps_ * (x[1] - x[0]));
+    if (J) {
+      ++exact_matrices;
+      *J = matrix(x);
+    }
+    return true;
+  }
+  bool has_step_matrices(double) const override { return true; }
+  bool evaluate_for_step(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, double,
+                         std::string* failure) const override {
+    ++step_matrices;
+    const bool ok = evaluate(x, F, nullptr, failure);
+    if (J) *J = scale_ * matrix(x);
+    return ok;
+  }
+  mutable int exact_matrices = 0, step_matrices = 0;
+
+ private:
+  Eigen::MatrixXd matrix(const Eigen::VectorXd& x) const {
+    return (Eigen::Matrix2d() << 2.0 * x[0], 0.0, -eps_, eps_).finished();
+  }
+  double scale_, eps_;
+};
+
+TEST(StepMatrices, AGoodOneIsUsedThroughout) {
+  // Within 1e-3 of the exact matrix, every full step more than halves |F|: no exact matrix.
+  const ScaledStepMatrices system(1.0 + 1e-3);
+  Eigen::VectorXd x = Eigen::Vector2d(1.0, 0.0);
+  NewtonOptions o;
+  o.fallback_search = false;
+  const NewtonSummary s = newton_solve(system, x, o);
+  ASSERT_TRUE(s.converged()) << s.brief_report();
+  EXPECT_NEAR(x[0], std::sqrt(2.0), 1e-10);
+  EXPECT_GT(system.step_matrices, 0);
+  EXPECT_EQ(system.exact_matrices, 0);
+}
+
+TEST(StepMatrices, AnIllConditionedOneGivesWayToTheExactMatrix) {
+  // Condition number ~ 1e8: a step matrix to 1e-8 would converge at a linear rate ~ 1.
+  const ScaledStepMatrices system(1.0 + 1e-8, 1e-8);
+  Eigen::VectorXd x = Eigen::Vector2d(1.0, 0.0);
+  NewtonOptions o;
+  o.fallback_search = false;
+  o.residual_tolerance = 1e-14;  // on the scale of the second residual, eps
+  const NewtonSummary s = newton_solve(system, x, o);
+  ASSERT_TRUE(s.converged()) << s.brief_report();
+  EXPECT_NEAR(x[0], std::sqrt(2.0), 1e-10);
+  EXPECT_EQ(system.step_matrices, 1);  // the first, refused on its condition number
+  EXPECT_GT(system.exact_matrices, 0);
+  // A well-conditioned one is kept.
+  const ScaledStepMatrices well(1.0 + 1e-8, 1.0);
+  x = Eigen::Vector2d(1.0, 0.0);
+  ASSERT_TRUE(newton_solve(well, x, o).converged());
+  EXPECT_EQ(well.exact_matrices, 0);
+}
+
+TEST(StepMatrices, ASingularOneIsRetriedOnTheExactMatrix) {
+  const ScaledStepMatrices system(0.0);
+  Eigen::VectorXd x = Eigen::Vector2d(1.0, 0.0);
+  NewtonOptions o;
+  o.fallback_search = false;
+  const NewtonSummary s = newton_solve(system, x, o);
+  ASSERT_TRUE(s.converged()) << s.brief_report();
+  EXPECT_EQ(system.step_matrices, 1);
+  EXPECT_GT(system.exact_matrices, 0);
+}
+
+TEST(StepMatrices, ToleranceZeroCallsOnlyEvaluate) {
+  const ScaledStepMatrices system(0.0);
+  Eigen::VectorXd x = Eigen::Vector2d(1.0, 0.0);
+  NewtonOptions o;
+  o.fallback_search = false;
+  o.step_matrix_tolerance = 0.0;
+  ASSERT_TRUE(newton_solve(system, x, o).converged());
+  EXPECT_EQ(system.step_matrices, 0);
+  o.step_matrix_tolerance = -1.0;
+  EXPECT_FALSE(o.validate().empty());
+}
+
+// The shooting problem's step matrices: F bit-identical to the residual alone, J the variational
+// one to about the step tolerance, every right-hand side counted on the problem.
+TEST(StepMatrices, ShootingKeepsTheResidualAndCountsTheWork) {
+  Case c = load_case(testing::case_path("simply_supported.toml"), {{"theta0", 2.8}});
+  const ShootingProblem problem(c.definition);
+  const double tol = c.definition.options.newton.step_matrix_tolerance;
+  ASSERT_TRUE(problem.has_step_matrices(tol));
+  const Eigen::VectorXd x = problem.initial_unknowns(c.start_guess);
+  Eigen::VectorXd F_alone, F_step, F_exact;
+  Eigen::MatrixXd J_step, J_exact;
+  std::string failure;
+  ASSERT_TRUE(problem.evaluate(x, &F_alone, nullptr, &failure));
+  ASSERT_TRUE(problem.evaluate(x, &F_exact, &J_exact, &failure));
+  const long before = problem.rhs_evaluations();
+  ASSERT_TRUE(problem.evaluate_for_step(x, &F_step, &J_step, tol, &failure));
+  const long step_rhs = problem.rhs_evaluations() - before;
+  EXPECT_EQ(F_step, F_alone);  // the same integration, bit for bit
+  // RK78 at 1e-8 per step: the matrix to ~1e-8 relative, its growth along an Elastica of order
+  // one; 1e-6 leaves a hundredfold margin and would catch a matrix at the wrong tolerance.
+  EXPECT_LE((J_step - J_exact).lpNorm<Eigen::Infinity>(), 1e-6 * J_exact.lpNorm<Eigen::Infinity>());
+  EXPECT_GT((J_step - J_exact).lpNorm<Eigen::Infinity>(), 0.0);  // really another integration
+  // Two passes counted: the state's (as F alone) and the variational equations'.
+  const long before_alone = problem.rhs_evaluations();
+  ASSERT_TRUE(problem.evaluate(x, &F_alone, nullptr, &failure));
+  EXPECT_GT(step_rhs, problem.rhs_evaluations() - before_alone);
+}
+
+TEST(StepMatrices, NotOfferedWithObstaclesOrLooserOwnMatrices) {
+  Case c = load_case(testing::case_path("simply_supported.toml"), {{"theta0", 1.0}});
+  const double tol = 1e-8;
+  ProblemDefinition with_wall = c.definition;
+  with_wall.obstacles.push_back(Obstacle::plane(Vec3(0.0, -10.0, 0.0), Vec3::UnitY()));
+  EXPECT_FALSE(ShootingProblem(with_wall).has_step_matrices(tol));
+  ProblemDefinition loose = c.definition;
+  loose.options.integrator.sensitivity_tol = 1e-8;
+  EXPECT_FALSE(ShootingProblem(loose).has_step_matrices(tol));
+  ProblemDefinition coarse = c.definition;
+  coarse.options.integrator.abs_tol = 1e-8;
+  EXPECT_FALSE(ShootingProblem(coarse).has_step_matrices(tol));
+  EXPECT_TRUE(ShootingProblem(c.definition).has_step_matrices(tol));
+  // Without step matrices evaluate_for_step is evaluate: the same F and J.
+  const ShootingProblem problem(with_wall);
+  const Eigen::VectorXd x = problem.initial_unknowns(c.start_guess);
+  Eigen::VectorXd F1, F2;
+  Eigen::MatrixXd J1, J2;
+  std::string failure;
+  ASSERT_TRUE(problem.evaluate(x, &F1, &J1, &failure));
+  ASSERT_TRUE(problem.evaluate_for_step(x, &F2, &J2, tol, &failure));
+  EXPECT_EQ(F1, F2);
+  EXPECT_EQ(J1, J2);
+}
+
+// Newton on the step matrices against Newton on the exact ones, for the Elastica far from its
+// solution (theta0 = 2.8 from the case's guess: 8 steps, damped ones among them): the same
+// iterations, and solutions as close as two points with |F| <= tol can be: |dx| <= |J^-1| 2 tol.
+TEST(StepMatrices, SameNewtonIterationsAndSolutionForTheElastica) {
+  Case c = load_case(testing::case_path("simply_supported.toml"), {{"theta0", 2.8}});
+  const ShootingProblem problem(c.definition);
+  NewtonOptions exact = c.definition.options.newton, step = exact;
+  exact.step_matrix_tolerance = 0.0;
+  ASSERT_GT(step.step_matrix_tolerance, 0.0);
+  const Eigen::VectorXd x0 = problem.initial_unknowns(c.start_guess);
+  Eigen::VectorXd x_exact = x0, x_step = x0;
+  long rhs = problem.rhs_evaluations();
+  const NewtonSummary s_exact = newton_solve(problem, x_exact, exact);
+  const long rhs_exact = problem.rhs_evaluations() - rhs;
+  rhs = problem.rhs_evaluations();
+  const NewtonSummary s_step = newton_solve(problem, x_step, step);
+  const long rhs_step = problem.rhs_evaluations() - rhs;
+  ASSERT_TRUE(s_exact.converged()) << s_exact.brief_report();
+  ASSERT_TRUE(s_step.converged()) << s_step.brief_report();
+  EXPECT_EQ(s_step.iterations, s_exact.iterations);
+  EXPECT_LT(s_step.evaluations, s_exact.evaluations);  // accepted full steps carry their matrices
+  EXPECT_LT(rhs_step, rhs_exact);
+  Eigen::VectorXd F;
+  Eigen::MatrixXd J;
+  std::string failure;
+  ASSERT_TRUE(problem.evaluate(x_exact, &F, &J, &failure));
+  const double inverse_norm = J.inverse().cwiseAbs().rowwise().sum().maxCoeff();
+  EXPECT_LE((x_step - x_exact).lpNorm<Eigen::Infinity>(), inverse_norm * 2.0 * exact.residual_tolerance);
+}
+
 }  // namespace
 }  // namespace kirchhoff

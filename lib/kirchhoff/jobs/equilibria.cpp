@@ -289,6 +289,10 @@ class Search {
     deadline_ = deadline_after(options.max_seconds);
     // Every solve of the search (the active-set loops, their fallback searches) ends by then too.
     definition_.options.newton.deadline = std::min(definition_.options.newton.deadline, deadline_);
+    // Newton on exact matrices (NewtonOptions::step_matrix_tolerance): the roots deflated and the
+    // seeds made from them steer the rest of the search, which a root moved by 1e-13 can change
+    // (the Euler column at P = 50 then finds three more rods whose ends meet, or fewer).
+    definition_.options.newton.step_matrix_tolerance = 0.0;
     deflated_ = options.deflation;
     deflated_.residual_tolerance = definition.options.newton.residual_tolerance;
     deflated_.deadline = std::min(deadline_, definition.options.newton.deadline);

@@ -30,6 +30,7 @@ std::string NewtonOptions::validate() const {
   if (!(residual_tolerance > 0)) return "residual_tolerance must be > 0";
   if (!(finite_difference_step > 0)) return "finite_difference_step must be > 0";
   if (max_backtracks < 0) return "max_backtracks must be >= 0";
+  if (!(step_matrix_tolerance >= 0)) return "step_matrix_tolerance must be >= 0 (0: exact matrices)";
   if (!(max_seconds >= 0 && max_seconds <= 1e9)) return "max_seconds must be in [0, 1e9] (0: no limit)";
   return {};
 }
@@ -95,18 +96,38 @@ bool finite_difference_jacobian(const NonlinearSystem& system, const Eigen::Vect
 
 namespace {
 
+// Largest linear convergence rate (tolerance x condition number) accepted of a step matrix: two
+// digits per iteration once the quadratic phase is over, so a solve ends at most a step or two
+// later than on the exact matrices.
+constexpr double kStepMatrixRate = 1e-2;
+
+// Whether the next full Newton step will likely converge, after a full step from |F_previous|
+// to |F|: quadratic convergence (|F_next| ~ |F|^3 / |F_previous|^2) takes |F| below the tolerance.
+bool expect_convergence(double norm, double previous_norm, double tolerance) {
+  if (!(previous_norm > 0)) return false;
+  const double ratio = norm / previous_norm;
+  return norm * ratio * ratio <= tolerance;
+}
+
 NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options,
                            const Deadline& deadline) {
   NewtonSummary summary;
   Eigen::VectorXd F, F_trial;
-  Eigen::MatrixXd J;
+  Eigen::MatrixXd J, J_trial;
   std::string failure;
   bool not_finite = false;  // the last failed evaluation returned NaN or inf (not an integrator failure)
+  // Step matrices (NonlinearSystem::has_step_matrices): F as evaluate's, a cheaper J. Cleared for
+  // the rest of the solve when such a matrix is too ill-conditioned or its step fails; without them
+  // every evaluation is exactly evaluate's, as it was before they existed.
+  bool step_matrices = options.step_matrix_tolerance > 0 && !options.finite_difference_jacobian &&
+                       system.has_step_matrices(options.step_matrix_tolerance);
   auto evaluate = [&](const Eigen::VectorXd& at, Eigen::VectorXd* f, Eigen::MatrixXd* jac) {
     ++summary.evaluations;
     not_finite = false;
     bool ok = false;
-    if (jac && options.finite_difference_jacobian)
+    if (jac && step_matrices)
+      ok = system.evaluate_for_step(at, f, jac, options.step_matrix_tolerance, &failure);
+    else if (jac && options.finite_difference_jacobian)
       ok = system.evaluate(at, f, nullptr, &failure) &&
            finite_difference_jacobian(system, at, options.finite_difference_step, jac);
     else
@@ -131,6 +152,12 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
   if (!evaluate(x, &F, nullptr)) return fail(INFINITY);
   double norm = max_abs_or_nan(F);
   summary.residual_norm = norm;
+  // With step matrices, the full step's trial carries its matrix (its F is the one a trial alone
+  // gives), so an accepted full step needs no evaluation at the new x. Not when the last step
+  // was damped (the full step is then likely rejected) nor when the trial likely converges.
+  bool have_matrix = false;  // J is the (step) matrix at x
+  bool last_step_full = true;
+  double previous_norm = NAN;
   for (int it = 0; it < options.max_iterations; ++it) {
     if (norm <= options.residual_tolerance) {
       summary.status = SolverStatus::Converged;
@@ -141,9 +168,17 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
       summary.message = "the wall-clock limit was reached";
       return summary;
     }
-    if (!evaluate(x, &F, &J)) return fail(norm);
+    if (!have_matrix && !evaluate(x, &F, &J)) return fail(norm);
+    have_matrix = false;
     const JacobianLU lu(J);
     const double rcond = lu.reciprocal_condition();
+    // A step matrix's error (~ its tolerance, relative) times the condition number is the rate
+    // of the linear convergence it ends in: above kStepMatrixRate (or singular), the exact one.
+    if (step_matrices && !(options.step_matrix_tolerance <= kStepMatrixRate * rcond)) {
+      step_matrices = false;
+      --it;
+      continue;
+    }
     if (!(rcond > options.singular_rcond)) {
       summary.status = SolverStatus::SingularJacobian;
       summary.message = "reciprocal condition number " + std::to_string(rcond);
@@ -154,15 +189,25 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
     // decrease with the usual 1e-4 slope fraction). A trial whose residual is NaN or inf fails
     // evaluate and is backed away from.
     const double merit = F.squaredNorm();
+    const bool matrix_with_full_step =
+        step_matrices && last_step_full &&
+        !expect_convergence(norm, previous_norm, options.residual_tolerance);
     double alpha = 1.0;
-    bool accepted = false;
+    bool accepted = false, trial_has_matrix = false;
     Eigen::VectorXd x_trial;
     for (int k = 0; k <= options.max_backtracks && !deadline.passed(); ++k, alpha *= 0.5) {
       x_trial = x + alpha * dx;
-      if (evaluate(x_trial, &F_trial, nullptr) && F_trial.squaredNorm() <= (1.0 - 1e-4 * alpha) * merit) {
+      trial_has_matrix = k == 0 && matrix_with_full_step;
+      if (evaluate(x_trial, &F_trial, trial_has_matrix ? &J_trial : nullptr) &&
+          F_trial.squaredNorm() <= (1.0 - 1e-4 * alpha) * merit) {
         accepted = true;
         break;
       }
+    }
+    if (!accepted && step_matrices && !deadline.passed()) {  // retried on the exact matrix
+      step_matrices = false;
+      --it;
+      continue;
     }
     ++summary.iterations;
     if (!accepted) {
@@ -174,6 +219,12 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
     }
     x = x_trial;
     F = F_trial;
+    if (trial_has_matrix) {
+      J.swap(J_trial);
+      have_matrix = true;
+    }
+    previous_norm = norm;
+    last_step_full = alpha == 1.0;
     norm = max_abs_or_nan(F);
     summary.residual_norm = norm;
     summary.history.push_back(norm);

@@ -18,6 +18,20 @@ class NonlinearSystem {
   // integrator gave up), with the reason in *failure.
   virtual bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
                         std::string* failure) const = 0;
+
+  // Cheaper matrices for Newton's steps (NewtonOptions::step_matrix_tolerance): whether
+  // evaluate_for_step at this tolerance gives F bit-identical to evaluate's F alone (so the
+  // converged point, decided by F, is unchanged) and J to about `tolerance` relative, for less
+  // than evaluate's F + J. The default: no such matrices, Newton calls evaluate.
+  virtual bool has_step_matrices(double tolerance) const {
+    (void)tolerance;
+    return false;
+  }
+  virtual bool evaluate_for_step(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, double tolerance,
+                                 std::string* failure) const {
+    (void)tolerance;
+    return evaluate(x, F, J, failure);
+  }
 };
 
 enum class SolverStatus {
@@ -45,6 +59,17 @@ struct NewtonOptions {
   double singular_rcond = 1e-15;  // below this LU's estimate, J is treated as singular
   bool finite_difference_jacobian = false;  // fallback; the default is the variational Jacobian
   double finite_difference_step = 1e-6;     // central differences: error ~ h^2 ~ 1e-12
+  // Newton's steps on matrices held to this relative tolerance where the system offers them
+  // (NonlinearSystem::has_step_matrices: shooting problems without obstacles or contacts, whose
+  // variational equations are then integrated to it, IntegratorOptions::sensitivity_tol). The
+  // residual stays exact, so the converged point is decided as before; the convergence stays
+  // quadratic down to ~tolerance x condition number and is linear with that rate below it. 1e-8:
+  // as the continuation's march matrices (ContinuationOptions::march_sensitivity_tol). A step
+  // matrix whose condition number times this tolerance exceeds 1e-2 (the linear rate it would
+  // converge at), or on which the step fails (no step length decreases |F|), is replaced by the
+  // exact one, and the exact matrices are kept to the end of the solve. 0: the exact matrices
+  // throughout, every evaluation as evaluate's.
+  double step_matrix_tolerance = 1e-8;
   bool fallback_search = true;  // run an NLopt least-squares search when Newton fails
   int fallback_evaluations = 2000;
   // Wall-clock limit of one solve in seconds (0: none), and an instant no solve runs past (a

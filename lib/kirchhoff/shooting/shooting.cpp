@@ -202,14 +202,14 @@ void ShootingProblem::for_each_segment(const Parameters& p, const std::function<
 }
 
 bool ShootingProblem::integrate_segments(const Eigen::VectorXd& x, const Parameters& p, bool sensitivities,
-                                         std::vector<SegmentFlow>* flows, std::string* failure) const {
+                                         const IntegratorOptions& integrator, std::vector<SegmentFlow>* flows,
+                                         std::string* failure) const {
   const int n = state_size_, M = segments();
   const double L = length(p);
   flows->assign(M, SegmentFlow{});
   try {
     for_each_segment(p, [&](int i, const RodEquations& equations) {
-      (*flows)[i] = equations.flow(x.segment(i * n, n), L * i / M, L * (i + 1) / M, sensitivities,
-                                   definition_.options.integrator);
+      (*flows)[i] = equations.flow(x.segment(i * n, n), L * i / M, L * (i + 1) / M, sensitivities, integrator);
     });
   } catch (const IntegrationError& e) {
     if (failure) *failure = e.what();
@@ -245,6 +245,21 @@ bool ShootingProblem::evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eig
                                std::string* failure) const {
   Eigen::VectorXd y_end;
   return evaluate_with_end(x, F, J, &y_end, failure);
+}
+
+bool ShootingProblem::has_step_matrices(double tolerance) const {
+  const IntegratorOptions& own = definition_.options.integrator;
+  return tolerance > std::max(own.sensitivity_tol, own.abs_tol) && definition_.contacts.empty() &&
+         definition_.obstacles.empty() && !definition_.moving_obstacles;
+}
+
+bool ShootingProblem::evaluate_for_step(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
+                                        double tolerance, std::string* failure) const {
+  Eigen::VectorXd y_end;
+  if (!J || !has_step_matrices(tolerance)) return evaluate_with_end(x, F, J, &y_end, failure);
+  IntegratorOptions loose = definition_.options.integrator;
+  loose.sensitivity_tol = tolerance;
+  return evaluate_with(x, F, J, &y_end, loose, failure);
 }
 
 bool ShootingProblem::parameter_derivative(const Eigen::VectorXd& x, const std::string& name, Eigen::VectorXd* dF,
@@ -285,9 +300,15 @@ void ShootingProblem::place_condition_rows(const Eigen::VectorXd& rows, Eigen::V
 
 bool ShootingProblem::evaluate_with_end(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
                                         Eigen::VectorXd* y_end_out, std::string* failure) const {
+  return evaluate_with(x, F, J, y_end_out, definition_.options.integrator, failure);
+}
+
+bool ShootingProblem::evaluate_with(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
+                                    Eigen::VectorXd* y_end_out, const IntegratorOptions& integrator,
+                                    std::string* failure) const {
   const Parameters p = parameters_at(x);
   Eigen::VectorXd& y_end = *y_end_out;
-  if (!residual(x, p, F, J, failure, &y_end)) return false;
+  if (!residual(x, p, F, J, failure, &y_end, &integrator)) return false;
   if (!J) return true;
   // Parameter columns by central differences (see the header for why this is accurate enough).
   // A parameter that only enters the boundary conditions moves only their rows, which are
@@ -353,7 +374,8 @@ void ShootingProblem::end_rows(const RodEquations& eq, const Eigen::VectorXd& y_
 }
 
 bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F,
-                               Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end) const {
+                               Eigen::MatrixXd* J, std::string* failure, Eigen::VectorXd* y_end,
+                               const IntegratorOptions* integrator) const {
   // A Newton or corrector iterate may take a parameter outside the model's domain (a slenderness
   // whose radius is <= 0): that point cannot be evaluated, like one that cannot be integrated.
   std::shared_ptr<const RodEquations> eq;
@@ -371,7 +393,9 @@ bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Ei
   int row = start_rows(*eq, y0, p, F, J);
 
   std::vector<SegmentFlow> flows;
-  if (!integrate_segments(x, p, J != nullptr, &flows, failure)) return false;
+  if (!integrate_segments(x, p, J != nullptr, integrator ? *integrator : definition_.options.integrator, &flows,
+                          failure))
+    return false;
   for (int i = 0; i + 1 < M; ++i) {
     F->segment(row, n) = flows[i].y - x.segment((i + 1) * n, n);
     if (J) {

@@ -118,6 +118,14 @@ class ShootingProblem final : public NonlinearSystem {
   int size() const override;
   bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
                 std::string* failure) const override;
+  // Newton's step matrices (NewtonOptions::step_matrix_tolerance): the variational equations
+  // integrated to `tolerance` for this call only (IntegratorOptions::sensitivity_tol), the state,
+  // hence F, to the problem's own. Offered where `tolerance` is looser than the problem's own
+  // sensitivity_tol and abs_tol, and not with obstacles or contacts (their active-set decisions
+  // and events follow Newton's last iterates, which stay exactly as they were).
+  bool has_step_matrices(double tolerance) const override;
+  bool evaluate_for_step(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, double tolerance,
+                         std::string* failure) const override;
 
   // Unknown vector from a state guess at s = 0 (completed with the start conditions) by
   // integrating across the segments; throws IntegrationError when that integration fails.
@@ -188,8 +196,13 @@ class ShootingProblem final : public NonlinearSystem {
                          std::string* failure) const;
 
  private:
+  // `integrator`: the options of the flows without contacts (null: the definition's).
   bool residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F, Eigen::MatrixXd* J,
-                std::string* failure, Eigen::VectorXd* y_end = nullptr) const;
+                std::string* failure, Eigen::VectorXd* y_end = nullptr,
+                const IntegratorOptions* integrator = nullptr) const;
+  // evaluate_with_end with the flows of x itself integrated with `integrator`.
+  bool evaluate_with(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, Eigen::VectorXd* y_end,
+                     const IntegratorOptions& integrator, std::string* failure) const;
   // Sizes F (and J) and fills the gauge and start-condition rows; returns the next row.
   int start_rows(const RodEquations& eq, const Eigen::VectorXd& y0, const Parameters& p, Eigen::VectorXd* F,
                  Eigen::MatrixXd* J) const;
@@ -238,7 +251,8 @@ class ShootingProblem final : public NonlinearSystem {
                         bool parallel = true) const;
   // The flows of all segments.
   bool integrate_segments(const Eigen::VectorXd& x, const Parameters& p, bool sensitivities,
-                          std::vector<SegmentFlow>* flows, std::string* failure) const;
+                          const IntegratorOptions& integrator, std::vector<SegmentFlow>* flows,
+                          std::string* failure) const;
 
   mutable std::vector<double> cached_model_values_;
   mutable std::shared_ptr<const RodEquations> cached_equations_;
