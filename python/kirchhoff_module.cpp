@@ -275,12 +275,15 @@ py::dict stability_dict(const StabilityReport& st, const DiscreteStability& disc
     d["cross_check"] = check;
   }
   d["method"] = st.method;
+  if (!st.method_reason.empty()) d["method_reason"] = st.method_reason;
   if (st.reduced_energy_curvature) {
     d["sliding_length"] = st.sliding_length;
     d["fixed_length_index"] = *st.fixed_length_index;
     d["reduced_energy_curvature"] = *st.reduced_energy_curvature;
   }
-  if (st.index) {
+  if (st.index && st.method == "discretised_energy") {
+    // No conjugate points, so no load-controlled count or correction.
+  } else if (st.index) {
     d["load_controlled_index"] = st.dead_load_index;
     d["held_chord_directions"] = st.constraint_count;
     d["constraint_correction"] = st.constraint_correction;

@@ -499,9 +499,8 @@ TEST(DiscreteStability, UnsupportedCasesSayWhy) {
     EXPECT_NE(d.reason.find(e.reason), std::string::npos) << d.reason;
     EXPECT_EQ(describe(d).rfind("discrete index undefined", 0), 0u);
   }
-  // The rod wrapped on the indenter lies on it over an interval: an extended contact.
-  const Solved wrapped = solve_with_contacts(testing::case_text("wrapped_indenter.toml"), {});
-  EXPECT_NE(discrete_stability(*wrapped.problem, wrapped.x).reason.find("extended contact"), std::string::npos);
+  // (The rod wrapped on the indenter, an extended contact, is covered:
+  // stability_extended_contact_test.cpp.)
   const Solved s = solve_text(kExtensible, {});
   EXPECT_NE(discrete_stability(*s.problem, s.x).reason.find("extensible"), std::string::npos);
   const Solved column = solve_shipped("euler_column.toml", {{"P", 5.0}, {"theta_guess", 0.0}});

@@ -2,6 +2,7 @@
 #include "kirchhoff/analysis/discrete_stability.hpp"
 
 #include "kirchhoff/analysis/detail/discrete_stability_contact.hpp"
+#include "kirchhoff/analysis/detail/discrete_stability_lying.hpp"
 #include "kirchhoff/analysis/detail/stability_free_length.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -15,9 +16,10 @@ namespace {
 
 using Vec2 = Eigen::Vector2d;
 
-// Where a constraint acts: a position component or the angle at one end, or a point contact
-// (the rod's closest approach to an obstacle held at zero, discrete_stability_contact.hpp).
-enum class Held { StartPosition, EndPosition, StartAngle, EndAngle, Contact };
+// Where a constraint acts: a position component or the angle at one end, a point contact (the
+// rod's closest approach to an obstacle held at zero, discrete_stability_contact.hpp), or a node
+// lying on an obstacle along an extended contact (its gap held at zero: discrete_stability_lying.hpp).
+enum class Held { StartPosition, EndPosition, StartAngle, EndAngle, Contact, Node };
 
 struct Constraint {
   Held kind = Held::StartPosition;
@@ -27,6 +29,7 @@ struct Constraint {
   // node of the interpolant is the node nearest to it) and its force there.
   std::shared_ptr<const Obstacle> obstacle;
   double s = 0.0, force = 0.0;
+  int node = -1;  // Held::Node: the node on the obstacle
 };
 
 Constraint held(Held kind, const Vec2& direction, double value) {
@@ -49,6 +52,9 @@ struct Reading {
   // the length is given.
   std::string sliding;
   double inside_hamiltonian = 0.0;
+  // Extended contacts: the intervals where the rod lies on an obstacle (every other node there is
+  // held on it: initial_lying_nodes).
+  std::vector<LyingInterval> lying;
 };
 
 std::string format(double v) {
@@ -101,10 +107,25 @@ std::string contacts_not_covered(const ShootingProblem& problem, const Eigen::Ve
   const std::vector<Obstacle> obstacles = problem.obstacles(problem.parameters_at(x));
   const double B = model.B[1](0.5 * model.length), L = model.length;
   for (const PointContact& c : problem.contacts_at(x)) {
-    if (c.extended)
-      return "an extended contact (the rod lying on the obstacle): not modelled by the discrete check";
     if (obstacles[c.obstacle].shape() == Obstacle::Shape::LevelSet)
       return "a contact with a level-set obstacle: not modelled by the discrete check (planes and discs are)";
+    // The rod lying on a plane or a disc: its nodes there held (discrete_stability_lying.hpp).
+    if (c.extended) {
+      if (!(c.force > 1e-10 * B / (L * L)) || !(c.force_end > 1e-10 * B / (L * L)))
+        return "an extended contact with zero force at an edge (weakly active where the rod leaves the obstacle): "
+               "the edge's direction is not held and the index depends on higher-order terms, not defined here";
+      if (model.field && obstacles[c.obstacle].is_flat())
+        return "a flat contact under an external field (a distributed contact force that the field sets): not "
+               "modelled by the discrete check";
+      if (!obstacles[c.obstacle].is_flat()) {
+        // A wrap presses with N / radius, N the tension n.t: zero tension is weakly active.
+        const RodPoint mid = problem.sample(x, {0.5 * (c.s + c.s_end)}).front();
+        const Vec3 t = mid.R.col(2);
+        if (!(mid.n.dot(t) > 1e-10 * B / L))
+          return "a wrap with zero tension (its pressure N / radius vanishes: weakly active): not defined here";
+      }
+      continue;
+    }
     if (!(c.force > 1e-10 * B / (L * L)))
       return "a contact with zero force (weakly active): the index depends on higher-order terms, not defined here";
     if (!(problem.contact_bending(x, c) > 1e-9 / L))
@@ -229,9 +250,19 @@ void read_end(const RodEquations& eq, const EndCondition& end, bool at_start, co
 // length the last unknown is ell, and the element length h = ell / N follows it (step(z)).
 class DiscreteRod {
  public:
-  DiscreteRod(const RodModel& model, const Reading& reading, const std::vector<RodPoint>& nodes)
-      : N_(static_cast<int>(nodes.size()) - 1), h_(model.length / N_), reading_(reading), field_(model.field.get()),
-        sliding_(!reading.sliding.empty()) {
+  // on_obstacle: the nodes held on an obstacle (extended contacts), with the obstacle of each.
+  DiscreteRod(const RodModel& model, const Reading& reading, const std::vector<RodPoint>& nodes,
+              const std::vector<LyingNode>& on_obstacle = {})
+      : N_(static_cast<int>(nodes.size()) - 1), h_(model.length / N_), reading_(reading),
+        constraints_(reading.constraints), field_(model.field.get()), sliding_(!reading.sliding.empty()) {
+    for (const LyingNode& n : on_obstacle) {
+      Constraint c;
+      c.kind = Held::Node;
+      c.obstacle = n.obstacle;
+      c.node = n.node;
+      c.s = nodes[n.node].s;
+      constraints_.push_back(c);
+    }
     for (const RodPoint& q : nodes) {
       arclengths_.push_back(q.s);
       if (field_ && field_->force_gradient(q.s, q.r).norm() > 0) position_dependent_ = true;
@@ -258,15 +289,18 @@ class DiscreteRod {
     for (const Vec2& f : nodal_) load_scale_ += f.norm();
     // The middle node of each contact's interpolant: the one nearest to the contact.
     contact_node_.assign(constraints(), -1);
-    for (int k = 0; k < constraints(); ++k)
-      if (reading.constraints[k].kind == Held::Contact)
-        contact_node_[k] = std::clamp(static_cast<int>(std::lround(reading.constraints[k].s / h_)), 1, N_ - 1);
+    for (int k = 0; k < constraints(); ++k) {
+      if (constraints_[k].kind == Held::Contact)
+        contact_node_[k] = std::clamp(static_cast<int>(std::lround(constraints_[k].s / h_)), 1, N_ - 1);
+      if (constraints_[k].kind == Held::Node) contact_node_[k] = constraints_[k].node;
+    }
   }
 
   int elements() const { return N_; }
   int unknowns() const { return N_ + 3 + (sliding_ ? 1 : 0); }  // r_0 (2), theta_0..theta_N, [ell]
-  int constraints() const { return static_cast<int>(reading_.constraints.size()); }
-  const Constraint& constraint(int k) const { return reading_.constraints[k]; }
+  int constraints() const { return static_cast<int>(constraints_.size()); }
+  const Constraint& constraint(int k) const { return constraints_[k]; }
+  Vec2 node_position(int i, const Eigen::VectorXd& z) const { return positions(z)[i]; }
   bool sliding() const { return sliding_; }
   int length_index() const { return N_ + 3; }  // ell's place among the unknowns, when it slides
   // The element length at z: ell / N with a sliding length, else L / N. (The constructor's lumped
@@ -295,13 +329,14 @@ class DiscreteRod {
     Eigen::VectorXd g(constraints());
     const Vec2 end = end_position(z);
     for (int k = 0; k < constraints(); ++k) {
-      const Constraint& c = reading_.constraints[k];
+      const Constraint& c = constraints_[k];
       switch (c.kind) {
         case Held::StartPosition: g[k] = c.direction.dot(z.head<2>()) - c.value; break;
         case Held::EndPosition: g[k] = c.direction.dot(end) - c.value; break;
         case Held::StartAngle: g[k] = z[angle(0)] - c.value; break;
         case Held::EndAngle: g[k] = z[angle(N_)] - c.value; break;
         case Held::Contact: g[k] = approach(k, z).value; break;
+        case Held::Node: g[k] = c.obstacle->gap(lift(positions(z)[c.node])); break;
       }
     }
     return g;
@@ -311,7 +346,7 @@ class DiscreteRod {
     Eigen::MatrixXd J = Eigen::MatrixXd::Zero(constraints(), unknowns());
     const Vec2 end = end_position(z);
     for (int k = 0; k < constraints(); ++k) {
-      const Constraint& c = reading_.constraints[k];
+      const Constraint& c = constraints_[k];
       switch (c.kind) {
         case Held::EndPosition:
           for (int j = 0; j <= N_; ++j) J(k, angle(j)) = step(z) * weight(j) * c.direction.dot(normal(z[angle(j)]));
@@ -330,6 +365,9 @@ class DiscreteRod {
           }
           break;
         }
+        case Held::Node:
+          J.row(k) = gap_gradient(k, positions(z)[c.node]).transpose() * node_jacobian(c.node, z);
+          break;
       }
     }
     return J;
@@ -344,11 +382,13 @@ class DiscreteRod {
     gradient->setZero(unknowns());
     const std::vector<Vec2> r = positions(z);
     for (int k = 0; k < constraints(); ++k) {
-      const Constraint& c = reading_.constraints[k];
+      const Constraint& c = constraints_[k];
       if (c.kind == Held::StartPosition) force.front() -= lambda[k] * c.direction;
       if (c.kind == Held::EndPosition) force.back() -= lambda[k] * c.direction;
       if (c.kind == Held::StartAngle) (*gradient)[angle(0)] += lambda[k];
       if (c.kind == Held::EndAngle) (*gradient)[angle(N_)] += lambda[k];
+      // A node on the obstacle: lambda dg(r_i), a reaction -lambda grad g on the node.
+      if (c.kind == Held::Node) force[c.node] -= lambda[k] * gap_gradient(k, r[c.node]);
       if (c.kind != Held::Contact) continue;
       // lambda dq* = lambda sum_m w_m grad g(r_i) . dr_i: nodal reactions -lambda w_m grad g.
       const ClosestApproach a = approach(k, z);
@@ -383,9 +423,10 @@ class DiscreteRod {
       (*gradient)[length_index()] += reading_.inside_hamiltonian - work / z[length_index()];
     }
     if (hessian && position_dependent_) add_field_stiffness(z, hessian);
-    if (hessian)
-      for (int k = 0; k < constraints(); ++k)
-        if (reading_.constraints[k].kind == Held::Contact) add_contact_curvature(k, lambda[k], z, hessian);
+    for (int k = 0; k < constraints() && hessian; ++k) {
+      if (constraints_[k].kind == Held::Contact) add_contact_curvature(k, lambda[k], z, hessian);
+      if (constraints_[k].kind == Held::Node) add_node_curvature(k, lambda[k], z, hessian);
+    }
     add_bending(z, gradient, hessian);
   }
 
@@ -401,7 +442,7 @@ class DiscreteRod {
   double residual_scale(const Eigen::VectorXd& lambda) const {
     double scale = stiffness_scale_ + load_scale_;
     for (int k = 0; k < constraints(); ++k)
-      scale += std::abs(lambda[k]) / (angular(reading_.constraints[k]) ? N_ * h_ : 1.0);
+      scale += std::abs(lambda[k]) / (angular(constraints_[k]) ? N_ * h_ : 1.0);
     return scale;
   }
 
@@ -417,7 +458,7 @@ class DiscreteRod {
     if (sliding_) worst = std::max(worst, std::abs(gradient[length_index()]) / F);
     const Eigen::VectorXd g = constraint_values(z);
     for (int k = 0; k < constraints(); ++k)
-      worst = std::max(worst, std::abs(g[k]) / (angular(reading_.constraints[k]) ? 1.0 : N_ * h_));
+      worst = std::max(worst, std::abs(g[k]) / (angular(constraints_[k]) ? 1.0 : N_ * h_));
     return worst;
   }
 
@@ -444,7 +485,7 @@ class DiscreteRod {
   }
   static double a(int i, int j) { return (j < i ? 1.0 : 0.0) + (j >= 1 && j <= i ? 1.0 : 0.0); }
 
-  Vec2 gap_gradient(int k, const Vec2& r) const { return reading_.constraints[k].obstacle->gradient(lift(r)).head<2>(); }
+  Vec2 gap_gradient(int k, const Vec2& r) const { return constraints_[k].obstacle->gradient(lift(r)).head<2>(); }
 
   // The nodal loads at the configuration z: dead loads, and the field where the rod is.
   std::vector<Vec2> loads(const Eigen::VectorXd& z) const {
@@ -498,10 +539,20 @@ class DiscreteRod {
       const int i = contact_node_[k] - 1 + m;
       const Eigen::MatrixXd D = node_jacobian(i, z);
       u += c.direction[m] * D.transpose() * gap_gradient(k, r[i]);
-      const Eigen::Matrix2d G = reading_.constraints[k].obstacle->hessian(lift(r[i])).topLeftCorner<2, 2>();
+      const Eigen::Matrix2d G = constraints_[k].obstacle->hessian(lift(r[i])).topLeftCorner<2, 2>();
       if (G.norm() > 0) *hessian += lambda * c.weights[m] * D.transpose() * G * D;
     }
     *hessian -= (lambda / c.curvature) * u * u.transpose();
+  }
+
+  // A node held on the obstacle: lambda times its gap's curvature, D_i^T g''(r_i) D_i (zero on a
+  // plane; on a disc the obstacle's curvature, as for a point contact).
+  void add_node_curvature(int k, double lambda, const Eigen::VectorXd& z, Eigen::MatrixXd* hessian) const {
+    const int i = constraints_[k].node;
+    const Eigen::Matrix2d G = constraints_[k].obstacle->hessian(lift(positions(z)[i])).topLeftCorner<2, 2>();
+    if (G.norm() == 0) return;
+    const Eigen::MatrixXd D = node_jacobian(i, z);
+    *hessian += lambda * D.transpose() * G * D;
   }
 
   // B / (2 h) (d - h u_hat)^2 per element, d = theta_e+1 - theta_e. With a sliding length, h =
@@ -535,6 +586,7 @@ class DiscreteRod {
   int N_;
   double h_;
   const Reading& reading_;
+  std::vector<Constraint> constraints_;  // the reading's, then the nodes held on an obstacle
   const ExternalField* field_ = nullptr;
   bool position_dependent_ = false;  // the field's force depends on where the rod is
   std::vector<double> arclengths_;   // of the nodes
@@ -564,6 +616,12 @@ struct Spectrum {
   std::string sliding_problem;
   double reduced_curvature = NAN;
   double length_deviation = 0.0;
+  // Extended contacts (discrete_stability_lying.hpp): the nodes held on an obstacle, how many of
+  // them have zero force (weakly active: between a flat contact's edges), the lowest lift-off
+  // eigenvalue (NaN without any) and whether its mode lifts the rod everywhere between the edges.
+  int lying_nodes = 0, weak_nodes = 0;
+  double lift_off = NAN;
+  bool lift_one_signed = false;
 };
 
 // Starting values: the shooting solution at the nodes, multipliers by least squares.
@@ -757,11 +815,71 @@ std::string contact_problem(const DiscreteRod& rod, const Eigen::VectorXd& z, co
   return "";
 }
 
+// The nodes held on the obstacle are every other node of the lying part (discrete_stability_lying.hpp
+// says why: holding every node leaves a checkerboard of multipliers), starting from the first node
+// inside the shooting solution's interval (end nodes excepted: an end's own conditions hold it).
+std::vector<LyingNode> initial_lying_nodes(const Reading& reading, const std::vector<RodPoint>& nodes) {
+  std::vector<LyingNode> out;
+  for (const LyingInterval& l : reading.lying) {
+    int first = -1;
+    for (int j = 1; j + 1 < static_cast<int>(nodes.size()); ++j) {
+      if (nodes[j].s < l.s1 || nodes[j].s > l.s2) continue;
+      if (first < 0) first = j;
+      if ((j - first) % 2 == 0) out.push_back({j, l.obstacle});
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const LyingNode& a, const LyingNode& b) { return a.node < b.node; });
+  return out;
+}
+
+// The lift-off of each lying part whose interior carries no force (LyingInterval::weak,
+// discrete_stability_lying.hpp): the strut's second variation on the angles strictly between its
+// first and last held nodes (the edges), with the last one kept in place.
+void analyse_lying(const DiscreteRod& rod, const Reading& reading, const Eigen::VectorXd& z,
+                   const Eigen::VectorXd& lambda, Spectrum* out) {
+  Eigen::VectorXd gradient;
+  Eigen::MatrixXd H;
+  bool hessian = false;
+  const double h = rod.step(z);
+  for (const LyingInterval& l : reading.lying) {
+    std::vector<int> held;
+    for (int k = 0; k < rod.constraints(); ++k)
+      if (rod.constraint(k).kind == Held::Node && rod.constraint(k).obstacle == l.obstacle &&
+          rod.constraint(k).s >= l.s1 && rod.constraint(k).s <= l.s2)
+        held.push_back(rod.constraint(k).node);
+    out->lying_nodes += static_cast<int>(held.size());
+    if (!l.weak) continue;
+    out->weak_nodes += std::max(0, static_cast<int>(held.size()) - 2);
+    if (held.size() < 3) continue;  // no node between the edges: nothing lifts at this resolution
+    if (!hessian) rod.lagrangian(z, lambda, &gradient, &H);
+    hessian = true;
+    const int from = held.front() + 1, m = held.back() - held.front() - 1, first = DiscreteRod::angle(from);
+    Eigen::MatrixXd rows(2, m), rates(m, m);
+    for (int j = 0; j < m; ++j) rows.col(j) = h * Vec2(-std::sin(z[first + j]), std::cos(z[first + j]));
+    // d gap_i / d theta_j = grad g(r_i) . (h/2 a_ij n_j), a_ij = 2 (j < i), 1 (j = i), 0 (j > i).
+    for (int i = 0; i < m; ++i) {
+      const Vec2 r = rod.node_position(from + i, z);
+      const Vec2 grad = l.obstacle->gradient(Vec3(r.x(), r.y(), 0.0)).head<2>();
+      for (int j = 0; j < m; ++j) rates(i, j) = j > i ? 0.0 : (j < i ? 1.0 : 0.5) * grad.dot(rows.col(j));
+    }
+    Eigen::VectorXd gaps;
+    const double mu = lift_off_eigenvalue(H.block(first, first, m, m), rows, rates, h, &gaps);
+    if (std::isnan(out->lift_off) || mu < out->lift_off) {
+      out->lift_off = mu;
+      // One-signed: every node's gap moves the same way (the mode lifts, its negative pushes in).
+      const double size = gaps.cwiseAbs().maxCoeff();
+      out->lift_one_signed = gaps.minCoeff() >= -1e-8 * size || gaps.maxCoeff() <= 1e-8 * size;
+    }
+  }
+}
+
 // modes: also the eigenvectors' bending parts (the scale of the eigenvalues' discretisation error).
+// With extended contacts, every other node lying on the obstacle is held (initial_lying_nodes).
 Spectrum solve_and_analyse(const RodModel& model, const Reading& reading, const std::vector<RodPoint>& nodes,
                            bool modes) {
   Spectrum out;
-  const DiscreteRod rod(model, reading, nodes);
+  const std::vector<LyingNode> lying = initial_lying_nodes(reading, nodes);
+  const DiscreteRod rod(model, reading, nodes, lying);
   Eigen::VectorXd z, lambda;
   starting_point(rod, nodes, &z, &lambda);
   const Eigen::VectorXd start = z;
@@ -772,7 +890,9 @@ Spectrum solve_and_analyse(const RodModel& model, const Reading& reading, const 
     out.reduced_curvature = reduced_curvature(rod, z, lambda);
   }
   out.contact_problem = contact_problem(rod, z, lambda);
-  for (int k = 0; k < rod.constraints(); ++k) out.contacts = out.contacts || rod.constraint(k).kind == Held::Contact;
+  for (int k = 0; k < rod.constraints(); ++k)
+    out.contacts = out.contacts || rod.constraint(k).kind == Held::Contact || rod.constraint(k).kind == Held::Node;
+  if (!reading.lying.empty()) analyse_lying(rod, reading, z, lambda, &out);
   spectrum(rod, z, lambda, modes, &out);
   return out;
 }
@@ -792,10 +912,18 @@ bool independent_constraints(const DiscreteRod& rod, const std::vector<RodPoint>
   return svd.singularValues().tail(1)[0] > 1e-8;
 }
 
-// The active point contacts as constraints (contacts_not_covered has refused the others).
+// The active point contacts as constraints, the extended ones as intervals lying on their obstacle
+// (contacts_not_covered has refused the others).
 void read_contacts(const ShootingProblem& problem, const Eigen::VectorXd& x, Reading* out) {
   const std::vector<Obstacle> obstacles = problem.obstacles(problem.parameters_at(x));
   for (const PointContact& c : problem.contacts_at(x)) {
+    if (c.extended) {
+      // A flat contact without a field carries no force inside (n' = 0, m = 0 there): weakly active
+      // (contacts_not_covered refuses one under a field); a wrap presses with N / radius > 0.
+      const Obstacle& o = obstacles[c.obstacle];
+      out->lying.push_back({std::make_shared<const Obstacle>(o), c.s, c.s_end, o.is_flat()});
+      continue;
+    }
     Constraint constraint;
     constraint.kind = Held::Contact;
     constraint.obstacle = std::make_shared<const Obstacle>(obstacles[c.obstacle]);
@@ -808,6 +936,8 @@ void read_contacts(const ShootingProblem& problem, const Eigen::VectorXd& x, Rea
 bool curved_contact(const Reading& reading) {
   for (const Constraint& c : reading.constraints)
     if (c.kind == Held::Contact && !c.obstacle->is_flat()) return true;
+  for (const LyingInterval& l : reading.lying)
+    if (!l.obstacle->is_flat()) return true;
   return false;
 }
 
@@ -859,6 +989,13 @@ std::string self_check(const Spectrum& fine, const Spectrum& coarse, double zero
   if (fine.length_deviation > 1e-9 && !(fine.length_deviation < coarse.length_deviation))
     return "the discrete sliding length does not approach the shooting one as the elements halve (" +
            format(coarse.length_deviation) + ", then " + format(fine.length_deviation) + " of itself)";
+  if (fine.weak_nodes > 0 || coarse.weak_nodes > 0) {
+    // The lift-off's sign, decided as the eigenvalues' below (first order, contacts).
+    const double mu = fine.lift_off, change = std::abs(fine.lift_off - coarse.lift_off);
+    if (!(std::abs(mu) > 2 * change + zero_tolerance) || (mu > 0) != (coarse.lift_off > 0))
+      return "the lift-off eigenvalue of the part lying on the obstacle with zero force is " + format(mu) +
+             " at N elements and " + format(coarse.lift_off) + " at N/2: its sign is not decided";
+  }
   const Counts a = count(fine, zero_tolerance), b = count(coarse, zero_tolerance);
   if (a.index != b.index || a.zero != b.zero)
     return "N and N/2 elements disagree: index " + std::to_string(a.index) + " / " + std::to_string(b.index) +
@@ -891,6 +1028,11 @@ std::string self_check(const Spectrum& fine, const Spectrum& coarse, double zero
 
 DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen::VectorXd& x, int elements) {
   DiscreteStability out;
+  if (elements == 0) {
+    elements = kDiscreteStabilityElements;
+    for (const PointContact& c : problem.contacts_at(x))
+      if (c.extended) elements = kDiscreteStabilityLyingElements;
+  }
   out.elements = elements;
   if (elements < 8 || elements % 2 != 0) {
     out.reason = "the number of elements must be even and at least 8, got " + std::to_string(elements);
@@ -960,9 +1102,24 @@ DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen
   out.reduced_curvature = fine.reduced_curvature;
   out.coarse_reduced_curvature = coarse.reduced_curvature;
   out.newton_iterations = fine.iterations;
+  out.lying_nodes = fine.lying_nodes;
+  out.weakly_active_nodes = fine.weak_nodes;
+  out.lift_off_eigenvalue = fine.lift_off;
+  out.coarse_lift_off_eigenvalue = coarse.lift_off;
   out.check_message = self_check(fine, coarse, out.zero_tolerance);
   out.trustworthy = out.check_message.empty();
   if (out.trustworthy) out.check_message = "passed";
+  // A part lying on the obstacle with zero force that lifts off with lower energy: unstable, and
+  // the perturbations that lower the energy form a cone, whose count is not an index.
+  if (out.trustworthy && fine.lift_off < -out.zero_tolerance) {
+    out.index.reset();
+    out.reason = fine.lift_one_signed
+                     ? "unstable: the part lying on the obstacle with zero contact force lifts off with lower energy "
+                       "(lift-off eigenvalue " + format(fine.lift_off) + ": a strut clamped by the obstacle past its "
+                       "Euler load); the lowering perturbations form a cone, not a space, so no index is given"
+                     : "the part lying on the obstacle with zero contact force has a negative strut mode that does not "
+                       "lift it everywhere (lift-off eigenvalue " + format(fine.lift_off) + "): not decided here";
+  }
   return out;
 }
 

@@ -1,6 +1,7 @@
 // The index of an equilibrium by conjugate points (see stability.hpp for the method).
 #include "kirchhoff/analysis/stability.hpp"
 
+#include "kirchhoff/analysis/detail/stability_extended_contact.hpp"
 #include "kirchhoff/analysis/detail/stability_free_length.hpp"
 #include "kirchhoff/analysis/detail/stability_symmetric.hpp"
 #include "kirchhoff/contact/self_contact.hpp"
@@ -1100,6 +1101,14 @@ StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::V
   try {
     // An unknown that changes the rod (a sleeve's sliding length): reduced on it, or null with why.
     if (!rod_changing_unknown(problem).empty()) return analyse_free_length_stability(problem, x, options);
+    // The rod lying on an obstacle: its own treatment (the discretised energy for planar rods).
+    if (has_extended_contact(problem, x)) {
+      if (options.extended_contacts) return extended_contact_stability(problem, x);
+      StabilityReport report;
+      report.reason = "an extended contact (the rod lying on the obstacle): its index (from the discretised energy, "
+                      "seconds per equilibrium) is not computed along a branch; `kirchhoff solve` gives it";
+      return report;
+    }
     const EndCondition& end = problem.definition().end;
     if (!end.is_half_turn_symmetry() || !unsupported(problem, x).empty())
       return StabilityAnalysis(problem, x, options, end, nullptr).run();

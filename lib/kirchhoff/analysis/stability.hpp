@@ -55,7 +55,11 @@
 // problem with the complementary end conditions and, with self-contact, the pair energy's other
 // second variation (stability_symmetric.hpp).
 //
-// Not covered (index null with the reason): extended contacts, contacts of extensible rods,
+// Extended contacts (the rod lying on a wall or wrapped on a disc): the perturbations hold the
+// lying part on the obstacle, sliding along it (detail/stability_extended_contact.hpp); for planar
+// rods the index is the discretised energy's (method "discretised_energy"), where its self-checks
+// pass.
+// Not covered (index null with the reason): extended contacts of spatial rods, contacts of extensible rods,
 // contacts with zero force (weakly active) or where the rod is about to flatten or wrap onto the
 // obstacle (g'' = 0), half-turn ends that impose the loop's rotation, half-turn points at s = 0
 // and half-turn symmetric rods with contacts, unknown parameters that are not end loads except a
@@ -101,6 +105,11 @@ struct StabilityOptions {
   // (position-dependent fields, contacts with curved obstacles); forcing it elsewhere only checks
   // that the two frames count alike (tests).
   bool positions_as_configuration = false;
+  // The index of a planar rod lying on an obstacle (an extended contact) from the discretised
+  // energy at 800 elements (detail/stability_extended_contact.hpp): seconds each (solves at 800
+  // and 400 elements and their dense eigenproblems), so a branch's points may leave it out (null,
+  // saying so).
+  bool extended_contacts = true;
 };
 
 struct StabilityReport {
@@ -119,6 +128,9 @@ struct StabilityReport {
   // sliding partners not defined: stability_symmetric.hpp).
   std::optional<int> symmetric_index, antisymmetric_index;
   std::string method = "conjugate_points";
+  // Why another method than the conjugate points gives the index ("discretised_energy" for the
+  // planar extended contacts: detail/stability_extended_contact.hpp), else empty.
+  std::string method_reason;
   // A sliding length among the unknowns (stability_free_length.hpp, method
   // "conjugate_points+reduced_energy"): its name, the index with it held, and S = d^2 E*/d ell^2
   // along the equilibria at fixed length (index = fixed_length_index + 1 if S < 0).

@@ -75,12 +75,15 @@ nlohmann::json stability_json(const StabilityReport& st, const DiscreteStability
       j["cross_check"]["reduced_energy_curvature"] = discrete->reduced_curvature;
   }
   j["method"] = st.method;
+  if (!st.method_reason.empty()) j["method_reason"] = st.method_reason;
   if (st.reduced_energy_curvature) {
     j["sliding_length"] = st.sliding_length;
     j["fixed_length_index"] = *st.fixed_length_index;
     j["reduced_energy_curvature"] = *st.reduced_energy_curvature;
   }
-  if (st.index) {
+  if (st.index && st.method == "discretised_energy") {
+    // No conjugate points, so no load-controlled count or correction.
+  } else if (st.index) {
     j["load_controlled_index"] = st.dead_load_index;
     j["held_chord_directions"] = st.constraint_count;
     j["constraint_correction"] = st.constraint_correction;
