@@ -214,7 +214,7 @@ TEST(FlatContact, TwoPointContactsWithTheRodFlatBetweenThemAreOneExtendedContact
 // it): the clamps' moment is 0 there (H = -P at a clamp parallel to the wall), a double root on
 // which Newton stalls at the integrator's round-off, just above the shipped tolerance 1e-12.
 std::string stated_flat_contact_case(const std::string& tolerance) {
-  const std::string path = ::testing::TempDir() + "/stated_flat_contact.toml";
+  const std::string path = testing::scratch_path("stated_flat_contact_" + tolerance + ".toml");
   std::ofstream out(path);
   out << R"(model = "planar"
 [parameters]

@@ -243,7 +243,7 @@ std::string edited_case(const std::vector<std::pair<std::string, std::string>>& 
     EXPECT_NE(at, std::string::npos) << from;
     if (at != std::string::npos) text.replace(at, from.size(), to);
   }
-  const std::string path = ::testing::TempDir() + "/plectoneme_edited.toml";
+  const std::string path = testing::scratch_path("plectoneme_edited.toml");
   std::ofstream(path) << text;
   return path;
 }

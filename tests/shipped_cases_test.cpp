@@ -330,7 +330,7 @@ struct CliOutput {
   std::string out, err;
 };
 CliOutput run_cli(const std::string& args) {
-  const std::string out = ::testing::TempDir() + "/shipped_cli.out", err = ::testing::TempDir() + "/shipped_cli.err";
+  const std::string out = testing::scratch_path("shipped_cli.out"), err = testing::scratch_path("shipped_cli.err");
   const int status = std::system((std::string(KIRCHHOFF_CLI) + " " + args + " > '" + out + "' 2> '" + err + "'").c_str());
   const auto read = [](const std::string& path) {
     std::ifstream in(path);
@@ -348,7 +348,7 @@ TEST(SolveCli, FlatContactFoundAsTwoPointContactsIsReportedAsExtended) {
   const std::string from = "Delta = 0.026";
   ASSERT_NE(text.find(from), std::string::npos);
   text.replace(text.find(from), from.size(), "Delta = 0.032");
-  const std::string path = ::testing::TempDir() + "/wall_flat.toml";
+  const std::string path = testing::scratch_path("wall_flat.toml");
   std::ofstream(path) << text;
   const CliOutput json = run_cli("solve '" + path + "' --json");
   ASSERT_EQ(json.status, 0) << json.err;

@@ -7,6 +7,8 @@
 #include <iterator>
 #include <string>
 
+#include <unistd.h>
+
 #include "kirchhoff/analysis/solution.hpp"
 #include "kirchhoff/contact/contact.hpp"
 #include "kirchhoff/equations/invariants.hpp"
@@ -16,6 +18,13 @@
 namespace kirchhoff::testing {
 
 inline std::string case_path(const std::string& name) { return std::string(KIRCHHOFF_CASES_DIR) + "/" + name; }
+
+// A scratch file's path in gtest's temporary directory, own to this process: ctest runs the tests
+// of one binary as parallel processes, and a shared name lets one overwrite what another is about
+// to read (two tolerances of one case read each other's file).
+inline std::string scratch_path(const std::string& name) {
+  return ::testing::TempDir() + "/kirchhoff_" + std::to_string(getpid()) + "_" + name;
+}
 
 // The text of a shipped case file, for tests that edit it before loading it.
 inline std::string case_text(const std::string& name) {
