@@ -7,6 +7,7 @@
 // so there is one physics and two state layouts; a test checks both give the same rod to 1e-10.
 //
 // State layout (6): x, y, theta, n_x, n_y, m. theta tracks whole turns by itself.
+#include <array>
 #include <cmath>
 
 #include "kirchhoff/equations/detail/field_eval.hpp"
@@ -64,6 +65,7 @@ class PlanarEquations final : public RodEquations {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     if (!sensitivities) return detail::flow_state<kStateSize>(f, y0, s0, s1, options);
     if (model_.field) return detail::flow_with_sensitivities<kStateSize>(f, y0, s0, s1, options);
+    if (options.sensitivity_tol > options.abs_tol) return flow_with_loose_variations(y0, s0, s1, options);
     // Without a field nothing depends on x(s0), y(s0): their columns of Phi are unit vectors.
     constexpr std::array<int, 4> kSeeds{kTheta, kNx, kNy, kMoment};
     SegmentFlow partial = detail::flow_with_partial_sensitivities<kStateSize, 4>(f, y0, s0, s1, options, kSeeds);
@@ -160,6 +162,91 @@ class PlanarEquations final : public RodEquations {
   }
 
  private:
+  // Without a field nothing depends on x(s0), y(s0), and n is constant: the columns x, y of Phi
+  // are unit vectors and its rows n_x, n_y those of the identity. The variational equations of
+  // the other columns (theta, n_x, n_y, m) are written out for the rows x, y, theta and m: 16
+  // entries beside the state, sin and cos shared, where Dual<4> carries four derivatives through
+  // every operation and its sin and cos. Used for the looser matrices only (sensitivity_tol, the
+  // state in its own pass): the exact pass keeps the dual numbers, whose round-off the contact
+  // legs and their tests were computed with.
+  static constexpr int kRows = 4;     // rows x, y, theta, m of Phi
+  static constexpr int kColumns = 4;  // columns theta, n_x, n_y, m
+  static constexpr std::array<int, kRows> kRowOf{kX, kY, kTheta, kMoment};
+  static constexpr std::array<int, kColumns> kColumnOf{kTheta, kNx, kNy, kMoment};
+  static constexpr int kAugmented = kStateSize + kRows * kColumns;  // y, then the 4 x 4 block row-major
+
+  // d/ds of the state (as rhs<double>) and of the block: delta r' = d(r')/dtheta delta theta +
+  // d(r')/dv delta v with d(r')/dtheta = (-r'_y, r'_x); delta theta' = delta m / B2;
+  // delta m' = delta(n_x r'_y - n_y r'_x).
+  void rhs_with_variations(const double* y, double* dy, double s) const {
+    const double c = std::cos(y[kTheta]), sn = std::sin(y[kTheta]);
+    double v1 = model_.v_hat[0](s), v3 = model_.v_hat[2](s);
+    double n1 = 0.0, n3 = 0.0, compliance1 = 0.0, compliance3 = 0.0;
+    if (model_.extensible) {
+      n1 = -y[kNx] * sn + y[kNy] * c;
+      n3 = y[kNx] * c + y[kNy] * sn;
+      compliance1 = 1.0 / model_.A[0](s);
+      compliance3 = 1.0 / model_.A[2](s);
+      v1 += n1 * compliance1;
+      v3 += n3 * compliance3;
+    }
+    const double dx = -v1 * sn + v3 * c, dyy = v1 * c + v3 * sn;
+    const double flexibility = 1.0 / model_.B[1](s);
+    dy[kX] = dx;
+    dy[kY] = dyy;
+    dy[kTheta] = model_.u_hat[1](s) + y[kMoment] * flexibility;
+    dy[kNx] = 0.0;
+    dy[kNy] = 0.0;
+    dy[kMoment] = y[kNx] * dyy - y[kNy] * dx;
+    const double* P = y + kStateSize;
+    double* dP = dy + kStateSize;
+    for (int j = 0; j < kColumns; ++j) {
+      const double d_theta = P[2 * kColumns + j], d_m = P[3 * kColumns + j];
+      const double d_nx = kColumnOf[j] == kNx ? 1.0 : 0.0, d_ny = kColumnOf[j] == kNy ? 1.0 : 0.0;
+      double d_v1 = 0.0, d_v3 = 0.0;
+      if (model_.extensible) {  // d(n1, n3)/dtheta = (-n3, n1)
+        d_v1 = (-d_nx * sn + d_ny * c - n3 * d_theta) * compliance1;
+        d_v3 = (d_nx * c + d_ny * sn + n1 * d_theta) * compliance3;
+      }
+      const double d_dx = -d_v1 * sn + d_v3 * c - dyy * d_theta;
+      const double d_dy = d_v1 * c + d_v3 * sn + dx * d_theta;
+      dP[0 * kColumns + j] = d_dx;
+      dP[1 * kColumns + j] = d_dy;
+      dP[2 * kColumns + j] = d_m * flexibility;
+      dP[3 * kColumns + j] = d_nx * dyy + y[kNx] * d_dy - d_ny * dx - y[kNy] * d_dx;
+    }
+  }
+
+  // Phi at options.sensitivity_tol by rhs_with_variations (every component under error control,
+  // as the dual numbers have it), the state at the state's own tolerance in a pass of its own (so
+  // F is bit for bit the one a residual alone gives), as detail::flow_with_loose_sensitivities.
+  SegmentFlow flow_with_loose_variations(const Eigen::VectorXd& y0, double s0, double s1,
+                                         const IntegratorOptions& options) const {
+    IntegratorOptions loose = options;
+    loose.abs_tol = loose.rel_tol = options.sensitivity_tol;
+    loose.sensitivity_tol = 0.0;
+    std::array<double, kAugmented> x{};
+    for (int i = 0; i < kStateSize; ++i) x[i] = y0[i];
+    for (int r = 0; r < kRows; ++r)
+      for (int j = 0; j < kColumns; ++j) x[kStateSize + r * kColumns + j] = kRowOf[r] == kColumnOf[j] ? 1.0 : 0.0;
+    long evaluations = 0;
+    auto system = [&](const std::array<double, kAugmented>& y, std::array<double, kAugmented>& dy, double s) {
+      ++evaluations;
+      rhs_with_variations(y.data(), dy.data(), s);
+    };
+    SegmentFlow out;
+    out.steps = detail::march(x, s0, s1, system, loose);
+    out.Phi = Eigen::MatrixXd::Identity(kStateSize, kStateSize);
+    for (int r = 0; r < kRows; ++r)
+      for (int j = 0; j < kColumns; ++j) out.Phi(kRowOf[r], kColumnOf[j]) = x[kStateSize + r * kColumns + j];
+    auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
+    const SegmentFlow state = detail::flow_state<kStateSize>(f, y0, s0, s1, options);
+    out.y = state.y;
+    out.steps += state.steps;
+    out.rhs_evaluations = evaluations + state.rhs_evaluations;
+    return out;
+  }
+
   RodModel model_;
 };
 
