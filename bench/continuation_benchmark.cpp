@@ -745,6 +745,10 @@ void cost_breakdown(const char* label, const ShootingProblem& base, const Contin
   double sink = 0;
   const double t_lu = median_us(reps, [&] { sink += M.partialPivLu().determinant(); });
   const double t_svd = median_us(reps, [&] { sink += Eigen::JacobiSVD<Eigen::MatrixXd>(M).singularValues()[n]; });
+  // What make_point uses away from branch points: the eigenvalues of M^T M.
+  const double t_eig = median_us(reps, [&] {
+    sink += Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(M.transpose() * M, Eigen::EigenvaluesOnly).eigenvalues()[0];
+  });
   ShootingResult r;
   r.x = x;
   r.summary.status = SolverStatus::Converged;
@@ -774,6 +778,7 @@ void cost_breakdown(const char* label, const ShootingProblem& base, const Contin
   std::printf("    F_lambda column (parameter_derivative)  %8.1f us  %6.0f rhs\n", t_dl, rhs_dl);
   std::printf("    LU of the bordered matrix               %8.2f us\n", t_lu);
   std::printf("    JacobiSVD of the bordered matrix        %8.2f us\n", t_svd);
+  std::printf("    eigenvalues of its M^T M (the tests')   %8.2f us\n", t_eig);
   std::printf("    describe: make_solution(%3d samples)    %8.1f us  (derived:", samples, t_desc);
   for (const auto& d : derived) std::printf(" %s", d.c_str());
   std::printf(", invariants always)\n");
