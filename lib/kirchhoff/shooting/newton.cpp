@@ -109,47 +109,96 @@ bool expect_convergence(double norm, double previous_norm, double tolerance) {
   return norm * ratio * ratio <= tolerance;
 }
 
-NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options,
-                           const Deadline& deadline) {
-  NewtonSummary summary;
-  Eigen::VectorXd F, F_trial;
-  Eigen::MatrixXd J, J_trial;
-  std::string failure;
-  bool not_finite = false;  // the last failed evaluation returned NaN or inf (not an integrator failure)
-  // Step matrices (NonlinearSystem::has_step_matrices): F as evaluate's, a cheaper J. Cleared for
-  // the rest of the solve when such a matrix is too ill-conditioned or its step fails; without them
-  // every evaluation is exactly evaluate's, as it was before they existed.
-  bool step_matrices = options.step_matrix_tolerance > 0 && !options.finite_difference_jacobian &&
-                       system.has_step_matrices(options.step_matrix_tolerance);
-  auto evaluate = [&](const Eigen::VectorXd& at, Eigen::VectorXd* f, Eigen::MatrixXd* jac) {
-    ++summary.evaluations;
-    not_finite = false;
+// One solve's evaluations of F, with J when asked: exact, by finite differences, or a step
+// matrix (NonlinearSystem::has_step_matrices: F as evaluate's, a cheaper J). Step matrices are
+// cleared for the rest of the solve when one is too ill-conditioned or its step fails; without
+// them every evaluation is exactly evaluate's, as it was before they existed.
+class Evaluations {
+ public:
+  Evaluations(const NonlinearSystem& system, const NewtonOptions& options, NewtonSummary* summary)
+      : system_(system),
+        options_(options),
+        summary_(summary),
+        step_matrices_(options.step_matrix_tolerance > 0 && !options.finite_difference_jacobian &&
+                       system.has_step_matrices(options.step_matrix_tolerance)) {}
+
+  bool operator()(const Eigen::VectorXd& at, Eigen::VectorXd* f, Eigen::MatrixXd* jac) {
+    ++summary_->evaluations;
+    not_finite_ = false;
     bool ok = false;
-    if (jac && step_matrices)
-      ok = system.evaluate_for_step(at, f, jac, options.step_matrix_tolerance, &failure);
-    else if (jac && options.finite_difference_jacobian)
-      ok = system.evaluate(at, f, nullptr, &failure) &&
-           finite_difference_jacobian(system, at, options.finite_difference_step, jac);
+    if (jac && step_matrices_)
+      ok = system_.evaluate_for_step(at, f, jac, options_.step_matrix_tolerance, &failure_);
+    else if (jac && options_.finite_difference_jacobian)
+      ok = system_.evaluate(at, f, nullptr, &failure_) &&
+           finite_difference_jacobian(system_, at, options_.finite_difference_step, jac);
     else
-      ok = system.evaluate(at, f, jac, &failure);
+      ok = system_.evaluate(at, f, jac, &failure_);
     if (!ok) return false;
     // A NaN or inf is never a residual: it is reported, never compared with the tolerance.
     if (!f->allFinite() || (jac && !jac->allFinite())) {
-      not_finite = true;
-      failure = std::string("the ") + (f->allFinite() ? "Jacobian" : "residual") + " holds NaN or inf";
+      not_finite_ = true;
+      failure_ = std::string("the ") + (f->allFinite() ? "Jacobian" : "residual") + " holds NaN or inf";
       return false;
     }
     return true;
-  };
-  auto fail = [&](double norm) {
-    summary.status = not_finite ? SolverStatus::NotFinite : SolverStatus::IntegrationFailed;
+  }
+
+  bool step_matrices() const { return step_matrices_; }
+  void use_exact_matrices() { step_matrices_ = false; }
+
+  // The summary of a solve ended by the last failed evaluation, at residual `norm`.
+  NewtonSummary failed(double norm) const {
+    NewtonSummary summary = *summary_;
+    summary.status = not_finite_ ? SolverStatus::NotFinite : SolverStatus::IntegrationFailed;
     summary.residual_norm = norm;
-    summary.message = failure;
+    summary.message = failure_;
     return summary;
-  };
+  }
+
+ private:
+  const NonlinearSystem& system_;
+  const NewtonOptions& options_;
+  NewtonSummary* summary_;
+  bool step_matrices_;
+  std::string failure_;
+  bool not_finite_ = false;  // the last failed evaluation returned NaN or inf (not an integrator failure)
+};
+
+// The accepted point of a backtracking line search along dx from x.
+struct LineStep {
+  bool accepted = false;
+  double alpha = 1.0;
+  bool has_matrix = false;  // J_trial holds the matrix at x_trial
+};
+
+// Backtracking on |F|_2: the first step length that decreases it (sufficient decrease with the
+// usual 1e-4 slope fraction). A trial whose residual is NaN or inf fails to evaluate and is
+// backed away from. The full step's trial carries its matrix when `matrix_with_full_step`.
+LineStep line_search(Evaluations& evaluate, const NewtonOptions& options, const Deadline& deadline,
+                     const Eigen::VectorXd& x, const Eigen::VectorXd& dx, double merit, bool matrix_with_full_step,
+                     Eigen::VectorXd* x_trial, Eigen::VectorXd* F_trial, Eigen::MatrixXd* J_trial) {
+  LineStep step;
+  for (int k = 0; k <= options.max_backtracks && !deadline.passed(); ++k, step.alpha *= 0.5) {
+    *x_trial = x + step.alpha * dx;
+    step.has_matrix = k == 0 && matrix_with_full_step;
+    if (evaluate(*x_trial, F_trial, step.has_matrix ? J_trial : nullptr) &&
+        F_trial->squaredNorm() <= (1.0 - 1e-4 * step.alpha) * merit) {
+      step.accepted = true;
+      return step;
+    }
+  }
+  return step;
+}
+
+NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options,
+                           const Deadline& deadline) {
+  NewtonSummary summary;
+  Evaluations evaluate(system, options, &summary);
+  Eigen::VectorXd F, F_trial, x_trial;
+  Eigen::MatrixXd J, J_trial;
 
   // F alone first: a converged guess (or iterate) never pays for a Jacobian.
-  if (!evaluate(x, &F, nullptr)) return fail(INFINITY);
+  if (!evaluate(x, &F, nullptr)) return evaluate.failed(INFINITY);
   double norm = max_abs_or_nan(F);
   summary.residual_norm = norm;
   // With step matrices, the full step's trial carries its matrix (its F is the one a trial alone
@@ -168,14 +217,14 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
       summary.message = "the wall-clock limit was reached";
       return summary;
     }
-    if (!have_matrix && !evaluate(x, &F, &J)) return fail(norm);
+    if (!have_matrix && !evaluate(x, &F, &J)) return evaluate.failed(norm);
     have_matrix = false;
     const JacobianLU lu(J);
     const double rcond = lu.reciprocal_condition();
     // A step matrix's error (~ its tolerance, relative) times the condition number is the rate
     // of the linear convergence it ends in: above kStepMatrixRate (or singular), the exact one.
-    if (step_matrices && !(options.step_matrix_tolerance <= kStepMatrixRate * rcond)) {
-      step_matrices = false;
+    if (evaluate.step_matrices() && !(options.step_matrix_tolerance <= kStepMatrixRate * rcond)) {
+      evaluate.use_exact_matrices();
       --it;
       continue;
     }
@@ -185,32 +234,17 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
       return summary;
     }
     const Eigen::VectorXd dx = -lu.solve(F);
-    // Backtracking on |F|_2: accept the first step length that decreases it (sufficient
-    // decrease with the usual 1e-4 slope fraction). A trial whose residual is NaN or inf fails
-    // evaluate and is backed away from.
-    const double merit = F.squaredNorm();
-    const bool matrix_with_full_step =
-        step_matrices && last_step_full &&
-        !expect_convergence(norm, previous_norm, options.residual_tolerance);
-    double alpha = 1.0;
-    bool accepted = false, trial_has_matrix = false;
-    Eigen::VectorXd x_trial;
-    for (int k = 0; k <= options.max_backtracks && !deadline.passed(); ++k, alpha *= 0.5) {
-      x_trial = x + alpha * dx;
-      trial_has_matrix = k == 0 && matrix_with_full_step;
-      if (evaluate(x_trial, &F_trial, trial_has_matrix ? &J_trial : nullptr) &&
-          F_trial.squaredNorm() <= (1.0 - 1e-4 * alpha) * merit) {
-        accepted = true;
-        break;
-      }
-    }
-    if (!accepted && step_matrices && !deadline.passed()) {  // retried on the exact matrix
-      step_matrices = false;
+    const bool matrix_with_full_step = evaluate.step_matrices() && last_step_full &&
+                                       !expect_convergence(norm, previous_norm, options.residual_tolerance);
+    const LineStep step = line_search(evaluate, options, deadline, x, dx, F.squaredNorm(), matrix_with_full_step,
+                                      &x_trial, &F_trial, &J_trial);
+    if (!step.accepted && evaluate.step_matrices() && !deadline.passed()) {  // retried on the exact matrix
+      evaluate.use_exact_matrices();
       --it;
       continue;
     }
     ++summary.iterations;
-    if (!accepted) {
+    if (!step.accepted) {
       const bool timed_out = deadline.passed();  // once: status and message must agree
       summary.status = timed_out ? SolverStatus::TimeLimit : SolverStatus::LineSearchFailed;
       summary.message =
@@ -219,16 +253,16 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
     }
     x = x_trial;
     F = F_trial;
-    if (trial_has_matrix) {
+    if (step.has_matrix) {
       J.swap(J_trial);
       have_matrix = true;
     }
     previous_norm = norm;
-    last_step_full = alpha == 1.0;
+    last_step_full = step.alpha == 1.0;
     norm = max_abs_or_nan(F);
     summary.residual_norm = norm;
     summary.history.push_back(norm);
-    const bool stalled = alpha * dx.lpNorm<Eigen::Infinity>() <=
+    const bool stalled = step.alpha * dx.lpNorm<Eigen::Infinity>() <=
                          options.step_tolerance * (1.0 + x.lpNorm<Eigen::Infinity>());
     if (stalled && norm <= 1e3 * options.residual_tolerance) {
       summary.status = SolverStatus::Converged;
