@@ -151,12 +151,7 @@ std::shared_ptr<const RodEquations> ShootingProblem::equations(const Parameters&
   std::vector<double> key;
   for (const auto& name : definition_.model_parameters)
     if (p.contains(name)) key.push_back(p.get(name));
-  if (!cached_equations_ || key != cached_model_values_) {
-    cached_equations_ = build_equations(p);
-    cached_model_values_ = key;
-    worker_equations_.clear();
-  }
-  return cached_equations_;
+  return workspace_.equations(key, [&] { return build_equations(p); });
 }
 
 namespace {
@@ -182,11 +177,12 @@ void ShootingProblem::for_each_segment(const Parameters& p, const std::function<
   }
   const int requested = definition_.options.threads > 0 ? definition_.options.threads : hardware_threads();
   const int workers = std::clamp(requested, 1, M / 4);
-  while (static_cast<int>(worker_equations_.size()) < workers - 1) worker_equations_.push_back(build_equations(p));
+  const ShootingWorkspace::Build build = [&] { return build_equations(p); };
+  for (int w = 1; w < workers; ++w) workspace_.worker(w, build);  // built here, not inside the threads
   // Worker w takes the segments w, w + workers, ... (neighbouring segments cost alike).
   std::vector<std::exception_ptr> errors(workers);
   auto run = [&](int w) {
-    const RodEquations& equations = w == 0 ? *eq : *worker_equations_[w - 1];
+    const RodEquations& equations = w == 0 ? *eq : workspace_.worker(w, build);
     try {
       for (int i = w; i < M; i += workers) work(i, equations);
     } catch (...) {
@@ -215,7 +211,7 @@ bool ShootingProblem::integrate_segments(const Eigen::VectorXd& x, const Paramet
     if (failure) *failure = e.what();
     return false;
   }
-  for (const auto& flow : *flows) rhs_evaluations_ += flow.rhs_evaluations;
+  for (const auto& flow : *flows) workspace_.count_rhs(flow.rhs_evaluations);
   return true;
 }
 

@@ -22,6 +22,7 @@
 #include "kirchhoff/model/parameters.hpp"
 #include "kirchhoff/shooting/boundary_conditions.hpp"
 #include "kirchhoff/shooting/newton.hpp"
+#include "kirchhoff/shooting/shooting_workspace.hpp"
 
 namespace kirchhoff {
 
@@ -150,7 +151,7 @@ class ShootingProblem final : public NonlinearSystem {
   // Solution sampled at the given arclengths (sorted, within [0, L]).
   std::vector<RodPoint> sample(const Eigen::VectorXd& x, const std::vector<double>& s) const;
 
-  long rhs_evaluations() const { return rhs_evaluations_; }
+  long rhs_evaluations() const { return workspace_.rhs_evaluations(); }
   // The obstacles at these parameter values.
   std::vector<Obstacle> obstacles(const Parameters& p) const;
   // The active contacts with their arclengths and forces taken from x.
@@ -254,11 +255,8 @@ class ShootingProblem final : public NonlinearSystem {
                           const IntegratorOptions& integrator, std::vector<SegmentFlow>* flows,
                           std::string* failure) const;
 
-  mutable std::vector<double> cached_model_values_;
-  mutable std::shared_ptr<const RodEquations> cached_equations_;
-  // Copies of the equations for the extra threads, built with cached_equations_.
-  mutable std::vector<std::shared_ptr<const RodEquations>> worker_equations_;
-  mutable long rhs_evaluations_ = 0;
+  // What evaluating changes (shooting_workspace.hpp): the equations' cache and the rhs count.
+  mutable ShootingWorkspace workspace_;
 };
 
 // Breaks the rotational symmetry of an isotropic (B1 = B2) spatial rod whose ends both lie on

@@ -113,7 +113,7 @@ bool ShootingProblem::residual_with_contacts(const Eigen::VectorXd& x, const Par
         wrap.reset();
       } else {
         SegmentFlow flow = eq->flow(y, s0, s1, J != nullptr, definition_.options.integrator);
-        rhs_evaluations_ += flow.rhs_evaluations;
+        workspace_.count_rhs(flow.rhs_evaluations);
         if (J) {
           S = flow.Phi * S;
           if (s0_column >= 0) S.col(s0_column) -= flow.Phi * eq->derivative(y, s0);
@@ -250,7 +250,7 @@ bool ShootingProblem::residual_pieces(const Eigen::VectorXd& x, const Parameters
     if (failure) *failure = e.what();
     return false;
   }
-  for (const auto& flow : flows) rhs_evaluations_ += flow.rhs_evaluations;
+  for (const auto& flow : flows) workspace_.count_rhs(flow.rhs_evaluations);
 
   // A segment's end state moves with the ends of its piece: d y1 / d s0 = -Phi y'(s0), d y1 / d s1 =
   // y'(s1), times how s0 and s1 move with the breakpoints.
