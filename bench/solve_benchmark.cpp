@@ -29,6 +29,8 @@
 // build, not this code, which is built with the project's build type.)
 #include <benchmark/benchmark.h>
 
+#include "allocation_count.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -316,6 +318,15 @@ void jacobian_breakdown(const CaseSpec& spec, int reps) {
     finite_difference_jacobian(problem, x, problem.definition().options.newton.finite_difference_step, &Jfd);
   });
   const double jac_diff = (J - Jfd).lpNorm<Eigen::Infinity>() / std::max(1.0, J.lpNorm<Eigen::Infinity>());
+  // Allocation calls of one evaluation at the solution (after the warm-up calls above).
+  auto allocations_of = [](auto&& call) {
+    const long before = bench::allocations();
+    call();
+    return bench::allocations() - before;
+  };
+  const long alloc_f = allocations_of([&] { problem.evaluate(x, &F, nullptr, &failure); });
+  const long alloc_var = allocations_of([&] { problem.evaluate(x, &F, &J, &failure); });
+  const long alloc_step = allocations_of([&] { problem.evaluate_for_step(x, &F, &J_step, step_tol, &failure); });
 
   const Parameters params = problem.parameters_at(x);
   const auto eq = problem.equations(params);
@@ -336,6 +347,8 @@ void jacobian_breakdown(const CaseSpec& spec, int reps) {
               plain.steps, plain.rhs_evaluations, sens.steps, sens.rhs_evaluations,
               problem.state_size() * (problem.state_size() + 1));
   std::printf("    residual F            %9.1f us %7.0f rhs\n", f_only.first, f_only.second);
+  std::printf("    allocation calls      F %ld, F + J variational %ld, F + J step matrix %ld (malloc/calloc/realloc)\n",
+              alloc_f, alloc_var, alloc_step);
   std::printf("    F + J variational     %9.1f us %7.0f rhs  (of which %d parameter column(s) by re-integrating "
               "F twice each: ~%.0f rhs, ~%.1f us)\n",
               f_var.first, f_var.second, n_model_params, 2.0 * n_model_params * f_only.second,

@@ -125,8 +125,8 @@ class PlanarEquations final : public RodEquations {
     return y;
   }
 
-  Eigen::MatrixXd slot_map(Slot slot) const override {
-    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(3, kStateSize);
+  SlotMap slot_map(Slot slot) const override {
+    SlotMap M = SlotMap::Zero(3, kStateSize);
     switch (slot) {
       case Slot::Position: M(0, kX) = 1; M(1, kY) = 1; break;
       case Slot::Force: M(0, kNx) = 1; M(1, kNy) = 1; break;
@@ -153,9 +153,9 @@ class PlanarEquations final : public RodEquations {
     return Eigen::VectorXd(0);
   }
 
-  Eigen::MatrixXd admissible_directions(Slot slot) const override {
+  LabDirections admissible_directions(Slot slot) const override {
     if (slot == Slot::Orientation || slot == Slot::Moment) return Vec3::UnitZ();
-    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(3, 2);
+    LabDirections E = LabDirections::Zero(3, 2);
     E(0, 0) = 1.0;
     E(1, 1) = 1.0;
     return E;

@@ -39,6 +39,13 @@ struct OrientationTarget {
   double angle = 0.0;
 };
 
+// Fixed largest sizes (no heap) for what the end conditions read at every evaluation: at most 3
+// lab directions (a 3 x k basis), and a 3 x state_size read-out of a slot. The largest state is
+// the spatial rod's (14).
+constexpr int kMaxStateSize = 14;
+using LabDirections = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, 3>;
+using SlotMap = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, kMaxStateSize>;
+
 class RodEquations {
  public:
   virtual ~RodEquations() = default;
@@ -72,7 +79,7 @@ class RodEquations {
   virtual Eigen::VectorXd state(const RodPoint& p) const = 0;
 
   // Linear read-out of position, force and moment: value = M y, with M of size 3 x state_size.
-  virtual Eigen::MatrixXd slot_map(Slot slot) const = 0;
+  virtual SlotMap slot_map(Slot slot) const = 0;
   // Lab-frame rotation taking the target frame to the current one (zero iff they agree). With
   // track_turns, its component along target.axis is replaced by turn_angle - target.angle, which
   // counts whole turns instead of working modulo 2 pi.
@@ -82,7 +89,7 @@ class RodEquations {
   virtual Eigen::VectorXd gauge_residual(const Eigen::VectorXd& y, Eigen::MatrixXd* jacobian) const = 0;
   // Orthonormal basis (3 x k) of the lab directions a slot can move in (all of R^3 in 3D; the
   // plane for positions and forces, e_z for orientations and moments in the planar case).
-  virtual Eigen::MatrixXd admissible_directions(Slot slot) const = 0;
+  virtual LabDirections admissible_directions(Slot slot) const = 0;
 };
 
 std::shared_ptr<const RodEquations> make_spatial_equations(RodModel model);

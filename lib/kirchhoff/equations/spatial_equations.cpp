@@ -190,8 +190,8 @@ class SpatialEquations final : public RodEquations {
     return y;
   }
 
-  Eigen::MatrixXd slot_map(Slot slot) const override {
-    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(3, kStateSize);
+  SlotMap slot_map(Slot slot) const override {
+    SlotMap M = SlotMap::Zero(3, kStateSize);
     const int offset = slot == Slot::Position ? kR : slot == Slot::Force ? kN : kM;
     M.block<3, 3>(0, offset).setIdentity();
     return M;
@@ -253,7 +253,7 @@ class SpatialEquations final : public RodEquations {
     return g;
   }
 
-  Eigen::MatrixXd admissible_directions(Slot) const override { return Eigen::MatrixXd::Identity(3, 3); }
+  LabDirections admissible_directions(Slot) const override { return LabDirections::Identity(3, 3); }
 
  private:
   RodModel model_;

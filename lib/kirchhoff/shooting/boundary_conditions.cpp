@@ -13,6 +13,17 @@ namespace {
 // are built from exact unit vectors, so anything above round-off is a genuine component.
 constexpr double kDirectionTolerance = 1e-9;
 
+// (Fixed largest sizes: the residual's end conditions take this at every evaluation.)
+LabDirections orthonormal_columns(const LabDirections& A) {
+  if (A.cols() == 0) return A;
+  Eigen::ColPivHouseholderQR<LabDirections> qr(A);
+  qr.setThreshold(kDirectionTolerance);
+  const int rank = static_cast<int>(qr.rank());
+  const Mat3 Q = qr.householderQ();
+  return Q.leftCols(rank);
+}
+
+// Wider sets of directions (the completeness check stacks two slots' bases: up to 6 columns).
 Eigen::MatrixXd orthonormal_columns(const Eigen::MatrixXd& A) {
   if (A.cols() == 0) return A;
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
@@ -47,14 +58,14 @@ OrientationFunction constant_orientation(const OrientationTarget& t) {
   return [t](const Parameters&) { return t; };
 }
 
-Eigen::MatrixXd SlotCondition::basis(const RodEquations& eq) const {
-  const Eigen::MatrixXd E = eq.admissible_directions(slot);
+LabDirections SlotCondition::basis(const RodEquations& eq) const {
+  const LabDirections E = eq.admissible_directions(slot);
   const Vec3 a = axis.normalized();
   switch (directions) {
     case Directions::All: return E;
     case Directions::AlongAxis: return a;
     case Directions::LateralToAxis: {
-      const Eigen::MatrixXd lateral = E - a * (a.transpose() * E);
+      const LabDirections lateral = E - a * (a.transpose() * E);
       return orthonormal_columns(lateral);
     }
   }
@@ -204,16 +215,17 @@ void EndCondition::append_residuals(const RodEquations& eq, bool at_start, const
   // Applied loads relate to the internal force/moment with a sign that depends on the end.
   const double load_sign = at_start ? -1.0 : 1.0;
   for (const auto& c : conditions_) {
-    const Eigen::MatrixXd B = c.basis(eq);
+    const LabDirections B = c.basis(eq);
     Vec3 error;
     Eigen::MatrixXd J;
     if (c.slot == Slot::Orientation) {
-      error = eq.orientation_error(y, c.orientation(p), c.track_turns, &J);
+      error = eq.orientation_error(y, c.orientation(p), c.track_turns, jacobian ? &J : nullptr);
     } else {
-      const Eigen::MatrixXd M = eq.slot_map(c.slot);
+      const SlotMap M = eq.slot_map(c.slot);
       const double sign = (c.slot == Slot::Position) ? 1.0 : load_sign;
-      error = M * y - sign * c.value(p);
-      J = M;
+      error.noalias() = M * y;
+      error -= sign * c.value(p);
+      if (jacobian) J = M;
     }
     for (int j = 0; j < B.cols(); ++j) {
       residual->push_back(B.col(j).dot(error));

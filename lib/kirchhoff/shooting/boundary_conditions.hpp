@@ -41,7 +41,7 @@ struct SlotCondition {
   bool extra = false;          // an extra condition balanced by an unknown parameter
 
   // Orthonormal 3 x k basis of the constrained lab directions.
-  Eigen::MatrixXd basis(const RodEquations& eq) const;
+  LabDirections basis(const RodEquations& eq) const;
 };
 
 class EndCondition {

@@ -31,6 +31,8 @@ namespace {
 constexpr double kParameterStep = 1e-6;
 
 struct ConditionRows {
+  // One allocation for an end's rows (at most 6 plus extra conditions), not one per push_back.
+  ConditionRows() { values.reserve(8); }
   std::vector<double> values;
   std::vector<Eigen::RowVectorXd> jacobian;
 };
