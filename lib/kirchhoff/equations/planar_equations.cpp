@@ -65,7 +65,9 @@ class PlanarEquations final : public RodEquations {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     if (!sensitivities) return detail::flow_state<kStateSize>(f, y0, s0, s1, options);
     if (model_.field) return detail::flow_with_sensitivities<kStateSize>(f, y0, s0, s1, options);
-    if (options.sensitivity_tol > options.abs_tol) return flow_with_loose_variations(y0, s0, s1, options);
+    if (options.sensitivity_tol > options.abs_tol)
+      return detail::flow_with_loose_pass<kStateSize>(
+          f, y0, s0, s1, options, [&](const IntegratorOptions& loose) { return variations_pass(y0, s0, s1, loose); });
     // Without a field nothing depends on x(s0), y(s0): their columns of Phi are unit vectors.
     constexpr std::array<int, 4> kSeeds{kTheta, kNx, kNy, kMoment};
     SegmentFlow partial = detail::flow_with_partial_sensitivities<kStateSize, 4>(f, y0, s0, s1, options, kSeeds);
@@ -167,8 +169,8 @@ class PlanarEquations final : public RodEquations {
   // the other columns (theta, n_x, n_y, m) are written out for the rows x, y, theta and m: 16
   // entries beside the state, sin and cos shared, where Dual<4> carries four derivatives through
   // every operation and its sin and cos. Used for the looser matrices only (sensitivity_tol, the
-  // state in its own pass): the exact pass keeps the dual numbers, whose round-off the contact
-  // legs and their tests were computed with.
+  // state in its own pass: detail::flow_with_loose_pass); the exact pass keeps the dual numbers,
+  // whose round-off the contact legs and their tests were computed with.
   static constexpr int kRows = 4;     // rows x, y, theta, m of Phi
   static constexpr int kColumns = 4;  // columns theta, n_x, n_y, m
   static constexpr std::array<int, kRows> kRowOf{kX, kY, kTheta, kMoment};
@@ -217,33 +219,22 @@ class PlanarEquations final : public RodEquations {
     }
   }
 
-  // Phi at options.sensitivity_tol by rhs_with_variations (every component under error control,
-  // as the dual numbers have it), the state at the state's own tolerance in a pass of its own (so
-  // F is bit for bit the one a residual alone gives), as detail::flow_with_loose_sensitivities.
-  SegmentFlow flow_with_loose_variations(const Eigen::VectorXd& y0, double s0, double s1,
-                                         const IntegratorOptions& options) const {
-    IntegratorOptions loose = options;
-    loose.abs_tol = loose.rel_tol = options.sensitivity_tol;
-    loose.sensitivity_tol = 0.0;
+  // Phi by rhs_with_variations (every component under error control, as the dual numbers have
+  // it) at `options`: the looser pass of detail::flow_with_loose_pass.
+  SegmentFlow variations_pass(const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options) const {
     std::array<double, kAugmented> x{};
     for (int i = 0; i < kStateSize; ++i) x[i] = y0[i];
     for (int r = 0; r < kRows; ++r)
       for (int j = 0; j < kColumns; ++j) x[kStateSize + r * kColumns + j] = kRowOf[r] == kColumnOf[j] ? 1.0 : 0.0;
-    long evaluations = 0;
+    SegmentFlow out;
     auto system = [&](const std::array<double, kAugmented>& y, std::array<double, kAugmented>& dy, double s) {
-      ++evaluations;
+      ++out.rhs_evaluations;
       rhs_with_variations(y.data(), dy.data(), s);
     };
-    SegmentFlow out;
-    out.steps = detail::march(x, s0, s1, system, loose);
+    out.steps = detail::march(x, s0, s1, system, options);
     out.Phi = Eigen::MatrixXd::Identity(kStateSize, kStateSize);
     for (int r = 0; r < kRows; ++r)
       for (int j = 0; j < kColumns; ++j) out.Phi(kRowOf[r], kColumnOf[j]) = x[kStateSize + r * kColumns + j];
-    auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
-    const SegmentFlow state = detail::flow_state<kStateSize>(f, y0, s0, s1, options);
-    out.y = state.y;
-    out.steps += state.steps;
-    out.rhs_evaluations = evaluations + state.rhs_evaluations;
     return out;
   }
 

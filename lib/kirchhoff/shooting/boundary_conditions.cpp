@@ -13,24 +13,15 @@ namespace {
 // are built from exact unit vectors, so anything above round-off is a genuine component.
 constexpr double kDirectionTolerance = 1e-9;
 
-// (Fixed largest sizes: the residual's end conditions take this at every evaluation.)
-LabDirections orthonormal_columns(const LabDirections& A) {
+// Directions: LabDirections (fixed largest size, as the residual takes it at every evaluation) or
+// Eigen::MatrixXd (the completeness check stacks two slots' bases: up to 6 columns).
+template <class Directions>
+Directions orthonormal_columns(const Directions& A) {
   if (A.cols() == 0) return A;
-  Eigen::ColPivHouseholderQR<LabDirections> qr(A);
+  Eigen::ColPivHouseholderQR<Directions> qr(A);
   qr.setThreshold(kDirectionTolerance);
   const int rank = static_cast<int>(qr.rank());
-  const Mat3 Q = qr.householderQ();
-  return Q.leftCols(rank);
-}
-
-// Wider sets of directions (the completeness check stacks two slots' bases: up to 6 columns).
-Eigen::MatrixXd orthonormal_columns(const Eigen::MatrixXd& A) {
-  if (A.cols() == 0) return A;
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
-  qr.setThreshold(kDirectionTolerance);
-  const int rank = static_cast<int>(qr.rank());
-  Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(A.rows(), rank);
-  return Q;
+  return qr.householderQ() * Directions::Identity(A.rows(), rank);
 }
 
 std::string describe(const Vec3& v) {

@@ -179,12 +179,11 @@ void ShootingProblem::for_each_segment(const Parameters& p, const std::function<
   }
   const int requested = definition_.options.threads > 0 ? definition_.options.threads : hardware_threads();
   const int workers = std::clamp(requested, 1, M / 4);
-  const ShootingWorkspace::Build build = [&] { return build_equations(p); };
-  for (int w = 1; w < workers; ++w) workspace_.worker(w, build);  // built here, not inside the threads
+  const auto& copies = workspace_.workers(workers - 1, [&] { return build_equations(p); });
   // Worker w takes the segments w, w + workers, ... (neighbouring segments cost alike).
   std::vector<std::exception_ptr> errors(workers);
   auto run = [&](int w) {
-    const RodEquations& equations = w == 0 ? *eq : workspace_.worker(w, build);
+    const RodEquations& equations = w == 0 ? *eq : *copies[w - 1];
     try {
       for (int i = w; i < M; i += workers) work(i, equations);
     } catch (...) {

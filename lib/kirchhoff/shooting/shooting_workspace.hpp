@@ -28,11 +28,12 @@ class ShootingWorkspace {
     return equations_;
   }
 
-  // Worker w's equations (w >= 1; worker 0 uses equations()), built on first use: a thread's own
+  // At least `count` copies of the equations for the extra worker threads (worker w >= 1 takes
+  // copy w - 1; worker 0 uses equations()), built here, before the threads start: a thread's own
   // copy, as the equations are not shared between threads while they integrate.
-  const RodEquations& worker(int w, const Build& build) {
-    while (static_cast<int>(workers_.size()) < w) workers_.push_back(build());
-    return *workers_[w - 1];
+  const std::vector<std::shared_ptr<const RodEquations>>& workers(int count, const Build& build) {
+    while (static_cast<int>(workers_.size()) < count) workers_.push_back(build());
+    return workers_;
   }
 
   void count_rhs(long evaluations) { rhs_evaluations_ += evaluations; }

@@ -109,19 +109,29 @@ template <int N, int K, class Rhs>
 SegmentFlow flow_with_partial_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
                                             const IntegratorOptions& opt, const std::array<int, K>& seeds);
 
-// Phi at opt.sensitivity_tol, the state at the state's own tolerance (IntegratorOptions).
-template <int N, int K, class Rhs>
-SegmentFlow flow_with_loose_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
-                                          const IntegratorOptions& opt, const std::array<int, K>& seeds) {
+// Phi at opt.sensitivity_tol by phi_pass(the looser options), the state at the state's own
+// tolerance (IntegratorOptions) in a pass of its own, so F is bit for bit a residual's alone.
+template <int N, class Rhs, class PhiPass>
+SegmentFlow flow_with_loose_pass(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                 const IntegratorOptions& opt, const PhiPass& phi_pass) {
   IntegratorOptions loose = opt;
   loose.abs_tol = loose.rel_tol = opt.sensitivity_tol;
   loose.sensitivity_tol = 0.0;
-  SegmentFlow out = flow_with_partial_sensitivities<N, K>(rhs, y0, s0, s1, loose, seeds);
+  SegmentFlow out = phi_pass(loose);
   const SegmentFlow state = flow_state<N>(rhs, y0, s0, s1, opt);
   out.y = state.y;
   out.steps += state.steps;
   out.rhs_evaluations += state.rhs_evaluations;
   return out;
+}
+
+// Phi's seeded columns on dual numbers at opt.sensitivity_tol (flow_with_loose_pass).
+template <int N, int K, class Rhs>
+SegmentFlow flow_with_loose_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                          const IntegratorOptions& opt, const std::array<int, K>& seeds) {
+  return flow_with_loose_pass<N>(rhs, y0, s0, s1, opt, [&](const IntegratorOptions& loose) {
+    return flow_with_partial_sensitivities<N, K>(rhs, y0, s0, s1, loose, seeds);
+  });
 }
 
 template <int N, int K, class Rhs>
