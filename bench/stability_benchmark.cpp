@@ -4,9 +4,18 @@
 // thread for each over `--runs N` repetitions (default 20; CPU time, not wall time, because the
 // machines are shared and a busy neighbour stretches wall time), their ratio, and
 // machine-independent counts: right-hand-side evaluations of each, and the conjugate points found.
-// `--only TEXT` keeps the equilibria whose label contains TEXT. Nothing here asserts on timings.
+// `--only TEXT` keeps the equilibria whose label contains TEXT.
+//
+// `--branch euler|twist` measures instead what the index adds to a continuation, the issue's
+// second goal (at most +30 %): the branch of docs/performance.md's table (continue_case, as the
+// CLI runs it) with the index at every point and without it, alternating, `--runs N` times each
+// (default 5), median CPU time of the process; and, in the same process, the index of every
+// point of the branch alone (analyse_stability with the continuation's options), summed, against
+// the branch without it - the share that does not depend on how two runs' times happened to vary.
+// Nothing here asserts on timings.
 //
 //   stability_benchmark [--runs N] [--only TEXT]
+//   stability_benchmark --branch euler|twist [--runs N]
 #include <algorithm>
 #include <ctime>
 #include <cstdio>
@@ -16,6 +25,7 @@
 #include <vector>
 
 #include "kirchhoff/analysis/stability.hpp"
+#include "kirchhoff/jobs/case_continue.hpp"
 #include "kirchhoff/jobs/case_file.hpp"
 
 namespace {
@@ -68,15 +78,117 @@ void measure(const Scenario& sc, int runs) {
               describe(report).c_str());
 }
 
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+// A branch of docs/performance.md's stability table, as `kirchhoff continue` runs it.
+struct Branch {
+  const char* file;
+  kirchhoff::ParameterOverrides overrides;
+  kirchhoff::ContinueRequest request;
+};
+
+Branch branch_named(const std::string& name) {
+  using namespace kirchhoff;
+  Branch b;
+  b.request.max_step = 1.0;
+  b.request.switch_at_bp = 1;
+  if (name == "euler") {
+    b.file = "euler_column.toml";
+    b.overrides = {{"P", 1.0}, {"theta_guess", 0.0}};
+    b.request.parameter = "P";
+    b.request.target = 12.0;
+    b.request.events = {{"theta0", 3.0, true, ""}};
+  } else if (name == "twist") {
+    b.file = "twisted_clamped.toml";
+    b.overrides = {{"phi", 6.0}, {"tension", 0.0}};
+    b.request.parameter = "phi";
+    b.request.target = 15.0;
+    b.request.events = {{"end_to_end", 0.5, true, ""}};
+  } else {
+    throw std::invalid_argument("--branch: euler or twist, not " + name);
+  }
+  return b;
+}
+
+// A copy of each point's problem, at the point's parameter, and its unknowns.
+struct KeepPoints : kirchhoff::ContinueSink {
+  std::string parameter;
+  std::vector<std::pair<kirchhoff::ShootingProblem, Eigen::VectorXd>> points;
+  void begin(const std::string& name, const std::vector<std::string>&, int) override { parameter = name; }
+  void point(const kirchhoff::RunPoint& p) override {
+    if (!p.problem) throw std::logic_error("a contact run: not one of this benchmark's branches");
+    points.emplace_back(*p.problem, p.point->x);
+    points.back().first.set_parameter(parameter, p.point->parameter);
+  }
+};
+
+int measure_branch(const std::string& name, int runs) {
+  using namespace kirchhoff;
+  const Branch b = branch_named(name);
+  const Case c = load_case(std::string(KIRCHHOFF_CASES_DIR) + "/" + b.file, b.overrides);
+  auto run = [&](bool stability, KeepPoints* keep) {
+    ContinueRequest r = b.request;
+    r.compute_stability = stability;
+    std::vector<ContinueSink*> sinks;
+    if (keep) sinks.push_back(keep);
+    const double t0 = process_cpu_seconds();
+    const ContinueRunResult result = continue_case(c, r, sinks);
+    if (!result.ok) throw std::runtime_error("the branch did not end normally: " + result.message);
+    return std::make_pair(process_cpu_seconds() - t0, result.points);
+  };
+  std::vector<double> with, without;
+  int points = 0;
+  for (int i = 0; i < runs; ++i) {
+    with.push_back(run(true, nullptr).first);
+    const auto w = run(false, nullptr);
+    without.push_back(w.first);
+    points = w.second;
+  }
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  KeepPoints keep;
+  const double branch = run(false, &keep).first;
+  std::printf("branch %s: %d points; CPU time, median of %d alternating runs: %.3f s with the index, %.3f s "
+              "without (+%.0f %%)\n",
+              name.c_str(), points, runs, median(with), median(without), 100 * (median(with) / median(without) - 1));
+  // The index of each point alone: with the continuation's options (point_record.cpp), and with
+  // its fields at the state's tolerance.
+  const double points_kept = static_cast<double>(std::max<size_t>(1, keep.points.size()));
+  for (const double field_tolerance : {RecordOptions{}.stability_field_tolerance, 0.0}) {
+    StabilityOptions options;
+    options.extended_contacts = false;
+    options.field_tolerance = field_tolerance;
+    long rhs = 0;
+    const double t0 = process_cpu_seconds();
+    for (const auto& [problem, x] : keep.points) rhs += analyse_stability(problem, x, options).rhs_evaluations;
+    const double index = process_cpu_seconds() - t0;
+    std::printf("  the index of each of its %zu points alone, fields at %s: %.3f s (%.0f us and %.0f rhs per "
+                "point) against %.3f s for the branch without it (+%.0f %%)\n",
+                keep.points.size(), field_tolerance > 0 ? "1e-8 (as continuation)" : "the state's tolerance",
+                index, 1e6 * index / points_kept, static_cast<double>(rhs) / points_kept, branch,
+                100 * index / branch);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  int runs = 20;
-  std::string only;
+  int runs = 0;
+  std::string only, branch;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--runs") == 0 && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
     else if (std::strcmp(argv[i], "--only") == 0 && i + 1 < argc) only = argv[++i];
+    else if (std::strcmp(argv[i], "--branch") == 0 && i + 1 < argc) branch = argv[++i];
   }
+  if (!branch.empty()) return measure_branch(branch, runs > 0 ? runs : 5);
+  if (runs == 0) runs = 20;
   const std::vector<Scenario> scenarios = {
       {"Fig. 3 Elastica, theta0 = 1 (simply_supported)", "simply_supported.toml", {{"theta0", 1.0}}},
       {"Euler column, mode 1, P = 20", "euler_column.toml", {{"P", 20.0}, {"theta_guess", 2.0}}},

@@ -35,10 +35,12 @@ PointRecorder rod_point_recorder(const ContinuationOptions& options) {
       p.H_flat = !s.invariants.H.applies || s.invariants.H.spread <= kFlatH * std::max(1.0, s.invariants.H.scale);
     };
   if (options.compute_stability)
-    recorder.record = [](ParameterisedSystem& system, ContinuationPoint* point) {
+    recorder.record = [field_tolerance = options.stability_field_tolerance](ParameterisedSystem& system,
+                                                                              ContinuationPoint* point) {
       // Not the extended contacts' discretised energy (seconds per point: a flat leg has thousands).
       StabilityOptions stability_options;
       stability_options.extended_contacts = false;
+      stability_options.field_tolerance = field_tolerance;
       const StabilityReport stability =
           analyse_stability(shooting_problem_at(system, point->parameter), point->x, stability_options);
       point->stability_index = stability.index;

@@ -285,6 +285,10 @@ class StabilityAnalysis {
     for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
     profile_ = problem_.sample(x_, s);
     full_ = options_.positions_as_configuration || positions_are_configuration();
+    field_integrator_ = problem_.definition().options.integrator;
+    if (options_.field_tolerance > field_integrator_.abs_tol) {
+      field_integrator_.abs_tol = field_integrator_.rel_tol = options_.field_tolerance;
+    }
     const int n = coords_.size(), kr = coords_.kr();
     offset_ = full_ ? 0 : kr;
     mU_ = full_ ? n : n - kr;
@@ -357,6 +361,7 @@ class StabilityAnalysis {
   Scales scales_;
   std::vector<RodPoint> profile_;  // the equilibrium at 17 equally spaced points, for the checks above
   long rhs_ = 0;
+  IntegratorOptions field_integrator_;  // the state's, or looser (StabilityOptions::field_tolerance)
   CarriedSteps steps_;  // the step sizes the fields' integration proposes next (flowed)
   // Workspaces kept across the index's steps (no allocation at each): the map (map_at), the
   // canonical coordinates of the fields (canonical_blocks), the frame a step arrives at (advance)
@@ -642,7 +647,7 @@ void StabilityAnalysis::flowed(const Frame& f, double s1, CarriedSteps* steps, b
   directions_.leftCols(m) = f.dY;
   for (int i = 0; i < count; ++i) directions_.col(m + i) = f.particular.col(started[i]);
   DirectionalFlow flow =
-      eq_->flow_directions(f.y, directions_, f.s, s1, problem_.definition().options.integrator, steps);
+      eq_->flow_directions(f.y, directions_, f.s, s1, field_integrator_, steps);
   rhs_ += flow.rhs_evaluations;
   next->y.swap(flow.y);
   next->s = s1;

@@ -97,6 +97,9 @@ struct StabilityOptions {
   // integrated to ~1e-10, so 1e-6 leaves four orders of margin; modes within 1e-6 of neutral
   // (next to a bifurcation) are reported as zero modes, not guessed.
   double zero_tolerance = 1e-6;
+  // Tolerance (absolute and relative) of the fields' integration; 0, or anything not looser than
+  // the state's: the state's.
+  double field_tolerance = 0.0;
   // Let point contacts slide along their plane (the right second variation). false holds them at
   // their material point instead, only to show the difference (tests, docs).
   bool contact_sliding = true;

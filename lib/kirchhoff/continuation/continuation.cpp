@@ -121,6 +121,8 @@ std::string DetectionOptions::validate() const {
 std::string RecordOptions::validate() const {
   // As a case file's [output] samples (case_file.hpp): 1e5 samples cost ~2 s per point already.
   if (samples < 2 || samples > 100000) return "samples must be in [2, 100000]";
+  if (!(stability_field_tolerance >= 0 && stability_field_tolerance < 1e-3))
+    return "stability_field_tolerance must be in [0, 1e-3) (0: the state's tolerance)";
   return {};
 }
 

@@ -150,6 +150,12 @@ struct RecordOptions {
   // The stability index of every point (stability.hpp): about one Jacobian's worth of
   // integration per point. Folds and branch points then show the exchange of stability.
   bool compute_stability = false;
+  // The tolerance of the index's Jacobi fields at each point (StabilityOptions::field_tolerance;
+  // 0: the state's). The index counts phase passages and compares singular values with 1e-6, so
+  // fields to 1e-8 give the same indices and zero modes (stability_branch_test checks them along
+  // branches against the state's tolerance), with fewer steps where the tolerance, not the
+  // phases' turning, sets them (the Euler column: 560 right-hand sides per point, not 699).
+  double stability_field_tolerance = 1e-8;
   // What is recorded at each point; nullopt: the rod layer's default from compute_invariants,
   // samples, derived and compute_stability above (rod_point_recorder, point_record.hpp).
   std::optional<PointRecorder> recorder;

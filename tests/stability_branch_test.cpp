@@ -1,0 +1,115 @@
+// The stability index a continuation records at each point (point_record.cpp) integrates the
+// Jacobi fields to RecordOptions::stability_field_tolerance, looser than the state's. The index
+// is a count (phase passages through pi, singular values against zero_tolerance = 1e-6), so the
+// looser fields must give the very same index and zero modes as the state's tolerance at every
+// point, through the branch points and folds where the index changes: checked here along
+// branches whose index changes, against analyse_stability with the fields at the state's
+// tolerance. (They agree on these branches even with fields to 5e-4; a recorder that reports
+// zero modes against 1e-2 instead of 1e-6 fails on the Euler column at its branch points.)
+#include <gtest/gtest.h>
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include "kirchhoff/analysis/stability.hpp"
+#include "kirchhoff/jobs/case_continue.hpp"
+#include "test_support.hpp"
+
+namespace kirchhoff {
+namespace {
+
+struct Recorded {
+  ShootingProblem problem;  // at the point's parameter
+  Eigen::VectorXd x;
+  std::optional<int> index;
+  int zero_modes = 0;
+};
+
+struct KeepPoints : ContinueSink {
+  std::string parameter;
+  std::vector<Recorded> points;
+  void begin(const std::string& name, const std::vector<std::string>&, int) override { parameter = name; }
+  void point(const RunPoint& p) override {
+    ASSERT_NE(p.problem, nullptr) << "a plain run";
+    points.push_back({*p.problem, p.point->x, p.point->stability_index, p.point->zero_modes});
+    points.back().problem.set_parameter(parameter, p.point->parameter);
+  }
+};
+
+// Runs the request and compares every point's recorded index with the state's tolerance's;
+// returns the distinct indices met (so that a test can require that the index changed).
+std::set<int> expect_same_indices(const std::string& file, const ParameterOverrides& overrides,
+                                  const ContinueRequest& request) {
+  const Case c = load_case(testing::case_path(file), overrides);
+  KeepPoints keep;
+  const ContinueRunResult result = continue_case(c, request, {&keep});
+  EXPECT_TRUE(result.ok) << result.message;
+  StabilityOptions tight;
+  tight.extended_contacts = false;
+  tight.field_tolerance = 0.0;
+  std::set<int> seen;
+  for (size_t i = 0; i < keep.points.size(); ++i) {
+    const Recorded& p = keep.points[i];
+    const StabilityReport reference = analyse_stability(p.problem, p.x, tight);
+    EXPECT_EQ(p.index, reference.index) << file << ", point " << i << ": " << reference.reason;
+    EXPECT_EQ(p.zero_modes, reference.zero_modes) << file << ", point " << i;
+    if (p.index) seen.insert(*p.index);
+  }
+  EXPECT_GT(keep.points.size(), 20u);
+  return seen;
+}
+
+TEST(StabilityAlongBranches, LooserFieldsAreLooserThanTheState) {
+  // Otherwise the tests below compare a computation with itself.
+  EXPECT_GT(RecordOptions{}.stability_field_tolerance, IntegratorOptions{}.abs_tol);
+}
+
+TEST(StabilityAlongBranches, EulerColumnThroughItsFirstTwoBranchPoints) {
+  ContinueRequest r;
+  r.parameter = "P";
+  r.target = 45.0;  // past (2 pi)^2 = 39.5: index 0, 1, 2 on the straight column
+  r.max_step = 1.0;
+  r.samples = 21;
+  const std::set<int> seen = expect_same_indices("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, r);
+  EXPECT_EQ(seen, (std::set<int>{0, 1, 2}));
+}
+
+TEST(StabilityAlongBranches, EulerColumnsFirstBuckledBranch) {
+  ContinueRequest r;
+  r.parameter = "P";
+  r.target = 12.0;
+  r.max_step = 1.0;
+  r.samples = 21;
+  r.switch_at_bp = 1;
+  r.events = {{"theta0", 3.0, true, ""}};
+  const std::set<int> seen = expect_same_indices("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, r);
+  EXPECT_TRUE(seen.count(0) && seen.count(1)) << "the straight column's index 1 and the stable branch";
+}
+
+TEST(StabilityAlongBranches, TwistedRodPastTheGreenhillTwistAndOntoTheBuckledBranch) {
+  ContinueRequest r;
+  r.parameter = "phi";
+  r.target = 15.0;
+  r.max_step = 1.0;
+  r.samples = 21;
+  r.switch_at_bp = 1;
+  r.events = {{"end_to_end", 0.5, true, ""}};
+  const std::set<int> seen = expect_same_indices("twisted_clamped.toml", {{"phi", 6.0}, {"tension", 0.0}}, r);
+  EXPECT_GE(seen.size(), 2u);
+}
+
+TEST(StabilityAlongBranches, ClampedClampedRodUnderEndShortening) {
+  // Both ends held: the isoperimetric correction at every point.
+  ContinueRequest r;
+  r.parameter = "D";
+  r.target = 0.3;
+  r.direction = -1.0;
+  r.max_step = 0.05;
+  r.samples = 21;
+  const std::set<int> seen = expect_same_indices("clamped_clamped.toml", {{"s_mode", 1.0}}, r);
+  EXPECT_TRUE(seen.count(1)) << "the S-shaped mode";
+}
+
+}  // namespace
+}  // namespace kirchhoff
