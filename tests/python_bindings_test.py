@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Tests of the `kirchhoff` Python module (python/kirchhoff_module.cpp).
+"""Tests of the `kirchhoff` Python module (python/kirchhoff_module.cpp and its parts).
 
 Run by ctest (python_bindings) with PYTHONPATH=<build>/python and KIRCHHOFF_CASES_DIR=<source>/cases;
 by hand:

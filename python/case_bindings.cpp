@@ -1,0 +1,323 @@
+// kirchhoff.Case: load_case, solve, continue_, equilibria, vibrate - each maps its arguments onto
+// the library's job (case_solve.hpp, case_continue.hpp, equilibria.hpp, vibration.hpp).
+#include "bindings.hpp"
+
+namespace kirchhoff::python_bindings {
+PyCase py_load_case(const std::string& path, const py::object& set, const std::string& phase_condition,
+                    const py::object& solver) {
+  ParameterOverrides overrides = named_values(set);
+  const SolverOverrides solver_overrides = solver_values(solver);
+  PyCase out;
+  {
+    py::gil_scoped_release release;
+    out.c = load_case(path, overrides, phase_condition, solver_overrides);
+  }
+  out.phase_condition = phase_condition;
+  out.path = path;
+  out.overrides = overrides;
+  out.solver = solver_overrides;
+  return out;
+}
+
+namespace {
+
+PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::string& seed, int seed_segments,
+                    double max_seconds, bool direct) {
+  Case c = pc.c;
+  limit_wall_clock(c.definition.options, max_seconds);  // std::invalid_argument (ValueError) outside [0, 1e9]
+  const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
+  if (samples < 2 || samples > 100000)  // as a case file's [output] samples
+    throw py::value_error("samples must be in [2, 100000] (got " + std::to_string(samples) + ")");
+  if (seed != "guess" && seed != "ipopt") throw py::value_error("seed must be 'guess' or 'ipopt' (got '" + seed + "')");
+  if (seed_segments < 4) throw py::value_error("seed_segments must be >= 4");
+  std::string seed_refused;  // raised as ValueError once the GIL is back
+
+  PySolution out;
+  CaseSolve solved;
+  bool integration_failed = false;
+  ShootingResult failed;
+  {
+    py::gil_scoped_release release;
+    try {
+      // The library's solve of a case, as the CLI's: homotopy from the file's values when
+      // parameters changed (or direct), the active-set loop with obstacles, Ipopt's seed; then
+      // the solution at `samples` points, its checks, and its stability.
+      CaseSolveOptions options;
+      options.direct = direct;
+      options.seed.ipopt = seed == "ipopt";
+      options.seed.segments = seed_segments;
+      options.samples = samples;
+      solved = solve_case(c, options);
+      if (!solved.failure.empty()) {
+        integration_failed = true;
+        failed.summary = solved.solved.result.summary;  // the failed start solve's, or no residual
+        failed.summary.message = solved.message;
+      } else if (!solved.converged()) {  // Newton's verdict, or the profile's checks' (verification.hpp)
+        failed = solved.solution ? solved.solution->result : solved.solved.result;
+      }
+    } catch (const InfeasibleContact& e) {
+      integration_failed = true;
+      failed.summary.status = SolverStatus::MaxIterations;
+      failed.summary.residual_norm = INFINITY;
+      failed.summary.message = std::string("infeasible: ") + e.what();
+    } catch (const IntegrationError& e) {
+      integration_failed = true;
+      failed.summary.status = SolverStatus::IntegrationFailed;
+      failed.summary.iterations = 0;
+      failed.summary.residual_norm = INFINITY;
+      failed.summary.message = std::string("the initial guess cannot be integrated: ") + e.what();
+    } catch (const std::invalid_argument& e) {  // a case the Ipopt seed does not model
+      seed_refused = e.what();
+    } catch (const std::runtime_error& e) {     // the seed's Ipopt did not converge
+      integration_failed = true;
+      failed.summary.status = SolverStatus::MaxIterations;
+      failed.summary.residual_norm = INFINITY;
+      failed.summary.message = e.what();
+    }
+  }
+  const std::unique_ptr<ShootingProblem>& problem = solved.solved.problem;
+  const Solution* sol = !integration_failed && seed_refused.empty() && solved.converged() ? &*solved.solution : nullptr;
+  const std::string& path_failure = solved.failure;  // a homotopy that stopped short: its status word
+  // As the CLI's JSON "path" (one builder for both).
+  out.path = py::module_::import("json").attr("loads")(path_json(solved.path).dump());
+  if (!seed_refused.empty()) throw py::value_error(seed_refused);
+  const ShootingResult& r = sol ? sol->result : failed;
+  out.status = path_failure.empty() ? to_string(r.summary.status) : path_failure;
+  out.converged = r.summary.converged();
+  out.iterations = r.summary.iterations;
+  out.residual = r.summary.residual_norm;
+  out.message = r.summary.message;
+  out.used_fallback_search = r.summary.used_fallback_search;
+  out.history = r.summary.history;
+  out.rhs_evaluations = problem ? problem->rhs_evaluations() : 0;  // none when the guess failed
+  if (!sol) {
+    // As the CLI's failure JSON: the case's parameters, no results.
+    out.parameters = parameters_dict(c.definition.parameters);
+    return out;
+  }
+  out.parameters = parameters_dict(sol->result.parameters);
+  for (const auto& name : c.derived) out.derived[py::str(name)] = sol->derived.at(name);
+  out.invariants = invariants_dict(sol->invariants);
+  out.profile = profile_dict(problem->equations(sol->result.parameters)->model(), sol->profile,
+                             problem->definition().kind);
+  out.stability = stability_dict(*solved.stability, *solved.stability_check);
+  out.contacts = contacts_list(*problem, *sol);
+  for (const auto& o : stated_contact_outcomes(c.definition.contacts, sol->contacts,
+                                               problem->obstacles(sol->result.parameters),
+                                               problem->length(sol->result.parameters))) {
+    py::dict d;
+    d["obstacle"] = o.stated.obstacle;
+    d["extended"] = o.stated.extended;
+    d["stated_s"] = o.stated.s;
+    d["stated_s_end"] = o.stated.extended ? o.stated.s_end : o.stated.s;
+    d["released"] = o.released;
+    d["moved"] = o.moved;
+    d["s"] = o.released ? py::object(py::none()) : py::object(py::float_(o.solved.s));
+    d["s_end"] = o.released ? py::object(py::none())
+                            : py::object(py::float_(o.solved.extended ? o.solved.s_end : o.solved.s));
+    d["message"] = o.message;
+    out.stated_contacts.append(d);
+  }
+  return out;
+}
+
+// Vibrations about the case's equilibrium (the CLI's `vibrate`).
+py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
+  const Case& c = pc.c;
+  if (c.definition.kind != RodKind::Planar)
+    throw py::value_error(c.path + ": vibrate handles planar rods only (eqs. B.4); this case is spatial");
+  VibrationOptions options;
+  options.modes = modes;
+  options.rho_s = rho_s;
+  options.profile_samples = samples;
+  if (std::string e = options.validate(); !e.empty()) throw py::value_error(e);
+  VibrationAnalysis analysis;
+  Parameters at;  // the equilibrium's parameters, solved-for ones included
+  {
+    py::gil_scoped_release release;
+    // The equilibrium as solve() and the CLI's `vibrate` reach it (homotopy from the file's
+    // values when parameters changed); the vibrations need neither its profile nor its index.
+    CaseSolveOptions solve_options;
+    solve_options.solution = solve_options.stability = solve_options.stability_check = false;
+    const CaseSolve solved = solve_case(c, solve_options);
+    if (!solved.failure.empty())
+      throw std::runtime_error(c.path + ": the equilibrium was not reached: " + solved.failure + ": " + solved.message);
+    if (!solved.converged())
+      throw std::runtime_error(c.path + ": the equilibrium did not converge: " + solved.summary().brief_report());
+    const DefinitionSolve& equilibrium = solved.solved;
+    analysis = VibrationProblem(*equilibrium.problem, equilibrium.result.x, options).analyse();  // invalid_argument -> ValueError
+    at = equilibrium.result.parameters;
+  }
+  auto mode_dict = [](const VibrationMode& m) {
+    py::dict d;
+    d["omega"] = m.omega;
+    d["omega2"] = m.omega2;
+    d["growth_rate"] = m.growth_rate();
+    d["H_vib"] = stats_dict(m.H_vib_stats);
+    d["matching_residual"] = m.matching_residual;
+    const size_t n = m.s.size();
+    d["s"] = column<double>(n, [&](size_t i) { return m.s[i]; });
+    // Planar state layout (x, y, theta, n_x, n_y, m).
+    const std::pair<const char*, int> components[] = {{"xbar", 0}, {"ybar", 1}, {"thetabar", 2},
+                                                      {"nbarx", 3}, {"nbary", 4}, {"mbar", 5}};
+    for (const auto& [name, index] : components)
+      d[name] = column<double>(n, [&, index = index](size_t i) { return m.state[i][index]; });
+    d["H_vib_along_s"] = column<double>(n, [&](size_t i) { return m.H_vib[i]; });
+    return d;
+  };
+  py::list mode_list, unstable_list;
+  for (const VibrationMode& m : analysis.modes) mode_list.append(mode_dict(m));
+  for (const VibrationMode& m : analysis.unstable_modes) unstable_list.append(mode_dict(m));
+  py::dict out;
+  // Imaginary frequencies: omega^2 < 0, their number the index under dead loads.
+  out["unstable_modes"] = unstable_list;
+  out["negative_omega2_count"] = analysis.negative_omega2_count();
+  out["unstable_searched"] = analysis.unstable_searched;
+  out["omega2"] = analysis.omega2();
+  out["frequencies"] = column<double>(analysis.modes.size(), [&](size_t k) { return analysis.modes[k].omega; });
+  out["straight_equilibrium"] = analysis.straight_equilibrium;
+  out["parameters"] = parameters_dict(at);  // as the CLI's JSON "parameters"
+  out["modes"] = mode_list;
+  return out;
+}
+
+// One equilibrium of Case.equilibria() as a Solution, with the fields solve() fills (the
+// stability without the discretised cross-check, as the CLI's `equilibria` JSON).
+PySolution equilibrium_solution(const Case& c, const Equilibrium& e) {
+  PySolution out;
+  const Solution& sol = e.solution;
+  out.status = to_string(sol.result.summary.status);
+  out.converged = sol.result.summary.converged();
+  out.residual = sol.result.summary.residual_norm;
+  out.message = e.found_by;
+  out.energy = e.energy;
+  out.found_by = e.found_by;
+  if (e.family > 0) out.family = py::int_(e.family);
+  out.parameters = parameters_dict(sol.result.parameters);
+  for (const auto& name : c.derived) out.derived[py::str(name)] = sol.derived.at(name);
+  out.invariants = invariants_dict(sol.invariants);
+  out.profile = profile_dict(e.problem->equations(sol.result.parameters)->model(), sol.profile,
+                             e.problem->definition().kind);
+  out.stability = stability_dict(e.stability, DiscreteStability{});
+  out.contacts = contacts_list(*e.problem, sol);
+  return out;
+}
+
+// The CLI's `equilibria`: distinct equilibria at the case's parameters, by increasing energy.
+py::list py_equilibria(const PyCase& pc, int max, double max_seconds, const py::object& samples_arg) {
+  const Case& c = pc.c;
+  const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
+  if (samples < 2 || samples > 100000) throw py::value_error("samples must be in [2, 100000]");
+  if (max < 1) throw py::value_error("max must be >= 1");
+  if (!(max_seconds >= 0)) throw py::value_error("max_seconds must be >= 0");
+  EquilibriaOptions options;
+  options.max_equilibria = max;
+  options.max_seconds = max_seconds;
+  EquilibriaSearch search;
+  {
+    py::gil_scoped_release release;
+    search = find_equilibria(c.definition, c.start_guess, c.derived, samples, options);
+  }
+  py::list out;
+  for (const auto& e : search.equilibria) out.append(equilibrium_solution(c, e));
+  return out;
+}
+
+// Case.equilibria() and Case.vibrate().
+void bind_case_equilibria_and_vibrations(py::class_<PyCase>& cls) {
+  cls.def("equilibria", &py_equilibria, py::kw_only(), py::arg("max") = 16, py::arg("max_seconds") = 120.0,
+          py::arg("samples") = py::none(),
+          R"doc(The distinct equilibria at the case's parameters (the CLI's `equilibria`), by deflated Newton.
+
+Starts from the case's guess, its mirror images, the low modes of every equilibrium found and,
+for planar rods clamped at both ends, Ipopt's discretised minimisers (docs/equilibria.md).
+
+Args:
+    max (int): stop once this many distinct equilibria are found.
+    max_seconds (float): wall-clock limit of the search (0: none).
+    samples (int, optional): profile points; default the case's [output] samples.
+
+Returns:
+    list of Solution, by increasing energy: each converged and admissible, with the fields
+    solve() gives (derived, invariants, profile, contacts, stability) and energy, found_by,
+    family (the continuous family of an equilibrium with zero modes, None when isolated).)doc")
+      .def("vibrate", &py_vibrate, py::kw_only(), py::arg("modes") = 3, py::arg("rho_s") = 1.0,
+           py::arg("samples") = 201,
+           R"doc(Small-amplitude vibrations about the case's equilibrium (the CLI's `vibrate`, eqs. B.4).
+
+The equilibrium is solved as solve() does; the ends keep the case's conditions with imposed
+positions and angles held and end loads dead (nbar = 0, mbar = 0 along them).
+
+Args:
+    modes (int): number of lowest frequencies.
+    rho_s (float): mass per unit length.
+    samples (int): points per mode shape.
+
+Returns:
+    dict: "frequencies" (numpy array, increasing), "straight_equilibrium" (bool), "modes": a list
+    of dicts with "omega", "H_vib" (mean, min, max, spread, relative_spread, applies: invariant of
+    eq. 95b only on a straight equilibrium), "matching_residual", and numpy arrays "s", "xbar",
+    "ybar", "thetabar", "nbarx", "nbary", "mbar", "H_vib_along_s" (and "omega2", "growth_rate").
+    "unstable_modes": the same for omega^2 < 0 (imaginary frequencies: the equilibrium is unstable
+    under dead loads; their number, "negative_omega2_count", is its index), most negative first;
+    "unstable_searched" (bool) and "omega2" (every mode's omega^2, increasing). "parameters": the
+    equilibrium's (those solved for included), as solve() gives them.
+
+Raises:
+    ValueError: a spatial case, bad options, or a rod the vibration equations do not cover.
+    RuntimeError: the equilibrium does not converge.)doc");
+}
+
+}  // namespace
+
+// Case: the loaded case, its properties and what can be done with it.
+void bind_case(py::module_& m) {
+  py::class_<PyCase> cls(m, "Case", R"doc(A loaded case file (see load_case).
+
+Attributes:
+    path, title, description (str)
+    kind (str): "planar" or "spatial".
+    parameters (dict): [parameters] after the overrides given to load_case.
+    unknowns (list of str): parameters solved for ([solver] unknowns).
+    derived_names (list of str): the derived quantities reported ([output] derived).
+    samples (int): default profile samples ([output] samples).
+    phase_condition (str): the override given to load_case ("" for the case's own).)doc");
+  cls.def_property_readonly("path", [](const PyCase& p) { return p.c.path; })
+      .def_property_readonly("title", [](const PyCase& p) { return p.c.title; })
+      .def_property_readonly("description", [](const PyCase& p) { return p.c.description; })
+      .def_property_readonly("kind", [](const PyCase& p) {
+        return p.c.definition.kind == RodKind::Planar ? "planar" : "spatial";
+      })
+      .def_property_readonly("parameters", [](const PyCase& p) { return parameters_dict(p.c.definition.parameters); })
+      .def_property_readonly("unknowns", [](const PyCase& p) { return p.c.definition.unknown_parameters; })
+      .def_property_readonly("derived_names", [](const PyCase& p) { return p.c.derived; })
+      .def_property_readonly("samples", [](const PyCase& p) { return p.c.samples; })
+      .def_readonly("phase_condition", &PyCase::phase_condition);
+  cls.def("solve", &py_solve, py::arg("samples") = py::none(), py::kw_only(), py::arg("seed") = "guess",
+          py::arg("seed_segments") = 200, py::arg("max_seconds") = kDefaultSolveSeconds, py::arg("direct") = false,
+          R"doc(Solves the case by shooting.
+
+Parameters changed from the file's values (load(..., set=...)) are reached by continuation from
+the file's own values (a homotopy in all of them together), so the equilibrium lies on the branch
+the case's guess starts; a fold on the way gives status 'fold' with where it is in `message`.
+
+Args:
+    samples (int, optional): profile points (>= 2); default the case's [output] samples.
+    seed (str): 'guess' starts from the case's [guess]; 'ipopt' from Ipopt's minimum of the
+        discretised energy, its shape and contact set (planar clamped-clamped rods; ValueError
+        for other cases).
+    seed_segments (int): segments of that discretised rod.
+    max_seconds (float): wall-clock limit of the solve (0: none); past it the result's status
+        is 'time_limit'.
+    direct (bool): Newton from the case's guess at the requested values instead of the homotopy.
+
+Returns:
+    Solution. Non-convergence is reported in Solution.status, not raised.)doc");
+  bind_case_continuation(cls);
+  bind_case_equilibria_and_vibrations(cls);
+  cls.def("__repr__", [](const PyCase& p) {
+        return "<kirchhoff.Case " + (p.c.title.empty() ? p.c.path : "'" + p.c.title + "'") + ">";
+      });
+}
+
+}  // namespace kirchhoff::python_bindings

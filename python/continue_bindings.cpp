@@ -1,0 +1,169 @@
+// Case.continue_: maps its arguments onto a ContinueRequest and runs the library's continue_case
+// (case_continue.hpp), as the CLI's `continue` does; the points come back as Branch.points.
+#include "bindings.hpp"
+
+namespace kirchhoff::python_bindings {
+namespace {
+
+// The points of a run, for Branch.points; Ctrl-C stops a long run between points (the exception
+// unwinds the continuation).
+class CollectingSink : public ContinueSink {
+ public:
+  std::vector<BranchPoint> points;
+  void point(const RunPoint& p) override {
+    points.push_back({*p.point, p.branch, p.row});
+    points.back().point.jacobian.reset();
+    py::gil_scoped_acquire acquire;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  }
+};
+
+// What identifies a run for resume=True (ContinueRequest::identity; the CLI's run_arguments): the
+// case file (path and content hash), how it was loaded, and the arguments that decide the points.
+std::string python_run_identity(const PyCase& pc, const ContinueRequest& r, const std::string& start_from) {
+  std::ifstream in(pc.path, std::ios::binary);
+  std::uint64_t hash = 14695981039346656037ull;  // FNV-1a, as the CLI's
+  for (char ch; in.get(ch);) hash = (hash ^ static_cast<unsigned char>(ch)) * 1099511628211ull;
+  std::ostringstream o;
+  o << std::setprecision(17) << "python case=" << pc.path << " case_hash=" << std::hex << hash << std::dec;
+  for (const auto& entry : pc.overrides) o << " set=" << entry.first << "=" << entry.second;
+  for (const auto& entry : pc.solver) o << " solver=" << entry.first << "=" << entry.second;
+  o << " phase=" << pc.phase_condition << " param=" << r.parameter << " to=" << r.target << " direction=" << r.direction
+    << " step=" << r.initial_step << " min_step=" << r.min_step << " max_step=" << r.max_step
+    << " max_points=" << r.max_points << " switch_at_bp=" << r.switch_at_bp << " side=" << r.switch_side
+    << " branch_points=" << r.detect_branch_points << " stability=" << r.compute_stability << " samples=" << r.samples;
+  for (const auto& e : r.events) o << (e.stop ? " event=" : " record=") << e.quantity << "=" << e.value;
+  if (!start_from.empty()) o << " start_from=" << start_from;
+  return o.str();
+}
+
+// resume / start_from as the CLI's --resume / --start-from: where the run starts, and the case
+// loaded again when the other run's parameter values differ from pc's (run_state.hpp).
+Case plan_python_start(const PyCase& pc, const std::string& state_path, bool resume, const std::string& start_from,
+                       const std::string& start_param, ContinueRequest* request) {
+  ParameterOverrides overrides = pc.overrides;
+  bool reload = false;
+  if (resume) {
+    if (state_path.empty()) throw CaseError("resume=True needs state=PATH, the state file of the run to resume");
+    if (!std::filesystem::exists(state_path))
+      throw CaseError("cannot resume: no state file " + state_path + " (a run saves it after its first point)");
+    request->resume = resumable_state(state_path, request->identity);
+    if (request->resume->has_set_parameters) overrides = request->resume->set_parameters, reload = true;
+  } else if (!start_from.empty()) {
+    const RunStart start = plan_start_from(start_from, start_param, pc.overrides);
+    overrides = start.parameters, reload = true;
+    request->start = start.at;
+    request->start_name = start_from;
+  }
+  request->set_parameters = overrides;
+  return reload ? load_case(pc.path, overrides, pc.phase_condition, pc.solver) : pc.c;
+}
+
+// The CLI's `continue` (continue_case: the same statuses and messages), its points in memory.
+PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::object& to, double step,
+                     double min_step, double max_step, int max_points, const py::object& events,
+                     const py::object& record, int switch_at_bp, double side, int samples, double direction,
+                     bool branch_points, bool stability, bool deflate, int deflate_max, double max_seconds,
+                     const py::object& state, bool resume, const py::object& start_from,
+                     const std::string& start_param) {
+  ContinueRequest request;
+  request.parameter = parameter;
+  if (!to.is_none()) request.target = to.cast<double>();
+  request.direction = direction;
+  request.initial_step = step;
+  request.min_step = min_step;
+  request.max_step = max_step;
+  request.max_points = max_points;
+  request.samples = samples;
+  request.detect_branch_points = branch_points;
+  request.compute_stability = stability;
+  request.events = events_from(events, true);
+  for (auto& e : events_from(record, false)) request.events.push_back(e);
+  request.switch_at_bp = switch_at_bp;
+  request.switch_side = side;
+  request.phase_condition = pc.phase_condition;
+  request.deflate = deflate;
+  request.deflate_max = deflate_max;
+  request.max_seconds = max_seconds;
+  const std::string state_path = path_text(state), from = path_text(start_from);
+  if (deflate && !state_path.empty()) throw CaseError("state: a deflate run is not resumable, so it saves no state");
+  request.identity = python_run_identity(pc, request, from);
+  const Case c = plan_python_start(pc, state_path, resume, from, start_param, &request);
+  if (std::string why = request.validate(c); !why.empty()) throw CaseError(why);
+  CollectingSink collect;
+  // The state after every point and at the end, as the CLI's --checkpoint 0.
+  StateFileSink state_file(state_path, std::chrono::steady_clock::duration::zero());
+  std::vector<ContinueSink*> sinks = {&collect};
+  if (!state_path.empty()) sinks.push_back(&state_file);
+  ContinueRunResult result;
+  {
+    py::gil_scoped_release release;
+    result = continue_case(c, request, sinks);
+  }
+  PyBranch out;
+  out.parameter = parameter;
+  out.reason = result.status;
+  out.message = result.message;
+  out.switched = result.switched;
+  out.ok = result.ok;
+  out.contact_changes = result.contact_changes;
+  out.size = collect.points.size();
+  out.points = branch_points_dict(collect.points, result.derived);
+  return out;
+}
+
+}  // namespace
+
+// Case.continue_().
+void bind_case_continuation(py::class_<PyCase>& cls) {
+  cls.def("continue_", &py_continue, py::arg("param"), py::arg("to") = py::none(), py::kw_only(),
+          py::arg("step") = 0.05, py::arg("min_step") = 1e-7, py::arg("max_step") = 0.5,
+          py::arg("max_points") = 500, py::arg("events") = py::none(), py::arg("record") = py::none(),
+          py::arg("switch_at_bp") = 0, py::arg("side") = 1.0, py::arg("samples") = 101,
+          py::arg("direction") = 1.0, py::arg("branch_points") = true, py::arg("stability") = true,
+          py::arg("deflate") = false, py::arg("deflate_max") = 16, py::arg("max_seconds") = 0.0,
+          py::arg("state") = py::none(), py::arg("resume") = false, py::arg("start_from") = py::none(),
+          py::arg("start_param") = "",
+          R"doc(Pseudo-arclength continuation in one parameter (the CLI's `continue`).
+
+Args:
+    param (str): the continued parameter; its value in the case is the starting one.
+    to (float, optional): stop on reaching this value (None: no target, go along `direction`).
+    step, min_step, max_step (float): initial, smallest and largest pseudo-arclength step.
+    max_points (int): points per branch.
+    events (dict name -> value): stop when a derived quantity crosses the value.
+    record (dict name -> value): record such crossings without stopping.
+    switch_at_bp (int): > 0: stop at that branch point and follow the bifurcating branch
+        (a double branch point of a spatial rod switches with the axial phase condition).
+    side (float): +1 / -1, which side of the bifurcating branch.
+    samples (int): profile points per point for invariants and derived quantities.
+    direction (float): +1 / -1, initial direction when there is no target.
+    branch_points (bool): look for branch points (an SVD per point: most of the cost of a run on
+        a multiple-shooting case of hundreds of unknowns, such as plectoneme.toml); folds are
+        found either way.
+    stability (bool): the stability index of every point (column stability_index: NaN where
+        it is not defined; zero_modes beside it), as the CLI's CSV.
+    deflate (bool): follow every branch through the equilibria found at the start by deflation
+        (as equilibria() lists them, at most deflate_max): branch k starts at the k-th by energy.
+    max_seconds (float): wall-clock limit of the whole run (0: none); past it the run stops
+        with reason 'time_limit', resumable with state= and resume=True.
+    state (str or path, optional): the run's state file (the CLI's OUT.csv.state.json), saved
+        after every point and at the end.
+    resume (bool): go on from the state file `state` of an interrupted run (time_limit, Ctrl-C)
+        made with the same case and arguments (another run's state is refused): the Branch
+        holds the points after the last one saved, their `index` continuing the run's, so the
+        two Branches together are the uninterrupted run's points.
+    start_from (str or path, optional): another run's state file: start at its last point
+        (its unknowns, active contacts and parameter values, then this case's `set`), as the
+        CLI's --start-from. start_param names that run's parameter for files too old to say.
+
+Returns:
+    Branch (points of all branches concatenated, with a `branch` column; `index` is the row of
+    the run, as in the CLI's CSV).
+
+Raises:
+    CaseError (ValueError): unknown parameter or derived quantity, invalid options.)doc");
+}
+
+
+}  // namespace kirchhoff::python_bindings
