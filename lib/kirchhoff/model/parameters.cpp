@@ -9,9 +9,17 @@ void Parameters::set(const std::string& name, double value) {
   if (i >= 0) {
     values_[i] = value;
   } else {
-    names_.push_back(name);
+    auto grown = names_ ? std::make_shared<std::vector<std::string>>(*names_)
+                        : std::make_shared<std::vector<std::string>>();
+    grown->push_back(name);
+    names_ = std::move(grown);
     values_.push_back(value);
   }
+}
+
+const std::vector<std::string>& Parameters::names() const {
+  static const std::vector<std::string> none;
+  return names_ ? *names_ : none;
 }
 
 double Parameters::get(const std::string& name) const {
@@ -21,8 +29,9 @@ double Parameters::get(const std::string& name) const {
 }
 
 int Parameters::index_of(const std::string& name) const {
+  const std::vector<std::string>& all = names();
   for (int i = 0; i < size(); ++i)
-    if (names_[i] == name) return i;
+    if (all[i] == name) return i;
   return -1;
 }
 

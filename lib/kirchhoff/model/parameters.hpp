@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -18,13 +19,16 @@ class Parameters {
   bool contains(const std::string& name) const { return index_of(name) >= 0; }
   int index_of(const std::string& name) const;
 
-  const std::vector<std::string>& names() const { return names_; }
+  const std::vector<std::string>& names() const;
   const std::vector<double>& values() const { return values_; }
   double& value_at(int index) { return values_[index]; }
-  int size() const { return static_cast<int>(names_.size()); }
+  int size() const { return static_cast<int>(values_.size()); }
 
  private:
-  std::vector<std::string> names_;
+  // The names are shared between copies and replaced, never changed, when one is added: a copy
+  // (a problem's parameters at its unknowns, made at every evaluation) allocates for its values
+  // only.
+  std::shared_ptr<const std::vector<std::string>> names_;
   std::vector<double> values_;
 };
 

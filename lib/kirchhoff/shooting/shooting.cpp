@@ -150,10 +150,11 @@ std::shared_ptr<const RodEquations> ShootingProblem::equations(const Parameters&
   Parameters recomputed;
   if (!definition_.dependent_parameters.empty()) recomputed = completed(given);
   const Parameters& p = definition_.dependent_parameters.empty() ? given : recomputed;
-  std::vector<double> key;
-  for (const auto& name : definition_.model_parameters)
-    if (p.contains(name)) key.push_back(p.get(name));
-  return workspace_.equations(key, [&] { return build_equations(p); });
+  const auto model_values = [&](auto&& visit) {
+    for (const auto& name : definition_.model_parameters)
+      if (p.contains(name)) visit(p.get(name));
+  };
+  return workspace_.equations(model_values, [&] { return build_equations(p); });
 }
 
 namespace {

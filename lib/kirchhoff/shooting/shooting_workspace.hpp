@@ -17,14 +17,22 @@ class ShootingWorkspace {
  public:
   using Build = std::function<std::shared_ptr<const RodEquations>()>;
 
-  // The equations for the model parameters' values `key`: those built last if the key is
-  // unchanged, else build()'s (and the workers' copies are dropped).
-  std::shared_ptr<const RodEquations> equations(const std::vector<double>& key, const Build& build) {
-    if (!equations_ || key != key_) {
-      equations_ = build();
-      key_ = key;
-      workers_.clear();
-    }
+  // The equations for the model parameters' values, which for_each_value(visit) hands to visit
+  // one by one: those built last if the values are unchanged (compared in place, so that an
+  // unchanged key allocates nothing), else build()'s (and the workers' copies are dropped).
+  template <class ForEachValue>
+  std::shared_ptr<const RodEquations> equations(ForEachValue&& for_each_value, const Build& build) {
+    size_t count = 0;
+    bool same = equations_ != nullptr;
+    for_each_value([&](double v) {
+      same = same && count < key_.size() && key_[count] == v;
+      ++count;
+    });
+    if (same && count == key_.size()) return equations_;
+    key_.clear();
+    for_each_value([&](double v) { key_.push_back(v); });
+    equations_ = build();
+    workers_.clear();
     return equations_;
   }
 
