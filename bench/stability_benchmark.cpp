@@ -10,8 +10,9 @@
 // second goal (at most +30 %): the branch of docs/performance.md's table (continue_case, as the
 // CLI runs it) with the index at every point and without it, alternating, `--runs N` times each
 // (default 5), median CPU time of the process; and, in the same process, the index of every
-// point of the branch alone (analyse_stability with the continuation's options), summed, against
-// the branch without it - the share that does not depend on how two runs' times happened to vary.
+// point of the branch alone (analyse_stability with the continuation's options: the fields at
+// its stability_field_tolerance, then at the state's tolerance), summed, against the branch
+// without it - the share that does not depend on how two runs' times happened to vary.
 // Nothing here asserts on timings.
 //
 //   stability_benchmark [--runs N] [--only TEXT]
