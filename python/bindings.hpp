@@ -128,8 +128,9 @@ py::dict profile_dict(const RodModel& model, const std::vector<RodPoint>& profil
 
 SolverOverrides solver_values(const py::object& solver);
 
-// The CLI's JSON "stability" block as a dict (index None where it is not defined).
-py::dict stability_dict(const StabilityReport& st, const DiscreteStability& discrete);
+// A JSON value of the CLI's output (result_json.hpp) as the Python object json.loads makes of it,
+// so that Python and the CLI report the same blocks from one builder (stability_json, path_json).
+py::object python_object(const nlohmann::json& j);
 
 std::vector<ContinuationEvent> events_from(const py::object& obj, bool stop);
 

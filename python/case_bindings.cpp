@@ -79,7 +79,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   const Solution* sol = !integration_failed && seed_refused.empty() && solved.converged() ? &*solved.solution : nullptr;
   const std::string& path_failure = solved.failure;  // a homotopy that stopped short: its status word
   // As the CLI's JSON "path" (one builder for both).
-  out.path = py::module_::import("json").attr("loads")(path_json(solved.path).dump());
+  out.path = python_object(path_json(solved.path));
   if (!seed_refused.empty()) throw py::value_error(seed_refused);
   const ShootingResult& r = sol ? sol->result : failed;
   out.status = path_failure.empty() ? to_string(r.summary.status) : path_failure;
@@ -100,7 +100,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   out.invariants = invariants_dict(sol->invariants);
   out.profile = profile_dict(problem->equations(sol->result.parameters)->model(), sol->profile,
                              problem->definition().kind);
-  out.stability = stability_dict(*solved.stability, *solved.stability_check);
+  out.stability = python_object(stability_json(*solved.stability, &*solved.stability_check));
   out.contacts = contacts_list(*problem, *sol);
   for (const auto& o : stated_contact_outcomes(c.definition.contacts, sol->contacts,
                                                problem->obstacles(sol->result.parameters),
@@ -198,7 +198,7 @@ PySolution equilibrium_solution(const Case& c, const Equilibrium& e) {
   out.invariants = invariants_dict(sol.invariants);
   out.profile = profile_dict(e.problem->equations(sol.result.parameters)->model(), sol.profile,
                              e.problem->definition().kind);
-  out.stability = stability_dict(e.stability, DiscreteStability{});
+  out.stability = python_object(stability_json(e.stability));
   out.contacts = contacts_list(*e.problem, sol);
   return out;
 }

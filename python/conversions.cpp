@@ -140,46 +140,7 @@ SolverOverrides solver_values(const py::object& solver) {
   return out;
 }
 
-// The CLI's JSON "stability" block as a dict (index None where it is not defined).
-py::dict stability_dict(const StabilityReport& st, const DiscreteStability& discrete) {
-  py::dict d;
-  d["index"] = st.index ? py::object(py::int_(*st.index)) : py::object(py::none());
-  d["stable"] = st.index ? py::object(py::bool_(st.stable())) : py::object(py::none());
-  d["zero_modes"] = st.zero_modes;
-  d["conjugate_points"] = st.conjugate_points;
-  d["lowest_eigenvalues"] = discrete.defined() && discrete.trustworthy ? py::cast(discrete.lowest_eigenvalues)
-                                                                       : py::object(py::list());
-  if (discrete.defined()) {
-    py::dict check;
-    check["method"] = "discretised_energy";
-    check["elements"] = discrete.elements;
-    check["index"] = *discrete.index;
-    check["zero_modes"] = discrete.zero_modes;
-    check["trustworthy"] = discrete.trustworthy;
-    check["check"] = discrete.check_message;
-    check["agrees"] = discrete.trustworthy && st.index && *st.index == *discrete.index;
-    if (!discrete.sliding_length.empty() && std::isfinite(discrete.reduced_curvature))
-      check["reduced_energy_curvature"] = discrete.reduced_curvature;
-    d["cross_check"] = check;
-  }
-  d["method"] = st.method;
-  if (!st.method_reason.empty()) d["method_reason"] = st.method_reason;
-  if (st.reduced_energy_curvature) {
-    d["sliding_length"] = st.sliding_length;
-    d["fixed_length_index"] = *st.fixed_length_index;
-    d["reduced_energy_curvature"] = *st.reduced_energy_curvature;
-  }
-  if (st.index && st.method == "discretised_energy") {
-    // No conjugate points, so no load-controlled count or correction.
-  } else if (st.index) {
-    d["load_controlled_index"] = st.dead_load_index;
-    d["held_chord_directions"] = st.constraint_count;
-    d["constraint_correction"] = st.constraint_correction;
-  } else {
-    d["reason"] = st.reason;
-  }
-  return d;
-}
+py::object python_object(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
 std::vector<ContinuationEvent> events_from(const py::object& obj, bool stop) {
   std::vector<ContinuationEvent> out;

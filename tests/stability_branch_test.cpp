@@ -60,27 +60,30 @@ std::set<int> expect_same_indices(const std::string& file, const ParameterOverri
   return seen;
 }
 
+// A run of `parameter` towards `target`, profiles at 21 points (the index does not use them).
+ContinueRequest towards(const std::string& parameter, double target, double max_step) {
+  ContinueRequest r;
+  r.parameter = parameter;
+  r.target = target;
+  r.max_step = max_step;
+  r.samples = 21;
+  return r;
+}
+
 TEST(StabilityAlongBranches, LooserFieldsAreLooserThanTheState) {
   // Otherwise the tests below compare a computation with itself.
   EXPECT_GT(RecordOptions{}.stability_field_tolerance, IntegratorOptions{}.abs_tol);
 }
 
 TEST(StabilityAlongBranches, EulerColumnThroughItsFirstTwoBranchPoints) {
-  ContinueRequest r;
-  r.parameter = "P";
-  r.target = 45.0;  // past (2 pi)^2 = 39.5: index 0, 1, 2 on the straight column
-  r.max_step = 1.0;
-  r.samples = 21;
+  // Past (2 pi)^2 = 39.5: index 0, 1, 2 on the straight column.
+  const ContinueRequest r = towards("P", 45.0, 1.0);
   const std::set<int> seen = expect_same_indices("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, r);
   EXPECT_EQ(seen, (std::set<int>{0, 1, 2}));
 }
 
 TEST(StabilityAlongBranches, EulerColumnsFirstBuckledBranch) {
-  ContinueRequest r;
-  r.parameter = "P";
-  r.target = 12.0;
-  r.max_step = 1.0;
-  r.samples = 21;
+  ContinueRequest r = towards("P", 12.0, 1.0);
   r.switch_at_bp = 1;
   r.events = {{"theta0", 3.0, true, ""}};
   const std::set<int> seen = expect_same_indices("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, r);
@@ -88,11 +91,7 @@ TEST(StabilityAlongBranches, EulerColumnsFirstBuckledBranch) {
 }
 
 TEST(StabilityAlongBranches, TwistedRodPastTheGreenhillTwistAndOntoTheBuckledBranch) {
-  ContinueRequest r;
-  r.parameter = "phi";
-  r.target = 15.0;
-  r.max_step = 1.0;
-  r.samples = 21;
+  ContinueRequest r = towards("phi", 15.0, 1.0);
   r.switch_at_bp = 1;
   r.events = {{"end_to_end", 0.5, true, ""}};
   const std::set<int> seen = expect_same_indices("twisted_clamped.toml", {{"phi", 6.0}, {"tension", 0.0}}, r);
@@ -101,12 +100,8 @@ TEST(StabilityAlongBranches, TwistedRodPastTheGreenhillTwistAndOntoTheBuckledBra
 
 TEST(StabilityAlongBranches, ClampedClampedRodUnderEndShortening) {
   // Both ends held: the isoperimetric correction at every point.
-  ContinueRequest r;
-  r.parameter = "D";
-  r.target = 0.3;
+  ContinueRequest r = towards("D", 0.3, 0.05);
   r.direction = -1.0;
-  r.max_step = 0.05;
-  r.samples = 21;
   const std::set<int> seen = expect_same_indices("clamped_clamped.toml", {{"s_mode", 1.0}}, r);
   EXPECT_TRUE(seen.count(1)) << "the S-shaped mode";
 }

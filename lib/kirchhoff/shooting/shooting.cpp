@@ -152,7 +152,7 @@ std::shared_ptr<const RodEquations> ShootingProblem::equations(const Parameters&
   const Parameters& p = definition_.dependent_parameters.empty() ? given : recomputed;
   const auto model_values = [&](auto&& visit) {
     for (const auto& name : definition_.model_parameters)
-      if (p.contains(name)) visit(p.get(name));
+      if (const int i = p.index_of(name); i >= 0) visit(p.values()[i]);
   };
   return workspace_.equations(model_values, [&] { return build_equations(p); });
 }
