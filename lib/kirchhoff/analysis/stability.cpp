@@ -68,23 +68,31 @@ Eigen::MatrixXd lab_rotation_jacobian(const RodEquations& eq, const Eigen::Vecto
   return jacobian;
 }
 
+// The rows of T and the block of G that depend on the state: the rotation's (its Jacobian
+// follows the frame) and G (it holds m). The other rows are constant along the rod.
+void update_rotation_part(const RodEquations& eq, const Coordinates& c, const Scales& sc, const Eigen::VectorXd& y,
+                          double s, CanonicalMap* map) {
+  const int n = c.size(), kr = c.kr();
+  const RodPoint point = eq.point(y, s);
+  const Eigen::MatrixXd rotation_jacobian = lab_rotation_jacobian(eq, y, point.R);
+  map->T.middleRows(kr, n - kr).noalias() = c.rotation_dirs.transpose() * rotation_jacobian;
+  map->G.bottomRightCorner(n - kr, n - kr).noalias() =
+      0.5 * (sc.length / (sc.bending * sc.rate)) * c.rotation_dirs.transpose() * cross_matrix(point.m) *
+      c.rotation_dirs;
+}
+
 CanonicalMap canonical_map(const RodEquations& eq, const Coordinates& c, const Scales& sc, const Eigen::VectorXd& y,
                            double s) {
   const int N = static_cast<int>(y.size()), n = c.size(), kr = c.kr();
-  const RodPoint point = eq.point(y, s);
-  const Eigen::MatrixXd rotation_jacobian = lab_rotation_jacobian(eq, y, point.R);
   CanonicalMap map;
   map.T = Eigen::MatrixXd::Zero(2 * n, N);
   map.T.topRows(kr) = c.position_dirs.transpose() * eq.slot_map(Slot::Position) / sc.length;
-  map.T.middleRows(kr, n - kr) = c.rotation_dirs.transpose() * rotation_jacobian;
   map.T.middleRows(n, kr) =
       c.position_dirs.transpose() * eq.slot_map(Slot::Force) * (sc.length * sc.length / (sc.bending * sc.force_rate));
   map.T.bottomRows(n - kr) =
       c.rotation_dirs.transpose() * eq.slot_map(Slot::Moment) * (sc.length / (sc.bending * sc.rate));
   map.G = Eigen::MatrixXd::Zero(n, n);
-  map.G.bottomRightCorner(n - kr, n - kr) =
-      0.5 * (sc.length / (sc.bending * sc.rate)) * c.rotation_dirs.transpose() * cross_matrix(point.m) *
-      c.rotation_dirs;
+  update_rotation_part(eq, c, sc, y, s, &map);
   return map;
 }
 
@@ -211,8 +219,9 @@ double wrap(double angle) { return std::remainder(angle, 2 * kPi); }
 // Eigenphases of W = (U + iP)(U - iP)^-1: with the frame made orthonormal, W = X X^T for the
 // unitary X = U + iP. One field (the planar rod's rotation frame): W = (u + ip)^2 / (u^2 + p^2),
 // whose phase is 2 atan2(p, u). The matrices are at most 12 x 6 (the full frame of a spatial rod):
-// fixed-capacity storage, no allocation at each of the index's steps.
-Eigen::VectorXd eigenphases(const Eigen::MatrixXd& U_in, const Eigen::MatrixXd& P_in) {
+// fixed-capacity storage, no allocation at each of the index's steps. `orthonormal`: [U; P] has
+// orthonormal columns already (orthonormalise), else they are made so by a QR here.
+Eigen::VectorXd eigenphases(const Eigen::MatrixXd& U_in, const Eigen::MatrixXd& P_in, bool orthonormal) {
   const int m = static_cast<int>(U_in.cols());
   Eigen::VectorXd phase(m);
   if (m == 0) return phase;
@@ -222,11 +231,13 @@ Eigen::VectorXd eigenphases(const Eigen::MatrixXd& U_in, const Eigen::MatrixXd& 
   }
   using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 6>;
   using SmallComplex = Eigen::Matrix<std::complex<double>, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
-  Small Z(2 * m, m);
-  Z << U_in, P_in;
-  Eigen::HouseholderQR<Small> qr(Z);
-  Small Q = Small::Identity(2 * m, m);
-  Q.applyOnTheLeft(qr.householderQ());
+  Small Q(2 * m, m);
+  Q << U_in, P_in;
+  if (!orthonormal) {
+    const Eigen::HouseholderQR<Small> qr(Q);
+    Q.setIdentity(2 * m, m);
+    Q.applyOnTheLeft(qr.householderQ());
+  }
   const SmallComplex X = Q.topRows(m).cast<std::complex<double>>() + std::complex<double>(0, 1) * Q.bottomRows(m);
   const SmallComplex W = X * X.transpose();
   Eigen::ComplexEigenSolver<SmallComplex> solver(W, false);
@@ -492,10 +503,14 @@ Frame StabilityAnalysis::start_frame(const Held& start, const Eigen::MatrixXd& s
 }
 
 // The canonical map at the frame's point. A planar rod's is the same everywhere (its rotation is
-// the state's angle, and G = 1/2 e_z.(m x e_z) = 0): computed once.
+// the state's angle, and G = 1/2 e_z.(m x e_z) = 0): computed once. A spatial rod's changes in its
+// rotation rows and G only (update_rotation_part).
 const CanonicalMap& StabilityAnalysis::map_at(const Eigen::VectorXd& y, double s) const {
   if (eq_->is_planar() && map_known_) return map_;
-  map_ = canonical_map(*eq_, coords_, scales_, y, s);
+  if (map_known_)
+    update_rotation_part(*eq_, coords_, scales_, y, s, &map_);
+  else
+    map_ = canonical_map(*eq_, coords_, scales_, y, s);
   map_known_ = true;
   map_has_G_ = !map_.G.isZero(0.0) || !eq_->is_planar();
   return map_;
@@ -506,11 +521,13 @@ void StabilityAnalysis::canonical_blocks(Frame* f) const {
   const CanonicalMap& map = map_at(f->y, f->s);
   auto blocks = [&](const Eigen::MatrixXd& dY, Eigen::MatrixXd* z, Eigen::MatrixXd* U, Eigen::MatrixXd* P,
                     Eigen::MatrixXd* P_phys, Eigen::MatrixXd* R) {
-    z->noalias() = map.T * dY;
+    // Products of a few rows and columns: coefficient-wise (lazyProduct), not through the
+    // blocked kernel that Eigen picks for dynamic sizes, whose set-up costs more than they do.
+    z->noalias() = map.T.lazyProduct(dY);
     *U = z->middleRows(offset_, mU_);
     *P_phys = z->middleRows(n + offset_, mU_);
     *P = *P_phys;
-    if (map_has_G_) P->noalias() += map.G.bottomRightCorner(mU_, mU_) * *U;
+    if (map_has_G_) P->noalias() += map.G.bottomRightCorner(mU_, mU_).lazyProduct(*U);
     *R = z->topRows(kr);
   };
   blocks(f->dY, &z_, &f->U, &f->P, &f->P_physical, &f->R);
@@ -611,7 +628,7 @@ double StabilityAnalysis::locate_passage(const Frame& f, const Eigen::VectorXd& 
     flowed(f, estimate, &steps, true, &trial_);
     canonical_blocks(&trial_);
     orthonormalise(&trial_);
-    const double t = std::tan(0.5 * (lift(before, eigenphases(trial_.U, trial_.P))[j] - multiple * kPi));
+    const double t = std::tan(0.5 * (lift(before, eigenphases(trial_.U, trial_.P, true))[j] - multiple * kPi));
     if (t > 0) {
       a = estimate, ta = t;
       if (kept == -1) tb *= 0.5;  // b kept twice
@@ -682,7 +699,7 @@ void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int dept
   flowed(*f, s1, &steps_, false, &next);
   canonical_blocks(&next);
   orthonormalise(&next);
-  const Eigen::VectorXd phases = eigenphases(next.U, next.P);
+  const Eigen::VectorXd phases = eigenphases(next.U, next.P, true);
   // The moves of the phases as record() pairs them: where two phases come close, a long step can
   // pair them wrongly though each lies near some new phase.
   const double largest =
@@ -750,7 +767,7 @@ std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contac
   // The shear leaves U, so no eigenphase passes -1 through it: each stays in its sheet between
   // consecutive odd multiples of pi (it may turn almost a whole turn inside it, so it is not
   // followed by small steps, which could not tell such a turn from a small one back).
-  const Eigen::VectorXd sheared = eigenphases(f->U, f->P + S * f->U);
+  const Eigen::VectorXd sheared = eigenphases(f->U, f->P + S * f->U, false);
   std::vector<bool> used(sheared.size(), false);
   for (int j = 0; j < track->lifted.size(); ++j) {
     const double sheet = 2 * kPi * std::round(track->lifted[j] / (2 * kPi));
@@ -980,7 +997,7 @@ StabilityReport StabilityAnalysis::run() {
   }
   orthonormalise(&f);
   PhaseTrack track;
-  track.lifted = eigenphases(f.U, f.P);
+  track.lifted = eigenphases(f.U, f.P, true);
   // The fields held at s = 0 start exactly at a conjugate point (U c = 0): their eigenphase is pi,
   // leaving it in the Legendre direction.
   const int held_count = static_cast<int>(start.rotation.cols());

@@ -14,16 +14,20 @@ enum SpatialIndex { kR = 0, kQ = 3, kN = 7, kM = 10, kChi = 13 };
 template <class T>
 void rotation_from_quaternion(const T* q, T R[3][3]) {
   const T w = q[0], x = q[1], y = q[2], z = q[3];
-  const T inv = 1.0 / (w * w + x * x + y * y + z * z);
-  R[0][0] = (w * w + x * x - y * y - z * z) * inv;
-  R[0][1] = 2.0 * (x * y - w * z) * inv;
-  R[0][2] = 2.0 * (x * z + w * y) * inv;
-  R[1][0] = 2.0 * (x * y + w * z) * inv;
-  R[1][1] = (w * w - x * x + y * y - z * z) * inv;
-  R[1][2] = 2.0 * (y * z - w * x) * inv;
-  R[2][0] = 2.0 * (x * z - w * y) * inv;
-  R[2][1] = 2.0 * (y * z + w * x) * inv;
-  R[2][2] = (w * w - x * x - y * y + z * z) * inv;
+  // Each product once (on dual numbers a product is the costly operation): the same values, in
+  // the same order of operations, as writing them out in every entry.
+  const T ww = w * w, xx = x * x, yy = y * y, zz = z * z;
+  const T xy = x * y, xz = x * z, yz = y * z, wx = w * x, wy = w * y, wz = w * z;
+  const T inv = 1.0 / (ww + xx + yy + zz);
+  R[0][0] = (ww + xx - yy - zz) * inv;
+  R[0][1] = 2.0 * (xy - wz) * inv;
+  R[0][2] = 2.0 * (xz + wy) * inv;
+  R[1][0] = 2.0 * (xy + wz) * inv;
+  R[1][1] = (ww - xx + yy - zz) * inv;
+  R[1][2] = 2.0 * (yz - wx) * inv;
+  R[2][0] = 2.0 * (xz - wy) * inv;
+  R[2][1] = 2.0 * (yz + wx) * inv;
+  R[2][2] = (ww - xx - yy + zz) * inv;
 }
 
 }  // namespace kirchhoff::detail
