@@ -16,6 +16,7 @@
 #include "kirchhoff/jobs/case_continue.hpp"
 #include "kirchhoff/jobs/case_file.hpp"
 #include "kirchhoff/jobs/continue_outputs.hpp"
+#include "kirchhoff/jobs/run_plan.hpp"
 #include "kirchhoff/jobs/run_state.hpp"
 #include "solve_command.hpp"
 
@@ -23,17 +24,6 @@ namespace kirchhoff::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Data rows of a branch CSV (0 when there is none).
-int data_rows(const fs::path& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);  // the header
-  int count = 0;
-  while (std::getline(in, line))
-    if (!line.empty()) ++count;
-  return count;
-}
 
 // The arguments that decide a run's points, in one line: a state file records them, and a
 // resume with other ones is refused (it would not continue the same run). The output paths,
@@ -135,16 +125,6 @@ std::vector<ContinuationEvent> parse_events(const std::vector<std::string>& text
   return out;
 }
 
-// A run started from another case's run: the names its state brings that this case lacks, said
-// as such (load_case would call them a --set the user never typed).
-void refuse_foreign_parameters(const RunStart& start, const ContinueArguments& args) {
-  const Case plain = load_case(args.case_path, {}, args.phase_condition);
-  for (size_t k = 0; k < start.parameters.size(); ++k)
-    if (!plain.file_parameters.contains(start.parameters[k].first))
-      throw CaseError(args.start_from + ": its run's parameter '" + start.parameters[k].first + "' (" +
-                      start.sources[k] + ") is not a parameter of " + args.case_path);
-}
-
 // The parameter values a run started from another one starts with: each that differs from the
 // case file's or was given (whence it comes), and the continued one.
 void print_start(const RunStart& start, const Case& c, const std::string& parameter) {
@@ -202,32 +182,10 @@ int report_end(const ContinueArguments& args, const ContinueRunResult& r) {
 
 int run_continue(const ContinueArguments& args) {
   const fs::path csv(args.out_path), state_path(args.out_path + ".state.json");
-  if (args.deflate && (args.resume || !args.start_from.empty() || args.switch_at_bp > 0 || args.seed.ipopt)) {
-    std::cerr << "error: --deflate starts every branch from the equilibria it finds: it does not combine with "
-                 "--resume, --start-from, --switch-at-bp or --seed (a --deflate run is not resumable)\n";
-    return kExitBadInput;
-  }
   if (!(args.checkpoint_seconds >= 0 && args.checkpoint_seconds <= 1e6)) {
     std::cerr << "error: --checkpoint must be in [0, 1e6] seconds\n";
     return kExitBadInput;
   }
-  // A run killed before it saved its first point (its start) has no state file, and at most the
-  // start's row, which it had not finished: resuming it is starting it again, which rewrites the
-  // CSV with the same rows. More rows and no state means the state was removed or the rows are
-  // another run's: nothing records where that march stood, so it is refused.
-  bool resuming = args.resume;
-  if (args.resume && !fs::exists(state_path)) {
-    if (const int rows = data_rows(csv); rows > 1) {
-      std::cerr << "error: cannot resume: " << csv.string() << " has " << rows << " rows but there is no state file "
-                << state_path.string() << " (a run saves it after its first point, so it was removed or the rows "
-                << "come from another run); run again without --resume to compute the branch from its start\n";
-      return kExitBadInput;
-    }
-    std::cerr << "resume: no state file " << state_path.string()
-              << ": the run was stopped before its first point was saved, so it starts from the beginning\n";
-    resuming = false;
-  }
-
   ContinueRequest request;
   request.parameter = args.parameter;
   if (args.has_to) request.target = args.to;
@@ -246,40 +204,31 @@ int run_continue(const ContinueArguments& args) {
   request.deflate_max = args.deflate_max;
   request.seed = args.seed;
   request.identity = run_arguments(args);
-  Case c;
-  std::optional<RunStart> start;  // --start-from: where and with which parameters the run starts
+  RunPlanInputs inputs;
+  inputs.case_path = args.case_path;
+  inputs.phase_condition = args.phase_condition;
+  inputs.resume = args.resume;
+  inputs.state_path = state_path;
+  inputs.csv_path = csv;
+  inputs.start_from = args.start_from;
+  inputs.start_param = args.start_param;
+  RunPlan plan;
   try {
-    ParameterOverrides overrides;  // the run's parameter values beyond the case file's
-    for (const auto& t : args.overrides) overrides.push_back(parse_override(t));
-    if (resuming) {
-      request.resume = resumable_state(state_path.string(), request.identity);
-      // A run started from another one keeps the values it started with (the other run's, which
-      // its arguments line does not hold).
-      if (request.resume->has_set_parameters) overrides = request.resume->set_parameters;
-    } else if (!args.start_from.empty()) {
-      if (args.seed.ipopt) throw CaseError("--start-from does not combine with --seed");
-      start = plan_start_from(args.start_from, args.start_param, overrides);
-      overrides = start->parameters;
-      refuse_foreign_parameters(*start, args);
-      request.start = start->at;
-      request.start_name = args.start_from;
-    }
-    c = load_case(args.case_path, overrides, args.phase_condition, parse_solver_overrides(args.solver));
-    request.set_parameters = overrides;
+    for (const auto& t : args.overrides) inputs.overrides.push_back(parse_override(t));
+    inputs.solver = parse_solver_overrides(args.solver);
     request.events = parse_events(args.stop_events, true);
     for (auto& e : parse_events(args.record_events, false)) request.events.push_back(e);
-    if (std::string why = request.validate(c); !why.empty()) throw CaseError(why);
-    if (start) print_start(*start, c, args.parameter);
+    plan = plan_run(inputs, &request);
+    for (const auto& note : plan.notes) std::cerr << note << "\n";
+    if (plan.start) print_start(*plan.start, plan.c, args.parameter);
   } catch (const std::invalid_argument& e) {  // CaseError, a bad NAME=VALUE, a state file refused
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;
-  } catch (const CaseError& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return kExitBadInput;
-  } catch (const std::runtime_error& e) {  // no state file to resume from
+  } catch (const std::runtime_error& e) {  // a state file that cannot be read
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;
   }
+  const Case& c = plan.c;
 
   BranchCsvSink branch_csv(csv);
   TerminalSink terminal(args.parameter);

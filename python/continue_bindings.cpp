@@ -1,6 +1,7 @@
 // Case.continue_: maps its arguments onto a ContinueRequest and runs the library's continue_case
 // (case_continue.hpp), as the CLI's `continue` does; the points come back as Branch.points.
 #include "bindings.hpp"
+#include "kirchhoff/jobs/run_plan.hpp"
 
 namespace kirchhoff::python_bindings {
 namespace {
@@ -37,28 +38,6 @@ std::string python_run_identity(const PyCase& pc, const ContinueRequest& r, cons
   return o.str();
 }
 
-// resume / start_from as the CLI's --resume / --start-from: where the run starts, and the case
-// loaded again when the other run's parameter values differ from pc's (run_state.hpp).
-Case plan_python_start(const PyCase& pc, const std::string& state_path, bool resume, const std::string& start_from,
-                       const std::string& start_param, ContinueRequest* request) {
-  ParameterOverrides overrides = pc.overrides;
-  bool reload = false;
-  if (resume) {
-    if (state_path.empty()) throw CaseError("resume=True needs state=PATH, the state file of the run to resume");
-    if (!std::filesystem::exists(state_path))
-      throw CaseError("cannot resume: no state file " + state_path + " (a run saves it after its first point)");
-    request->resume = resumable_state(state_path, request->identity);
-    if (request->resume->has_set_parameters) overrides = request->resume->set_parameters, reload = true;
-  } else if (!start_from.empty()) {
-    const RunStart start = plan_start_from(start_from, start_param, pc.overrides);
-    overrides = start.parameters, reload = true;
-    request->start = start.at;
-    request->start_name = start_from;
-  }
-  request->set_parameters = overrides;
-  return reload ? load_case(pc.path, overrides, pc.phase_condition, pc.solver) : pc.c;
-}
-
 // The CLI's `continue` (continue_case: the same statuses and messages), its points in memory.
 PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::object& to, double step,
                      double min_step, double max_step, int max_points, const py::object& events,
@@ -88,8 +67,16 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
   const std::string state_path = path_text(state), from = path_text(start_from);
   if (deflate && !state_path.empty()) throw CaseError("state: a deflate run is not resumable, so it saves no state");
   request.identity = python_run_identity(pc, request, from);
-  const Case c = plan_python_start(pc, state_path, resume, from, start_param, &request);
-  if (std::string why = request.validate(c); !why.empty()) throw CaseError(why);
+  RunPlanInputs inputs;  // the case loaded again where the run's parameter values differ from pc's
+  inputs.case_path = pc.path;
+  inputs.overrides = pc.overrides;
+  inputs.phase_condition = pc.phase_condition;
+  inputs.solver = pc.solver;
+  inputs.resume = resume;
+  inputs.state_path = state_path;
+  inputs.start_from = from;
+  inputs.start_param = start_param;
+  const Case c = plan_run(inputs, &request, &pc.c).c;
   CollectingSink collect;
   // The state after every point and at the end, as the CLI's --checkpoint 0.
   StateFileSink state_file(state_path, std::chrono::steady_clock::duration::zero());

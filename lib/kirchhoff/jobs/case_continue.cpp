@@ -18,12 +18,12 @@ bool ended_normally(StopReason reason) {
          reason != StopReason::Inadmissible && reason != StopReason::TimeLimit;
 }
 
-namespace {
-
-// Refusal of deflate with what it does not combine with (the CLI says it before it reads a state).
-constexpr const char* kDeflateRefusal =
+const char kDeflateRefusal[] =
     "--deflate starts every branch from the equilibria it finds: it does not combine with --resume, --start-from, "
     "--switch-at-bp or --seed (a --deflate run is not resumable)";
+
+namespace {
+
 
 std::string text(double value) {
   std::ostringstream o;

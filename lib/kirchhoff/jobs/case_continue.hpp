@@ -83,6 +83,10 @@ struct ContinueRequest {
   std::string validate(const Case& c) const;
 };
 
+// Refusal of deflate with what it does not combine with (validate; plan_run says it before it
+// reads a state file).
+extern const char kDeflateRefusal[];
+
 // A point as the run reports it.
 struct RunPoint {
   int row = 0;     // its index among all points of the run (continuous across branches)

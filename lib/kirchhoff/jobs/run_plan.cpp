@@ -1,0 +1,74 @@
+#include "kirchhoff/jobs/run_plan.hpp"
+
+#include <fstream>
+
+namespace kirchhoff {
+namespace {
+
+// A run started from another case's run: the names its state brings that this case lacks, said
+// as such (load_case would call them a --set the user never typed).
+void refuse_foreign_parameters(const RunStart& start, const RunPlanInputs& in) {
+  const Case plain = load_case(in.case_path, {}, in.phase_condition);
+  for (size_t k = 0; k < start.parameters.size(); ++k)
+    if (!plain.file_parameters.contains(start.parameters[k].first))
+      throw CaseError(in.start_from + ": its run's parameter '" + start.parameters[k].first + "' (" +
+                      start.sources[k] + ") is not a parameter of " + in.case_path);
+}
+
+// Whether the run resumes: a state file to resume from, or none and nothing to lose (see
+// RunPlanInputs::csv_path), said in a note.
+bool resumes(const RunPlanInputs& in, std::vector<std::string>* notes) {
+  if (in.state_path.empty())
+    throw CaseError("resume needs state=PATH, the state file of the run to resume");
+  if (std::filesystem::exists(in.state_path)) return true;
+  if (in.csv_path.empty())
+    throw CaseError("cannot resume: no state file " + in.state_path.string() +
+                    " (a run saves it after its first point)");
+  if (const int rows = branch_csv_rows(in.csv_path); rows > 1)
+    throw CaseError("cannot resume: " + in.csv_path.string() + " has " + std::to_string(rows) +
+                    " rows but there is no state file " + in.state_path.string() +
+                    " (a run saves it after its first point, so it was removed or the rows come from another "
+                    "run); run again without --resume to compute the branch from its start");
+  notes->push_back("resume: no state file " + in.state_path.string() +
+                   ": the run was stopped before its first point was saved, so it starts from the beginning");
+  return false;
+}
+
+}  // namespace
+
+int branch_csv_rows(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);  // the header
+  int count = 0;
+  while (std::getline(in, line))
+    if (!line.empty()) ++count;
+  return count;
+}
+
+RunPlan plan_run(const RunPlanInputs& in, ContinueRequest* request, const Case* loaded) {
+  // Refused before any file is read (validate says the same once the case is loaded).
+  if (request->deflate && (in.resume || !in.start_from.empty())) throw CaseError(kDeflateRefusal);
+  if (!in.start_from.empty() && request->seed.ipopt) throw CaseError("--start-from does not combine with --seed");
+  RunPlan plan;
+  ParameterOverrides overrides = in.overrides;
+  bool reload = loaded == nullptr;
+  if (const bool resuming = in.resume && resumes(in, &plan.notes); resuming) {
+    request->resume = resumable_state(in.state_path.string(), request->identity);
+    // A run started from another one keeps the values it started with (the other run's, which
+    // its arguments do not hold).
+    if (request->resume->has_set_parameters) overrides = request->resume->set_parameters, reload = true;
+  } else if (!in.start_from.empty()) {
+    plan.start = plan_start_from(in.start_from, in.start_param, overrides);
+    refuse_foreign_parameters(*plan.start, in);
+    overrides = plan.start->parameters, reload = true;
+    request->start = plan.start->at;
+    request->start_name = in.start_from;
+  }
+  plan.c = reload ? load_case(in.case_path, overrides, in.phase_condition, in.solver) : *loaded;
+  request->set_parameters = overrides;
+  if (std::string why = request->validate(plan.c); !why.empty()) throw CaseError(why);
+  return plan;
+}
+
+}  // namespace kirchhoff
