@@ -60,6 +60,12 @@ class PlanarEquations final : public RodEquations {
     dy[kMoment] = y[kNx] * dyy - y[kNy] * dx;
   }
 
+  void flow_state_into(const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options,
+                       SegmentFlow* out) const override {
+    auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
+    detail::flow_state_into<kStateSize>(f, y0, s0, s1, options, out);
+  }
+
   SegmentFlow flow(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities,
                    const IntegratorOptions& options) const override {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
@@ -150,9 +156,9 @@ class PlanarEquations final : public RodEquations {
     return Vec3(0.0, 0.0, y[kTheta] - sign * target.angle);
   }
 
-  Eigen::VectorXd gauge_residual(const Eigen::VectorXd&, Eigen::MatrixXd* jacobian) const override {
+  GaugeRows gauge_residual(const Eigen::VectorXd&, Eigen::MatrixXd* jacobian) const override {
     if (jacobian) jacobian->resize(0, kStateSize);
-    return Eigen::VectorXd(0);
+    return GaugeRows(0);
   }
 
   LabDirections admissible_directions(Slot slot) const override {

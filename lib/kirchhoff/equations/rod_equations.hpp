@@ -45,6 +45,8 @@ struct OrientationTarget {
 constexpr int kMaxStateSize = 14;
 using LabDirections = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, 3>;
 using SlotMap = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, kMaxStateSize>;
+// The gauge conditions of a state representation (RodEquations::gauge_residual): at most two.
+using GaugeRows = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 2, 1>;
 
 class RodEquations {
  public:
@@ -57,6 +59,12 @@ class RodEquations {
   // Flow over [s0, s1]; throws IntegrationError when the integrator gives up.
   virtual SegmentFlow flow(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities,
                            const IntegratorOptions& options) const = 0;
+  // flow() without sensitivities, into *out: its storage reused, so that a residual evaluation
+  // allocates nothing once its buffers have their sizes (ShootingWorkspace::buffers).
+  virtual void flow_state_into(const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options,
+                               SegmentFlow* out) const {
+    *out = flow(y0, s0, s1, false, options);
+  }
   // The state and the columns of `directions` (state perturbations at s0) carried to s1 by the
   // variational equations, Phi directions, without forming Phi when there are fewer directions
   // than Phi has non-trivial columns. *carried hands the adaptive step sizes from one call to the
@@ -86,7 +94,8 @@ class RodEquations {
   virtual Vec3 orientation_error(const Eigen::VectorXd& y, const OrientationTarget& target, bool track_turns,
                                  Eigen::MatrixXd* jacobian) const = 0;
   // Conditions internal to the state representation, imposed once at s = 0 (e.g. |q| = 1).
-  virtual Eigen::VectorXd gauge_residual(const Eigen::VectorXd& y, Eigen::MatrixXd* jacobian) const = 0;
+  // At most two rows (fixed-capacity storage: no allocation).
+  virtual GaugeRows gauge_residual(const Eigen::VectorXd& y, Eigen::MatrixXd* jacobian) const = 0;
   // Orthonormal basis (3 x k) of the lab directions a slot can move in (all of R^3 in 3D; the
   // plane for positions and forces, e_z for orientations and moments in the planar case).
   virtual LabDirections admissible_directions(Slot slot) const = 0;

@@ -115,6 +115,12 @@ class SpatialEquations final : public RodEquations {
     return partial;
   }
 
+  void flow_state_into(const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options,
+                       SegmentFlow* out) const override {
+    auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
+    detail::flow_state_into<kStateSize>(f, y0, s0, s1, options, out);
+  }
+
   SegmentFlow flow(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities,
                    const IntegratorOptions& options) const override {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
@@ -232,9 +238,9 @@ class SpatialEquations final : public RodEquations {
     return e;
   }
 
-  Eigen::VectorXd gauge_residual(const Eigen::VectorXd& y, Eigen::MatrixXd* jacobian) const override {
+  GaugeRows gauge_residual(const Eigen::VectorXd& y, Eigen::MatrixXd* jacobian) const override {
     const Eigen::Vector4d q = y.segment<4>(kQ);
-    Eigen::VectorXd g(2);
+    GaugeRows g(2);
     g[0] = q.squaredNorm() - 1.0;
     const double w = q[0], qz = q[3], d = w * w + qz * qz;
     // chi(0) is the twist of R(0) up to whole turns: 2 atan2(qz, w) is it for q and -q alike

@@ -203,11 +203,28 @@ bool ShootingProblem::integrate_segments(const Eigen::VectorXd& x, const Paramet
                                          const IntegratorOptions& integrator, std::vector<SegmentFlow>* flows,
                                          std::string* failure) const {
   const int n = state_size_, M = segments();
-  const double L = length(p);
-  flows->assign(M, SegmentFlow{});
+  // Each segment's start state and flow in the workspace's buffers (resized, not rebuilt: their
+  // storage is reused), and the work handed to for_each_segment as one pointer, which a
+  // std::function holds without allocating.
+  auto& starts = workspace_.buffers().starts;
+  starts.resize(M);
+  for (int i = 0; i < M; ++i) starts[i] = x.segment(i * n, n);
+  flows->resize(M);
+  struct Work {
+    const std::vector<Eigen::VectorXd>& starts;
+    std::vector<SegmentFlow>& flows;
+    double L;
+    int M;
+    bool sensitivities;
+    const IntegratorOptions& integrator;
+  } work{starts, *flows, length(p), M, sensitivities, integrator};
   try {
-    for_each_segment(p, [&](int i, const RodEquations& equations) {
-      (*flows)[i] = equations.flow(x.segment(i * n, n), L * i / M, L * (i + 1) / M, sensitivities, integrator);
+    for_each_segment(p, [w = &work](int i, const RodEquations& equations) {
+      const double s0 = w->L * i / w->M, s1 = w->L * (i + 1) / w->M;
+      if (w->sensitivities)
+        w->flows[i] = equations.flow(w->starts[i], s0, s1, true, w->integrator);
+      else
+        equations.flow_state_into(w->starts[i], s0, s1, w->integrator, &w->flows[i]);
     });
   } catch (const IntegrationError& e) {
     if (failure) *failure = e.what();
@@ -218,11 +235,16 @@ bool ShootingProblem::integrate_segments(const Eigen::VectorXd& x, const Paramet
 }
 
 Parameters ShootingProblem::parameters_at(const Eigen::VectorXd& x) const {
-  Parameters p = definition_.parameters;
-  const int offset = segments() * state_size_;
-  for (size_t j = 0; j < unknown_index_.size(); ++j) p.value_at(unknown_index_[j]) = x[offset + j];
-  complete(&p, definition_.dependent_parameters);
+  Parameters p;
+  parameters_into(x, &p);
   return p;
+}
+
+void ShootingProblem::parameters_into(const Eigen::VectorXd& x, Parameters* p) const {
+  *p = definition_.parameters;  // (the values' storage reused when *p has as many)
+  const int offset = segments() * state_size_;
+  for (size_t j = 0; j < unknown_index_.size(); ++j) p->value_at(unknown_index_[j]) = x[offset + j];
+  complete(p, definition_.dependent_parameters);
 }
 
 void ShootingProblem::set_parameter(const std::string& name, double value) {
@@ -241,8 +263,7 @@ bool ShootingProblem::moves_beyond_conditions(int unknown) const {
 
 bool ShootingProblem::evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
                                std::string* failure) const {
-  Eigen::VectorXd y_end;
-  return evaluate_with_end(x, F, J, &y_end, failure);
+  return evaluate_with_end(x, F, J, &workspace_.buffers().y_end, failure);
 }
 
 bool ShootingProblem::has_step_matrices(double tolerance) const {
@@ -253,7 +274,7 @@ bool ShootingProblem::has_step_matrices(double tolerance) const {
 
 bool ShootingProblem::evaluate_for_step(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
                                         double tolerance, std::string* failure) const {
-  Eigen::VectorXd y_end;
+  Eigen::VectorXd& y_end = workspace_.buffers().y_end;
   if (!J || !has_step_matrices(tolerance)) return evaluate_with_end(x, F, J, &y_end, failure);
   IntegratorOptions loose = definition_.options.integrator;
   loose.sensitivity_tol = tolerance;
@@ -304,7 +325,8 @@ bool ShootingProblem::evaluate_with_end(const Eigen::VectorXd& x, Eigen::VectorX
 bool ShootingProblem::evaluate_with(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
                                     Eigen::VectorXd* y_end_out, const IntegratorOptions& integrator,
                                     std::string* failure) const {
-  const Parameters p = parameters_at(x);
+  Parameters& p = workspace_.buffers().parameters;
+  parameters_into(x, &p);
   Eigen::VectorXd& y_end = *y_end_out;
   if (!residual(x, p, F, J, failure, &y_end, &integrator)) return false;
   if (!J) return true;
@@ -348,15 +370,18 @@ int ShootingProblem::start_rows(const RodEquations& eq, const Eigen::VectorXd& y
   F->resize(residual_count_);
   if (J) J->setZero(residual_count_, size());
   Eigen::MatrixXd Jg;
-  const Eigen::VectorXd g = eq.gauge_residual(y0, J ? &Jg : nullptr);
+  const GaugeRows g = eq.gauge_residual(y0, J ? &Jg : nullptr);
   F->head(g.size()) = g;
   if (J) J->block(0, 0, g.size(), n) = Jg;
   int row = static_cast<int>(g.size());
-  ConditionRows start;
-  definition_.start.append_residuals(eq, true, y0, p, &start.values, J ? &start.jacobian : nullptr);
-  for (size_t k = 0; k < start.values.size(); ++k, ++row) {
-    (*F)[row] = start.values[k];
-    if (J) J->block(row, 0, 1, n) = start.jacobian[k];
+  auto& values = workspace_.buffers().start_values;
+  auto& jacobian = workspace_.buffers().start_jacobian;
+  values.clear();
+  jacobian.clear();
+  definition_.start.append_residuals(eq, true, y0, p, &values, J ? &jacobian : nullptr);
+  for (size_t k = 0; k < values.size(); ++k, ++row) {
+    (*F)[row] = values[k];
+    if (J) J->block(row, 0, 1, n) = jacobian[k];
   }
   return row;
 }
@@ -387,13 +412,11 @@ bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Ei
     return segments() > 1 ? residual_pieces(x, p, F, J, failure, y_end)
                           : residual_with_contacts(x, p, F, J, failure, y_end);
   const int n = state_size_, M = segments();
-  const Eigen::VectorXd y0 = x.head(n);
-  int row = start_rows(*eq, y0, p, F, J);
-
-  std::vector<SegmentFlow> flows;
+  std::vector<SegmentFlow>& flows = workspace_.buffers().flows;
   if (!integrate_segments(x, p, J != nullptr, integrator ? *integrator : definition_.options.integrator, &flows,
                           failure))
     return false;
+  int row = start_rows(*eq, workspace_.buffers().starts.front(), p, F, J);  // (the start state: x's first n)
   for (int i = 0; i + 1 < M; ++i) {
     F->segment(row, n) = flows[i].y - x.segment((i + 1) * n, n);
     if (J) {
@@ -405,11 +428,14 @@ bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Ei
   const SegmentFlow& last = flows.back();
 
   if (y_end) *y_end = last.y;
-  ConditionRows end;
-  definition_.end.append_residuals(*eq, false, last.y, p, &end.values, J ? &end.jacobian : nullptr);
-  for (size_t k = 0; k < end.values.size(); ++k, ++row) {
-    (*F)[row] = end.values[k];
-    if (J) J->block(row, (M - 1) * n, 1, n) = end.jacobian[k] * last.Phi;
+  auto& values = workspace_.buffers().end_values;
+  auto& jacobian = workspace_.buffers().end_jacobian;
+  values.clear();
+  jacobian.clear();
+  definition_.end.append_residuals(*eq, false, last.y, p, &values, J ? &jacobian : nullptr);
+  for (size_t k = 0; k < values.size(); ++k, ++row) {
+    (*F)[row] = values[k];
+    if (J) J->block(row, (M - 1) * n, 1, n) = jacobian[k] * last.Phi;
   }
   return true;
 }

@@ -251,6 +251,7 @@ class ShootingProblem final : public NonlinearSystem {
   void for_each_segment(const Parameters& p, const std::function<void(int, const RodEquations&)>& work,
                         bool parallel = true) const;
   // The flows of all segments.
+  void parameters_into(const Eigen::VectorXd& x, Parameters* p) const;  // parameters_at, into *p
   bool integrate_segments(const Eigen::VectorXd& x, const Parameters& p, bool sensitivities,
                           const IntegratorOptions& integrator, std::vector<SegmentFlow>* flows,
                           std::string* failure) const;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "kirchhoff/equations/rod_equations.hpp"
+#include "kirchhoff/model/parameters.hpp"
 
 namespace kirchhoff {
 
@@ -44,6 +45,21 @@ class ShootingWorkspace {
     return workers_;
   }
 
+  // What one evaluation of the residual works in (ShootingProblem::evaluate and residual), kept
+  // from one evaluation to the next so that, once they have their sizes, a residual allocates
+  // nothing. Their contents mean nothing between evaluations; an evaluation made inside another
+  // (a parameter column's residual) starts only after the outer residual is done with them, and
+  // takes the parameters and the end state it is given, not these.
+  struct Buffers {
+    Parameters parameters;                // at the unknowns (evaluate)
+    Eigen::VectorXd y_end;                // the last segment's end state (evaluate)
+    std::vector<Eigen::VectorXd> starts;  // each segment's start state, out of the unknowns
+    std::vector<SegmentFlow> flows;       // each segment's flow
+    std::vector<double> start_values, end_values;  // the end conditions' rows
+    std::vector<Eigen::RowVectorXd> start_jacobian, end_jacobian;
+  };
+  Buffers& buffers() { return buffers_; }
+
   void count_rhs(long evaluations) { rhs_evaluations_ += evaluations; }
   long rhs_evaluations() const { return rhs_evaluations_; }
 
@@ -52,6 +68,7 @@ class ShootingWorkspace {
   std::shared_ptr<const RodEquations> equations_;
   std::vector<std::shared_ptr<const RodEquations>> workers_;
   long rhs_evaluations_ = 0;
+  Buffers buffers_;
 };
 
 }  // namespace kirchhoff

@@ -82,10 +82,11 @@ struct DualSystem {
   }
 };
 
-// Integrates the state alone.
+// Integrates the state alone, into *out (whose y keeps its storage: nothing is allocated once it
+// has the state's size; Phi is left empty).
 template <int N, class Rhs>
-SegmentFlow flow_state(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
-                       const IntegratorOptions& opt) {
+void flow_state_into(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& opt,
+                     SegmentFlow* out) {
   using State = std::array<double, N>;
   State x;
   for (int i = 0; i < N; ++i) x[i] = y0[i];
@@ -94,10 +95,17 @@ SegmentFlow flow_state(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, dou
     ++evaluations;
     rhs(y.data(), dy.data(), s);
   };
+  out->steps = march(x, s0, s1, system, opt);
+  out->y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
+  out->Phi.resize(0, 0);
+  out->rhs_evaluations = evaluations;
+}
+
+template <int N, class Rhs>
+SegmentFlow flow_state(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                       const IntegratorOptions& opt) {
   SegmentFlow out;
-  out.steps = march(x, s0, s1, system, opt);
-  out.y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
-  out.rhs_evaluations = evaluations;
+  flow_state_into<N>(rhs, y0, s0, s1, opt, &out);
   return out;
 }
 

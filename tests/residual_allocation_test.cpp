@@ -1,0 +1,56 @@
+// A residual evaluation allocates nothing once the problem's workspace has its buffers
+// (ShootingWorkspace::Buffers): counted by interposing malloc, calloc and realloc in this test
+// executable (bench/allocation_count.hpp, the count solve_benchmark --summary prints). Not under
+// AddressSanitizer, which interposes them itself.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "../bench/allocation_count.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/shooting/shooting.hpp"
+
+namespace kirchhoff {
+namespace {
+
+// Allocation calls of one residual evaluation at the case's solution, after three (the first
+// sizes the buffers).
+long allocations_of_a_residual(const std::string& file, const ParameterOverrides& overrides,
+                               const SolverOverrides& solver = {}) {
+  const Case c = load_case(std::string(KIRCHHOFF_CASES_DIR) + "/" + file, overrides, "", solver);
+  const ShootingProblem problem(c.definition);
+  const ShootingResult solved = solve(problem, problem.initial_unknowns(c.start_guess));
+  EXPECT_TRUE(solved.summary.converged()) << file;
+  Eigen::VectorXd F;
+  std::string failure;
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(problem.evaluate(solved.x, &F, nullptr, &failure)) << failure;
+  const long before = bench::allocations();
+  problem.evaluate(solved.x, &F, nullptr, &failure);
+  return bench::allocations() - before;
+}
+
+class ResidualAllocationTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+#if defined(__SANITIZE_ADDRESS__)
+    GTEST_SKIP() << "AddressSanitizer interposes malloc itself";
+#endif
+  }
+};
+
+TEST_F(ResidualAllocationTest, PlanarRodAllocatesNothingPerResidual) {
+  EXPECT_EQ(allocations_of_a_residual("simply_supported.toml", {{"theta0", 2.0}}), 0);
+}
+
+TEST_F(ResidualAllocationTest, SpatialRodAllocatesNothingPerResidual) {
+  EXPECT_EQ(allocations_of_a_residual("twisted_clamped.toml", {{"phi", 6.0}}), 0);
+  EXPECT_EQ(allocations_of_a_residual("reissner.toml", {}), 0);
+}
+
+// Multiple shooting on one thread (fewer than 8 segments): each segment's start and flow reused.
+TEST_F(ResidualAllocationTest, MultipleShootingAllocatesNothingPerResidual) {
+  EXPECT_EQ(allocations_of_a_residual("simply_supported.toml", {{"theta0", 2.0}}, {{"segments", "4"}}), 0);
+}
+
+}  // namespace
+}  // namespace kirchhoff
