@@ -90,6 +90,34 @@ Eigen::MatrixXd orthonormal_columns(const Eigen::MatrixXd& A) {
   return qr.householderQ() * Eigen::MatrixXd::Identity(A.rows(), rank);
 }
 
+// One end's conditions linearised: the Jacobian rows of its complete (non-extra) set, i.e. the
+// same conditions with every imposed value held (dead loads, fixed supports).
+Eigen::MatrixXd held_condition_rows(const RodEquations& eq, const EndCondition& given, bool at_start,
+                                    const Eigen::VectorXd& y, const Parameters& p) {
+  const char* where = at_start ? "s = 0" : "s = L";
+  EndCondition held;
+  int extra_slots = 0;
+  for (const auto& c : given.conditions()) {
+    if (c.extra)
+      ++extra_slots;
+    else
+      held.add(c);
+  }
+  if (given.extra_count() > extra_slots)
+    throw std::invalid_argument(std::string("vibrations: the end at ") + where +
+                                " is closed by the continuity of H (a sleeve): its position along the rod is not a "
+                                "fixed end condition, not supported");
+  std::vector<double> residual;
+  std::vector<Eigen::RowVectorXd> rows;
+  held.append_residuals(eq, at_start, y, p, &residual, &rows);
+  Eigen::MatrixXd B(rows.size(), kState);
+  for (size_t i = 0; i < rows.size(); ++i) B.row(static_cast<Eigen::Index>(i)) = rows[i];
+  if (B.rows() != 3 || orthonormal_columns(B.transpose()).cols() != 3)
+    throw std::invalid_argument(std::string("vibrations: the conditions at ") + where +
+                                " are not three independent conditions (" + std::to_string(B.rows()) + " rows)");
+  return B;
+}
+
 // The terms of eq. (95b), in order: 1/2 EI thetabar'^2, -thetabar (nbar x d3).e_z,
 // 1/2 rhoS omega^2 |rbar|^2, -1/2 thetabar^2 n_e.d3 (omega2 = omega^2, negative for unstable modes).
 std::array<double, 4> eq95b_terms(double EI, double rho_s, double omega2, double theta_e, double n_xe, double n_ye,
@@ -211,41 +239,26 @@ VibrationProblem::VibrationProblem(const ShootingProblem& problem, const Eigen::
     throw std::invalid_argument(std::string("vibrations: the equilibrium cannot be integrated: ") + e.what());
   }
 
-  // Each end's conditions linearised: the Jacobian rows of its complete (non-extra) set, i.e. the
-  // same conditions with every imposed value held (dead loads, fixed supports).
-  Eigen::MatrixXd condition_rows[2];
-  for (int end = 0; end < 2; ++end) {
-    const bool at_start = end == 0;
-    const EndCondition& given = at_start ? definition.start : definition.end;
-    const char* where = at_start ? "s = 0" : "s = L";
-    EndCondition held;
-    int extra_slots = 0;
-    for (const auto& c : given.conditions()) {
-      if (c.extra)
-        ++extra_slots;
-      else
-        held.add(c);
-    }
-    if (given.extra_count() > extra_slots)
-      throw std::invalid_argument(std::string("vibrations: the end at ") + where +
-                                  " is closed by the continuity of H (a sleeve): its position along the rod is not a "
-                                  "fixed end condition, not supported");
-    std::vector<double> residual;
-    std::vector<Eigen::RowVectorXd> rows;
-    held.append_residuals(*equations_, at_start, at_start ? y_start_ : y_end_, p, &residual, &rows);
-    Eigen::MatrixXd B(rows.size(), kState);
-    for (size_t i = 0; i < rows.size(); ++i) B.row(static_cast<Eigen::Index>(i)) = rows[i];
-    if (B.rows() != 3 || orthonormal_columns(B.transpose()).cols() != 3)
-      throw std::invalid_argument(std::string("vibrations: the conditions at ") + where +
-                                  " are not three independent conditions (" + std::to_string(B.rows()) + " rows)");
-    condition_rows[end] = B;
-  }
+  const Eigen::MatrixXd start_rows = held_condition_rows(*equations_, definition.start, true, y_start_, p);
+  const Eigen::MatrixXd end_rows = held_condition_rows(*equations_, definition.end, false, y_end_, p);
+  matching_spaces(start_rows, end_rows);
+
+  // Dimensionless components: lengths by L, forces by EI/L^2, moments by EI/L.
+  const double EI = model.B[1](0.0);
+  row_scale_.resize(kState);
+  row_scale_ << 1.0 / length_, 1.0 / length_, 1.0, length_ * length_ / EI, length_ * length_ / EI, length_ / EI;
+}
+
+// The spaces the matching matrix is built on: the perturbations each end's linearised
+// conditions admit, and the rows matched at the far end. The degenerate straight case, a pure
+// axial force perturbation z free at both ends, is solved as the transverse problem.
+void VibrationProblem::matching_spaces(const Eigen::MatrixXd& start_rows, const Eigen::MatrixXd& end_rows) {
   auto null_space = [](const Eigen::MatrixXd& B) {
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(B, Eigen::ComputeFullV);
     return Eigen::MatrixXd(svd.matrixV().rightCols(kState - B.rows()));
   };
-  start_basis_ = null_space(condition_rows[0]);
-  end_basis_ = null_space(condition_rows[1]);
+  start_basis_ = null_space(start_rows);
+  end_basis_ = null_space(end_rows);
 
   // The degenerate straight case: a pure axial force perturbation z free at both ends.
   const double theta0 = y_start_[kTheta];
@@ -253,8 +266,8 @@ VibrationProblem::VibrationProblem(const ShootingProblem& problem, const Eigen::
   VibrationState z = VibrationState::Zero();
   z[kNx] = t.x();
   z[kNy] = t.y();
-  axial_indeterminate_ = straight_ && (condition_rows[0] * z).norm() < kRowTolerance &&
-                         (condition_rows[1] * z).norm() < kRowTolerance;
+  axial_indeterminate_ = straight_ && (start_rows * z).norm() < kRowTolerance &&
+                         (end_rows * z).norm() < kRowTolerance;
   if (axial_indeterminate_) {
     // Solve the transverse problem: drop z from the starting spaces and the axial pair
     // (rbar.t, nbar.t), identically zero on the modes, from the matching rows.
@@ -273,11 +286,6 @@ VibrationProblem::VibrationProblem(const ShootingProblem& problem, const Eigen::
   }
   if (start_basis_.cols() + end_basis_.cols() != row_projection_.rows())
     throw std::logic_error("vibrations: matching matrix is not square");
-
-  // Dimensionless components: lengths by L, forces by EI/L^2, moments by EI/L.
-  const double EI = model.B[1](0.0);
-  row_scale_.resize(kState);
-  row_scale_ << 1.0 / length_, 1.0 / length_, 1.0, length_ * length_ / EI, length_ * length_ / EI, length_ / EI;
 }
 
 void VibrationProblem::bound_growth_rate(const std::vector<RodPoint>& points, const ProblemDefinition& definition) {

@@ -178,6 +178,9 @@ class VibrationProblem {
   double bracketed_root(double a, double fa, double b, double fb, const Omega2& omega2_of, const char* name) const;
   // sigma_bound from the equilibrium sampled at `points` (see the header comment).
   void bound_growth_rate(const std::vector<RodPoint>& points, const ProblemDefinition& definition);
+  // start_basis_, end_basis_, row_projection_ and axial_indeterminate_ from the ends' linearised
+  // conditions (held_condition_rows in vibration.cpp).
+  void matching_spaces(const Eigen::MatrixXd& start_rows, const Eigen::MatrixXd& end_rows);
 
   std::shared_ptr<const RodEquations> equations_;
   VibrationOptions options_;

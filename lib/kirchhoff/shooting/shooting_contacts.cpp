@@ -204,6 +204,45 @@ void ShootingProblem::set_piece_segments() {
   for (int i = 0; i < spare - given_out; ++i) ++piece_segments_[remainders[i % pieces].second];
 }
 
+namespace {
+
+// Where a spatial rod enters or leaves a cylinder (the only extended contact of multiple
+// shooting): entering, it is on the cylinder with g = g' = g'' = 0, and g''' = 0 once the edge
+// force is applied (rod_on_cylinder.hpp); leaving, only the edge force. Both push along e: *jump
+// is n's jump per unit edge force, and S (dy/dx at the breakpoint, with J) turns with e.
+int cylinder_breakpoint_rows(const RodEquations& eq, const Obstacle& o, const Breakpoint& b, const Eigen::VectorXd& y,
+                             Eigen::MatrixXd* S, Eigen::VectorXd* F, Eigen::MatrixXd* J, int row,
+                             Eigen::VectorXd* jump) {
+  const CylinderSupport c = support_of(o);
+  const RodModel& model = eq.model();
+  const Eigen::MatrixXd force = eq.slot_map(Slot::Force);
+  Eigen::MatrixXd dG, de;
+  if (b.kind == Breakpoint::ExtendedStart) {
+    const Eigen::Vector4d G = cylinder_gap_derivatives(model, c, y, J ? &dG : nullptr);
+    for (int k = 0; k < 3; ++k, ++row) {
+      (*F)[row] = G[k];
+      if (J) J->row(row) = dG.row(k) * *S;
+    }
+  }
+  const Vec3 e = cylinder_normal(c, y, J ? &de : nullptr);
+  if (J) *S -= b.force * force.transpose() * de * *S;
+  *jump = -force.transpose() * e;
+  if (b.kind == Breakpoint::ExtendedStart) {
+    const Eigen::VectorXd after = y + b.force * *jump;
+    const Eigen::Vector4d G = cylinder_gap_derivatives(model, c, after, J ? &dG : nullptr);
+    (*F)[row] = G[3];
+    if (J) {
+      Eigen::MatrixXd S_after = *S;
+      S_after.col(b.force_column) += *jump;
+      J->row(row) = dG.row(3) * S_after;
+    }
+    ++row;
+  }
+  return row;
+}
+
+}  // namespace
+
 std::vector<std::shared_ptr<const RodEquations>> ShootingProblem::piece_equations(const Eigen::VectorXd& x,
                                                                                 const Parameters& p) const {
   const auto points = breakpoints(contacts_at(x), contact_columns());
@@ -298,33 +337,7 @@ bool ShootingProblem::residual_pieces(const Eigen::VectorXd& x, const Parameters
       if (J && !o.is_flat()) S -= b.force * force.transpose() * terms.d_normal * S;
       jump = -force.transpose() * terms.here.normal;  // n jumps by -force * nu
     } else {
-      // A spatial rod on a cylinder (the only extended contact of multiple shooting): entering, it
-      // is on the cylinder with g = g' = g'' = 0, and g''' = 0 once the edge force is applied
-      // (rod_on_cylinder.hpp); leaving, only the edge force. Both push along e.
-      const CylinderSupport c = support_of(o);
-      const RodModel& model = eq->model();
-      Eigen::MatrixXd dG, de;
-      if (b.kind == Breakpoint::ExtendedStart) {
-        const Eigen::Vector4d G = cylinder_gap_derivatives(model, c, y, J ? &dG : nullptr);
-        for (int k = 0; k < 3; ++k, ++row) {
-          (*F)[row] = G[k];
-          if (J) J->row(row) = dG.row(k) * S;
-        }
-      }
-      const Vec3 e = cylinder_normal(c, y, J ? &de : nullptr);
-      if (J) S -= b.force * force.transpose() * de * S;
-      jump = -force.transpose() * e;
-      if (b.kind == Breakpoint::ExtendedStart) {
-        const Eigen::VectorXd after = y + b.force * jump;
-        const Eigen::Vector4d G = cylinder_gap_derivatives(model, c, after, J ? &dG : nullptr);
-        (*F)[row] = G[3];
-        if (J) {
-          Eigen::MatrixXd S_after = S;
-          S_after.col(b.force_column) += jump;
-          J->row(row) = dG.row(3) * S_after;
-        }
-        ++row;
-      }
+      row = cylinder_breakpoint_rows(*eq, o, b, y, J ? &S : nullptr, F, J, row, &jump);
     }
     if (J) S.col(b.force_column) += jump;
     y += b.force * jump;
