@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -367,6 +368,126 @@ TEST(Stability, FullFrameCountsAsTheRotationFrameWhereTheEnergyIgnoresPosition) 
     ASSERT_EQ(positions.conjugate_points.size(), rotation.conjugate_points.size());
     for (size_t j = 0; j < rotation.conjugate_points.size(); ++j)
       EXPECT_NEAR(positions.conjugate_points[j], rotation.conjugate_points[j], 1e-5);
+  }
+}
+
+// Straight columns under a dead compressive end load P (EI = L = 1) with other supports: each
+// index is the number of the support's critical loads below P, known in closed form.
+StabilityReport straight_column_index(const std::string& text, double P) {
+  const Case c = load_case_text(text, "column.toml", {{"P", P}});
+  const ShootingProblem problem(c.definition);
+  const ShootingResult solved = solve(problem, problem.initial_unknowns(c.start_guess));
+  EXPECT_TRUE(solved.summary.converged());
+  EXPECT_LT(std::abs(problem.sample(solved.x, {0.5, 1.0}).back().r.y()), 1e-12);  // straight
+  return analyse_stability(problem, solved.x);
+}
+
+const char* const kColumnHead = R"(model = "planar"
+[parameters]
+P = 1.0
+[rod]
+length = 1.0
+B = 1.0
+[guess]
+orientation = { axis = [0, 0, 1], angle = 0 }
+force = ["-P", 0]
+)";
+
+// Clamped at s = 0, the dead load at the free end (a cantilever): theta'' + P theta = 0 with
+// theta(0) = 0, theta'(1) = 0, critical loads ((2k - 1) pi / 2)^2 = 2.467, 22.21, 61.69.
+// Clamped and pinned (the end slides along e_x, free to turn): the roots of tan(q) = q, P = q^2
+// = 20.19, 59.68, 118.9. Clamped and guided (the end slides, its rotation held): (2 k pi)^2 and
+// the antisymmetric roots of tan(q / 2) = q / 2, q^2 = 39.48, 80.76, 157.9.
+TEST(Stability, StraightColumnsWithOtherSupportsCountTheirCriticalLoads) {
+  const std::string clamped_start = R"([start]
+type = "clamped"
+position = [0, 0]
+orientation = { axis = [0, 0, 1], angle = 0 }
+)";
+  const std::string cantilever = std::string(kColumnHead) + clamped_start + R"([end]
+type = "loaded"
+force = ["-P", 0]
+)";
+  const std::string pinned_end = std::string(kColumnHead) + clamped_start + R"([end]
+type = "sliding"
+axis = [1, 0, 0]
+position = [0, 0]
+force = ["-P", 0]
+)";
+  const std::string guided_end = pinned_end + "orientation = { axis = [0, 0, 1], angle = 0 }\n";
+  // Roots of tan(q) = q on ((k + 1/2) pi - pi / 2, (k + 1/2) pi) by bisection: tan(q) - q rises
+  // from -inf at k pi - pi/2 (k >= 1) through its root before (k + 1/2) pi.
+  auto tan_root = [](int k) {
+    double a = k * M_PI + 1e-9, b = (k + 0.5) * M_PI - 1e-9;
+    for (int i = 0; i < 200; ++i) {
+      const double m = 0.5 * (a + b);
+      (std::tan(m) - m < 0 ? a : b) = m;
+    }
+    return a;
+  };
+  std::vector<double> cantilever_loads, pinned_loads, guided_loads;
+  for (int k = 1; k <= 4; ++k) {
+    cantilever_loads.push_back(std::pow((2 * k - 1) * M_PI / 2, 2));
+    pinned_loads.push_back(std::pow(tan_root(k), 2));
+    guided_loads.push_back(std::pow(2 * k * M_PI, 2));         // symmetric modes
+    guided_loads.push_back(std::pow(2 * tan_root(k), 2));      // antisymmetric: tan(q/2) = q/2
+  }
+  auto below = [](const std::vector<double>& loads, double P) {
+    return static_cast<int>(std::count_if(loads.begin(), loads.end(), [P](double l) { return l < P; }));
+  };
+  const struct {
+    const std::string& text;
+    const std::vector<double>& loads;
+    std::vector<double> P;
+  } supports[] = {{cantilever, cantilever_loads, {2.0, 3.0, 25.0, 70.0}},
+                  {pinned_end, pinned_loads, {19.0, 21.0, 59.0, 61.0, 125.0}},
+                  {guided_end, guided_loads, {39.0, 40.0, 80.0, 81.0, 160.0}}};
+  for (const auto& s : supports)
+    for (double P : s.P) {
+      SCOPED_TRACE(s.text + "P = " + std::to_string(P));
+      const StabilityReport r = straight_column_index(s.text, P);
+      ASSERT_TRUE(r.defined()) << r.reason;
+      EXPECT_EQ(*r.index, below(s.loads, P));
+      EXPECT_EQ(r.zero_modes, 0);
+    }
+}
+
+// The extensible, shearable pinned column (Reissner's rod, shear stiffness A1, axial A3): the
+// straight column under P is compressed, v3 = 1 - P / A3, and a rotation theta shears it, v1 =
+// P theta / A1, so the moment balance linearises to theta'' + P (1 + P / A1 - P / A3) theta = 0
+// with theta' = 0 at both ends: the k-th mode is critical where P (1 + P / A1 - P / A3) = (k pi)^2
+// (A1 = 20, A3 = 50: P = 7.966, 23.25, 40.10), not at the inextensible (k pi)^2.
+TEST(Stability, ShearableColumnCountsItsShearedCriticalLoads) {
+  const std::string text = R"(model = "planar"
+[parameters]
+P = 1.0
+[rod]
+length = 1.0
+B = 1.0
+extensible = true
+A1 = 20.0
+A3 = 50.0
+[start]
+type = "pinned"
+position = [0, 0]
+[end]
+type = "sliding"
+axis = [1, 0, 0]
+position = [0, 0]
+force = ["-P", 0]
+[guess]
+orientation = { axis = [0, 0, 1], angle = 0 }
+force = ["-P", 0]
+)";
+  for (double P : {5.0, 9.0, 20.0, 30.0, 45.0}) {
+    SCOPED_TRACE("P = " + std::to_string(P));
+    const StabilityReport r = straight_column_index(text, P);
+    ASSERT_TRUE(r.defined()) << r.reason;
+    int below = 0;
+    for (int k = 1; k < 20; ++k)
+      if (k * k * M_PI * M_PI < P * (1 + P / 20.0 - P / 50.0)) ++below;
+    EXPECT_EQ(*r.index, below);
+    EXPECT_EQ(r.zero_modes, 0);
   }
 }
 
