@@ -60,10 +60,10 @@ Eigen::Matrix3d cross_matrix(const Vec3& a) {
 
 // dy -> the lab-frame rotation vector dpsi of the frame at state y (whose frame is R): the
 // Jacobian of the orientation error against the frame itself as target.
-Eigen::MatrixXd lab_rotation_jacobian(const RodEquations& eq, const Eigen::VectorXd& y, const Mat3& R) {
+SlotMap lab_rotation_jacobian(const RodEquations& eq, const Eigen::VectorXd& y, const Mat3& R) {
   const Mat3 reference = eq.is_planar() ? planar_reference_frame() : Mat3::Identity();
   const Eigen::AngleAxisd frame(Mat3(R * reference.transpose()));
-  Eigen::MatrixXd jacobian;
+  SlotMap jacobian;
   eq.orientation_error(y, OrientationTarget{frame.axis(), frame.angle()}, false, &jacobian);
   return jacobian;
 }
@@ -74,7 +74,7 @@ void update_rotation_part(const RodEquations& eq, const Coordinates& c, const Sc
                           double s, CanonicalMap* map) {
   const int n = c.size(), kr = c.kr();
   const RodPoint point = eq.point(y, s);
-  const Eigen::MatrixXd rotation_jacobian = lab_rotation_jacobian(eq, y, point.R);
+  const SlotMap rotation_jacobian = lab_rotation_jacobian(eq, y, point.R);
   map->T.middleRows(kr, n - kr).noalias() = c.rotation_dirs.transpose() * rotation_jacobian;
   map->G.bottomRightCorner(n - kr, n - kr).noalias() =
       0.5 * (sc.length / (sc.bending * sc.rate)) * c.rotation_dirs.transpose() * cross_matrix(point.m) *

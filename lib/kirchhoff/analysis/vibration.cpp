@@ -108,7 +108,7 @@ Eigen::MatrixXd held_condition_rows(const RodEquations& eq, const EndCondition& 
                                 " is closed by the continuity of H (a sleeve): its position along the rod is not a "
                                 "fixed end condition, not supported");
   std::vector<double> residual;
-  std::vector<Eigen::RowVectorXd> rows;
+  std::vector<StateRow> rows;
   held.append_residuals(eq, at_start, y, p, &residual, &rows);
   Eigen::MatrixXd B(rows.size(), kState);
   for (size_t i = 0; i < rows.size(); ++i) B.row(static_cast<Eigen::Index>(i)) = rows[i];

@@ -147,7 +147,7 @@ class PlanarEquations final : public RodEquations {
   // In the plane every admissible target is a rotation about e_z, and theta - angle is the exact
   // rotation error, turns included.
   Vec3 orientation_error(const Eigen::VectorXd& y, const OrientationTarget& target, bool,
-                         Eigen::MatrixXd* jacobian) const override {
+                         SlotMap* jacobian) const override {
     const double sign = target.axis.z() < 0 ? -1.0 : 1.0;
     if (jacobian) {
       jacobian->setZero(3, kStateSize);

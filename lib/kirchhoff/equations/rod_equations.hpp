@@ -45,6 +45,8 @@ struct OrientationTarget {
 constexpr int kMaxStateSize = 14;
 using LabDirections = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, 3>;
 using SlotMap = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, kMaxStateSize>;
+// One condition's row of a Jacobian with respect to the state (fixed capacity: no allocation).
+using StateRow = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxStateSize>;
 // The gauge conditions of a state representation (RodEquations::gauge_residual): at most two.
 using GaugeRows = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 2, 1>;
 
@@ -92,7 +94,7 @@ class RodEquations {
   // track_turns, its component along target.axis is replaced by turn_angle - target.angle, which
   // counts whole turns instead of working modulo 2 pi.
   virtual Vec3 orientation_error(const Eigen::VectorXd& y, const OrientationTarget& target, bool track_turns,
-                                 Eigen::MatrixXd* jacobian) const = 0;
+                                 SlotMap* jacobian) const = 0;
   // Conditions internal to the state representation, imposed once at s = 0 (e.g. |q| = 1).
   // At most two rows (fixed-capacity storage: no allocation).
   virtual GaugeRows gauge_residual(const Eigen::VectorXd& y, Eigen::MatrixXd* jacobian) const = 0;

@@ -206,7 +206,7 @@ class SpatialEquations final : public RodEquations {
   // Error rotation E = q conj(q_t), normalised: e = 2 sign(E_w) vec(E) is the lab-frame
   // rotation vector to first order. Linear in q/|q|, so its Jacobian is exact and cheap.
   Vec3 orientation_error(const Eigen::VectorXd& y, const OrientationTarget& target, bool track_turns,
-                         Eigen::MatrixXd* jacobian) const override {
+                         SlotMap* jacobian) const override {
     const Eigen::Vector4d q = y.segment<4>(kQ);
     const double norm = q.norm();
     const Eigen::Vector4d p = q / norm;

@@ -202,13 +202,13 @@ std::string EndCondition::check(const RodEquations& eq) const {
 
 void EndCondition::append_residuals(const RodEquations& eq, bool at_start, const Eigen::VectorXd& y,
                                     const Parameters& p, std::vector<double>* residual,
-                                    std::vector<Eigen::RowVectorXd>* jacobian) const {
+                                    std::vector<StateRow>* jacobian) const {
   // Applied loads relate to the internal force/moment with a sign that depends on the end.
   const double load_sign = at_start ? -1.0 : 1.0;
   for (const auto& c : conditions_) {
     const LabDirections B = c.basis(eq);
     Vec3 error;
-    Eigen::MatrixXd J;
+    SlotMap J;
     if (c.slot == Slot::Orientation) {
       error = eq.orientation_error(y, c.orientation(p), c.track_turns, jacobian ? &J : nullptr);
     } else {
@@ -229,7 +229,7 @@ void EndCondition::append_residuals(const RodEquations& eq, bool at_start, const
     residual->push_back(H(y) - hamiltonian_(p));
     if (jacobian) {
       // Central differences of a closed-form function of the state (no integration).
-      Eigen::RowVectorXd row(y.size());
+      StateRow row(y.size());
       for (int i = 0; i < y.size(); ++i) {
         const double h = 1e-7 * (1.0 + std::abs(y[i]));
         Eigen::VectorXd plus = y, minus = y;

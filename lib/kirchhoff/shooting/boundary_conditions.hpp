@@ -104,7 +104,7 @@ class EndCondition {
 
   // Residuals and their Jacobian with respect to the state y at this end.
   void append_residuals(const RodEquations& eq, bool at_start, const Eigen::VectorXd& y, const Parameters& p,
-                        std::vector<double>* residual, std::vector<Eigen::RowVectorXd>* jacobian) const;
+                        std::vector<double>* residual, std::vector<StateRow>* jacobian) const;
 
   // A state satisfying the imposed values (used to complete an initial guess).
   void impose_on(const RodEquations& eq, bool at_start, const Parameters& p, RodPoint* point) const;

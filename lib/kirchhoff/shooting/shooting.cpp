@@ -30,13 +30,6 @@ namespace {
 // ~h^2 and round-off ~eps/h balance near 1e-6 for the smooth closed-form targets.
 constexpr double kParameterStep = 1e-6;
 
-struct ConditionRows {
-  // One allocation for an end's rows (at most 6 plus extra conditions), not one per push_back.
-  ConditionRows() { values.reserve(8); }
-  std::vector<double> values;
-  std::vector<Eigen::RowVectorXd> jacobian;
-};
-
 }  // namespace
 
 std::string ShootingOptions::validate() const {
@@ -240,10 +233,11 @@ Parameters ShootingProblem::parameters_at(const Eigen::VectorXd& x) const {
   return p;
 }
 
-void ShootingProblem::parameters_into(const Eigen::VectorXd& x, Parameters* p) const {
+void ShootingProblem::parameters_into(const Eigen::VectorXd& x, Parameters* p, int moved, double by) const {
   *p = definition_.parameters;  // (the values' storage reused when *p has as many)
   const int offset = segments() * state_size_;
   for (size_t j = 0; j < unknown_index_.size(); ++j) p->value_at(unknown_index_[j]) = x[offset + j];
+  if (moved >= 0) p->value_at(unknown_index_[moved]) = x[offset + moved] + by;
   complete(p, definition_.dependent_parameters);
 }
 
@@ -334,33 +328,49 @@ bool ShootingProblem::evaluate_with(const Eigen::VectorXd& x, Eigen::VectorXd* F
   // A parameter that only enters the boundary conditions moves only their rows, which are
   // closed-form in the end states: no re-integration is needed for it.
   const int offset = segments() * state_size_;
-  const Eigen::VectorXd y0 = x.head(state_size_);
+  auto& b = workspace_.buffers();
+  b.y0 = x.head(state_size_);
   for (size_t j = 0; j < unknown_index_.size(); ++j) {
     const double h = kParameterStep * (1.0 + std::abs(x[offset + j]));
-    Eigen::VectorXd xp = x, xm = x, Fp, Fm;
-    xp[offset + j] += h;
-    xm[offset + j] -= h;
     if (moves_beyond_conditions(static_cast<int>(j))) {
+      Eigen::VectorXd xp = x, xm = x, Fp, Fm;
+      xp[offset + j] += h;
+      xm[offset + j] -= h;
       if (!residual(xp, parameters_at(xp), &Fp, nullptr, failure)) return false;
       if (!residual(xm, parameters_at(xm), &Fm, nullptr, failure)) return false;
       J->col(offset + j) = (Fp - Fm) / (2.0 * h);
     } else {
-      const Eigen::VectorXd rows =
-          (condition_rows(y0, y_end, parameters_at(xp)) - condition_rows(y0, y_end, parameters_at(xm))) / (2.0 * h);
-      Eigen::VectorXd column = Eigen::VectorXd::Zero(residual_count_);
-      place_condition_rows(rows, &column);
-      J->col(offset + j) = column;
+      parameters_into(x, &b.moved, static_cast<int>(j), h);
+      condition_rows_into(b.y0, y_end, b.moved, &b.rows_plus);
+      parameters_into(x, &b.moved, static_cast<int>(j), -h);
+      condition_rows_into(b.y0, y_end, b.moved, &b.rows_minus);
+      auto column = J->col(offset + static_cast<Eigen::Index>(j));
+      column.setZero();
+      for (size_t k = 0; k < b.rows_plus.size(); ++k)
+        column[condition_row_index(static_cast<int>(k), static_cast<int>(b.rows_plus.size()))] =
+            (b.rows_plus[k] - b.rows_minus[k]) / (2.0 * h);
     }
   }
   return true;
 }
 
+int ShootingProblem::condition_row_index(int k, int count) const {
+  // Start rows follow the gauge rows; end rows are the last ones (contact rows lie between).
+  return k < start_condition_count_ ? gauge_count_ + k : residual_count_ - count + k;
+}
+
+void ShootingProblem::condition_rows_into(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end,
+                                          const Parameters& p, std::vector<double>* rows) const {
+  const auto eq = equations(p);
+  rows->clear();
+  definition_.start.append_residuals(*eq, true, y0, p, rows, nullptr);
+  definition_.end.append_residuals(*eq, false, y_end, p, rows, nullptr);
+}
+
 Eigen::VectorXd ShootingProblem::condition_rows(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end,
                                                 const Parameters& p) const {
-  const auto eq = equations(p);
   std::vector<double> rows;
-  definition_.start.append_residuals(*eq, true, y0, p, &rows, nullptr);
-  definition_.end.append_residuals(*eq, false, y_end, p, &rows, nullptr);
+  condition_rows_into(y0, y_end, p, &rows);
   return Eigen::Map<Eigen::VectorXd>(rows.data(), static_cast<Eigen::Index>(rows.size()));
 }
 
@@ -388,11 +398,14 @@ int ShootingProblem::start_rows(const RodEquations& eq, const Eigen::VectorXd& y
 
 void ShootingProblem::end_rows(const RodEquations& eq, const Eigen::VectorXd& y_end, const Parameters& p,
                                const Eigen::MatrixXd* S, Eigen::VectorXd* F, Eigen::MatrixXd* J, int row) const {
-  ConditionRows end;
-  definition_.end.append_residuals(eq, false, y_end, p, &end.values, J ? &end.jacobian : nullptr);
-  for (size_t k = 0; k < end.values.size(); ++k, ++row) {
-    (*F)[row] = end.values[k];
-    if (J) J->row(row) = end.jacobian[k] * *S;
+  auto& values = workspace_.buffers().end_values;
+  auto& jacobian = workspace_.buffers().end_jacobian;
+  values.clear();
+  jacobian.clear();
+  definition_.end.append_residuals(eq, false, y_end, p, &values, J ? &jacobian : nullptr);
+  for (size_t k = 0; k < values.size(); ++k, ++row) {
+    (*F)[row] = values[k];
+    if (J) J->row(row).noalias() = jacobian[k] * *S;
   }
 }
 
@@ -435,7 +448,7 @@ bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Ei
   definition_.end.append_residuals(*eq, false, last.y, p, &values, J ? &jacobian : nullptr);
   for (size_t k = 0; k < values.size(); ++k, ++row) {
     (*F)[row] = values[k];
-    if (J) J->block(row, (M - 1) * n, 1, n) = jacobian[k] * last.Phi;
+    if (J) J->block(row, (M - 1) * n, 1, n).noalias() = jacobian[k] * last.Phi;
   }
   return true;
 }

@@ -212,6 +212,11 @@ class ShootingProblem final : public NonlinearSystem {
                 Eigen::VectorXd* F, Eigen::MatrixXd* J, int row) const;
   // The rows of F that come from the boundary conditions, at fixed end states.
   Eigen::VectorXd condition_rows(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end, const Parameters& p) const;
+  // condition_rows into *rows (its storage reused).
+  void condition_rows_into(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end, const Parameters& p,
+                           std::vector<double>* rows) const;
+  // The row of F that condition row k of `count` (start then end) is.
+  int condition_row_index(int k, int count) const;
   // Scatters condition rows (start then end) into a full-length residual column.
   void place_condition_rows(const Eigen::VectorXd& rows, Eigen::VectorXd* column) const;
   // Whether an unknown parameter enters the rod model or moves an obstacle (its column then needs
@@ -251,7 +256,9 @@ class ShootingProblem final : public NonlinearSystem {
   void for_each_segment(const Parameters& p, const std::function<void(int, const RodEquations&)>& work,
                         bool parallel = true) const;
   // The flows of all segments.
-  void parameters_into(const Eigen::VectorXd& x, Parameters* p) const;  // parameters_at, into *p
+  // parameters_at, into *p; with moved >= 0 that unknown parameter's value moved by `by` (as
+  // parameters_at of x with x[its column] += by).
+  void parameters_into(const Eigen::VectorXd& x, Parameters* p, int moved = -1, double by = 0.0) const;
   bool integrate_segments(const Eigen::VectorXd& x, const Parameters& p, bool sensitivities,
                           const IntegratorOptions& integrator, std::vector<SegmentFlow>* flows,
                           std::string* failure) const;

@@ -56,7 +56,11 @@ class ShootingWorkspace {
     std::vector<Eigen::VectorXd> starts;  // each segment's start state, out of the unknowns
     std::vector<SegmentFlow> flows;       // each segment's flow
     std::vector<double> start_values, end_values;  // the end conditions' rows
-    std::vector<Eigen::RowVectorXd> start_jacobian, end_jacobian;
+    std::vector<StateRow> start_jacobian, end_jacobian;
+    // A Jacobian's columns of parameters that enter the end conditions only (evaluate).
+    Eigen::VectorXd y0;
+    Parameters moved;
+    std::vector<double> rows_plus, rows_minus;
   };
   Buffers& buffers() { return buffers_; }
 
