@@ -298,17 +298,16 @@ bool ShootingProblem::parameter_derivative(const Eigen::VectorXd& x, const std::
     if (!residual(x, parameters_at(x), &F, nullptr, failure, &end_state)) return false;
     y_end = &end_state;
   }
-  const Eigen::VectorXd y0 = x.head(state_size_);
-  const Eigen::VectorXd column = (condition_rows(y0, *y_end, plus) - condition_rows(y0, *y_end, minus)) / (2.0 * h);
+  // The end conditions' rows alone, in the workspace's buffers.
+  auto& b = workspace_.buffers();
+  b.y0 = x.head(state_size_);
+  condition_rows_into(b.y0, *y_end, plus, &b.rows_plus);
+  condition_rows_into(b.y0, *y_end, minus, &b.rows_minus);
   dF->setZero(residual_count_);
-  place_condition_rows(column, dF);
+  for (size_t k = 0; k < b.rows_plus.size(); ++k)
+    (*dF)[condition_row_index(static_cast<int>(k), static_cast<int>(b.rows_plus.size()))] =
+        (b.rows_plus[k] - b.rows_minus[k]) / (2.0 * h);
   return true;
-}
-
-void ShootingProblem::place_condition_rows(const Eigen::VectorXd& rows, Eigen::VectorXd* column) const {
-  // Start rows follow the gauge rows; end rows are the last ones (contact rows lie between).
-  column->segment(gauge_count_, start_condition_count_) = rows.head(start_condition_count_);
-  column->tail(rows.size() - start_condition_count_) = rows.tail(rows.size() - start_condition_count_);
 }
 
 bool ShootingProblem::evaluate_with_end(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
@@ -365,13 +364,6 @@ void ShootingProblem::condition_rows_into(const Eigen::VectorXd& y0, const Eigen
   rows->clear();
   definition_.start.append_residuals(*eq, true, y0, p, rows, nullptr);
   definition_.end.append_residuals(*eq, false, y_end, p, rows, nullptr);
-}
-
-Eigen::VectorXd ShootingProblem::condition_rows(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end,
-                                                const Parameters& p) const {
-  std::vector<double> rows;
-  condition_rows_into(y0, y_end, p, &rows);
-  return Eigen::Map<Eigen::VectorXd>(rows.data(), static_cast<Eigen::Index>(rows.size()));
 }
 
 int ShootingProblem::start_rows(const RodEquations& eq, const Eigen::VectorXd& y0, const Parameters& p,

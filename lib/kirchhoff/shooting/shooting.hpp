@@ -210,15 +210,12 @@ class ShootingProblem final : public NonlinearSystem {
   // Fills the end-condition rows from `row` on (the last rows), with S = dy(L)/dx for their Jacobian.
   void end_rows(const RodEquations& eq, const Eigen::VectorXd& y_end, const Parameters& p, const Eigen::MatrixXd* S,
                 Eigen::VectorXd* F, Eigen::MatrixXd* J, int row) const;
-  // The rows of F that come from the boundary conditions, at fixed end states.
-  Eigen::VectorXd condition_rows(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end, const Parameters& p) const;
-  // condition_rows into *rows (its storage reused).
+  // The rows of F that come from the boundary conditions, at fixed end states, into *rows (its
+  // storage reused).
   void condition_rows_into(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end, const Parameters& p,
                            std::vector<double>* rows) const;
   // The row of F that condition row k of `count` (start then end) is.
   int condition_row_index(int k, int count) const;
-  // Scatters condition rows (start then end) into a full-length residual column.
-  void place_condition_rows(const Eigen::VectorXd& rows, Eigen::VectorXd* column) const;
   // Whether an unknown parameter enters the rod model or moves an obstacle (its column then needs
   // whole residuals, not only the boundary-condition rows).
   bool moves_beyond_conditions(int unknown) const;
