@@ -376,28 +376,33 @@ int ShootingProblem::start_rows(const RodEquations& eq, const Eigen::VectorXd& y
   F->head(g.size()) = g;
   if (J) J->block(0, 0, g.size(), n) = Jg;
   int row = static_cast<int>(g.size());
-  auto& values = workspace_.buffers().start_values;
-  auto& jacobian = workspace_.buffers().start_jacobian;
-  values.clear();
-  jacobian.clear();
-  definition_.start.append_residuals(eq, true, y0, p, &values, J ? &jacobian : nullptr);
-  for (size_t k = 0; k < values.size(); ++k, ++row) {
-    (*F)[row] = values[k];
-    if (J) J->block(row, 0, 1, n) = jacobian[k];
+  const auto& b = condition_rows_at(eq, true, y0, p, J != nullptr);
+  for (size_t k = 0; k < b.start_values.size(); ++k, ++row) {
+    (*F)[row] = b.start_values[k];
+    if (J) J->block(row, 0, 1, n) = b.start_jacobian[k];
   }
   return row;
 }
 
-void ShootingProblem::end_rows(const RodEquations& eq, const Eigen::VectorXd& y_end, const Parameters& p,
-                               const Eigen::MatrixXd* S, Eigen::VectorXd* F, Eigen::MatrixXd* J, int row) const {
-  auto& values = workspace_.buffers().end_values;
-  auto& jacobian = workspace_.buffers().end_jacobian;
+const ShootingWorkspace::Buffers& ShootingProblem::condition_rows_at(const RodEquations& eq, bool at_start,
+                                                                     const Eigen::VectorXd& y, const Parameters& p,
+                                                                     bool with_jacobian) const {
+  auto& b = workspace_.buffers();
+  auto& values = at_start ? b.start_values : b.end_values;
+  auto& jacobian = at_start ? b.start_jacobian : b.end_jacobian;
   values.clear();
   jacobian.clear();
-  definition_.end.append_residuals(eq, false, y_end, p, &values, J ? &jacobian : nullptr);
-  for (size_t k = 0; k < values.size(); ++k, ++row) {
-    (*F)[row] = values[k];
-    if (J) J->row(row).noalias() = jacobian[k] * *S;
+  (at_start ? definition_.start : definition_.end)
+      .append_residuals(eq, at_start, y, p, &values, with_jacobian ? &jacobian : nullptr);
+  return b;
+}
+
+void ShootingProblem::end_rows(const RodEquations& eq, const Eigen::VectorXd& y_end, const Parameters& p,
+                               const Eigen::MatrixXd* S, Eigen::VectorXd* F, Eigen::MatrixXd* J, int row) const {
+  const auto& b = condition_rows_at(eq, false, y_end, p, J != nullptr);
+  for (size_t k = 0; k < b.end_values.size(); ++k, ++row) {
+    (*F)[row] = b.end_values[k];
+    if (J) J->row(row).noalias() = b.end_jacobian[k] * *S;
   }
 }
 
@@ -433,14 +438,10 @@ bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Ei
   const SegmentFlow& last = flows.back();
 
   if (y_end) *y_end = last.y;
-  auto& values = workspace_.buffers().end_values;
-  auto& jacobian = workspace_.buffers().end_jacobian;
-  values.clear();
-  jacobian.clear();
-  definition_.end.append_residuals(*eq, false, last.y, p, &values, J ? &jacobian : nullptr);
-  for (size_t k = 0; k < values.size(); ++k, ++row) {
-    (*F)[row] = values[k];
-    if (J) J->block(row, (M - 1) * n, 1, n).noalias() = jacobian[k] * last.Phi;
+  const auto& b = condition_rows_at(*eq, false, last.y, p, J != nullptr);
+  for (size_t k = 0; k < b.end_values.size(); ++k, ++row) {
+    (*F)[row] = b.end_values[k];
+    if (J) J->block(row, (M - 1) * n, 1, n).noalias() = b.end_jacobian[k] * last.Phi;
   }
   return true;
 }

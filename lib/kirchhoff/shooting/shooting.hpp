@@ -207,6 +207,10 @@ class ShootingProblem final : public NonlinearSystem {
   // Sizes F (and J) and fills the gauge and start-condition rows; returns the next row.
   int start_rows(const RodEquations& eq, const Eigen::VectorXd& y0, const Parameters& p, Eigen::VectorXd* F,
                  Eigen::MatrixXd* J) const;
+  // An end's condition values and, with_jacobian, their Jacobian rows, into the workspace's
+  // buffers (start_values / start_jacobian or end_values / end_jacobian), which it returns.
+  const ShootingWorkspace::Buffers& condition_rows_at(const RodEquations& eq, bool at_start, const Eigen::VectorXd& y,
+                                                      const Parameters& p, bool with_jacobian) const;
   // Fills the end-condition rows from `row` on (the last rows), with S = dy(L)/dx for their Jacobian.
   void end_rows(const RodEquations& eq, const Eigen::VectorXd& y_end, const Parameters& p, const Eigen::MatrixXd* S,
                 Eigen::VectorXd* F, Eigen::MatrixXd* J, int row) const;
