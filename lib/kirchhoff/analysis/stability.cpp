@@ -292,14 +292,16 @@ class StabilityAnalysis {
     coords_.rotation_dirs = eq_->admissible_directions(Slot::Orientation);
     scales_.length = eq_->model().length;
     scales_.bending = eq_->model().B[0](0.0);
-    std::vector<double> s(17);
-    for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
-    profile_ = problem_.sample(x_, s);
-    full_ = options_.positions_as_configuration || positions_are_configuration();
     field_integrator_ = problem_.definition().options.integrator;
     if (options_.field_tolerance > field_integrator_.abs_tol) {
       field_integrator_.abs_tol = field_integrator_.rel_tol = options_.field_tolerance;
     }
+    // The profile sets scales (the fields' rate) and whether a field's gradient acts: integrated
+    // to the fields' tolerance, as they are.
+    std::vector<double> s(17);
+    for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
+    profile_ = problem_.sample(x_, s, &field_integrator_);
+    full_ = options_.positions_as_configuration || positions_are_configuration();
     const int n = coords_.size(), kr = coords_.kr();
     offset_ = full_ ? 0 : kr;
     mU_ = full_ ? n : n - kr;

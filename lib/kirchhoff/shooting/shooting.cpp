@@ -528,7 +528,9 @@ Eigen::VectorXd ShootingProblem::initial_unknowns(const RodPoint& start_guess) c
   return x;
 }
 
-std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const std::vector<double>& s) const {
+std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const std::vector<double>& s,
+                                              const IntegratorOptions* integrator) const {
+  const IntegratorOptions& options = integrator ? *integrator : definition_.options.integrator;
   const Parameters p = parameters_at(x);
   const auto eq = equations(p);
   const int n = state_size_, M = segments();
@@ -557,10 +559,10 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
         wrap.reset();
       } else {
         if (local.size() > 1) {
-          const auto states = eq->sample(y, local, definition_.options.integrator);
+          const auto states = eq->sample(y, local, options);
           for (size_t j = 1; j < states.size(); ++j) out.push_back(eq->point(states[j], local[j]));
         }
-        if (!last) y = eq->flow(y, s0, s1, false, definition_.options.integrator).y;
+        if (!last) y = eq->flow(y, s0, s1, false, options).y;
       }
       if (last) break;
       const Obstacle& o = obstacles_here[points[c].obstacle];
@@ -597,7 +599,7 @@ std::vector<RodPoint> ShootingProblem::sample(const Eigen::VectorXd& x, const st
   for_each_segment(p, [&](int i, const RodEquations& own) {
     if (local[i].size() == 1) return;
     const RodEquations& equations = on_piece[spans[i].piece] ? *on_piece[spans[i].piece] : own;
-    const auto states = equations.sample(x.segment(i * n, n), local[i], definition_.options.integrator);
+    const auto states = equations.sample(x.segment(i * n, n), local[i], options);
     for (size_t j = 1; j < states.size(); ++j) points[i].push_back(equations.point(states[j], local[i][j]));
   }, s.size() >= 64);
   for (auto& segment : points) out.insert(out.end(), segment.begin(), segment.end());

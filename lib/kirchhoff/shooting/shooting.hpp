@@ -148,8 +148,11 @@ class ShootingProblem final : public NonlinearSystem {
   int segments() const { return definition_.options.segments; }
   // State at s = 0 stored in x.
   Eigen::VectorXd start_state(const Eigen::VectorXd& x) const { return x.head(state_size_); }
-  // Solution sampled at the given arclengths (sorted, within [0, L]).
-  std::vector<RodPoint> sample(const Eigen::VectorXd& x, const std::vector<double>& s) const;
+  // Solution sampled at the given arclengths (sorted, within [0, L]), integrated with the case's
+  // integrator options or, given, with `integrator` (a looser one where the samples serve as
+  // scales only: the stability index's field rate).
+  std::vector<RodPoint> sample(const Eigen::VectorXd& x, const std::vector<double>& s,
+                               const IntegratorOptions* integrator = nullptr) const;
 
   long rhs_evaluations() const { return workspace_.rhs_evaluations(); }
   // The obstacles at these parameter values.
