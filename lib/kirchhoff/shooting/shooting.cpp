@@ -298,15 +298,8 @@ bool ShootingProblem::parameter_derivative(const Eigen::VectorXd& x, const std::
     if (!residual(x, parameters_at(x), &F, nullptr, failure, &end_state)) return false;
     y_end = &end_state;
   }
-  // The end conditions' rows alone, in the workspace's buffers.
-  auto& b = workspace_.buffers();
-  b.y0 = x.head(state_size_);
-  condition_rows_into(b.y0, *y_end, plus, &b.rows_plus);
-  condition_rows_into(b.y0, *y_end, minus, &b.rows_minus);
-  dF->setZero(residual_count_);
-  for (size_t k = 0; k < b.rows_plus.size(); ++k)
-    (*dF)[condition_row_index(static_cast<int>(k), static_cast<int>(b.rows_plus.size()))] =
-        (b.rows_plus[k] - b.rows_minus[k]) / (2.0 * h);
+  dF->resize(residual_count_);
+  condition_column(x, *y_end, plus, minus, h, *dF);
   return true;
 }
 
@@ -328,7 +321,6 @@ bool ShootingProblem::evaluate_with(const Eigen::VectorXd& x, Eigen::VectorXd* F
   // closed-form in the end states: no re-integration is needed for it.
   const int offset = segments() * state_size_;
   auto& b = workspace_.buffers();
-  b.y0 = x.head(state_size_);
   for (size_t j = 0; j < unknown_index_.size(); ++j) {
     const double h = kParameterStep * (1.0 + std::abs(x[offset + j]));
     if (moves_beyond_conditions(static_cast<int>(j))) {
@@ -339,23 +331,26 @@ bool ShootingProblem::evaluate_with(const Eigen::VectorXd& x, Eigen::VectorXd* F
       if (!residual(xm, parameters_at(xm), &Fm, nullptr, failure)) return false;
       J->col(offset + j) = (Fp - Fm) / (2.0 * h);
     } else {
-      parameters_into(x, &b.moved, static_cast<int>(j), h);
-      condition_rows_into(b.y0, y_end, b.moved, &b.rows_plus);
-      parameters_into(x, &b.moved, static_cast<int>(j), -h);
-      condition_rows_into(b.y0, y_end, b.moved, &b.rows_minus);
-      auto column = J->col(offset + static_cast<Eigen::Index>(j));
-      column.setZero();
-      for (size_t k = 0; k < b.rows_plus.size(); ++k)
-        column[condition_row_index(static_cast<int>(k), static_cast<int>(b.rows_plus.size()))] =
-            (b.rows_plus[k] - b.rows_minus[k]) / (2.0 * h);
+      parameters_into(x, &b.plus, static_cast<int>(j), h);
+      parameters_into(x, &b.minus, static_cast<int>(j), -h);
+      condition_column(x, y_end, b.plus, b.minus, h, J->col(offset + static_cast<Eigen::Index>(j)));
     }
   }
   return true;
 }
 
-int ShootingProblem::condition_row_index(int k, int count) const {
+void ShootingProblem::condition_column(const Eigen::VectorXd& x, const Eigen::VectorXd& y_end, const Parameters& plus,
+                                       const Parameters& minus, double h, Eigen::Ref<Eigen::VectorXd> column) const {
+  auto& b = workspace_.buffers();
+  b.y0 = x.head(state_size_);
+  condition_rows_into(b.y0, y_end, plus, &b.rows_plus);
+  condition_rows_into(b.y0, y_end, minus, &b.rows_minus);
+  column.setZero();
   // Start rows follow the gauge rows; end rows are the last ones (contact rows lie between).
-  return k < start_condition_count_ ? gauge_count_ + k : residual_count_ - count + k;
+  const int count = static_cast<int>(b.rows_plus.size());
+  for (int k = 0; k < count; ++k)
+    column[k < start_condition_count_ ? gauge_count_ + k : residual_count_ - count + k] =
+        (b.rows_plus[k] - b.rows_minus[k]) / (2.0 * h);
 }
 
 void ShootingProblem::condition_rows_into(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end,

@@ -221,8 +221,11 @@ class ShootingProblem final : public NonlinearSystem {
   // storage reused).
   void condition_rows_into(const Eigen::VectorXd& y0, const Eigen::VectorXd& y_end, const Parameters& p,
                            std::vector<double>* rows) const;
-  // The row of F that condition row k of `count` (start then end) is.
-  int condition_row_index(int k, int count) const;
+  // A parameter's column of the Jacobian where it enters the end conditions only: their rows'
+  // central difference between `plus` and `minus` (the parameter moved by +h and -h, the end
+  // states held), zero elsewhere.
+  void condition_column(const Eigen::VectorXd& x, const Eigen::VectorXd& y_end, const Parameters& plus,
+                        const Parameters& minus, double h, Eigen::Ref<Eigen::VectorXd> column) const;
   // Whether an unknown parameter enters the rod model or moves an obstacle (its column then needs
   // whole residuals, not only the boundary-condition rows).
   bool moves_beyond_conditions(int unknown) const;

@@ -59,7 +59,7 @@ class ShootingWorkspace {
     std::vector<StateRow> start_jacobian, end_jacobian;
     // A Jacobian's columns of parameters that enter the end conditions only (evaluate).
     Eigen::VectorXd y0;
-    Parameters moved;
+    Parameters plus, minus;
     std::vector<double> rows_plus, rows_minus;
   };
   Buffers& buffers() { return buffers_; }
