@@ -36,6 +36,7 @@
 #include "kirchhoff/jobs/case_continue.hpp"
 #include "kirchhoff/jobs/case_file.hpp"
 #include "kirchhoff/jobs/continue_outputs.hpp"
+#include "kirchhoff/jobs/process_memory.hpp"
 
 extern char** environ;
 
@@ -193,6 +194,7 @@ Options parse(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  kirchhoff::keep_freed_memory_for_reuse();  // as the CLI's main, so that the two run alike
   try {
     const Options o = parse(argc, argv);
     Series library{"library, no outputs", {}}, outputs{"library + CSV + state file", {}}, cli{"CLI (child process)", {}};

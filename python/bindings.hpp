@@ -41,6 +41,7 @@
 #include "kirchhoff/jobs/continue_outputs.hpp"
 #include "kirchhoff/jobs/deflated_continuation.hpp"
 #include "kirchhoff/jobs/equilibria.hpp"
+#include "kirchhoff/jobs/process_memory.hpp"
 #include "kirchhoff/jobs/result_json.hpp"
 #include "kirchhoff/jobs/run_state.hpp"
 #include "kirchhoff/reproduce/reproduce.hpp"

@@ -113,7 +113,7 @@ py::dict py_plectonemes(const std::string& out, const std::vector<double>& slend
 
 }  // namespace
 
-// The whole jobs: load_case, reproduce, sweep, plectonemes.
+// The whole jobs: load_case, reproduce, sweep, plectonemes (and the heap setting long ones want).
 void bind_jobs(py::module_& m) {
   m.def("load_case", &py_load_case, py::arg("path"), py::arg("set") = py::none(), py::arg("phase_condition") = "",
         py::arg("solver") = py::none(),
@@ -205,6 +205,16 @@ Raises:
         slenderness from a ply the sweep would not have) or a case file that cannot be used.
     RuntimeError: a branch failed (its message says which and why; the CSVs so far are kept).
     KeyboardInterrupt: Ctrl-C (the sweep stops after its current point).)doc");
+
+  m.def("keep_freed_memory", &keep_freed_memory_for_reuse,
+        R"doc(Keep freed memory blocks of up to 1 GiB in the process's heap for reuse (what the CLI does
+when it starts). Long multiple-shooting rods (the exact plies of `plectonemes` at L/2R = 500
+and 1000) allocate Jacobians of 100 MB and more several times per point; by default each is
+mapped afresh and page-faulted in by the system, a third of such a run's time. Process-wide and
+for the rest of the process: its resident memory then stays at its peak.
+
+Returns:
+    bool: False where the C library has no such setting (nothing changed).)doc");
 }
 
 // derived_catalogue and the closed forms the tests and notebooks compare with.

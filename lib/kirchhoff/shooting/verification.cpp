@@ -3,6 +3,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "kirchhoff/shooting/detail/jacobian_lu.hpp"
+
 namespace kirchhoff {
 namespace {
 
@@ -21,19 +23,32 @@ std::string at(double s) {
 // J^-1 F with J equilibrated by rows and columns first (LAPACK's dgeequ idea): a case in units far
 // from 1 has Jacobian entries spread over hundreds of orders of magnitude (a rod of length 1e-100:
 // d y(L) / d P ~ L^3), which an unscaled solve reads as rank deficiency. NaN when the equilibrated
-// matrix is still singular (rcond below 1e-12), where no correction can be told. Partial pivoting:
-// after the equilibration the rows are of one size; on 1300 unknowns (a plectoneme at L/2R = 500)
-// its blocked factorisation takes 0.5 s against full pivoting's 5-6 s (same rcond), and this runs
-// on every solve that starts converged.
+// matrix is still singular (rcond below 1e-12), where no correction can be told. This runs on
+// every solve that starts converged, so large multiple-shooting matrices go through the sparse LU
+// (JacobianLU; its 1-norm condition estimate is Hager's, as the dense rcond): on 4,236 unknowns
+// (the exact ply at L/2R = 1000) a dense factorisation takes seconds. Small or dense ones, and
+// those the sparse LU cannot factorise, by partial pivoting: after the equilibration the rows are
+// of one size; on 1300 unknowns its blocked factorisation takes 0.5 s against full pivoting's 5-6 s.
 Eigen::VectorXd equilibrated_newton_correction(const Eigen::MatrixXd& J, const Eigen::VectorXd& F) {
   const auto power_of_two_inverse = [](double m) { return m > 0.0 ? std::exp2(-std::ilogb(m)) : 1.0; };
   Eigen::VectorXd rows(J.rows()), columns(J.cols());
   for (int i = 0; i < J.rows(); ++i) rows[i] = power_of_two_inverse(J.row(i).lpNorm<Eigen::Infinity>());
-  const Eigen::MatrixXd row_scaled = rows.asDiagonal() * J;
-  for (int j = 0; j < J.cols(); ++j) columns[j] = power_of_two_inverse(row_scaled.col(j).lpNorm<Eigen::Infinity>());
-  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(row_scaled * columns.asDiagonal());
+  Eigen::MatrixXd equilibrated = rows.asDiagonal() * J;
+  for (int j = 0; j < J.cols(); ++j) {
+    columns[j] = power_of_two_inverse(equilibrated.col(j).lpNorm<Eigen::Infinity>());
+    equilibrated.col(j) *= columns[j];
+  }
+  const Eigen::VectorXd scaled_F = rows.asDiagonal() * F;
+  if (equilibrated.rows() >= JacobianLU::kSparseFrom) {
+    const JacobianLU lu(equilibrated);
+    if (lu.sparse()) {
+      if (!(lu.reciprocal_condition() > 1e-12)) return Eigen::VectorXd::Constant(F.size(), std::nan(""));
+      return columns.asDiagonal() * lu.solve(scaled_F);
+    }
+  }
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(equilibrated);
   if (!(lu.rcond() > 1e-12)) return Eigen::VectorXd::Constant(F.size(), std::nan(""));
-  return columns.asDiagonal() * lu.solve(rows.asDiagonal() * F);
+  return columns.asDiagonal() * lu.solve(scaled_F);
 }
 
 }  // namespace
