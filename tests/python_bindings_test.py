@@ -11,6 +11,7 @@ import math
 import os
 import pathlib
 import re
+import subprocess
 import sys
 import tempfile
 import threading
@@ -736,6 +737,31 @@ class PlectonemesTest(unittest.TestCase):
             with self.assertRaises(kirchhoff.CaseError):
                 kirchhoff.plectonemes(tmp, [100], [3], case=str(pathlib.Path(tmp) / "no_such_case.toml"))
             self.assertEqual(os.listdir(tmp), [])  # refused before anything ran
+
+
+class KeepFreedMemoryTest(unittest.TestCase):
+    # glibc's own count of blocks that have a mapping of their own (mallinfo2().hblks), read
+    # with ctypes: a 143 MB array (the exact ply's Jacobian at L/2R = 1000) gets one by default
+    # and none once freed memory is kept in the heap. The setting is process-wide, so this runs
+    # in a child interpreter.
+    def test_large_blocks_come_from_the_heap(self):
+        if not sys.platform.startswith("linux"):
+            self.skipTest("glibc's malloc")
+        child = r"""
+import ctypes, numpy as np, kirchhoff
+class MallInfo2(ctypes.Structure):
+    _fields_ = [(name, ctypes.c_size_t) for name in
+                ("arena", "ordblks", "smblks", "hblks", "hblkhd", "usmblks", "fsmblks", "uordblks", "fordblks", "keepcost")]
+libc = ctypes.CDLL(None)
+libc.mallinfo2.restype = MallInfo2
+def mappings_while_holding():
+    block = np.ones(4236 * 4236)
+    return libc.mallinfo2().hblks
+before = libc.mallinfo2().hblks
+print(mappings_while_holding() - before, kirchhoff.keep_freed_memory(), mappings_while_holding() - before)
+"""
+        out = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True, check=True).stdout
+        self.assertEqual(out.split(), ["1", "True", "0"])
 
 
 class SweepTest(unittest.TestCase):
