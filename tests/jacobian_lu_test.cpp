@@ -32,11 +32,8 @@ Eigen::MatrixXd multiple_shooting_like(int segments, int block, unsigned seed) {
   return M;
 }
 
-TEST(JacobianLU, SparsePathSolvesAsTheDenseLU) {
-  const Eigen::MatrixXd M = multiple_shooting_like(20, 14, 1);
-  const JacobianLU lu(M);
-  ASSERT_TRUE(lu.sparse());
-  ASSERT_TRUE(lu.ok());
+// lu (of M) solves, estimates the condition and gives the determinant as the dense LU of M.
+void expect_as_the_dense_lu(const JacobianLU& lu, const Eigen::MatrixXd& M) {
   const Eigen::PartialPivLU<Eigen::MatrixXd> dense(M);
   const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(M.rows(), -1.0, 2.0);
   const Eigen::VectorXd x = lu.solve(b), x_dense = dense.solve(b);
@@ -48,6 +45,35 @@ TEST(JacobianLU, SparsePathSolvesAsTheDenseLU) {
   EXPECT_GT(lu.reciprocal_condition(), 0.99 * dense.rcond() / 10.0);
   EXPECT_LT(lu.reciprocal_condition(), 10.0 * dense.rcond());
   EXPECT_NEAR(lu.determinant() / dense.determinant(), 1.0, 1e-9);
+}
+
+TEST(JacobianLU, SparsePathSolvesAsTheDenseLU) {
+  const Eigen::MatrixXd M = multiple_shooting_like(20, 14, 1);
+  const JacobianLU lu(M);
+  ASSERT_TRUE(lu.sparse());
+  ASSERT_TRUE(lu.ok());
+  expect_as_the_dense_lu(lu, M);
+}
+
+// The continuation's bordered matrix [F_x F_lambda; t^T]: its tangent row is its densest line (the
+// parameter column is dense only in some rows, as a plectoneme's contact parameters), so its
+// factors are those of the transpose; the solution, condition estimate and determinant are the
+// matrix's own. Its columns of very different scales (forces beside positions) are equilibrated
+// for the transpose's pivoting. Newton's matrix alone (no tangent row) is factorised as it is.
+TEST(JacobianLU, BorderedMatrixWithADenseRowIsFactorisedTransposed) {
+  Eigen::MatrixXd M = multiple_shooting_like(20, 14, 4);
+  const Eigen::Index n = M.rows();
+  M.col(n - 1).tail(n / 2).setZero();
+  for (Eigen::Index j = 0; j < n; j += 10) M.col(j) *= 1e4;  // (every 10th: the determinant stays finite)
+  const JacobianLU lu(M.topRows(n - 1), M.row(n - 1).transpose());
+  ASSERT_TRUE(lu.ok());
+  ASSERT_TRUE(lu.transposed());
+  // The condition estimate is still of the 1-norm of M^-1 (its solves swapped), not of M^-T.
+  expect_as_the_dense_lu(lu, M);
+
+  const JacobianLU newton(M.topLeftCorner(n - 1, n - 1));
+  ASSERT_TRUE(newton.sparse());
+  EXPECT_FALSE(newton.transposed());
 }
 
 TEST(JacobianLU, SmallOrDenseMatricesStayDense) {

@@ -87,6 +87,12 @@ class RodEquations {
   virtual int turn_angle_index() const = 0;
   // State from lab-frame data (used to build initial guesses); the frame must be admissible.
   virtual Eigen::VectorXd state(const RodPoint& p) const = 0;
+  // state(p) for a point beside one whose state is `neighbour` (consecutive nodes of a guess):
+  // where p's frame leaves its representation to round-off (a spatial rod's quaternion sign when
+  // q0 is at round-off: state() picks q0 >= 0), the one continuous with the neighbour's.
+  virtual Eigen::VectorXd state_beside(const RodPoint& p, const Eigen::VectorXd& /*neighbour*/) const {
+    return state(p);
+  }
 
   // Linear read-out of position, force and moment: value = M y, with M of size 3 x state_size.
   virtual SlotMap slot_map(Slot slot) const = 0;

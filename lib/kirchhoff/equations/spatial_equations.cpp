@@ -196,6 +196,22 @@ class SpatialEquations final : public RodEquations {
     return y;
   }
 
+  // A frame turned by pi about e3 (the plectoneme's clamp at -pi * turns, whole turns) has
+  // q0 = 0: state() then chose q or -q, and chi = +pi or -pi, by the sign of a q0 of round-off,
+  // and a guess whose first node took the other sign from its second was a whole segment's
+  // quaternion and a turn of chi away from any solution (Newton from the hard ply's seed failed).
+  // Below kTie, the sign that continues the neighbour's quaternion.
+  Eigen::VectorXd state_beside(const RodPoint& p, const Eigen::VectorXd& neighbour) const override {
+    constexpr double kTie = 1e-9;  // below the accuracy of any solved frame
+    Eigen::VectorXd y = state(p);
+    Eigen::Ref<Eigen::VectorXd> q = y.segment<4>(kQ);
+    if (std::abs(q[0]) < kTie && q.dot(neighbour.segment<4>(kQ)) < 0) {
+      q = -q;
+      y[kChi] = 2.0 * std::atan2(q[3], q[0]);
+    }
+    return y;
+  }
+
   SlotMap slot_map(Slot slot) const override {
     SlotMap M = SlotMap::Zero(3, kStateSize);
     const int offset = slot == Slot::Position ? kR : slot == Slot::Force ? kN : kM;

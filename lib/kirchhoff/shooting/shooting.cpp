@@ -458,13 +458,17 @@ Eigen::VectorXd ShootingProblem::unknowns_from(const std::vector<RodPoint>& node
     throw std::invalid_argument("unknowns_from: one point per segment needed");
   const auto eq = equations(definition_.parameters);
   Eigen::VectorXd x = unknowns_without_states();
-  // The turn angle counts whole turns along the rod; at s = 0 the gauge wants it in (-pi, pi].
+  // Each node's state continues its neighbour's representation (the second node's for the first).
+  std::vector<Eigen::VectorXd> states(nodes.size());
+  for (size_t i = 0; i < nodes.size(); ++i) states[i] = eq->state(nodes[i]);
+  if (nodes.size() > 1) states[0] = eq->state_beside(nodes[0], states[1]);
+  for (size_t i = 1; i < nodes.size(); ++i) states[i] = eq->state_beside(nodes[i], states[i - 1]);
+  // The turn angle counts whole turns along the rod; at s = 0 the gauge wants it in [-pi, pi].
   const int turns = eq->turn_angle_index();
-  const double offset = eq->state(nodes.front())[turns] - nodes.front().turn_angle;
+  const double offset = states.front()[turns] - nodes.front().turn_angle;
   for (int i = 0; i < segments(); ++i) {
-    Eigen::VectorXd y = eq->state(nodes[i]);
-    y[turns] = nodes[i].turn_angle + offset;
-    x.segment(i * state_size_, state_size_) = y;
+    states[i][turns] = nodes[i].turn_angle + offset;
+    x.segment(i * state_size_, state_size_) = states[i];
   }
   return x;
 }

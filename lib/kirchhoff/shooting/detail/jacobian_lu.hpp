@@ -12,7 +12,8 @@ namespace kirchhoff {
 // parameters, the continuation parameter and the arclength row). A dense LU costs
 // O((segments * state)^3) and dominated long multiple-shooting runs; a sparse LU costs
 // O(segments * state^3). Large matrices that are mostly zeros are therefore factorised as sparse
-// (COLAMD ordering); small or dense ones by partial-pivoting dense LU, as before.
+// (COLAMD ordering; transposed when a dense row, such as the continuation's tangent row, would
+// otherwise spread through the factors); small or dense ones by partial-pivoting dense LU.
 class JacobianLU {
  public:
   explicit JacobianLU(const Eigen::MatrixXd& M);
@@ -22,6 +23,7 @@ class JacobianLU {
   // False when the factorisation broke down (an exactly singular sparse matrix).
   bool ok() const { return ok_; }
   bool sparse() const { return sparse_ != nullptr; }
+  bool transposed() const { return sparse_ != nullptr && transposed_; }  // factors of M^T (a dense row)
   // 1 / cond_1 estimate (of the row-equilibrated matrix when large); for dense matrices also at most the
   // smallest pivot over the largest (a cheap guard that the estimate alone can miss). 0 when the
   // factorisation failed.
@@ -36,7 +38,9 @@ class JacobianLU {
   static constexpr double kSparseDensity = 0.15;
 
  private:
-  Eigen::VectorXd solve_scaled(const Eigen::VectorXd& b) const;  // by the factors of the row-scaled matrix
+  // Solves with the row-scaled matrix S = row_scale M and with its transpose, whichever factors
+  // are kept.
+  Eigen::VectorXd solve_scaled(const Eigen::VectorXd& b) const;
   Eigen::VectorXd solve_transposed(const Eigen::VectorXd& b) const;
   // Of the factorised (row-scaled) matrix, whose 1-norm is norm_M.
   double estimate_reciprocal_condition(double norm_M) const;
@@ -44,6 +48,9 @@ class JacobianLU {
 
   Eigen::VectorXd row_scale_;  // 1 / largest |entry| of each row
   bool ok_ = false;
+  // The sparse factors are those of (row_scale M column_scale)^T, the columns equilibrated too.
+  bool transposed_ = false;
+  Eigen::VectorXd column_scale_;
   double rcond_ = 0.0;
   Eigen::PartialPivLU<Eigen::MatrixXd> dense_;
   std::unique_ptr<Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>>> sparse_;
