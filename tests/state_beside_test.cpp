@@ -1,6 +1,6 @@
 // RodEquations::state_beside: a guess's node whose frame leaves its state's representation to
 // round-off takes the one its neighbour continues. A spatial frame turned by pi about e3 (the
-// plectoneme's clamp at -pi * turns, whole turns) has quaternion +-(0, 0, 0, 1): state() chooses
+// plectoneme's clamp at -pi * turns, odd turns) has quaternion +-(0, 0, 0, 1): state() chooses
 // by the sign of a q0 of round-off, and a first node of the other sign from its second put a hard
 // ply's seed a segment's quaternion and a turn of chi from any solution.
 #include <gtest/gtest.h>

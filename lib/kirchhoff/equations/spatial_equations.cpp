@@ -196,7 +196,7 @@ class SpatialEquations final : public RodEquations {
     return y;
   }
 
-  // A frame turned by pi about e3 (the plectoneme's clamp at -pi * turns, whole turns) has
+  // A frame turned by pi about e3 (the plectoneme's clamp at -pi * turns, odd turns) has
   // q0 = 0: state() then chose q or -q, and chi = +pi or -pi, by the sign of a q0 of round-off,
   // and a guess whose first node took the other sign from its second was a whole segment's
   // quaternion and a turn of chi away from any solution (Newton from the hard ply's seed failed).
