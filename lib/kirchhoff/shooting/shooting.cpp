@@ -458,11 +458,12 @@ Eigen::VectorXd ShootingProblem::unknowns_from(const std::vector<RodPoint>& node
     throw std::invalid_argument("unknowns_from: one point per segment needed");
   const auto eq = equations(definition_.parameters);
   Eigen::VectorXd x = unknowns_without_states();
-  // Each node's state continues its neighbour's representation (the second node's for the first).
+  // Each node's state continues its neighbour's representation: from the second node on along the
+  // rod, and the first (a clamp's frame may leave its representation to round-off) the second's.
   std::vector<Eigen::VectorXd> states(nodes.size());
-  for (size_t i = 0; i < nodes.size(); ++i) states[i] = eq->state(nodes[i]);
-  if (nodes.size() > 1) states[0] = eq->state_beside(nodes[0], states[1]);
-  for (size_t i = 1; i < nodes.size(); ++i) states[i] = eq->state_beside(nodes[i], states[i - 1]);
+  for (size_t i = 1; i < nodes.size(); ++i)
+    states[i] = i == 1 ? eq->state(nodes[i]) : eq->state_beside(nodes[i], states[i - 1]);
+  states[0] = nodes.size() > 1 ? eq->state_beside(nodes[0], states[1]) : eq->state(nodes[0]);
   // The turn angle counts whole turns along the rod; at s = 0 the gauge wants it in [-pi, pi].
   const int turns = eq->turn_angle_index();
   const double offset = states.front()[turns] - nodes.front().turn_angle;

@@ -39,7 +39,7 @@ Eigen::VectorXd equilibrated_newton_correction(const Eigen::MatrixXd& J, const E
     equilibrated.col(j) *= columns[j];
   }
   const Eigen::VectorXd scaled_F = rows.asDiagonal() * F;
-  if (equilibrated.rows() >= JacobianLU::kSparseFrom) {
+  if (JacobianLU::sparse_enough(equilibrated)) {
     const JacobianLU lu(equilibrated);
     if (lu.sparse()) {
       if (!(lu.reciprocal_condition() > 1e-12)) return Eigen::VectorXd::Constant(F.size(), std::nan(""));

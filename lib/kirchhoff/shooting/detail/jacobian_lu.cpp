@@ -9,6 +9,11 @@ namespace kirchhoff {
 
 namespace {
 
+// 1 / v of each largest |entry| v, 1 where a row or column is zero: the equilibrating scales.
+Eigen::VectorXd reciprocals_or_one(const Eigen::VectorXd& maxima) {
+  return maxima.unaryExpr([](double v) { return v > 0 ? 1.0 / v : 1.0; });
+}
+
 // The largest number of non-zeros in one row and in one column of a sparse matrix.
 struct DensestLines {
   Eigen::Index row = 0, column = 0;
@@ -52,7 +57,7 @@ std::optional<Eigen::SparseMatrix<double>> sparse_bordered(const Eigen::MatrixXd
   }
   S.finalize();
   densest->row = *std::max_element(row_count.begin(), row_count.end());
-  *row_scale = row_max.unaryExpr([](double v) { return v > 0 ? 1.0 / v : 1.0; });
+  *row_scale = reciprocals_or_one(row_max);
   for (Eigen::Index j = 0; j < cols; ++j)
     for (Eigen::SparseMatrix<double>::InnerIterator it(S, j); it; ++it) it.valueRef() *= (*row_scale)[it.row()];
   return S;
@@ -76,6 +81,12 @@ Eigen::MatrixXd stacked(const Eigen::MatrixXd& top, const Eigen::VectorXd& botto
 }  // namespace
 
 JacobianLU::JacobianLU(const Eigen::MatrixXd& M) : JacobianLU(M, Eigen::VectorXd()) {}
+
+bool JacobianLU::sparse_enough(const Eigen::MatrixXd& M) {
+  if (M.rows() < kSparseFrom) return false;
+  const auto allowed = static_cast<Eigen::Index>(kSparseDensity * static_cast<double>(M.size()));
+  return (M.array() != 0.0).count() <= allowed;
+}
 
 JacobianLU::JacobianLU(const Eigen::MatrixXd& top, const Eigen::VectorXd& bottom) {
   // Rows of large matrices are equilibrated first: residuals of forces (~1e4 on a tight
@@ -101,9 +112,9 @@ JacobianLU::JacobianLU(const Eigen::MatrixXd& top, const Eigen::VectorXd& bottom
       if (transposed_) {
         // Partial pivoting on the transpose compares entries along a row of M, across its
         // unknowns, whose scales differ by orders (forces ~1e4 beside positions ~1e-3 on a
-        // plectoneme): the columns are equilibrated too. (Unequilibrated, Newton from the hard
-        // ply's seed stalled and a barrier branch's H_A - H_B grew past 1e-8.)
-        column_scale_ = column_maxima(*S).unaryExpr([](double v) { return v > 0 ? 1.0 / v : 1.0; });
+        // plectoneme): the columns are equilibrated too. (Unequilibrated, a plectoneme barrier
+        // branch's H_A - H_B grew past 1e-8.)
+        column_scale_ = reciprocals_or_one(column_maxima(*S));
         const Eigen::SparseMatrix<double> T = (*S * column_scale_.asDiagonal()).transpose();
         sparse_->compute(T);
       } else {
@@ -118,7 +129,7 @@ JacobianLU::JacobianLU(const Eigen::MatrixXd& top, const Eigen::VectorXd& bottom
       transposed_ = false;
     }
     const Eigen::MatrixXd M = stacked(top, bottom);
-    row_scale_ = M.cwiseAbs().rowwise().maxCoeff().unaryExpr([](double v) { return v > 0 ? 1.0 / v : 1.0; });
+    row_scale_ = reciprocals_or_one(M.cwiseAbs().rowwise().maxCoeff());
     dense_.compute(row_scale_.asDiagonal() * M);
   } else {
     dense_.compute(stacked(top, bottom));

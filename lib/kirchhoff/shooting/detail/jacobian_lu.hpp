@@ -20,6 +20,10 @@ class JacobianLU {
   // The bordered matrix [top; bottom^T] (the continuation's [F_x F_lambda; t^T]) without forming it.
   JacobianLU(const Eigen::MatrixXd& top, const Eigen::VectorXd& bottom);
 
+  // Whether M is large and sparse enough for the sparse path (kSparseFrom, kSparseDensity): a
+  // caller with a dense LU of its own need not have this class repeat it.
+  static bool sparse_enough(const Eigen::MatrixXd& M);
+
   // False when the factorisation broke down (an exactly singular sparse matrix).
   bool ok() const { return ok_; }
   bool sparse() const { return sparse_ != nullptr; }
