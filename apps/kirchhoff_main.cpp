@@ -360,7 +360,7 @@ CLI::App* add_sweep_command(CLI::App& app, SweepArguments* args) {
 int main(int argc, char** argv) {
   using namespace kirchhoff::cli;
   // Long rods' Jacobians (over 100 MB) are reused from the heap instead of mapped afresh for
-  // each one (process_memory.hpp): the exact ply at L/2R = 1000 in about 0.6 of the time.
+  // each one (process_memory.hpp): the exact ply at L/2R = 1000 in about two thirds of the time.
   kirchhoff::keep_freed_memory_for_reuse();
   CLI::App app{
       "kirchhoff - equilibria of elastic rods (planar Elastica, twisted Kirchhoff rods, extensible and\n"

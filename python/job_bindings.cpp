@@ -180,7 +180,7 @@ barrier branch stops at that many turns and its ply is re-solved with exact cont
 shooting core (the strands touching: rho = R, complementarity checked) and followed up to
 `turns` and down to `turns_min`. Slendernesses in `from_ply` are reached from the ply of the one
 before them in `slenderness` (with `hard_from`: from its exact ply, no barrier branch).
-The long exact plies (L/2R = 500 and 1000) run about 1.6 times faster after
+The long exact plies (L/2R = 500 and 1000) run about 1.5 times faster after
 kirchhoff.keep_freed_memory(), which the CLI calls at its start.
 
 Args:
