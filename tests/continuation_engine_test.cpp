@@ -4,10 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
 #include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/continuation/detail/broyden_steps.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -163,6 +166,68 @@ TEST(ContinuationEngine, ResumedMarchRepeatsTheUninterruptedOne) {
     EXPECT_EQ(a.parameter, b.parameter) << "point " << a.index;
     EXPECT_EQ(a.x[0], b.x[0]) << "point " << a.index;
   }
+}
+
+// The quadratic predictor (the default) against the tangent alone, on the circle at a fixed
+// step h = 0.1: the tangent's prediction lies h^2 / 2 = 5e-3 off the circle, the quadratic one's
+// O(h^3) (its curvature is estimated from the last two tangents), so the correctors need fewer
+// iterations in all; both runs' points lie on the circle.
+TEST(ContinuationEngine, QuadraticPredictorNeedsFewerCorrectorIterations) {
+  auto total_iterations = [](StepControl::Predictor predictor) {
+    ContinuationOptions o = options_for("lambda");
+    o.initial_step = o.max_step = 0.1;
+    o.max_points = 50;
+    o.predictor = predictor;
+    Continuation run(std::make_unique<Circle>(0.0), o);
+    const ContinuationResult r = run.run(kNearOne);
+    EXPECT_EQ(r.reason, StopReason::MaxPoints) << r.message;
+    int sum = 0;
+    for (const auto& p : r.points) {
+      EXPECT_LE(std::abs(p.x[0] * p.x[0] + p.parameter * p.parameter - 1.0), kOnBranch) << "point " << p.index;
+      if (p.type == PointType::Regular) sum += p.newton_iterations;
+    }
+    return sum;
+  };
+  const int tangent = total_iterations(StepControl::Predictor::Tangent);
+  const int quadratic = total_iterations(StepControl::Predictor::Quadratic);
+  EXPECT_LT(quadratic, tangent);
+  std::cout << "corrector iterations on 50 points: tangent " << tangent << ", quadratic " << quadratic << "\n";
+}
+
+// Broyden's updates of a chord matrix B0 != A on a linear system A z = b: by Gay's theorem
+// (D. M. Gay, SIAM J. Numer. Anal. 16, 1979) the iterates reach the solution in at most 2n steps
+// in exact arithmetic, whatever B0; here to round-off (1e-12 of the first residual). The chord
+// on B0 alone contracts only by its ||I - B0^-1 A|| = 0.5 per step, still above 1e-3 of it
+// after 2n steps: the test would fail on plain chord steps.
+TEST(BroydenSteps, SolveALinearSystemInAtMostTwiceItsSizeSteps) {
+  constexpr int n = 4;
+  Eigen::Matrix4d A;
+  A << 4, 1, 0, 0.5,  //
+      1, 3, 1, 0,     //
+      0, 1, 5, 1,     //
+      0.5, 0, 1, 2;
+  const Eigen::Vector4d b(1.0, -2.0, 0.5, 3.0);
+  Eigen::Matrix4d B0 = 2.0 * A;  // I - B0^-1 A = I / 2
+  B0(0, 1) += 0.3;               // and not a multiple of A
+  const Eigen::PartialPivLU<Eigen::Matrix4d> lu(B0);
+  auto residual_after = [&](bool broyden_updates) {
+    detail::BroydenSteps broyden;
+    Eigen::VectorXd z = Eigen::VectorXd::Zero(n);
+    for (int k = 0; k < 2 * n; ++k) {
+      if ((A * z - b).norm() <= 1e-13 * b.norm()) break;  // solved (a zero step would not update)
+      const Eigen::VectorXd chord = -lu.solve(A * z - b);
+      if (!broyden_updates) {
+        z += chord;
+        continue;
+      }
+      const std::optional<Eigen::VectorXd> step = broyden.next(chord);
+      if (!step) return std::numeric_limits<double>::infinity();  // a degenerate update: not expected on this system
+      z += *step;
+    }
+    return (A * z - b).norm() / b.norm();
+  };
+  EXPECT_LT(residual_after(true), 1e-12);
+  EXPECT_GT(residual_after(false), 1e-3);
 }
 
 TEST(ContinuationEngine, RefusesNoSystemAndAStartThatDoesNotConverge) {

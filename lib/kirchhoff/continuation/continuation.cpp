@@ -9,7 +9,9 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
+#include "kirchhoff/continuation/detail/broyden_steps.hpp"
 #include "kirchhoff/continuation/detail/continuation_detectors.hpp"
 #include "kirchhoff/shooting/detail/jacobian_lu.hpp"
 #include "kirchhoff/shooting/newton.hpp"
@@ -30,6 +32,20 @@ constexpr double kChordContraction = 0.3;
 constexpr double kModifiedNewtonContraction = 0.5;
 
 double sign_of(double v) { return v < 0 ? -1.0 : 1.0; }
+
+// Within a bracket this small against the step, a smooth monitor is monotone (its linear term
+// dominates, or it has a double root there, which no sign change brackets), so a value at an
+// interior trial larger than both ends' is noise at this scale: next to a singular point (the
+// Euler column's touching ends) the correctors land on either branch and the determinant's sign
+// means nothing, and Illinois went on for its 60 iterations at up to 13 exact matrices each.
+// The location is then as good as the correctors allow; the trial with the smallest value is it.
+constexpr double kMonotoneBracket = 1e-4;
+
+bool monitor_is_noise(double value, double at_a, double at_b, double bracket, double step) {
+  return std::abs(bracket) < kMonotoneBracket * std::abs(step) &&
+         std::abs(value) > std::max(std::abs(at_a), std::abs(at_b));
+}
+
 
 // Points a march can be resumed from: a special point (fold, branch point, event, end) is found
 // by locating inside a step, and a resumed run finds it again by redoing that step.
@@ -171,7 +187,9 @@ bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen:
 }
 
 bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
-                           int* iterations, const Eigen::MatrixXd* chord, bool* by_chord, bool march) {
+                           int* iterations, const Eigen::MatrixXd* chord, bool* by_chord, bool march,
+                           std::shared_ptr<const Eigen::MatrixXd>* matrix_at_z) {
+  if (matrix_at_z) matrix_at_z->reset();
   Eigen::VectorXd F, G(n_ + 1);
   Eigen::MatrixXd A;
   std::string failure;
@@ -181,6 +199,7 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
     if (lu.reciprocal_condition() > 1e-15) {
       const Eigen::VectorXd z_start = z;
       double previous = INFINITY;
+      detail::BroydenSteps broyden;
       for (; it <= options_.corrector_max_iterations; ++it) {
         if (!evaluate(z, &F, nullptr, &failure)) break;
         G << F, normal.dot(z - z_predicted);
@@ -194,7 +213,9 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
         // Chord iterations contract linearly; slower than this, full Newton is cheaper.
         if (norm > kChordContraction * previous) break;
         previous = norm;
-        z -= lu.solve(G);
+        const std::optional<Eigen::VectorXd> step = broyden.next(-lu.solve(G));
+        if (!step) break;
+        z += *step;
       }
       if (!z.allFinite()) z = z_start;
     }
@@ -225,6 +246,8 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
     best = std::min(best, norm);
     if (norm <= options_.corrector_tolerance) {
       *iterations = it;
+      // Converged on a matrix evaluated at z itself: the point's own, for its tangent.
+      if (matrix_at_z && !lu) *matrix_at_z = std::make_shared<const Eigen::MatrixXd>(std::move(A));
       return true;
     }
     if (!lu) {
@@ -249,9 +272,9 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
 
 std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z, const Eigen::VectorXd& previous,
                                                         PointType type, int index, double arclength, int iterations,
-                                                        std::shared_ptr<const Eigen::MatrixXd> reused) {
-  const bool is_reused = reused != nullptr;
-  std::shared_ptr<const Eigen::MatrixXd> A = std::move(reused);
+                                                        std::shared_ptr<const Eigen::MatrixXd> given, bool given_is_own) {
+  const bool is_reused = given != nullptr && !given_is_own;
+  std::shared_ptr<const Eigen::MatrixXd> A = std::move(given);
   if (!A) {
     Eigen::VectorXd F;
     Eigen::MatrixXd own;
@@ -326,22 +349,30 @@ void Continuation::record(ContinuationPoint* point) {
   if (options_.recorder->record) options_.recorder->record(*system_, point);
 }
 
-std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint& from, double h, PointType type) {
+std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint& from, double h, PointType type,
+                                                         const Eigen::VectorXd* curvature) {
   const Eigen::VectorXd z0 = join(from.x, from.parameter);
-  const Eigen::VectorXd z_pred = z0 + h * from.tangent;
+  Eigen::VectorXd z_pred = z0 + h * from.tangent;
+  if (curvature) z_pred += (0.5 * h * h) * *curvature;
   Eigen::VectorXd z = z_pred;
   int iterations = 0;
   bool by_chord = false;
   // The march's own steps with its matrices; a located point's correctors (and its matrix, in
   // point_at) with the problem's own, as its test functions are.
   const bool march = type == PointType::Regular;
-  if (!correct(z, z_pred, from.tangent, &iterations, from.jacobian.get(), &by_chord, march)) {
+  // The matrix Newton converged on, when it was evaluated at the point itself and is of the
+  // kind point_at evaluates for this type (the march's at resumable points, which restore()
+  // evaluates again): the point's own, not evaluated a second time.
+  std::shared_ptr<const Eigen::MatrixXd> own;
+  if (!correct(z, z_pred, from.tangent, &iterations, from.jacobian.get(), &by_chord, march,
+               march == resumable_type(type) ? &own : nullptr)) {
     // Where Newton needs the matrix to more digits than the march's (a stiff self-contact
     // barrier, where it stalled at a residual of 2e-8), the step is corrected again with the
     // problem's own before it counts as failed. Its chord iterations on the same matrix from the
     // same prediction would fail again: Newton at once.
     if (!march || !system_->has_approximate_matrices()) return std::nullopt;
     z = z_pred;
+    own.reset();
     if (!correct(z, z_pred, from.tangent, &iterations)) return std::nullopt;
   }
   // A corrector that converged quickly on the previous matrix shows that matrix still serves:
@@ -350,8 +381,10 @@ std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint
   // tangents cost three times the run time in harder correctors.)
   const bool reuse =
       by_chord && iterations <= options_.reuse_jacobian_iterations && from.jacobian && from.jacobian->rows() == n_;
-  auto point = point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations,
-                        reuse ? from.jacobian : nullptr);
+  auto point = own ? point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations,
+                              std::move(own), true)
+                   : point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations,
+                              reuse ? from.jacobian : nullptr);
   if (point) describe(&*point);
   // A corrected point that is not an admissible solution is a failed step, as a corrector that
   // did not converge is: the step shrinks, and the run ends saying why at the smallest step.
@@ -377,7 +410,7 @@ std::optional<ContinuationPoint> Continuation::at_parameter(const ContinuationPo
 
 std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& from, double h_max,
                                                       const std::function<double(const ContinuationPoint&)>& monitor,
-                                                      bool minimise, PointType type) {
+                                                      bool minimise, PointType type, const Eigen::VectorXd* curvature) {
   std::optional<ContinuationPoint> best;
   if (minimise) {
     auto f = [&](double h) {
@@ -386,30 +419,43 @@ std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& f
     };
     const auto [h, value] = boost::math::tools::brent_find_minima(f, 0.0, h_max, 40);
     (void)value;
-    best = step_from(from, h, type);
+    best = step_from(from, h, type, curvature);
   } else {
     // Illinois (modified regula falsi) on h: brackets the root and converges superlinearly.
     double a = 0.0, fa = monitor(from), b = h_max;
-    auto pb = step_from(from, b, type);
+    auto pb = step_from(from, b, type, curvature);
     if (!pb) return std::nullopt;
     double fb = monitor(*pb);
     best = pb;
+    // The monitor's values at the bracket's ends (Illinois halves fa and fb), and the trial
+    // with the smallest |monitor|.
+    double value_a = fa, value_b = fb;
+    std::optional<ContinuationPoint> smallest = pb;
+    double smallest_value = std::abs(fb);
     int side = 0;
     for (int it = 0; it < kLocateIterations && std::abs(b - a) > kLocateTolerance * h_max; ++it) {
       const double c = (a * fb - b * fa) / (fb - fa);
-      auto pc = step_from(from, c, type);
+      auto pc = step_from(from, c, type, curvature);
       if (!pc) break;  // keep the best estimate so far (e.g. at a singular point)
       const double fc = monitor(*pc);
+      if (monitor_is_noise(fc, value_a, value_b, b - a, h_max)) {
+        best = smallest;
+        break;
+      }
       best = pc;
+      if (std::abs(fc) < smallest_value) {
+        smallest = pc;
+        smallest_value = std::abs(fc);
+      }
       if (fc == 0.0) break;
       if (sign_of(fc) == sign_of(fb)) {
         b = c;
-        fb = fc;
+        fb = value_b = fc;
         if (side == -1) fa *= 0.5;
         side = -1;
       } else {
         a = c;
-        fa = fc;
+        fa = value_a = fc;
         if (side == +1) fb *= 0.5;
         side = +1;
       }
@@ -577,6 +623,7 @@ struct Continuation::Marcher {
   // count against max_points as if it had not been interrupted.
   int points_before;
   double ds;
+  std::optional<Eigen::VectorXd> curvature;  // branch_curvature() at `current`
   // Only branch points keep their matrix in the branch (for switching); the newest point's moves
   // on to `current`, for the next corrector's chord. A long branch keeping every one would hold
   // n^2 doubles per point.
@@ -640,11 +687,24 @@ struct Continuation::Marcher {
     return true;
   }
 
+  // The branch's curvature at `current`, d t / d s from the tangents of `before` and `current`
+  // and the arclength between them, for the quadratic predictor (StepControl::predictor). None
+  // where the two points are not consecutive points of one smooth piece of branch (a start, a
+  // resumed state without its predecessor, a tangent turned by more than max_tangent_angle).
+  std::optional<Eigen::VectorXd> branch_curvature() const {
+    if (o.predictor != StepControl::Predictor::Quadratic || !before || !resumable_type(before->type) || !resumable_type(current.type)) return std::nullopt;
+    const double ds_between = current.arclength - before->arclength;
+    if (!(ds_between > 0.0) || before->tangent.size() != current.tangent.size()) return std::nullopt;
+    if (!(current.tangent.dot(before->tangent) > std::cos(o.max_tangent_angle))) return std::nullopt;
+    return Eigen::VectorXd((current.tangent - before->tangent) / ds_between);
+  }
+
   // The corrected point a step ds ahead, if it is taken: a corrector failure, a turn of the
   // tangent beyond max_tangent_angle or a refusal of step_check shortens the step instead (none),
   // down to the minimum step, where the run stops (*stop).
   std::optional<ContinuationPoint> next_candidate(std::optional<detail::Stop>* stop) {
-    auto candidate = c.step_from(current, ds, PointType::Regular);
+    curvature = branch_curvature();
+    auto candidate = c.step_from(current, ds, PointType::Regular, curvature ? &*curvature : nullptr);
     if (!candidate) {
       if (refresh_current()) return std::nullopt;
       ds *= kShrink;
@@ -676,7 +736,12 @@ struct Continuation::Marcher {
                                 just_reported_branch_point, ds * kShrink >= o.min_step,
                                 [this](const ContinuationPoint& from, double h_max, const detail::TestFunction& test,
                                        bool minimise, PointType type) {
-                                  return c.locate(from, h_max, test, minimise, type);
+                                  // From `current`, the march's own predictor: the trial of the
+                                  // whole step then starts where the candidate's corrector did.
+                                  const bool from_current = from.index == current.index &&
+                                                            from.arclength == current.arclength;
+                                  return c.locate(from, h_max, test, minimise, type,
+                                                  from_current && curvature ? &*curvature : nullptr);
                                 },
                                 [this](const ContinuationPoint& located, double value) {
                                   return c.at_parameter(located, value);

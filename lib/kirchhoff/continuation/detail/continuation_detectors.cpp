@@ -19,7 +19,10 @@ class SignChange : public Detector {
     const TestFunction test = [this](const ContinuationPoint& p) { return value(p); };
     if (!crossed(value(step.current), value(step.candidate))) return Verdict::Nothing;
     auto p = step.locate(step.current, step.h, test, false, type());
-    if (!p) return Verdict::Nothing;
+    // A crossing that could not be located (a corrector failed on the step's first trial) is
+    // not passed over silently (a target run used to march on past its target): the step is
+    // retried shorter while it can be.
+    if (!p) return step.can_shrink ? Verdict::RetryShorter : Verdict::Nothing;
     if (!close_enough(*p) && step.can_shrink) return Verdict::RetryShorter;
     refine(step, &*p);
     finish(&*p);
