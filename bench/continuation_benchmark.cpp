@@ -20,6 +20,8 @@
 //       phase condition evaluates one more Jacobian at the solution (its degeneracy check).
 //   (4) the same engine at a fixed small step (a quarter of the branch's max_step: initial and
 //       max step equal, no growth), over the same branch: what the step control buys.
+//   (5) the branches (1) and (2) with the tangent predictor (StepControl::Predictor::Tangent)
+//       instead of the default quadratic one: what the predictor buys.
 // Goals (issue 24): >= 10x AUTO-07p's points per second, stated there as >= 35,000 planar and
 // >= 2,500 3D points/s on the project's 2-core machine. AUTO-07p is not run by this program
 // unless --auto-euler DIR / --auto-twist DIR name prepared AUTO run directories (an executable
@@ -272,7 +274,9 @@ void fix_step(ContinuationOptions& o, double fixed_step) {
   o.max_points = 100000;
 }
 
-Run euler_branch(bool invariants, double fixed_step = 0) {
+using Predictor = StepControl::Predictor;
+
+Run euler_branch(bool invariants, double fixed_step = 0, Predictor predictor = Predictor::Quadratic) {
   const EulerSetup& s = euler_setup();
   if (!s.error.empty()) {
     Run run;
@@ -281,11 +285,12 @@ Run euler_branch(bool invariants, double fixed_step = 0) {
   }
   ContinuationOptions o = euler_branch_options(invariants);
   fix_step(o, fixed_step);
+  o.predictor = predictor;
   Continuation branch(*s.problem, o);
   return timed(branch, [&] { return branch.switch_branch(s.branch_point); });
 }
 
-Run twist_branch(double fixed_step = 0) {
+Run twist_branch(double fixed_step = 0, Predictor predictor = Predictor::Quadratic) {
   const TwistSetup& s = twist_setup();
   if (!s.error.empty()) {
     Run run;
@@ -294,6 +299,7 @@ Run twist_branch(double fixed_step = 0) {
   }
   ContinuationOptions o = twist_branch_options();
   fix_step(o, fixed_step);
+  o.predictor = predictor;
   Continuation branch(*s.switched, o);
   return timed(branch, [&] {
     return branch.run_along(s.start.x, s.start.parameter, s.start.direction, PointType::BranchPoint);
@@ -940,6 +946,8 @@ int run_table(int reps) {
   print_branch("euler buckled, derived theta0, 2 samples", e_fast, kPlanarGoalIssue);
   const BranchStats e_inv = time_branch(reps, [] { return euler_branch(true); });
   print_branch("euler buckled, invariants on, 101 samples", e_inv, kPlanarGoalIssue);
+  const BranchStats e_tangent = time_branch(reps, [] { return euler_branch(false, 0, Predictor::Tangent); });
+  print_branch("euler buckled, tangent predictor", e_tangent, kPlanarGoalIssue);
 
   // (3a) naive Euler
   NaiveStats n_euler;
@@ -963,6 +971,8 @@ int run_table(int reps) {
   twist_branch();  // warm-up
   const BranchStats t_inv = time_branch(reps, [] { return twist_branch(); });
   print_branch("twisted buckled, invariants on, 101 samples", t_inv, kSpatialGoal);
+  const BranchStats t_tangent = time_branch(reps, [] { return twist_branch(0, Predictor::Tangent); });
+  print_branch("twisted buckled, tangent predictor", t_tangent, kSpatialGoal);
 
   // (3b) naive twisted: solve() at the branch's phi values from the previous solution
   NaiveStats n_twist;
@@ -1047,6 +1057,14 @@ int run_table(int reps) {
   if (e_fast.ok && e_inv.ok)
     std::printf("  planar: invariants on (101 samples) cost %.2fx the time per point of derived-only (2 samples)\n",
                 e_fast.points_per_s / e_inv.points_per_s);
+  if (e_fast.ok && e_tangent.ok)
+    std::printf("  planar: tangent / quadratic predictor = %.2f in time for the branch (%.1f / %.1f ms; %d / %d points)\n",
+                e_tangent.median_cpu / e_fast.median_cpu, 1e3 * e_tangent.median_cpu, 1e3 * e_fast.median_cpu,
+                e_tangent.points, e_fast.points);
+  if (t_inv.ok && t_tangent.ok)
+    std::printf("  3D:     tangent / quadratic predictor = %.2f in time for the branch (%.1f / %.1f ms; %d / %d points)\n",
+                t_tangent.median_cpu / t_inv.median_cpu, 1e3 * t_tangent.median_cpu, 1e3 * t_inv.median_cpu,
+                t_tangent.points, t_inv.points);
   if (t_inv.ok && n_twist.ok)
     std::printf("  3D:     pseudo-arclength / naive solve() per point = %.2f  (%.0f / %.0f points/s)\n",
                 t_inv.points_per_s / n_twist.points_per_s, t_inv.points_per_s, n_twist.points_per_s);
