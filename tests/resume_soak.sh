@@ -2,7 +2,12 @@
 # Developer tool (not run by CI): kills the README's continuation commands with SIGKILL at random
 # moments, resumes each with --resume, and compares the resumed CSV with the uninterrupted run's.
 #
-#   tests/resume_soak.sh N [euler|wall|twisted|arch ...]     (default: euler wall)
+#   tests/resume_soak.sh N [euler|wall|twisted|arch|wrap ...]     (default: euler wall)
+#   tests/resume_soak.sh --rows STRIDE [euler|wall|twisted|arch|wrap ...]
+#
+# With --rows, the kills are deterministic instead: after rows -1, 0, STRIDE, 2 STRIDE, ... and
+# the last row (KIRCHHOFF_TEST_KILL_AFTER_ROW, which the CLI honours for tests), each resumed and
+# compared; it prints "K of M kills matched".
 #
 # For each command: one uninterrupted run (run twice, to check it is itself reproducible), then N
 # trials that start the run, kill it after a uniformly random time in [0, its duration], resume it
@@ -10,8 +15,15 @@
 # run ended before the kill count too, and are reported). Exit status 1 when a trial differs.
 # KIRCHHOFF (default build/apps/kirchhoff) and CASES (default cases) locate the binary and cases.
 set -u
-N=${1:?usage: resume_soak.sh N [euler|wall|twisted|arch ...]}
-shift
+STRIDE=""
+if [ "${1:-}" = "--rows" ]; then
+  STRIDE=${2:?usage: resume_soak.sh --rows STRIDE [euler|wall|twisted|arch|wrap ...]}
+  shift 2
+  N=0
+else
+  N=${1:?usage: resume_soak.sh N [euler|wall|twisted|arch|wrap ...]}
+  shift
+fi
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BIN=${KIRCHHOFF:-$ROOT/build/apps/kirchhoff}
 CASES=${CASES:-$ROOT/cases}
@@ -25,7 +37,8 @@ command_of() {
     wall) echo "$CASES/wall.toml --param Delta --to 0.07 --set Delta=0.005 --set m_guess=0.9 --max-step 2 --max-points 6000" ;;
     twisted) echo "$CASES/twisted_clamped.toml --param phi --to 15 --switch-at-bp 1 --event end_to_end=0.5 --max-step 0.2" ;;
     arch) echo "$CASES/shallow_arch.toml --param w --to 120 --max-step 2" ;;
-    *) echo "unknown command '$1' (euler, wall, twisted, arch)" >&2; exit 2 ;;
+    wrap) echo "$CASES/wrapped_indenter.toml --set radius=0.5 --set half_span=0.5 --set rise=0.18 --param rise --to -0.01 --step 0.01 --max-step 1" ;;
+    *) echo "unknown command '$1' (euler, wall, twisted, arch, wrap)" >&2; exit 2 ;;
   esac
 }
 
@@ -44,6 +57,28 @@ for name in "$@"; do
     continue
   fi
   rows=$(($(wc -l < "$WORK/full.csv") - 1))
+  if [ -n "$STRIDE" ]; then
+    matched=0 kills=0 bad=""
+    for row in -1 $(seq 0 "$STRIDE" $((rows - 1))) $((rows - 1)); do
+      rm -f "$WORK/run.csv" "$WORK/run.csv.state.json"
+      # (Braced, so that the shell's "Killed" notice goes to /dev/null with the run's stderr.)
+      # shellcheck disable=SC2086
+      { KIRCHHOFF_TEST_KILL_AFTER_ROW=$row "$BIN" continue $args --out "$WORK/run.csv"; } 2>/dev/null
+      # shellcheck disable=SC2086
+      "$BIN" continue $args --out "$WORK/run.csv" --resume 2>/dev/null
+      rc=$?
+      kills=$((kills + 1))
+      if [ $rc -eq 0 ] && cmp -s "$WORK/run.csv" "$WORK/full.csv"; then
+        matched=$((matched + 1))
+      else
+        bad="$bad [after row $row: resume exit $rc]"
+        status=1
+      fi
+    done
+    printf '%s: %d of %d kills matched (after rows -1, 0, every %d-th and the last of %d rows)%s\n' \
+      "$name" "$matched" "$kills" "$STRIDE" "$rows" "$bad"
+    continue
+  fi
   matched=0 finished=0 bad=""
   for trial in $(seq 1 "$N"); do
     rm -f "$WORK/run.csv" "$WORK/run.csv.state.json"
