@@ -29,10 +29,10 @@ std::vector<std::string> euler_args(const fs::path& csv) {
           "--max-step", "1", "--out", csv.string()};
 }
 
-// The README's wall: contact at Delta = 0.02507 (row 7), the contact flattens at 0.03075
-// (row 84; row 83 is the point-contact leg's singular point there, where g'' reaches 0), the
-// flat contact buckles into a hanging fold at 0.04805 (row 236), a fold at 0.046613 (row 279),
-// Delta = 0.07 at P = 197.23 (row 359). A few seconds.
+// The README's wall: contact at Delta = 0.02507 (row 7), the contact flattens at 0.03075 (row
+// 84; row 83 is the branch point there, where a single contact moving off mid-span branches off
+// the symmetric one), the flat contact buckles into a hanging fold at 0.04805 (row 236), a fold
+// at 0.046613 (row 279), Delta = 0.07 at P = 197.23 (row 359). A few seconds.
 std::vector<std::string> wall_args(const fs::path& csv, const std::string& max_points = "6000") {
   return {KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/wall.toml", "--param", "Delta",
           "--to", "0.07", "--set", "Delta=0.005", "--set", "m_guess=0.9", "--max-step", "2",

@@ -19,10 +19,12 @@ class SignChange : public Detector {
     const TestFunction test = [this](const ContinuationPoint& p) { return value(p); };
     if (!crossed(value(step.current), value(step.candidate))) return Verdict::Nothing;
     auto p = step.locate(step.current, step.h, test, false, type());
-    // A crossing that could not be located (a corrector failed on the step's first trial) is
-    // not passed over silently (a target run used to march on past its target): the step is
-    // retried shorter while it can be.
-    if (!p) return step.can_shrink ? Verdict::RetryShorter : Verdict::Nothing;
+    // A target or an event whose crossing could not be located (a corrector failed on the
+    // locator's first trial) is not passed over (a run in log_b on the soft wall marched on past
+    // its target): the step is retried shorter while it can be. A fold's or a branch point's
+    // is: where the correctors fail next to one, the problem is singular there for another
+    // reason (the wall's point contact as it flattens, g'' = 0, which its event handles).
+    if (!p) return must_locate() && step.can_shrink ? Verdict::RetryShorter : Verdict::Nothing;
     if (!close_enough(*p) && step.can_shrink) return Verdict::RetryShorter;
     refine(step, &*p);
     finish(&*p);
@@ -37,6 +39,8 @@ class SignChange : public Detector {
   // False: the located point missed (a corrector failed inside the step) and the step is retried
   // shorter while it can be.
   virtual bool close_enough(const ContinuationPoint&) const { return true; }
+  // True: a crossing whose location failed retries the step shorter instead of being passed over.
+  virtual bool must_locate() const { return false; }
   // The located point made exact where the test function allows it (the parameter's value).
   virtual void refine(const StepView&, ContinuationPoint*) const {}
   virtual void finish(ContinuationPoint*) const {}
@@ -51,6 +55,7 @@ class ParameterValue : public SignChange {
   double value(const ContinuationPoint& p) const override { return p.parameter - value_; }
   PointType type() const override { return PointType::Endpoint; }
   std::optional<StopReason> stop() const override { return reason_; }
+  bool must_locate() const override { return true; }
   // A corrector that failed inside the step leaves the location short of the target (or the whole
   // step's point, beyond it): retried with a shorter step rather than stopped off the target.
   bool close_enough(const ContinuationPoint& p) const override { return reason_ != StopReason::ReachedTarget || near(p); }
@@ -155,6 +160,7 @@ class Event : public SignChange {
     return it == p.derived.end() ? NAN : it->second - event_.value;
   }
   PointType type() const override { return PointType::Event; }
+  bool must_locate() const override { return true; }
   std::optional<StopReason> stop() const override {
     return event_.stop ? std::optional<StopReason>(StopReason::EventStop) : std::nullopt;
   }
