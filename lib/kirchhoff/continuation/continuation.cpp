@@ -46,7 +46,6 @@ bool monitor_is_noise(double value, double at_a, double at_b, double bracket, do
          std::abs(value) > std::max(std::abs(at_a), std::abs(at_b));
 }
 
-
 // Points a march can be resumed from: a special point (fold, branch point, event, end) is found
 // by locating inside a step, and a resumed run finds it again by redoing that step.
 bool resumable_type(PointType t) { return t == PointType::Start || t == PointType::Regular; }
@@ -414,7 +413,7 @@ std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& f
   std::optional<ContinuationPoint> best;
   if (minimise) {
     auto f = [&](double h) {
-      auto p = step_from(from, h, type);
+      auto p = step_from(from, h, type, curvature);
       return p ? monitor(*p) : INFINITY;
     };
     const auto [h, value] = boost::math::tools::brent_find_minima(f, 0.0, h_max, 40);
@@ -692,7 +691,8 @@ struct Continuation::Marcher {
   // where the two points are not consecutive points of one smooth piece of branch (a start, a
   // resumed state without its predecessor, a tangent turned by more than max_tangent_angle).
   std::optional<Eigen::VectorXd> branch_curvature() const {
-    if (o.predictor != StepControl::Predictor::Quadratic || !before || !resumable_type(before->type) || !resumable_type(current.type)) return std::nullopt;
+    if (o.predictor != StepControl::Predictor::Quadratic || !before) return std::nullopt;
+    if (!resumable_type(before->type) || !resumable_type(current.type)) return std::nullopt;
     const double ds_between = current.arclength - before->arclength;
     if (!(ds_between > 0.0) || before->tangent.size() != current.tangent.size()) return std::nullopt;
     if (!(current.tangent.dot(before->tangent) > std::cos(o.max_tangent_angle))) return std::nullopt;

@@ -21,9 +21,9 @@ class SignChange : public Detector {
     auto p = step.locate(step.current, step.h, test, false, type());
     // A target or an event whose crossing could not be located (a corrector failed on the
     // locator's first trial) is not passed over (a run in log_b on the soft wall marched on past
-    // its target): the step is retried shorter while it can be. A fold's or a branch point's
-    // is: where the correctors fail next to one, the problem is singular there for another
-    // reason (the wall's point contact as it flattens, g'' = 0, which its event handles).
+    // its target): the step is retried shorter while it can be. A fold's or a branch point's is,
+    // as before: their correctors fail where the bordered matrix is near singular, which a
+    // shorter step approaches rather than avoids.
     if (!p) return must_locate() && step.can_shrink ? Verdict::RetryShorter : Verdict::Nothing;
     if (!close_enough(*p) && step.can_shrink) return Verdict::RetryShorter;
     refine(step, &*p);
