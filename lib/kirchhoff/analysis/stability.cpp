@@ -360,6 +360,13 @@ class StabilityAnalysis {
   std::string end_moment_reason(const Frame& f, const Held& end) const;
   bool constraint_correction(const Frame& f, const Held& end, const Eigen::MatrixXd& constraints,
                              const Eigen::MatrixXd& zero_modes, StabilityReport* report) const;
+  // The steps of run(): the eigenphases at s = 0, the pieces the rod is cut into, the fields
+  // carried across them, and the count at s = L.
+  PhaseTrack starting_track(const Frame& f, int held_count) const;
+  std::vector<double> piece_breaks(const std::vector<PointContact>& contacts) const;
+  std::string carry_across(Frame* f, const std::vector<PointContact>& contacts, PhaseTrack* track);
+  bool count_at_end(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start_phases, const Held& start,
+                    const Held& end, const Eigen::MatrixXd& constraints, StabilityReport* report) const;
   // The shear of the canonical momenta a point quadratic form 1/2 z^T S z of the lab
   // perturbation z = (dr, dpsi) makes (p += S_c u), in the frame's U coordinates.
   Eigen::MatrixXd canonical_shear(const Eigen::MatrixXd& lab_S) const;
@@ -968,6 +975,96 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
   return true;
 }
 
+// The eigenphases at s = 0. The fields held there start exactly at a conjugate point (U c = 0):
+// their eigenphase is pi, leaving it in the Legendre direction.
+PhaseTrack StabilityAnalysis::starting_track(const Frame& f, int held_count) const {
+  const int m = static_cast<int>(f.U.cols());
+  PhaseTrack track;
+  track.lifted = eigenphases(f.U, f.P, true);
+  std::vector<int> order(m);
+  for (int j = 0; j < m; ++j) order[j] = j;
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return std::abs(wrap(track.lifted[a] - kPi)) < std::abs(wrap(track.lifted[b] - kPi)); });
+  for (int k = 0; k < held_count; ++k) track.lifted[order[k]] = kPi;
+  for (int j = 0; j < m; ++j)
+    if (track.lifted[j] < -kPi + 1e-9) track.lifted[j] += 2 * kPi;
+  track.lowest = track.lifted;
+  track.passages.assign(m, {});
+  return track;
+}
+
+// The rod in pieces between shooting nodes and contacts (their arclengths, the ends included).
+std::vector<double> StabilityAnalysis::piece_breaks(const std::vector<PointContact>& contacts) const {
+  std::vector<double> breaks = problem_.node_arclengths(x_);
+  for (const PointContact& c : contacts) breaks.push_back(c.s);
+  breaks.push_back(scales_.length);
+  std::sort(breaks.begin(), breaks.end());
+  breaks.erase(std::unique(breaks.begin(), breaks.end(),
+                           [&](double a, double b) { return std::abs(a - b) < 1e-12 * scales_.length; }),
+               breaks.end());
+  return breaks;
+}
+
+// The fields carried from s = 0 to L across the pieces, each contact applying its jump; the
+// reason where a contact cannot be passed, else empty.
+std::string StabilityAnalysis::carry_across(Frame* f, const std::vector<PointContact>& contacts, PhaseTrack* track) {
+  const std::vector<double> breaks = piece_breaks(contacts);
+  const int pieces = static_cast<int>(breaks.size()) - 1;
+  // Steps no longer than these, so that the eigenphases, turning at ~2 rate / L, move ~0.5 rad
+  // per step at most (march takes the integrator's own steps below that).
+  const int wanted = std::max(options_.min_steps, static_cast<int>(std::ceil(4.0 * scales_.rate)));
+  const int steps = std::max(2, (wanted + pieces - 1) / pieces);
+  double shear = 0.0;  // of the contact just passed
+  for (int i = 0; i < pieces; ++i) {
+    const double longest = (breaks[i + 1] - breaks[i]) / steps;
+    // Past a contact whose shear S is large (the contact near flattening, f / g'' large) the
+    // fields turn on the length L / S: steps grow geometrically from a fraction of it, so no
+    // eigenphase turns a whole turn within one (which a step could not tell from no turn).
+    for (double h = 0.25 * scales_.length / (1.0 + shear); shear > 0 && h < longest; h *= 2)
+      advance(f, breaks[i] + h, track, 0);
+    shear = 0.0;
+    march(f, breaks[i + 1], longest, track);
+    for (size_t c = 0; c < contacts.size(); ++c) {
+      if (std::abs(contacts[c].s - breaks[i + 1]) > 1e-12 * scales_.length) continue;
+      if (std::string why = pass_contact(f, contacts[c], static_cast<int>(c), track, &shear); !why.empty()) return why;
+    }
+  }
+  return "";
+}
+
+// The index from the fields at s = L: the conjugate points inside, the end's terms, the
+// isoperimetric correction and the zero modes; false (report->reason set) where it is not defined.
+bool StabilityAnalysis::count_at_end(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start_phases,
+                                     const Held& start, const Held& end, const Eigen::MatrixXd& constraints,
+                                     StabilityReport* report) const {
+  if (track.reversed) {
+    std::ostringstream reason;
+    reason << "an eigenphase passed against the Legendre direction near s = " << track.reversed_at
+           << ": the Jacobi system is degenerate there and the count is not valid";
+    report->reason = reason.str();
+    return false;
+  }
+  if (!count_interior(f, track, start_phases, report)) return false;
+  if (std::string why = end_moment_reason(f, end); !why.empty()) {
+    report->reason = why;
+    return false;
+  }
+  const Eigen::MatrixXd zero_modes = end_terms(f, end, report);
+  report->dead_load_index = report->interior_count + report->end_count;
+  if (!constraint_correction(f, end, constraints, zero_modes, report)) return false;
+  // Rigid translations along directions neither end holds map equilibria to equilibria (the full
+  // frame carries them, and counts them where they are zero modes).
+  Eigen::MatrixXd held(coords_.kr(), start.position.cols() + end.position.cols());
+  held << start.position, end.position;
+  if (!full_) report->zero_modes += coords_.kr() - static_cast<int>(column_basis(held).cols());
+  report->index = report->dead_load_index + report->constraint_correction;
+  if (*report->index < 0) {
+    report->reason = "the isoperimetric correction exceeds the load-controlled index: degenerate constraints";
+    report->index.reset();
+  }
+  return true;
+}
+
 StabilityReport StabilityAnalysis::run() {
   StabilityReport report;
   std::vector<std::string> multipliers;
@@ -991,87 +1088,21 @@ StabilityReport StabilityAnalysis::run() {
 
   Frame f = start_frame(start, start_multipliers, static_cast<int>(contacts.size()),
                         full_ ? static_cast<int>(end.position.cols()) : 0);
-  const int m = static_cast<int>(f.U.cols());
   const Eigen::MatrixXd lagrange = f.U.transpose() * f.P - f.P.transpose() * f.U;
   if (lagrange.norm() > 1e-8 * (1.0 + f.U.norm() * f.P.norm())) {
     report.reason = "the start's loads are not conservative (a dead couple on an end free to rotate in 3D)";
     return report;
   }
   orthonormalise(&f);
-  PhaseTrack track;
-  track.lifted = eigenphases(f.U, f.P, true);
-  // The fields held at s = 0 start exactly at a conjugate point (U c = 0): their eigenphase is pi,
-  // leaving it in the Legendre direction.
-  const int held_count = static_cast<int>(start.rotation.cols());
-  std::vector<int> order(m);
-  for (int j = 0; j < m; ++j) order[j] = j;
-  std::sort(order.begin(), order.end(),
-            [&](int a, int b) { return std::abs(wrap(track.lifted[a] - kPi)) < std::abs(wrap(track.lifted[b] - kPi)); });
-  for (int k = 0; k < held_count; ++k) track.lifted[order[k]] = kPi;
-  for (int j = 0; j < m; ++j)
-    if (track.lifted[j] < -kPi + 1e-9) track.lifted[j] += 2 * kPi;
+  PhaseTrack track = starting_track(f, static_cast<int>(start.rotation.cols()));
   const Eigen::VectorXd start_phases = track.lifted;
-  track.lowest = start_phases;
-  track.passages.assign(m, {});
-
-  // The rod in pieces between shooting nodes and contacts; the equilibrium is integrated across
-  // them from its start (each contact applies its jump).
-  std::vector<double> breaks = problem_.node_arclengths(x_);
-  for (const PointContact& c : contacts) breaks.push_back(c.s);
-  breaks.push_back(scales_.length);
-  std::sort(breaks.begin(), breaks.end());
-  breaks.erase(std::unique(breaks.begin(), breaks.end(),
-                           [&](double a, double b) { return std::abs(a - b) < 1e-12 * scales_.length; }),
-               breaks.end());
-  const int pieces = static_cast<int>(breaks.size()) - 1;
-  // Steps no longer than these, so that the eigenphases, turning at ~2 rate / L, move ~0.5 rad
-  // per step at most (march takes the integrator's own steps below that).
-  const int wanted = std::max(options_.min_steps, static_cast<int>(std::ceil(4.0 * scales_.rate)));
-  const int steps = std::max(2, (wanted + pieces - 1) / pieces);
-  double shear = 0.0;  // of the contact just passed
-  for (int i = 0; i < pieces; ++i) {
-    const double longest = (breaks[i + 1] - breaks[i]) / steps;
-    // Past a contact whose shear S is large (the contact near flattening, f / g'' large) the
-    // fields turn on the length L / S: steps grow geometrically from a fraction of it, so no
-    // eigenphase turns a whole turn within one (which a step could not tell from no turn).
-    for (double h = 0.25 * scales_.length / (1.0 + shear); shear > 0 && h < longest; h *= 2)
-      advance(&f, breaks[i] + h, &track, 0);
-    shear = 0.0;
-    march(&f, breaks[i + 1], longest, &track);
-    for (size_t c = 0; c < contacts.size(); ++c) {
-      if (std::abs(contacts[c].s - breaks[i + 1]) > 1e-12 * scales_.length) continue;
-      if (std::string why = pass_contact(&f, contacts[c], static_cast<int>(c), &track, &shear); !why.empty()) {
-        report.reason = why;
-        return report;
-      }
-    }
-  }
-  report.rhs_evaluations = rhs_;
-  if (track.reversed) {
-    std::ostringstream reason;
-    reason << "an eigenphase passed against the Legendre direction near s = " << track.reversed_at
-           << ": the Jacobi system is degenerate there and the count is not valid";
-    report.reason = reason.str();
-    return report;
-  }
-  if (!count_interior(f, track, start_phases, &report)) return report;
-  if (std::string why = end_moment_reason(f, end); !why.empty()) {
+  why = carry_across(&f, contacts, &track);
+  if (!why.empty()) {
     report.reason = why;
     return report;
   }
-  const Eigen::MatrixXd zero_modes = end_terms(f, end, &report);
-  report.dead_load_index = report.interior_count + report.end_count;
-  if (!constraint_correction(f, end, constraints, zero_modes, &report)) return report;
-  // Rigid translations along directions neither end holds map equilibria to equilibria (the full
-  // frame carries them, and counts them where they are zero modes).
-  Eigen::MatrixXd held(coords_.kr(), start.position.cols() + end.position.cols());
-  held << start.position, end.position;
-  if (!full_) report.zero_modes += coords_.kr() - static_cast<int>(column_basis(held).cols());
-  report.index = report.dead_load_index + report.constraint_correction;
-  if (*report.index < 0) {
-    report.reason = "the isoperimetric correction exceeds the load-controlled index: degenerate constraints";
-    report.index.reset();
-  }
+  report.rhs_evaluations = rhs_;
+  count_at_end(f, track, start_phases, start, end, constraints, &report);
   return report;
 }
 
