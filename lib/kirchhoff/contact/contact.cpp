@@ -647,123 +647,172 @@ ContinuationOptions leg_options(const ContinuationOptions& options, const Proble
   return leg;
 }
 
-// The legs of a contact continuation, from unknowns x (a new run) or from a saved state (a resume).
-ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const ContactMarchState* resume_from,
-                                   ContinuationOptions options, const PointSink& sink, const ContactOptions& contact,
-                                   const ActiveSetSink& active_set_sink, const ContactStateSink& state_sink,
-                                   ContactContinuationResult out, const ContinuationPoint* switch_at = nullptr,
-                                   double side = 1.0) {
-  const int max_points = options.max_points;
-  bool first_leg = true;  // the first leg of this call (its start is not a point reported before)
-  // The run's points reported so far and whether the leg is the run's first: with a resume they
-  // continue those of the interrupted run, so that the legs' shares of max_points are the same.
-  int reported = resume_from ? resume_from->reported : 0;
-  bool run_first_leg = resume_from ? resume_from->first_leg : true;
-  // Branch points found by earlier legs: stop_at_branch_point counts the run's, not one leg's.
-  int branch_points_before = resume_from ? resume_from->branch_points_before : 0;
-  // Set when a flat contact has just buckled: the next leg leaves the flat branch along the fold.
-  std::optional<ContinuationPoint> fold_onset;
-  size_t fold_contact = 0;  // the first of the fold's two contacts
-  std::optional<double> unwound_bending;  // g'' of a contact that has just shrunk to a point
-  std::optional<size_t> unwound_contact;  // which one, set at the event
-  while (true) {
-    const bool resuming = first_leg && resume_from;
+// The legs of a contact continuation, one continuation per active set, each ending at the event
+// where the set changes; from unknowns x (a new run) or from a saved state (a resume).
+class LegMarch {
+ public:
+  LegMarch(ProblemDefinition d, Eigen::VectorXd x, const ContactMarchState* resume_from, ContinuationOptions options,
+           const PointSink& sink, const ContactOptions& contact, const ActiveSetSink& active_set_sink,
+           const ContactStateSink& state_sink, const ContinuationPoint* switch_at, double side)
+      : d_(std::move(d)),
+        x_(std::move(x)),
+        resume_from_(resume_from),
+        options_(std::move(options)),
+        sink_(sink),
+        contact_(contact),
+        active_set_sink_(active_set_sink),
+        state_sink_(state_sink),
+        switch_at_(switch_at),
+        side_(side),
+        reported_(resume_from ? resume_from->reported : 0),
+        run_first_leg_(resume_from ? resume_from->first_leg : true),
+        branch_points_before_(resume_from ? resume_from->branch_points_before : 0) {}
+
+  ContactContinuationResult run(ContactContinuationResult out) {
+    while (true) {
+      const ShootingProblem problem(d_);
+      const ContinuationResult r = follow_leg(problem);
+      out.result.points.insert(out.result.points.end(), r.points.begin(), r.points.end());
+      out.result.reason = r.reason;
+      out.result.message = r.message;
+      out.definition = d_;
+      first_leg_ = false;
+      run_first_leg_ = false;
+      if (r.reason != StopReason::EventStop || r.points.empty()) return out;
+      if (!change_active_set(problem, r.points.back(), &out)) return out;
+    }
+  }
+
+ private:
+  // One leg on the present active set, to its first stopping event; its points without its
+  // start where that is the previous leg's last point, and without a point that violates
+  // complementarity or any after it (the run then stops as inadmissible).
+  ContinuationResult follow_leg(const ShootingProblem& problem) {
+    const bool resuming = first_leg_ && resume_from_;
     // After a contact shrank to a point, contact_flattens is armed at its g'' there.
-    const double bending_event = resuming ? resume_from->contact_bending_event : unwound_bending.value_or(0.0);
-    unwound_bending.reset();
-    std::vector<ContactChange> changes;  // of the leg's events after the caller's
-    ContinuationOptions leg = leg_options(options, d, contact, bending_event, &changes);
+    const double bending_event = resuming ? resume_from_->contact_bending_event : unwound_bending_.value_or(0.0);
+    unwound_bending_.reset();
+    ContinuationOptions leg = leg_options(options_, d_, contact_, bending_event, &changes_);
     // (A later leg's start is the last point of the previous one, counted there.)
-    leg.max_points = resuming ? resume_from->leg_max_points : max_points - reported + (run_first_leg ? 0 : 1);
-    if (options.stop_at_branch_point > 0) leg.stop_at_branch_point = options.stop_at_branch_point - branch_points_before;
-    const ShootingProblem problem(d);
-    if (active_set_sink) active_set_sink(d.contacts);
+    leg.max_points =
+        resuming ? resume_from_->leg_max_points : options_.max_points - reported_ + (run_first_leg_ ? 0 : 1);
+    if (options_.stop_at_branch_point > 0)
+      leg.stop_at_branch_point = options_.stop_at_branch_point - branch_points_before_;
+    if (active_set_sink_) active_set_sink_(d_.contacts);
     // A leg starts on the previous leg's last point, which is already reported. A point that
     // violates complementarity (an event missed, e.g. a leg started where two changes coincide)
     // ends the run there: it and the points after it are not reported.
-    bool skip = !first_leg;
+    bool skip = !first_leg_;
     std::string violation;
     auto leg_sink = [&](const ContinuationPoint& p) {
       if (skip) {
         skip = false;
         return;
       }
-      if (violation.empty()) violation = complementarity_violation(p, contact);
+      if (violation.empty()) violation = complementarity_violation(p, contact_);
       if (violation.empty()) {
-        ++reported;
-        if (sink) sink(p);
+        ++reported_;
+        if (sink_) sink_(p);
       }
     };
     // The state to resume from at each resumable point of the leg, the leg's start included: a
     // later leg's start (not reported: it is the previous leg's event point) is where a run
     // killed before the leg's first new point resumes, without redoing the change of active set.
     leg.on_resumable = nullptr;
-    if (state_sink)
+    if (state_sink_)
       leg.on_resumable = [&, leg_max_points = leg.max_points, bending_event](const MarchState& m) {
-        if (violation.empty()) state_sink({m, d.contacts, bending_event, leg_max_points, reported, run_first_leg,
-                                          branch_points_before});
+        if (violation.empty())
+          state_sink_({m, d_.contacts, bending_event, leg_max_points, reported_, run_first_leg_, branch_points_before_});
       };
-    const bool switching = first_leg && switch_at && !resuming;
-    ContinuationResult r = resuming    ? Continuation(problem, leg).resume(resume_from->march, leg_sink)
-                           : switching ? Continuation(problem, leg).switch_branch(*switch_at, leg_sink, side)
-                           : fold_onset ? leave_flat_branch(problem, leg, *fold_onset, fold_contact, leg_sink)
-                                        : Continuation(problem, leg).run(x, leg_sink);
-    fold_onset.reset();
-    if (!first_leg && !r.points.empty()) r.points.erase(r.points.begin());
+    const bool switching = first_leg_ && switch_at_ && !resuming;
+    ContinuationResult r = resuming    ? Continuation(problem, leg).resume(resume_from_->march, leg_sink)
+                           : switching ? Continuation(problem, leg).switch_branch(*switch_at_, leg_sink, side_)
+                           : fold_onset_ ? leave_flat_branch(problem, leg, *fold_onset_, fold_contact_, leg_sink)
+                                         : Continuation(problem, leg).run(x_, leg_sink);
+    fold_onset_.reset();
+    if (!first_leg_ && !r.points.empty()) r.points.erase(r.points.begin());
     // (The switched leg's start is the branch point switched at, not one found on this branch.)
-    branch_points_before += static_cast<int>(
+    branch_points_before_ += static_cast<int>(
         std::count_if(r.points.begin() + (switching && !r.points.empty() ? 1 : 0), r.points.end(),
                       [](const ContinuationPoint& p) { return p.type == PointType::BranchPoint; }));
     if (!violation.empty()) {
       const auto bad = std::find_if(r.points.begin(), r.points.end(), [&](const ContinuationPoint& p) {
-        return !complementarity_violation(p, contact).empty();
+        return !complementarity_violation(p, contact_).empty();
       });
       r.points.erase(bad, r.points.end());
       r.reason = StopReason::Inadmissible;
       r.message = "the branch leaves the admissible set: " + violation + " (no event located before it)";
     }
-    out.result.points.insert(out.result.points.end(), r.points.begin(), r.points.end());
-    out.result.reason = r.reason;
-    out.result.message = r.message;
-    out.definition = d;
-    first_leg = false;
-    run_first_leg = false;
-    if (r.reason != StopReason::EventStop || r.points.empty()) return out;
+    return r;
+  }
 
-    // The active set changes at the event point.
-    const ContinuationPoint& at = r.points.back();
+  // The active set changed at the leg's event point `at`: the next leg's set and starting
+  // unknowns, and the change logged in *out; false where the run ends there (a stopping event of
+  // the caller's, or a change that is not modelled or not admissible).
+  bool change_active_set(const ShootingProblem& problem, const ContinuationPoint& at, ContactContinuationResult* out) {
     ShootingProblem here = problem;
-    here.set_parameter(options.parameter, at.parameter);
+    here.set_parameter(options_.parameter, at.parameter);
     std::ostringstream change;
-    change << options.parameter << " = " << at.parameter << ": ";
+    change << options_.parameter << " = " << at.parameter << ": ";
     const auto contacts = here.contacts_at(at.x);
     // A stopping event of the caller's ends the run there; the leg's own change the active set.
-    const int own = at.event_index - static_cast<int>(options.events.size());
-    if (own < 0) return out;
-    ChangeAt c{here, at, contacts, contact, change};
-    if (const auto end = kind_of(changes[own]).handle(c)) {
-      if (end->inadmissible) out.result.reason = StopReason::Inadmissible;
-      out.result.message = end->inadmissible ? end->message + "; the run stops here" : end->message;
-      out.changes.push_back(change.str() + out.result.message);
-      return out;
+    const int own = at.event_index - static_cast<int>(options_.events.size());
+    if (own < 0) return false;
+    ChangeAt c{here, at, contacts, contact_, change};
+    if (const auto end = kind_of(changes_[own]).handle(c)) {
+      if (end->inadmissible) out->result.reason = StopReason::Inadmissible;
+      out->result.message = end->inadmissible ? end->message + "; the run stops here" : end->message;
+      out->changes.push_back(change.str() + out->result.message);
+      return false;
     }
-    d.contacts = std::move(c.next);
-    if (c.fold_onset) fold_onset = std::move(c.fold_onset);
-    fold_contact = c.fold_contact;
-    unwound_contact = c.unwound_contact;
-    out.changes.push_back(change.str());
-    out.result.points.back().event = change.str();
+    d_.contacts = std::move(c.next);
+    if (c.fold_onset) fold_onset_ = std::move(c.fold_onset);
+    fold_contact_ = c.fold_contact;
+    out->changes.push_back(change.str());
+    out->result.points.back().event = change.str();
     // The next leg starts from the same configuration with the new set.
-    ProblemDefinition next_definition = d;
-    next_definition.parameters.set(options.parameter, at.parameter);
+    ProblemDefinition next_definition = d_;
+    next_definition.parameters.set(options_.parameter, at.parameter);
     const ShootingProblem next(next_definition);
-    x = carry_over(problem, at.x, next);
-    if (unwound_contact) unwound_bending = next.contact_bending(x, next.contacts_at(x)[*unwound_contact]);
-    unwound_contact.reset();
-    d = next_definition;
+    x_ = carry_over(problem, at.x, next);
+    if (c.unwound_contact) unwound_bending_ = next.contact_bending(x_, next.contacts_at(x_)[*c.unwound_contact]);
+    d_ = next_definition;
+    return true;
   }
-}
 
+  ProblemDefinition d_;  // the present leg's, with its active set
+  Eigen::VectorXd x_;    // its starting unknowns
+  const ContactMarchState* resume_from_;
+  const ContinuationOptions options_;
+  const PointSink& sink_;
+  const ContactOptions& contact_;
+  const ActiveSetSink& active_set_sink_;
+  const ContactStateSink& state_sink_;
+  const ContinuationPoint* switch_at_;
+  double side_;
+  bool first_leg_ = true;  // the first leg of this call (its start is not a point reported before)
+  // The run's points reported so far and whether the leg is the run's first: with a resume they
+  // continue those of the interrupted run, so that the legs' shares of max_points are the same.
+  int reported_;
+  bool run_first_leg_;
+  // Branch points found by earlier legs: stop_at_branch_point counts the run's, not one leg's.
+  int branch_points_before_;
+  std::vector<ContactChange> changes_;  // of the present leg's events after the caller's
+  // Set when a flat contact has just buckled: the next leg leaves the flat branch along the fold.
+  std::optional<ContinuationPoint> fold_onset_;
+  size_t fold_contact_ = 0;  // the first of the fold's two contacts
+  std::optional<double> unwound_bending_;  // g'' of a contact that has just shrunk to a point
+};
+
+ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const ContactMarchState* resume_from,
+                                   ContinuationOptions options, const PointSink& sink, const ContactOptions& contact,
+                                   const ActiveSetSink& active_set_sink, const ContactStateSink& state_sink,
+                                   ContactContinuationResult out, const ContinuationPoint* switch_at = nullptr,
+                                   double side = 1.0) {
+  LegMarch legs(std::move(d), std::move(x), resume_from, std::move(options), sink, contact, active_set_sink,
+                state_sink, switch_at, side);
+  return legs.run(std::move(out));
+}
 
 }  // namespace
 
