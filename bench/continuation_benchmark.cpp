@@ -36,7 +36,7 @@
 //                          [--auto-euler DIR] [--auto-twist DIR] [--tight-march]
 //                                        the timed table (default; --summary is accepted too):
 //                                        N repetitions of each timed run (default 7), medians;
-//                                        max steps default to 1.0 (127 points) and 0.23 (139);
+//                                        max steps default to 1.0 (88 points) and 0.23 (129);
 //                                        AUTO-07p timed side by side when its run directories
 //                                        are given (see above).
 //   continuation_benchmark --once euler|euler-inv|twist
