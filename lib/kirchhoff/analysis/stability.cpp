@@ -365,7 +365,7 @@ class StabilityAnalysis {
   PhaseTrack starting_track(const Frame& f, int held_count) const;
   std::vector<double> piece_breaks(const std::vector<PointContact>& contacts) const;
   std::string carry_across(Frame* f, const std::vector<PointContact>& contacts, PhaseTrack* track);
-  bool count_at_end(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start_phases, const Held& start,
+  void count_at_end(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start_phases, const Held& start,
                     const Held& end, const Eigen::MatrixXd& constraints, StabilityReport* report) const;
   // The shear of the canonical momenta a point quadratic form 1/2 z^T S z of the lab
   // perturbation z = (dr, dpsi) makes (p += S_c u), in the frame's U coordinates.
@@ -1034,7 +1034,7 @@ std::string StabilityAnalysis::carry_across(Frame* f, const std::vector<PointCon
 
 // The index from the fields at s = L: the conjugate points inside, the end's terms, the
 // isoperimetric correction and the zero modes; false (report->reason set) where it is not defined.
-bool StabilityAnalysis::count_at_end(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start_phases,
+void StabilityAnalysis::count_at_end(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start_phases,
                                      const Held& start, const Held& end, const Eigen::MatrixXd& constraints,
                                      StabilityReport* report) const {
   if (track.reversed) {
@@ -1042,16 +1042,16 @@ bool StabilityAnalysis::count_at_end(const Frame& f, const PhaseTrack& track, co
     reason << "an eigenphase passed against the Legendre direction near s = " << track.reversed_at
            << ": the Jacobi system is degenerate there and the count is not valid";
     report->reason = reason.str();
-    return false;
+    return;
   }
-  if (!count_interior(f, track, start_phases, report)) return false;
+  if (!count_interior(f, track, start_phases, report)) return;
   if (std::string why = end_moment_reason(f, end); !why.empty()) {
     report->reason = why;
-    return false;
+    return;
   }
   const Eigen::MatrixXd zero_modes = end_terms(f, end, report);
   report->dead_load_index = report->interior_count + report->end_count;
-  if (!constraint_correction(f, end, constraints, zero_modes, report)) return false;
+  if (!constraint_correction(f, end, constraints, zero_modes, report)) return;
   // Rigid translations along directions neither end holds map equilibria to equilibria (the full
   // frame carries them, and counts them where they are zero modes).
   Eigen::MatrixXd held(coords_.kr(), start.position.cols() + end.position.cols());
@@ -1062,7 +1062,6 @@ bool StabilityAnalysis::count_at_end(const Frame& f, const PhaseTrack& track, co
     report->reason = "the isoperimetric correction exceeds the load-controlled index: degenerate constraints";
     report->index.reset();
   }
-  return true;
 }
 
 StabilityReport StabilityAnalysis::run() {

@@ -380,10 +380,10 @@ std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint
   // tangents cost three times the run time in harder correctors.)
   const bool reuse =
       by_chord && iterations <= options_.reuse_jacobian_iterations && from.jacobian && from.jacobian->rows() == n_;
-  auto point = own ? point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations,
-                              std::move(own), true)
-                   : point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations,
-                              reuse ? from.jacobian : nullptr);
+  const bool is_own = own != nullptr;
+  std::shared_ptr<const Eigen::MatrixXd> given = is_own ? std::move(own) : reuse ? from.jacobian : nullptr;
+  auto point = point_at(z, from.tangent, type, from.index + 1, from.arclength + (z - z0).norm(), iterations,
+                        std::move(given), is_own);
   if (point) describe(&*point);
   // A corrected point that is not an admissible solution is a failed step, as a corrector that
   // did not converge is: the step shrinks, and the run ends saying why at the smallest step.
@@ -622,7 +622,6 @@ struct Continuation::Marcher {
   // count against max_points as if it had not been interrupted.
   int points_before;
   double ds;
-  std::optional<Eigen::VectorXd> curvature;  // branch_curvature() at `current`
   // Only branch points keep their matrix in the branch (for switching); the newest point's moves
   // on to `current`, for the next corrector's chord. A long branch keeping every one would hold
   // n^2 doubles per point.
@@ -703,7 +702,7 @@ struct Continuation::Marcher {
   // tangent beyond max_tangent_angle or a refusal of step_check shortens the step instead (none),
   // down to the minimum step, where the run stops (*stop).
   std::optional<ContinuationPoint> next_candidate(std::optional<detail::Stop>* stop) {
-    curvature = branch_curvature();
+    const std::optional<Eigen::VectorXd> curvature = branch_curvature();
     auto candidate = c.step_from(current, ds, PointType::Regular, curvature ? &*curvature : nullptr);
     if (!candidate) {
       if (refresh_current()) return std::nullopt;
@@ -740,8 +739,9 @@ struct Continuation::Marcher {
                                   // whole step then starts where the candidate's corrector did.
                                   const bool from_current = from.index == current.index &&
                                                             from.arclength == current.arclength;
+                                  const auto curvature = from_current ? branch_curvature() : std::nullopt;
                                   return c.locate(from, h_max, test, minimise, type,
-                                                  from_current && curvature ? &*curvature : nullptr);
+                                                  curvature ? &*curvature : nullptr);
                                 },
                                 [this](const ContinuationPoint& located, double value) {
                                   return c.at_parameter(located, value);

@@ -27,7 +27,7 @@ class JacobianLU {
   // False when the factorisation broke down (an exactly singular sparse matrix).
   bool ok() const { return ok_; }
   bool sparse() const { return sparse_ != nullptr; }
-  bool transposed() const { return sparse_ != nullptr && transposed_; }  // factors of M^T (a dense row)
+  bool transposed() const { return transposed_; }  // sparse factors of M^T (a dense row)
   // 1 / cond_1 estimate (of the row-equilibrated matrix when large); for dense matrices also at most the
   // smallest pivot over the largest (a cheap guard that the estimate alone can miss). 0 when the
   // factorisation failed.
