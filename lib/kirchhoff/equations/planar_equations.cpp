@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 
+#include "kirchhoff/equations/detail/compliances.hpp"
 #include "kirchhoff/equations/detail/field_eval.hpp"
 #include "kirchhoff/equations/detail/integrator_impl.hpp"
 #include "kirchhoff/equations/detail/planar_state.hpp"
@@ -24,7 +25,7 @@ constexpr int kStateSize = kPlanarStateSize;
 
 class PlanarEquations final : public RodEquations {
  public:
-  explicit PlanarEquations(RodModel model) : model_(std::move(model)) {}
+  explicit PlanarEquations(RodModel model) : model_(std::move(model)), compliances_(model_) {}
 
   int state_size() const override { return kStateSize; }
   const RodModel& model() const override { return model_; }
@@ -39,14 +40,14 @@ class PlanarEquations final : public RodEquations {
     if (model_.extensible) {
       const T n1 = -y[kNx] * sn + y[kNy] * c;
       const T n3 = y[kNx] * c + y[kNy] * sn;
-      v1 = v1 + n1 * (1.0 / model_.A[0](s));
-      v3 = v3 + n3 * (1.0 / model_.A[2](s));
+      v1 = v1 + n1 * compliances_.stretching(model_, 0, s);
+      v3 = v3 + n3 * compliances_.stretching(model_, 2, s);
     }
     const T dx = -v1 * sn + v3 * c;
     const T dyy = v1 * c + v3 * sn;
     dy[kX] = dx;
     dy[kY] = dyy;
-    dy[kTheta] = model_.u_hat[1](s) + y[kMoment] * (1.0 / model_.B[1](s));
+    dy[kTheta] = model_.u_hat[1](s) + y[kMoment] * compliances_.bending(model_, 1, s);
     if (model_.field) {
       const T r[3] = {y[kX], y[kY], T(0.0)};
       T f[3];
@@ -193,13 +194,13 @@ class PlanarEquations final : public RodEquations {
     if (model_.extensible) {
       n1 = -y[kNx] * sn + y[kNy] * c;
       n3 = y[kNx] * c + y[kNy] * sn;
-      compliance1 = 1.0 / model_.A[0](s);
-      compliance3 = 1.0 / model_.A[2](s);
+      compliance1 = compliances_.stretching(model_, 0, s);
+      compliance3 = compliances_.stretching(model_, 2, s);
       v1 += n1 * compliance1;
       v3 += n3 * compliance3;
     }
     const double dx = -v1 * sn + v3 * c, dyy = v1 * c + v3 * sn;
-    const double flexibility = 1.0 / model_.B[1](s);
+    const double flexibility = compliances_.bending(model_, 1, s);
     dy[kX] = dx;
     dy[kY] = dyy;
     dy[kTheta] = model_.u_hat[1](s) + y[kMoment] * flexibility;
@@ -245,6 +246,7 @@ class PlanarEquations final : public RodEquations {
   }
 
   RodModel model_;
+  detail::Compliances compliances_;  // of model_ (declared after it: built from it)
 };
 
 }  // namespace

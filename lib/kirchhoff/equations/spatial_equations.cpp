@@ -17,10 +17,12 @@
 #include <optional>
 #include <stdexcept>
 
+#include "kirchhoff/equations/detail/compliances.hpp"
 #include "kirchhoff/equations/detail/field_eval.hpp"
 #include "kirchhoff/equations/detail/integrator_impl.hpp"
 #include "kirchhoff/equations/detail/rod_on_cylinder_impl.hpp"
 #include "kirchhoff/equations/detail/spatial_state.hpp"
+#include "kirchhoff/equations/detail/spatial_variations.hpp"
 #include "kirchhoff/equations/rod_equations.hpp"
 
 namespace kirchhoff {
@@ -42,7 +44,7 @@ Eigen::Vector4d quaternion_from_rotation(const Mat3& R) {
 class SpatialEquations final : public RodEquations {
  public:
   explicit SpatialEquations(RodModel model, std::optional<CylinderSupport> support = std::nullopt)
-      : model_(std::move(model)), support_(std::move(support)),
+      : model_(std::move(model)), compliances_(model_), support_(std::move(support)),
         tangent_stiffness_(model_.field && !support_ && model_.field->has_tangent_stiffness()) {}
 
   int state_size() const override { return kStateSize; }
@@ -56,10 +58,10 @@ class SpatialEquations final : public RodEquations {
     T u[3], v[3];
     for (int i = 0; i < 3; ++i) {
       const T m_body = R[0][i] * y[kM] + R[1][i] * y[kM + 1] + R[2][i] * y[kM + 2];
-      u[i] = model_.u_hat[i](s) + m_body * (1.0 / model_.B[i](s));
+      u[i] = model_.u_hat[i](s) + m_body * compliances_.bending(model_, i, s);
       if (model_.extensible) {
         const T n_body = R[0][i] * y[kN] + R[1][i] * y[kN + 1] + R[2][i] * y[kN + 2];
-        v[i] = model_.v_hat[i](s) + n_body * (1.0 / model_.A[i](s));
+        v[i] = model_.v_hat[i](s) + n_body * compliances_.stretching(model_, i, s);
       } else {
         v[i] = T(model_.v_hat[i](s));
       }
@@ -125,6 +127,14 @@ class SpatialEquations final : public RodEquations {
                    const IntegratorOptions& options) const override {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     if (!sensitivities) return detail::flow_state<kStateSize>(f, y0, s0, s1, options);
+    // The looser matrices of a rod without field or cylinder: the variational equations written
+    // out (spatial_variations.hpp) instead of dual numbers.
+    if (options.sensitivity_tol > options.abs_tol && detail::has_written_out_variations(model_, support_.has_value())) {
+      auto state_rhs = [this](const double* y, double* dy, double s) { rhs(y, dy, s); };
+      return detail::flow_with_loose_pass<kStateSize>(f, y0, s0, s1, options, [&](const IntegratorOptions& loose) {
+        return detail::written_out_variations_pass(model_, compliances_, state_rhs, y0, s0, s1, loose);
+      });
+    }
     // Nothing depends on chi(s0), and without a field or a cylinder nothing depends on r(s0)
     // either: their columns of Phi are unit vectors, and only the other directions are carried by
     // the dual numbers (13 with a field - self-contact, gravity - or a cylinder, 10 without).
@@ -279,6 +289,7 @@ class SpatialEquations final : public RodEquations {
 
  private:
   RodModel model_;
+  detail::Compliances compliances_;         // of model_ (declared after it: built from it)
   std::optional<CylinderSupport> support_;  // set: the rod lies on this cylinder
   bool tangent_stiffness_ = false;           // the field has a tangent stiffness (rod_model.hpp)
 };
