@@ -646,6 +646,33 @@ void add_axial_phase_condition(ProblemDefinition& d) {
 
 void limit_wall_clock(ShootingOptions& options, double seconds) { options.newton.deadline = deadline_after(seconds); }
 
+namespace {
+
+// How far above its tolerance a step matrix's reciprocal condition estimate must be for the exact
+// Jacobian to be certainly far from singular. The step matrix differs from the exact one by about
+// its tolerance (relative), which moves a reciprocal condition number by about as much, and LU's
+// estimate may exceed the true value by a factor of the order of the size (tens here): an
+// estimate 1e4 times the tolerance (1e-4 at the default 1e-8) leaves the exact matrix's reciprocal
+// condition at ~1e-6 or more, six orders above the singular thresholds (1e-12).
+constexpr double kClearlyRegular = 1e4;
+
+// Whether the Jacobian at x has a reciprocal condition number at or below `threshold`. The step
+// matrix (NewtonOptions::step_matrix_tolerance, a quarter of the exact matrix's cost on a 3D rod)
+// answers where it is clearly regular; otherwise the exact matrix decides.
+bool singular_at_solution(const ShootingProblem& problem, const Eigen::VectorXd& x, double threshold) {
+  Eigen::VectorXd F;
+  Eigen::MatrixXd J;
+  std::string failure;
+  const double step_tolerance = problem.definition().options.newton.step_matrix_tolerance;
+  if (step_tolerance > 0 && problem.has_step_matrices(step_tolerance) &&
+      problem.evaluate_for_step(x, &F, &J, step_tolerance, &failure) &&
+      JacobianLU(J).reciprocal_condition() > std::max(kClearlyRegular * step_tolerance, threshold))
+    return false;
+  return problem.evaluate(x, &F, &J, &failure) && !(JacobianLU(J).reciprocal_condition() > threshold);
+}
+
+}  // namespace
+
 ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) {
   ShootingResult result;
   result.x = x0;
@@ -662,11 +689,7 @@ ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) 
   }
   // A guess that is already a straight solution converges in zero iterations; the phase
   // condition is degenerate there, which shows as a singular Jacobian.
-  Eigen::VectorXd F;
-  Eigen::MatrixXd J;
-  std::string failure;
-  if (problem.evaluate(result.x, &F, &J, &failure) &&
-      !(JacobianLU(J).reciprocal_condition() > problem.definition().options.newton.singular_rcond * 1e3)) {
+  if (singular_at_solution(problem, result.x, problem.definition().options.newton.singular_rcond * 1e3)) {
     result.summary.status = SolverStatus::SingularJacobian;
     result.summary.message =
         "the axial phase condition is degenerate here (a straight rod): solve it without the phase condition";
