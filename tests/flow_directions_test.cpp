@@ -65,6 +65,20 @@ TEST(FlowDirections, ArePhiTimesTheDirectionsForEveryDualSize) {
   }
 }
 
+// Without a field the spatial rod's directions follow its variational equations written out
+// (spatial_variations.hpp), Phi still the dual numbers': on an extensible, shearable rod with an
+// unfolding couple every term of those equations acts (the force directions through the
+// stretch, the couple's mu dR e3).
+TEST(FlowDirections, WrittenOutSpatialVariationsArePhiTimesTheDirections) {
+  RodModel model = curved_rod(false);
+  model.extensible = true;
+  model.A = {Profile(20.0), Profile(30.0), Profile(40.0)};
+  model.v_hat = {Profile(0.02), Profile(-0.01), Profile(1.05)};
+  model.symmetry_unfolding = 0.3;
+  const auto spatial = make_spatial_equations(model);
+  for (int k : {2, 3, 5, 7, 9, 11, 14}) expect_phi_directions(*spatial, start_point(false), k);
+}
+
 // With sensitivity_tol looser than the state's, the state comes from a pass of its own at the
 // state's tolerance (as flow() does it) and the directions at the looser one.
 TEST(FlowDirections, LooseSensitivitiesKeepTheStateTight) {

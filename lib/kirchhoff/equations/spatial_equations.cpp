@@ -127,13 +127,15 @@ class SpatialEquations final : public RodEquations {
                    const IntegratorOptions& options) const override {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     if (!sensitivities) return detail::flow_state<kStateSize>(f, y0, s0, s1, options);
-    // The looser matrices of a rod without field or cylinder: the variational equations written
-    // out (spatial_variations.hpp) instead of dual numbers.
-    if (options.sensitivity_tol > options.abs_tol && detail::has_written_out_variations(model_, support_.has_value())) {
+    // A rod without field or cylinder: the variational equations written out
+    // (spatial_variations.hpp) instead of dual numbers, the looser matrices in a pass of their own.
+    if (detail::has_written_out_variations(model_, support_.has_value())) {
       auto state_rhs = [this](const double* y, double* dy, double s) { rhs(y, dy, s); };
-      return detail::flow_with_loose_pass<kStateSize>(f, y0, s0, s1, options, [&](const IntegratorOptions& loose) {
-        return detail::written_out_variations_pass(model_, compliances_, state_rhs, y0, s0, s1, loose);
-      });
+      auto pass = [&](const IntegratorOptions& at) {
+        return detail::written_out_variations_pass(model_, compliances_, state_rhs, y0, s0, s1, at);
+      };
+      if (options.sensitivity_tol > options.abs_tol) return detail::flow_with_loose_pass<kStateSize>(f, y0, s0, s1, options, pass);
+      return pass(options);
     }
     // Nothing depends on chi(s0), and without a field or a cylinder nothing depends on r(s0)
     // either: their columns of Phi are unit vectors, and only the other directions are carried by
@@ -151,6 +153,11 @@ class SpatialEquations final : public RodEquations {
 
   DirectionalFlow flow_directions(const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions, double s0, double s1,
                                   const IntegratorOptions& options, CarriedSteps* carried) const override {
+    if (detail::has_written_out_variations(model_, support_.has_value())) {
+      auto state_rhs = [this](const double* y, double* dy, double s) { rhs(y, dy, s); };
+      return detail::written_out_directional_flow<3, 4, 5, 6, 8, 10>(model_, compliances_, state_rhs, y0, directions,
+                                                                     s0, s1, options, carried);
+    }
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     // The seeds of flow(); the dual sizes those of the stability index's Jacobi fields (a frame
     // of 3 or 6 columns and a few particular ones), then all the seeds.

@@ -32,16 +32,20 @@
 
 namespace kirchhoff::detail {
 
-// The carried block of Phi: rows r, q, m, chi; columns q, n, m.
+// The carried block of a set of C perturbation columns: rows r, q, m, chi (the rows n are
+// constant without a field, so they are kept beside the integration, not in it).
 constexpr int kVariationRows = 11;
-constexpr int kVariationColumns = 10;
 constexpr std::array<int, kVariationRows> kVariationRowOf{kR,     kR + 1, kR + 2, kQ,     kQ + 1, kQ + 2,
                                                           kQ + 3, kM,     kM + 1, kM + 2, kChi};
+// Where the block's rows start (row-major, C per row).
+enum VariationRow { kRowR = 0, kRowQ = 3, kRowM = 7, kRowChi = 10 };
+template <int C>
+constexpr int kVariedStateSize = kSpatialStateSize + kVariationRows * C;
+
+// The columns of Phi that are not unit vectors (nothing depends on r(s0) or chi(s0)).
+constexpr int kVariationColumns = 10;
 constexpr std::array<int, kVariationColumns> kVariationColumnOf{kQ,     kQ + 1, kQ + 2, kQ + 3, kN,
                                                                 kN + 1, kN + 2, kM,     kM + 1, kM + 2};
-// Where the block's rows start (row-major, kVariationColumns per row).
-enum VariationRow { kRowR = 0, kRowQ = 3, kRowM = 7, kRowChi = 10 };
-constexpr int kVariedStateSize = kSpatialStateSize + kVariationRows * kVariationColumns;
 
 // Whether the written-out equations hold for this rod (the scope above).
 inline bool has_written_out_variations(const RodModel& model, bool on_cylinder) {
@@ -73,15 +77,12 @@ inline FrameAtPoint frame_at_point(const RodModel& model, const Compliances& com
   return f;
 }
 
-constexpr int kColumnN = 4;  // the columns of n(s0) are kColumnN + 0, 1, 2 (kVariationColumnOf)
-static_assert(kVariationColumnOf[kColumnN] == kN);
-
 // d/ds of the state (by `state_rhs`, the equations' own right-hand side on doubles) and of the
-// carried block of Phi, for a rod in scope (has_written_out_variations).
-template <class StateRhs>
+// carried block of C perturbation columns, whose force perturbations are the constants dn, for a
+// rod in scope (has_written_out_variations).
+template <int C, class StateRhs>
 void rhs_with_written_out_variations(const RodModel& model, const Compliances& compliances, const StateRhs& state_rhs,
-                                     const double* y, double* dy, double s) {
-  constexpr int C = kVariationColumns;
+                                     const double (&dn)[3][C], const double* y, double* dy, double s) {
   state_rhs(y, dy, s);
   const FrameAtPoint f = frame_at_point(model, compliances, y, s);
   const double(&R)[3][3] = f.R;
@@ -103,9 +104,9 @@ void rhs_with_written_out_variations(const RodModel& model, const Compliances& c
       const double rotated = f.m_body[i1] * omega[i2][j] - f.m_body[i2] * omega[i1][j];
       du[i][j] = f.flex[i] * (rotated + R[0][i] * dm[0][j] + R[1][i] * dm[1][j] + R[2][i] * dm[2][j]);
       e[i][j] = omega[i1][j] * f.v[i2] - omega[i2][j] * f.v[i1];
-      if (model.extensible)  // R^T dn: dn is the unit seed of the columns of n(s0)
+      if (model.extensible)
         e[i][j] += f.compliance[i] * (f.n_body[i1] * omega[i2][j] - f.n_body[i2] * omega[i1][j] +
-                                      (j >= kColumnN && j < kColumnN + 3 ? R[j - kColumnN][i] : 0.0));
+                                      R[0][i] * dn[0][j] + R[1][i] * dn[1][j] + R[2][i] * dn[2][j]);
     }
   }
   double d_dr[3][C];
@@ -133,10 +134,8 @@ void rhs_with_written_out_variations(const RodModel& model, const Compliances& c
   for (int i = 0; i < 3; ++i) {
     const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
     for (int j = 0; j < C; ++j)
-      dP[(kRowM + i) * C + j] =
-          n[i1] * d_dr[i2][j] - n[i2] * d_dr[i1][j] + mu * (R[i][0] * omega[1][j] - R[i][1] * omega[0][j]);
-    for (int a = 0; a < 3; ++a)  // (e_a x r')_i on the column of n_a(s0)
-      dP[(kRowM + i) * C + kColumnN + a] += (a == i1 ? dr[i2] : 0.0) - (a == i2 ? dr[i1] : 0.0);
+      dP[(kRowM + i) * C + j] = dn[i1][j] * dr[i2] - dn[i2][j] * dr[i1] + n[i1] * d_dr[i2][j] -
+                                n[i2] * d_dr[i1][j] + mu * (R[i][0] * omega[1][j] - R[i][1] * omega[0][j]);
   }
   // chi' = 2 N / D with N = w z' - z w', D = w^2 + z^2.
   const double w = q[0], z = q[3], w_prime = dy[kQ], z_prime = dy[kQ + 3];
@@ -148,29 +147,107 @@ void rhs_with_written_out_variations(const RodModel& model, const Compliances& c
   }
 }
 
-// Phi by rhs_with_written_out_variations at `options` (every component under error control, as
-// the dual numbers have it): the looser pass of detail::flow_with_loose_pass.
+// Integrates the state and the columns of `directions` (at most C, rows as the state's; fewer are
+// padded with zero columns, which stay zero) from s0 to s1 by rhs_with_written_out_variations,
+// every carried component under error control (as the dual numbers have it), continuing from the
+// step size *ds and leaving there the one proposed next.
+template <int C, class StateRhs>
+DirectionalFlow written_out_directions(const RodModel& model, const Compliances& compliances,
+                                       const StateRhs& state_rhs, const Eigen::VectorXd& y0,
+                                       const Eigen::MatrixXd& directions, double s0, double s1,
+                                       const IntegratorOptions& options, double* ds) {
+  using State = std::array<double, kVariedStateSize<C>>;
+  const int k = static_cast<int>(directions.cols());
+  State x{};
+  double dn[3][C] = {};
+  for (int i = 0; i < kSpatialStateSize; ++i) x[i] = y0[i];
+  for (int j = 0; j < k; ++j) {
+    for (int r = 0; r < kVariationRows; ++r) x[kSpatialStateSize + r * C + j] = directions(kVariationRowOf[r], j);
+    for (int a = 0; a < 3; ++a) dn[a][j] = directions(kN + a, j);
+  }
+  DirectionalFlow out;
+  auto system = [&](const State& y, State& dy, double s) {
+    ++out.rhs_evaluations;
+    rhs_with_written_out_variations<C>(model, compliances, state_rhs, dn, y.data(), dy.data(), s);
+  };
+  out.steps = march_carrying(x, s0, s1, system, options, ds);
+  out.y = Eigen::Map<const Eigen::Matrix<double, kSpatialStateSize, 1>>(x.data());
+  out.directions.resize(kSpatialStateSize, k);
+  for (int j = 0; j < k; ++j) {
+    for (int r = 0; r < kVariationRows; ++r) out.directions(kVariationRowOf[r], j) = x[kSpatialStateSize + r * C + j];
+    for (int a = 0; a < 3; ++a) out.directions(kN + a, j) = dn[a][j];
+  }
+  return out;
+}
+
+// The columns of Phi that are not unit vectors (kVariationColumnOf), by written_out_directions.
 template <class StateRhs>
 SegmentFlow written_out_variations_pass(const RodModel& model, const Compliances& compliances,
                                         const StateRhs& state_rhs, const Eigen::VectorXd& y0, double s0, double s1,
                                         const IntegratorOptions& options) {
-  using State = std::array<double, kVariedStateSize>;
-  State x{};
-  for (int i = 0; i < kSpatialStateSize; ++i) x[i] = y0[i];
-  for (int r = 0; r < kVariationRows; ++r)
-    for (int j = 0; j < kVariationColumns; ++j)
-      x[kSpatialStateSize + r * kVariationColumns + j] = kVariationRowOf[r] == kVariationColumnOf[j] ? 1.0 : 0.0;
+  Eigen::MatrixXd seeds = Eigen::MatrixXd::Zero(kSpatialStateSize, kVariationColumns);
+  for (int j = 0; j < kVariationColumns; ++j) seeds(kVariationColumnOf[j], j) = 1.0;
+  double ds = options.initial_step * (s1 - s0);
+  DirectionalFlow flow =
+      written_out_directions<kVariationColumns>(model, compliances, state_rhs, y0, seeds, s0, s1, options, &ds);
   SegmentFlow out;
-  auto system = [&](const State& y, State& dy, double s) {
-    ++out.rhs_evaluations;
-    rhs_with_written_out_variations(model, compliances, state_rhs, y.data(), dy.data(), s);
-  };
-  out.steps = march(x, s0, s1, system, options);
-  out.y = Eigen::Map<const Eigen::Matrix<double, kSpatialStateSize, 1>>(x.data());
+  out.y = std::move(flow.y);
   out.Phi = Eigen::MatrixXd::Identity(kSpatialStateSize, kSpatialStateSize);
-  for (int r = 0; r < kVariationRows; ++r)
-    for (int j = 0; j < kVariationColumns; ++j)
-      out.Phi(kVariationRowOf[r], kVariationColumnOf[j]) = x[kSpatialStateSize + r * kVariationColumns + j];
+  for (int j = 0; j < kVariationColumns; ++j) out.Phi.col(kVariationColumnOf[j]) = flow.directions.col(j);
+  out.steps = flow.steps;
+  out.rhs_evaluations = flow.rhs_evaluations;
+  return out;
+}
+
+// written_out_directions with C the first of Cs (ascending) that holds the columns; false when none does.
+template <int C, int... More, class StateRhs>
+bool written_out_directions_fitting(const RodModel& model, const Compliances& compliances, const StateRhs& state_rhs,
+                                    const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions, double s0,
+                                    double s1, const IntegratorOptions& options, double* ds, DirectionalFlow* out) {
+  if (directions.cols() <= C) {
+    *out = written_out_directions<C>(model, compliances, state_rhs, y0, directions, s0, s1, options, ds);
+    return true;
+  }
+  if constexpr (sizeof...(More) > 0)
+    return written_out_directions_fitting<More...>(model, compliances, state_rhs, y0, directions, s0, s1, options, ds,
+                                                   out);
+  else
+    return false;
+}
+
+// RodEquations::flow_directions by written_out_directions: the columns themselves when Cs (the
+// column counts compiled) hold them, else through the non-unit columns of Phi; the state at the
+// options' own tolerance in a pass of its own where sensitivity_tol is looser (the contract of
+// detail::flow_directions on dual numbers).
+template <int... Cs, class StateRhs>
+DirectionalFlow written_out_directional_flow(const RodModel& model, const Compliances& compliances,
+                                             const StateRhs& state_rhs, const Eigen::VectorXd& y0,
+                                             const Eigen::MatrixXd& directions, double s0, double s1,
+                                             const IntegratorOptions& options, CarriedSteps* carried) {
+  const bool loose = options.sensitivity_tol > options.abs_tol;
+  IntegratorOptions carried_options = options;
+  if (loose) carried_options.abs_tol = carried_options.rel_tol = options.sensitivity_tol;
+  DirectionalFlow out;
+  if (!written_out_directions_fitting<Cs...>(model, compliances, state_rhs, y0, directions, s0, s1, carried_options,
+                                             &carried->directions, &out)) {
+    Eigen::MatrixXd seeds = Eigen::MatrixXd::Zero(kSpatialStateSize, kVariationColumns);
+    for (int j = 0; j < kVariationColumns; ++j) seeds(kVariationColumnOf[j], j) = 1.0;
+    out = written_out_directions<kVariationColumns>(model, compliances, state_rhs, y0, seeds, s0, s1, carried_options,
+                                                    &carried->directions);
+    Eigen::MatrixXd Phi = Eigen::MatrixXd::Identity(kSpatialStateSize, kSpatialStateSize);
+    for (int j = 0; j < kVariationColumns; ++j) Phi.col(kVariationColumnOf[j]) = out.directions.col(j);
+    out.directions = Phi * directions;
+  }
+  if (!loose) return out;
+  std::array<double, kSpatialStateSize> state;
+  for (int i = 0; i < kSpatialStateSize; ++i) state[i] = y0[i];
+  auto state_system = [&](const std::array<double, kSpatialStateSize>& y, std::array<double, kSpatialStateSize>& dy,
+                          double s) {
+    ++out.rhs_evaluations;
+    state_rhs(y.data(), dy.data(), s);
+  };
+  out.steps += march_carrying(state, s0, s1, state_system, options, &carried->state);
+  out.y = Eigen::Map<const Eigen::Matrix<double, kSpatialStateSize, 1>>(state.data());
   return out;
 }
 
