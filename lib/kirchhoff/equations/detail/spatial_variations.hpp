@@ -46,6 +46,8 @@ constexpr int kVariedStateSize = kSpatialStateSize + kVariationRows * C;
 constexpr int kVariationColumns = 10;
 constexpr std::array<int, kVariationColumns> kVariationColumnOf{kQ,     kQ + 1, kQ + 2, kQ + 3, kN,
                                                                 kN + 1, kN + 2, kM,     kM + 1, kM + 2};
+constexpr int kColumnN = 4;  // the columns of n(s0) are kColumnN + 0, 1, 2
+static_assert(kVariationColumnOf[kColumnN] == kN);
 
 // Whether the written-out equations hold for this rod (the scope above).
 inline bool has_written_out_variations(const RodModel& model, bool on_cylinder) {
@@ -147,18 +149,31 @@ void rhs_with_written_out_variations(const RodModel& model, const Compliances& c
   }
 }
 
-// Integrates the state and the columns of `directions` (at most C, rows as the state's; fewer are
-// padded with zero columns, which stay zero) from s0 to s1 by rhs_with_written_out_variations,
-// every carried component under error control (as the dual numbers have it), continuing from the
-// step size *ds and leaving there the one proposed next.
+// Marches the state and the carried block x (kVariedStateSize<C>: the state, then the block
+// row-major) from s0 to s1 by rhs_with_written_out_variations, every carried component under
+// error control (as the dual numbers have it), continuing from the step size *ds and leaving there
+// the one proposed next. Returns the steps taken; adds the right-hand sides to *evaluations.
+template <int C, class StateRhs>
+long march_written_out(const RodModel& model, const Compliances& compliances, const StateRhs& state_rhs,
+                       const double (&dn)[3][C], std::array<double, kVariedStateSize<C>>& x, double s0, double s1,
+                       const IntegratorOptions& options, double* ds, long* evaluations) {
+  using State = std::array<double, kVariedStateSize<C>>;
+  auto system = [&](const State& y, State& dy, double s) {
+    ++*evaluations;
+    rhs_with_written_out_variations<C>(model, compliances, state_rhs, dn, y.data(), dy.data(), s);
+  };
+  return march_carrying(x, s0, s1, system, options, ds);
+}
+
+// The state and the columns of `directions` (at most C, rows as the state's; fewer are padded with
+// zero columns, which stay zero) carried from s0 to s1 by march_written_out.
 template <int C, class StateRhs>
 DirectionalFlow written_out_directions(const RodModel& model, const Compliances& compliances,
                                        const StateRhs& state_rhs, const Eigen::VectorXd& y0,
                                        const Eigen::MatrixXd& directions, double s0, double s1,
                                        const IntegratorOptions& options, double* ds) {
-  using State = std::array<double, kVariedStateSize<C>>;
   const int k = static_cast<int>(directions.cols());
-  State x{};
+  std::array<double, kVariedStateSize<C>> x{};
   double dn[3][C] = {};
   for (int i = 0; i < kSpatialStateSize; ++i) x[i] = y0[i];
   for (int j = 0; j < k; ++j) {
@@ -166,11 +181,7 @@ DirectionalFlow written_out_directions(const RodModel& model, const Compliances&
     for (int a = 0; a < 3; ++a) dn[a][j] = directions(kN + a, j);
   }
   DirectionalFlow out;
-  auto system = [&](const State& y, State& dy, double s) {
-    ++out.rhs_evaluations;
-    rhs_with_written_out_variations<C>(model, compliances, state_rhs, dn, y.data(), dy.data(), s);
-  };
-  out.steps = march_carrying(x, s0, s1, system, options, ds);
+  out.steps = march_written_out<C>(model, compliances, state_rhs, dn, x, s0, s1, options, ds, &out.rhs_evaluations);
   out.y = Eigen::Map<const Eigen::Matrix<double, kSpatialStateSize, 1>>(x.data());
   out.directions.resize(kSpatialStateSize, k);
   for (int j = 0; j < k; ++j) {
@@ -180,22 +191,26 @@ DirectionalFlow written_out_directions(const RodModel& model, const Compliances&
   return out;
 }
 
-// The columns of Phi that are not unit vectors (kVariationColumnOf), by written_out_directions.
+// The columns of Phi that are not unit vectors (kVariationColumnOf) by march_written_out, the
+// others unit vectors: the whole of Phi over [s0, s1].
 template <class StateRhs>
 SegmentFlow written_out_variations_pass(const RodModel& model, const Compliances& compliances,
                                         const StateRhs& state_rhs, const Eigen::VectorXd& y0, double s0, double s1,
                                         const IntegratorOptions& options) {
-  Eigen::MatrixXd seeds = Eigen::MatrixXd::Zero(kSpatialStateSize, kVariationColumns);
-  for (int j = 0; j < kVariationColumns; ++j) seeds(kVariationColumnOf[j], j) = 1.0;
-  double ds = options.initial_step * (s1 - s0);
-  DirectionalFlow flow =
-      written_out_directions<kVariationColumns>(model, compliances, state_rhs, y0, seeds, s0, s1, options, &ds);
+  constexpr int C = kVariationColumns;
+  std::array<double, kVariedStateSize<C>> x{};
+  double dn[3][C] = {};
+  for (int i = 0; i < kSpatialStateSize; ++i) x[i] = y0[i];
+  for (int r = 0; r < kVariationRows; ++r)
+    for (int j = 0; j < C; ++j) x[kSpatialStateSize + r * C + j] = kVariationRowOf[r] == kVariationColumnOf[j];
+  for (int a = 0; a < 3; ++a) dn[a][kColumnN + a] = 1.0;
   SegmentFlow out;
-  out.y = std::move(flow.y);
+  double ds = options.initial_step * (s1 - s0);
+  out.steps = march_written_out<C>(model, compliances, state_rhs, dn, x, s0, s1, options, &ds, &out.rhs_evaluations);
+  out.y = Eigen::Map<const Eigen::Matrix<double, kSpatialStateSize, 1>>(x.data());
   out.Phi = Eigen::MatrixXd::Identity(kSpatialStateSize, kSpatialStateSize);
-  for (int j = 0; j < kVariationColumns; ++j) out.Phi.col(kVariationColumnOf[j]) = flow.directions.col(j);
-  out.steps = flow.steps;
-  out.rhs_evaluations = flow.rhs_evaluations;
+  for (int r = 0; r < kVariationRows; ++r)
+    for (int j = 0; j < C; ++j) out.Phi(kVariationRowOf[r], kVariationColumnOf[j]) = x[kSpatialStateSize + r * C + j];
   return out;
 }
 
