@@ -53,6 +53,7 @@ INSTANTIATE_TEST_SUITE_P(
                       JacobianCase{"tapered.toml", {}, "", 1},
                       JacobianCase{"heavy_cantilever.toml", {}, "", 2},
                       JacobianCase{"twisted_clamped.toml", {{"phi", 11.58}, {"m_lateral", -1.7}, {"n_lateral", 3.4}}, "axial", 1},
+                      JacobianCase{"twisted_clamped.toml", {{"phi", 11.58}, {"m_lateral", -1.7}, {"n_lateral", 3.4}}, "axial", 3},
                       JacobianCase{"twisted_clamped.toml", {{"phi", 8.0}, {"m_lateral", 0.5}}, "", 2},
                       JacobianCase{"reissner.toml", {}, "", 1},
                       JacobianCase{"reissner.toml", {}, "", 4}),

@@ -42,6 +42,9 @@ struct IntegrationError : std::runtime_error {
 struct SegmentFlow {
   Eigen::VectorXd y;    // state at the end of the segment
   Eigen::MatrixXd Phi;  // dy(s1)/dy(s0); empty unless sensitivities were requested
+  // dy(s1)/dmu at fixed y(s0), mu the unfolding couple (RodModel::unfolding_sensitivity); empty
+  // where the equations do not carry it (the caller differences instead).
+  Eigen::VectorXd dy_dunfolding;
   long rhs_evaluations = 0;
   long steps = 0;
 };

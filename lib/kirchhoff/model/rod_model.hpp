@@ -120,6 +120,10 @@ struct RodModel {
   // fictitious distributed couple l = mu (e3 - d3), m' = n x r' - l. Every solution of a
   // well-posed problem drives it to zero; while it is non-zero H is not reported invariant.
   double symmetry_unfolding = 0.0;
+  // Set where mu is an unknown (add_axial_phase_condition): flows with sensitivities then also
+  // carry the end state's derivative with respect to mu where the equations can
+  // (SegmentFlow::dy_dunfolding), so that its Jacobian column needs no differencing.
+  bool unfolding_sensitivity = false;
 
   // Throws std::invalid_argument naming the offending property (non-positive length or
   // stiffness at any sampled s).

@@ -316,12 +316,15 @@ bool ShootingProblem::evaluate_with(const Eigen::VectorXd& x, Eigen::VectorXd* F
   Eigen::VectorXd& y_end = *y_end_out;
   if (!residual(x, p, F, J, failure, &y_end, &integrator)) return false;
   if (!J) return true;
+  // (Before any differencing below integrates again over the flows it reads.)
+  const int from_flows = unfolding_column_from_flows(x, p, y_end, J);
   // Parameter columns by central differences (see the header for why this is accurate enough).
   // A parameter that only enters the boundary conditions moves only their rows, which are
   // closed-form in the end states: no re-integration is needed for it.
   const int offset = segments() * state_size_;
   auto& b = workspace_.buffers();
   for (size_t j = 0; j < unknown_index_.size(); ++j) {
+    if (static_cast<int>(j) == from_flows) continue;
     const double h = kParameterStep * (1.0 + std::abs(x[offset + j]));
     if (moves_beyond_conditions(static_cast<int>(j))) {
       Eigen::VectorXd xp = x, xm = x, Fp, Fm;
@@ -337,6 +340,34 @@ bool ShootingProblem::evaluate_with(const Eigen::VectorXd& x, Eigen::VectorXd* F
     }
   }
   return true;
+}
+
+int ShootingProblem::unfolding_column_from_flows(const Eigen::VectorXd& x, const Parameters& p,
+                                                 const Eigen::VectorXd& y_end, Eigen::MatrixXd* J) const {
+  if (!definition_.contacts.empty()) return -1;
+  const int n = state_size_, M = segments(), offset = M * n;
+  int j = -1;
+  for (size_t k = 0; k < unknown_index_.size(); ++k)
+    if (is_unfolding_parameter(definition_.parameters.names()[unknown_index_[k]])) j = static_cast<int>(k);
+  const std::vector<SegmentFlow>& flows = workspace_.buffers().flows;
+  if (j < 0 || static_cast<int>(flows.size()) != M) return -1;
+  for (const SegmentFlow& flow : flows)
+    if (flow.dy_dunfolding.size() != n) return -1;
+  // Where the conditions name the parameter: their rows' closed-form difference, the states held.
+  auto& b = workspace_.buffers();
+  const double h = kParameterStep * (1.0 + std::abs(x[offset + j]));
+  parameters_into(x, &b.plus, j, h);
+  parameters_into(x, &b.minus, j, -h);
+  Eigen::Ref<Eigen::VectorXd> column = J->col(offset + j);
+  condition_column(x, y_end, b.plus, b.minus, h, column);
+  // Through the flows: the continuity rows y_i(s_{i+1}) - x_{i+1}, then the end rows G(y(L)).
+  int row = gauge_count_ + start_condition_count_;
+  for (int i = 0; i + 1 < M; ++i, row += n) column.segment(row, n) += flows[i].dy_dunfolding;
+  const auto& rows = condition_rows_at(*equations(p), false, flows.back().y, p, true);
+  const int end_count = static_cast<int>(rows.end_values.size());
+  for (int k = 0; k < end_count; ++k)
+    column[residual_count_ - end_count + k] += rows.end_jacobian[k].dot(flows.back().dy_dunfolding);
+  return j;
 }
 
 void ShootingProblem::condition_column(const Eigen::VectorXd& x, const Eigen::VectorXd& y_end, const Parameters& plus,
@@ -631,6 +662,7 @@ void add_axial_phase_condition(ProblemDefinition& d) {
   d.model = [inner = d.model, name](const Parameters& p) {
     RodModel m = inner(p);
     m.symmetry_unfolding = p.get(name);
+    m.unfolding_sensitivity = true;
     return m;
   };
   d.model_parameters.insert(name);

@@ -229,6 +229,11 @@ class ShootingProblem final : public NonlinearSystem {
   // Whether an unknown parameter enters the rod model or moves an obstacle (its column then needs
   // whole residuals, not only the boundary-condition rows).
   bool moves_beyond_conditions(int unknown) const;
+  // The unfolding couple's column of J from the last integration's flows, where each carries
+  // its sensitivity to it (SegmentFlow::dy_dunfolding) and the rod has no contacts: returns the
+  // unknown's index, or -1 where the column must be differenced.
+  int unfolding_column_from_flows(const Eigen::VectorXd& x, const Parameters& p, const Eigen::VectorXd& y_end,
+                                  Eigen::MatrixXd* J) const;
   int contact_offset() const { return segments() * state_size_ + static_cast<int>(unknown_index_.size()); }
   int contact_column(size_t k) const;  // first unknown of contact k
   std::vector<int> contact_columns() const;

@@ -81,10 +81,12 @@ inline FrameAtPoint frame_at_point(const RodModel& model, const Compliances& com
 
 // d/ds of the state (by `state_rhs`, the equations' own right-hand side on doubles) and of the
 // carried block of C perturbation columns, whose force perturbations are the constants dn, for a
-// rod in scope (has_written_out_variations).
+// rod in scope (has_written_out_variations). Column `forced` (if >= 0) is the state's derivative
+// with respect to the unfolding couple mu: its equations gain the forcing df/dmu = (0, 0, 0,
+// d3 - e3 in the rows m).
 template <int C, class StateRhs>
 void rhs_with_written_out_variations(const RodModel& model, const Compliances& compliances, const StateRhs& state_rhs,
-                                     const double (&dn)[3][C], const double* y, double* dy, double s) {
+                                     const double (&dn)[3][C], int forced, const double* y, double* dy, double s) {
   state_rhs(y, dy, s);
   const FrameAtPoint f = frame_at_point(model, compliances, y, s);
   const double(&R)[3][3] = f.R;
@@ -138,6 +140,7 @@ void rhs_with_written_out_variations(const RodModel& model, const Compliances& c
     for (int j = 0; j < C; ++j)
       dP[(kRowM + i) * C + j] = dn[i1][j] * dr[i2] - dn[i2][j] * dr[i1] + n[i1] * d_dr[i2][j] -
                                 n[i2] * d_dr[i1][j] + mu * (R[i][0] * omega[1][j] - R[i][1] * omega[0][j]);
+    if (forced >= 0) dP[(kRowM + i) * C + forced] += R[i][2] - (i == 2 ? 1.0 : 0.0);
   }
   // chi' = 2 N / D with N = w z' - z w', D = w^2 + z^2.
   const double w = q[0], z = q[3], w_prime = dy[kQ], z_prime = dy[kQ + 3];
@@ -155,12 +158,12 @@ void rhs_with_written_out_variations(const RodModel& model, const Compliances& c
 // the one proposed next. Returns the steps taken; adds the right-hand sides to *evaluations.
 template <int C, class StateRhs>
 long march_written_out(const RodModel& model, const Compliances& compliances, const StateRhs& state_rhs,
-                       const double (&dn)[3][C], std::array<double, kVariedStateSize<C>>& x, double s0, double s1,
-                       const IntegratorOptions& options, double* ds, long* evaluations) {
+                       const double (&dn)[3][C], int forced, std::array<double, kVariedStateSize<C>>& x, double s0,
+                       double s1, const IntegratorOptions& options, double* ds, long* evaluations) {
   using State = std::array<double, kVariedStateSize<C>>;
   auto system = [&](const State& y, State& dy, double s) {
     ++*evaluations;
-    rhs_with_written_out_variations<C>(model, compliances, state_rhs, dn, y.data(), dy.data(), s);
+    rhs_with_written_out_variations<C>(model, compliances, state_rhs, dn, forced, y.data(), dy.data(), s);
   };
   return march_carrying(x, s0, s1, system, options, ds);
 }
@@ -181,7 +184,8 @@ DirectionalFlow written_out_directions(const RodModel& model, const Compliances&
     for (int a = 0; a < 3; ++a) dn[a][j] = directions(kN + a, j);
   }
   DirectionalFlow out;
-  out.steps = march_written_out<C>(model, compliances, state_rhs, dn, x, s0, s1, options, ds, &out.rhs_evaluations);
+  out.steps =
+      march_written_out<C>(model, compliances, state_rhs, dn, -1, x, s0, s1, options, ds, &out.rhs_evaluations);
   out.y = Eigen::Map<const Eigen::Matrix<double, kSpatialStateSize, 1>>(x.data());
   out.directions.resize(kSpatialStateSize, k);
   for (int j = 0; j < k; ++j) {
@@ -192,26 +196,42 @@ DirectionalFlow written_out_directions(const RodModel& model, const Compliances&
 }
 
 // The columns of Phi that are not unit vectors (kVariationColumnOf) by march_written_out, the
-// others unit vectors: the whole of Phi over [s0, s1].
-template <class StateRhs>
-SegmentFlow written_out_variations_pass(const RodModel& model, const Compliances& compliances,
-                                        const StateRhs& state_rhs, const Eigen::VectorXd& y0, double s0, double s1,
-                                        const IntegratorOptions& options) {
-  constexpr int C = kVariationColumns;
+// others unit vectors: the whole of Phi over [s0, s1]; C = kVariationColumns + 1 adds the forced
+// column of the unfolding couple's sensitivity (SegmentFlow::dy_dunfolding).
+template <int C, class StateRhs>
+SegmentFlow written_out_phi(const RodModel& model, const Compliances& compliances, const StateRhs& state_rhs,
+                            const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options) {
+  static_assert(C == kVariationColumns || C == kVariationColumns + 1);
+  constexpr bool with_unfolding = C > kVariationColumns;
   std::array<double, kVariedStateSize<C>> x{};
   double dn[3][C] = {};
   for (int i = 0; i < kSpatialStateSize; ++i) x[i] = y0[i];
   for (int r = 0; r < kVariationRows; ++r)
-    for (int j = 0; j < C; ++j) x[kSpatialStateSize + r * C + j] = kVariationRowOf[r] == kVariationColumnOf[j];
+    for (int j = 0; j < kVariationColumns; ++j) x[kSpatialStateSize + r * C + j] = kVariationRowOf[r] == kVariationColumnOf[j];
   for (int a = 0; a < 3; ++a) dn[a][kColumnN + a] = 1.0;
   SegmentFlow out;
   double ds = options.initial_step * (s1 - s0);
-  out.steps = march_written_out<C>(model, compliances, state_rhs, dn, x, s0, s1, options, &ds, &out.rhs_evaluations);
+  const int forced = with_unfolding ? kVariationColumns : -1;
+  out.steps =
+      march_written_out<C>(model, compliances, state_rhs, dn, forced, x, s0, s1, options, &ds, &out.rhs_evaluations);
   out.y = Eigen::Map<const Eigen::Matrix<double, kSpatialStateSize, 1>>(x.data());
   out.Phi = Eigen::MatrixXd::Identity(kSpatialStateSize, kSpatialStateSize);
   for (int r = 0; r < kVariationRows; ++r)
-    for (int j = 0; j < C; ++j) out.Phi(kVariationRowOf[r], kVariationColumnOf[j]) = x[kSpatialStateSize + r * C + j];
+    for (int j = 0; j < kVariationColumns; ++j) out.Phi(kVariationRowOf[r], kVariationColumnOf[j]) = x[kSpatialStateSize + r * C + j];
+  if (with_unfolding) {  // (zero at s0 and in the rows n, which mu does not move)
+    out.dy_dunfolding = Eigen::VectorXd::Zero(kSpatialStateSize);
+    for (int r = 0; r < kVariationRows; ++r) out.dy_dunfolding[kVariationRowOf[r]] = x[kSpatialStateSize + r * C + forced];
+  }
   return out;
+}
+
+template <class StateRhs>
+SegmentFlow written_out_variations_pass(const RodModel& model, const Compliances& compliances,
+                                        const StateRhs& state_rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                        const IntegratorOptions& options) {
+  if (model.unfolding_sensitivity)
+    return written_out_phi<kVariationColumns + 1>(model, compliances, state_rhs, y0, s0, s1, options);
+  return written_out_phi<kVariationColumns>(model, compliances, state_rhs, y0, s0, s1, options);
 }
 
 // written_out_directions with C the first of Cs (ascending) that holds the columns; false when none does.
