@@ -64,6 +64,26 @@ INSTANTIATE_TEST_SUITE_P(
       return name;
     });
 
+// With the axial phase condition the unfolding couple's column comes from the flows' own
+// sensitivity (SegmentFlow::dy_dunfolding), not from two more integrations: F + J costs one pass
+// with the variational equations (1.2 residuals' right-hand sides here; 3.2 with the differences), under the 2 residuals'
+// worth that the central differences alone would add. (Its values: EqualsFiniteDifferences above.)
+TEST(VariationalJacobian, UnfoldingColumnNeedsNoFurtherIntegration) {
+  Case c = load_case(testing::case_path("twisted_clamped.toml"), {{"phi", 11.58}, {"m_lateral", -1.7}, {"n_lateral", 3.4}},
+                     "axial");
+  const ShootingProblem problem(c.definition);
+  const Eigen::VectorXd x = perturbed_guess(problem, c, 0.05);
+  Eigen::VectorXd F;
+  Eigen::MatrixXd J;
+  std::string failure;
+  long before = problem.rhs_evaluations();
+  ASSERT_TRUE(problem.evaluate(x, &F, nullptr, &failure)) << failure;
+  const long residual_rhs = problem.rhs_evaluations() - before;
+  before = problem.rhs_evaluations();
+  ASSERT_TRUE(problem.evaluate(x, &F, &J, &failure)) << failure;
+  EXPECT_LT(problem.rhs_evaluations() - before, 2 * residual_rhs);
+}
+
 // The planar variational equations written out (planar_equations.cpp) for an extensible,
 // shearable rod without a field, with stiffnesses and natural strains that vary along it: every
 // term of their linearisation (the internal force's components in the frame, the s-dependence).
