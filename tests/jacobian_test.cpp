@@ -66,11 +66,11 @@ INSTANTIATE_TEST_SUITE_P(
 
 // With the axial phase condition the unfolding couple's column comes from the flows' own
 // sensitivity (SegmentFlow::dy_dunfolding), not from two more integrations: F + J costs one pass
-// with the variational equations (1.2 residuals' right-hand sides here; 3.2 with the differences), under the 2 residuals'
-// worth that the central differences alone would add. (Its values: EqualsFiniteDifferences above.)
+// with the variational equations, 1.2 residuals' right-hand sides here (3.2 with the central
+// differences); the bound is 2. (The column's values: EqualsFiniteDifferences above.)
 TEST(VariationalJacobian, UnfoldingColumnNeedsNoFurtherIntegration) {
-  Case c = load_case(testing::case_path("twisted_clamped.toml"), {{"phi", 11.58}, {"m_lateral", -1.7}, {"n_lateral", 3.4}},
-                     "axial");
+  Case c = load_case(testing::case_path("twisted_clamped.toml"),
+                     {{"phi", 11.58}, {"m_lateral", -1.7}, {"n_lateral", 3.4}}, "axial");
   const ShootingProblem problem(c.definition);
   const Eigen::VectorXd x = perturbed_guess(problem, c, 0.05);
   Eigen::VectorXd F;
