@@ -134,7 +134,8 @@ class SpatialEquations final : public RodEquations {
       auto pass = [&](const IntegratorOptions& at) {
         return detail::written_out_variations_pass(model_, compliances_, state_rhs, y0, s0, s1, at);
       };
-      if (options.sensitivity_tol > options.abs_tol) return detail::flow_with_loose_pass<kStateSize>(f, y0, s0, s1, options, pass);
+      if (options.sensitivity_tol > options.abs_tol)
+        return detail::flow_with_loose_pass<kStateSize>(f, y0, s0, s1, options, pass);
       return pass(options);
     }
     // Nothing depends on chi(s0), and without a field or a cylinder nothing depends on r(s0)

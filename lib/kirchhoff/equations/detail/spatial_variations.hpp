@@ -207,7 +207,8 @@ SegmentFlow written_out_phi(const RodModel& model, const Compliances& compliance
   double dn[3][C] = {};
   for (int i = 0; i < kSpatialStateSize; ++i) x[i] = y0[i];
   for (int r = 0; r < kVariationRows; ++r)
-    for (int j = 0; j < kVariationColumns; ++j) x[kSpatialStateSize + r * C + j] = kVariationRowOf[r] == kVariationColumnOf[j];
+    for (int j = 0; j < kVariationColumns; ++j)
+      x[kSpatialStateSize + r * C + j] = kVariationRowOf[r] == kVariationColumnOf[j];
   for (int a = 0; a < 3; ++a) dn[a][kColumnN + a] = 1.0;
   SegmentFlow out;
   double ds = options.initial_step * (s1 - s0);
@@ -217,10 +218,12 @@ SegmentFlow written_out_phi(const RodModel& model, const Compliances& compliance
   out.y = Eigen::Map<const Eigen::Matrix<double, kSpatialStateSize, 1>>(x.data());
   out.Phi = Eigen::MatrixXd::Identity(kSpatialStateSize, kSpatialStateSize);
   for (int r = 0; r < kVariationRows; ++r)
-    for (int j = 0; j < kVariationColumns; ++j) out.Phi(kVariationRowOf[r], kVariationColumnOf[j]) = x[kSpatialStateSize + r * C + j];
+    for (int j = 0; j < kVariationColumns; ++j)
+      out.Phi(kVariationRowOf[r], kVariationColumnOf[j]) = x[kSpatialStateSize + r * C + j];
   if (with_unfolding) {  // (zero at s0 and in the rows n, which mu does not move)
     out.dy_dunfolding = Eigen::VectorXd::Zero(kSpatialStateSize);
-    for (int r = 0; r < kVariationRows; ++r) out.dy_dunfolding[kVariationRowOf[r]] = x[kSpatialStateSize + r * C + forced];
+    for (int r = 0; r < kVariationRows; ++r)
+      out.dy_dunfolding[kVariationRowOf[r]] = x[kSpatialStateSize + r * C + forced];
   }
   return out;
 }
