@@ -6,8 +6,9 @@
 // continuity y(s_{i+1}^-) - y(s_{i+1}) for interior nodes, the end conditions. Extra conditions
 // sit with the conditions of their end. The Jacobian comes from the variational equations
 // (state-transition matrices); parameters that enter the rod model are differentiated by
-// central differences of the flow, those that enter only the boundary conditions by central
-// differences of the (closed-form) conditions.
+// central differences of the flow (the unfolding couple of the axial phase condition from the
+// flows' own sensitivity where the equations carry it: SegmentFlow::dy_dunfolding), those that
+// enter only the boundary conditions by central differences of the (closed-form) conditions.
 #pragma once
 
 #include <functional>
