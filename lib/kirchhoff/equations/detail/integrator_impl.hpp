@@ -83,7 +83,7 @@ struct DualSystem {
 };
 
 // Integrates the state alone, into *out (whose y keeps its storage: nothing is allocated once it
-// has the state's size; Phi is left empty).
+// has the state's size; Phi and dy_dunfolding are left empty).
 template <int N, class Rhs>
 void flow_state_into(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& opt,
                      SegmentFlow* out) {
@@ -98,6 +98,7 @@ void flow_state_into(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, doubl
   out->steps = march(x, s0, s1, system, opt);
   out->y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
   out->Phi.resize(0, 0);
+  out->dy_dunfolding.resize(0);  // (no sensitivities: none left from a previous flow into *out)
   out->rhs_evaluations = evaluations;
 }
 
