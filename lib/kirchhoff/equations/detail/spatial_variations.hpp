@@ -1,16 +1,18 @@
-// Internal: the variational equations of the spatial rod (spatial_equations.cpp) written out, for
-// its looser matrices (IntegratorOptions::sensitivity_tol, the state in a pass of its own:
-// detail::flow_with_loose_pass).
+// Internal: the variational equations of the spatial rod (spatial_equations.cpp) written out: its
+// matrices (exact, and looser with IntegratorOptions::sensitivity_tol, the state then in a pass of
+// its own: detail::flow_with_loose_pass), the directions of RodEquations::flow_directions (the
+// stability index's Jacobi fields) and, where the unfolding couple mu is an unknown
+// (RodModel::unfolding_sensitivity), the state's sensitivity to it (SegmentFlow::dy_dunfolding).
 //
 // Why: on Dual<10> every product of the right-hand side carries ten derivatives, the quaternion's
 // rotation matrix included, and the dual pass was about half of a 3D continuation point's time.
 // Written out, the rotation and the body-frame quantities are formed once per evaluation on
-// doubles and each column of Phi costs its own linearisation only.
+// doubles and each column costs its own linearisation only. The same components are under error
+// control as with the dual numbers, so the steps are theirs.
 //
 // Scope: a rod with neither an external field nor a supporting cylinder (then n is constant, so
 // the rows n of Phi are those of the identity, and nothing depends on r(s0) or chi(s0), so those
-// columns are unit vectors). The exact matrices (sensitivity_tol 0) and every other rod keep the
-// dual numbers.
+// columns are unit vectors). Every other rod keeps the dual numbers.
 //
 // With y = (r, q, n, m, chi) and R = R(q / |q|) (spatial_state.hpp), a perturbation dq turns the
 // frame by the body-frame angle omega = 2 vec(conj(q) dq) / |q|^2 (q + dq = q (1 + conj(q) dq / |q|^2),
@@ -19,7 +21,8 @@
 //   dr' = R (omega x v + dv),  dq' = (dq (0, u) + q (0, du)) / 2,
 //   dm' = dn x r' + n x dr' (+ the unfolding's mu dR e3 = mu R (omega_2, -omega_1, 0)),
 //   dchi' from chi' = 2 (w z' - z w') / (w^2 + z^2) by the quotient rule,
-// each a loop over the ten columns (contiguous in the row-major block, so they vectorise).
+// each a loop over the columns (contiguous in the row-major block, so they vectorise); the
+// sensitivity to mu is one more column, zero at s0, whose rows m gain df/dmu = d3 - e3.
 #pragma once
 
 #include <array>
