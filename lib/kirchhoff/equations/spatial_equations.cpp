@@ -138,17 +138,11 @@ class SpatialEquations final : public RodEquations {
         return detail::flow_with_loose_pass<kStateSize>(f, y0, s0, s1, options, pass);
       return pass(options);
     }
-    // Nothing depends on chi(s0), and without a field or a cylinder nothing depends on r(s0)
-    // either: their columns of Phi are unit vectors, and only the other directions are carried by
-    // the dual numbers (13 with a field - self-contact, gravity - or a cylinder, 10 without).
-    if (model_.field || support_) {
-      constexpr std::array<int, 13> kSeeds{kR,     kR + 1, kR + 2, kQ,     kQ + 1, kQ + 2, kQ + 3,
-                                           kN,     kN + 1, kN + 2, kM,     kM + 1, kM + 2};
-      return with_unit_columns(detail::flow_with_partial_sensitivities<kStateSize, 13>(f, y0, s0, s1, options, kSeeds),
-                               kSeeds);
-    }
-    constexpr std::array<int, 10> kSeeds{kQ, kQ + 1, kQ + 2, kQ + 3, kN, kN + 1, kN + 2, kM, kM + 1, kM + 2};
-    return with_unit_columns(detail::flow_with_partial_sensitivities<kStateSize, 10>(f, y0, s0, s1, options, kSeeds),
+    // With a field (self-contact, gravity) or a cylinder, on dual numbers. Nothing depends on
+    // chi(s0): its column of Phi is a unit vector, and the 13 others are carried.
+    constexpr std::array<int, 13> kSeeds{kR,     kR + 1, kR + 2, kQ,     kQ + 1, kQ + 2, kQ + 3,
+                                         kN,     kN + 1, kN + 2, kM,     kM + 1, kM + 2};
+    return with_unit_columns(detail::flow_with_partial_sensitivities<kStateSize, 13>(f, y0, s0, s1, options, kSeeds),
                              kSeeds);
   }
 
@@ -160,13 +154,12 @@ class SpatialEquations final : public RodEquations {
                                                                      s0, s1, options, carried);
     }
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
-    // The seeds of flow(); the dual sizes those of the stability index's Jacobi fields (a frame
-    // of 3 or 6 columns and a few particular ones), then all the seeds.
-    static const std::vector<int> kFieldSeeds{kR,     kR + 1, kR + 2, kQ,     kQ + 1, kQ + 2, kQ + 3,
-                                              kN,     kN + 1, kN + 2, kM,     kM + 1, kM + 2};
-    static const std::vector<int> kSeeds(kFieldSeeds.begin() + 3, kFieldSeeds.end());
-    return detail::flow_directions_through_seeds<kStateSize, 3, 4, 5, 6, 8, 10, 13>(
-        f, y0, directions, model_.field || support_ ? kFieldSeeds : kSeeds, s0, s1, options, carried);
+    // With a field or a cylinder: the seeds of flow(); the dual sizes those of the stability
+    // index's Jacobi fields (a frame of 3 or 6 columns and a few particular ones), then all the seeds.
+    static const std::vector<int> kSeeds{kR,     kR + 1, kR + 2, kQ,     kQ + 1, kQ + 2, kQ + 3,
+                                         kN,     kN + 1, kN + 2, kM,     kM + 1, kM + 2};
+    return detail::flow_directions_through_seeds<kStateSize, 3, 4, 5, 6, 8, 10, 13>(f, y0, directions, kSeeds, s0, s1,
+                                                                                  options, carried);
   }
 
   std::vector<Eigen::VectorXd> sample(const Eigen::VectorXd& y0, const std::vector<double>& s,
