@@ -171,6 +171,22 @@ SegmentFlow flow_with_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, d
   return flow_with_partial_sensitivities<N, N>(rhs, y0, s0, s1, opt, all);
 }
 
+// The state alone carried from s0 to s1 at opt's own tolerance, continuing the step sizes in
+// carried->state: the directional flows' state where their directions took a looser tolerance
+// (IntegratorOptions::sensitivity_tol). Replaces out->y; adds its steps and right-hand sides.
+template <int N, class Rhs>
+void carry_state_alone(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& opt,
+                       CarriedSteps* carried, DirectionalFlow* out) {
+  std::array<double, N> state;
+  for (int i = 0; i < N; ++i) state[i] = y0[i];
+  auto state_system = [&](const std::array<double, N>& y, std::array<double, N>& dy, double s) {
+    ++out->rhs_evaluations;
+    rhs(y.data(), dy.data(), s);
+  };
+  out->steps += march_carrying(state, s0, s1, state_system, opt, &carried->state);
+  out->y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(state.data());
+}
+
 // The state and the columns of `directions` (at most K; fewer are padded with zero columns, which
 // stay zero) carried from s0 to s1, continuing from the step sizes in *carried and leaving there
 // those proposed next. With opt.sensitivity_tol looser than abs_tol, as flow_with_loose_sensitivities:
@@ -195,15 +211,7 @@ DirectionalFlow flow_directions(const Rhs& rhs, const Eigen::VectorXd& y0, const
   // (A single column is stored alike either way; Eigen refuses a row-major column vector.)
   constexpr int kLayout = K == 1 ? Eigen::ColMajor : Eigen::RowMajor;
   out.directions = Eigen::Map<const Eigen::Matrix<double, N, K, kLayout>>(x.data() + N).leftCols(k);
-  if (!loose) return out;
-  std::array<double, N> state;
-  for (int i = 0; i < N; ++i) state[i] = y0[i];
-  auto state_system = [&](const std::array<double, N>& y, std::array<double, N>& dy, double s) {
-    ++out.rhs_evaluations;
-    rhs(y.data(), dy.data(), s);
-  };
-  out.steps += march_carrying(state, s0, s1, state_system, opt, &carried->state);
-  out.y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(state.data());
+  if (loose) carry_state_alone<N>(rhs, y0, s0, s1, opt, carried, &out);
   return out;
 }
 

@@ -201,9 +201,11 @@ DirectionalFlow written_out_directions(const RodModel& model, const Compliances&
 // The columns of Phi that are not unit vectors (kVariationColumnOf) by march_written_out, the
 // others unit vectors: the whole of Phi over [s0, s1]; C = kVariationColumns + 1 adds the forced
 // column of the unfolding couple's sensitivity (SegmentFlow::dy_dunfolding).
+// Continues from the step size *ds and leaves there the one proposed next.
 template <int C, class StateRhs>
 SegmentFlow written_out_phi(const RodModel& model, const Compliances& compliances, const StateRhs& state_rhs,
-                            const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options) {
+                            const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options,
+                            double* ds) {
   static_assert(C == kVariationColumns || C == kVariationColumns + 1);
   constexpr bool with_unfolding = C > kVariationColumns;
   std::array<double, kVariedStateSize<C>> x{};
@@ -214,10 +216,9 @@ SegmentFlow written_out_phi(const RodModel& model, const Compliances& compliance
       x[kSpatialStateSize + r * C + j] = kVariationRowOf[r] == kVariationColumnOf[j];
   for (int a = 0; a < 3; ++a) dn[a][kColumnN + a] = 1.0;
   SegmentFlow out;
-  double ds = options.initial_step * (s1 - s0);
   const int forced = with_unfolding ? kVariationColumns : -1;
   out.steps =
-      march_written_out<C>(model, compliances, state_rhs, dn, forced, x, s0, s1, options, &ds, &out.rhs_evaluations);
+      march_written_out<C>(model, compliances, state_rhs, dn, forced, x, s0, s1, options, ds, &out.rhs_evaluations);
   out.y = Eigen::Map<const Eigen::Matrix<double, kSpatialStateSize, 1>>(x.data());
   out.Phi = Eigen::MatrixXd::Identity(kSpatialStateSize, kSpatialStateSize);
   for (int r = 0; r < kVariationRows; ++r)
@@ -235,9 +236,10 @@ template <class StateRhs>
 SegmentFlow written_out_variations_pass(const RodModel& model, const Compliances& compliances,
                                         const StateRhs& state_rhs, const Eigen::VectorXd& y0, double s0, double s1,
                                         const IntegratorOptions& options) {
+  double ds = options.initial_step * (s1 - s0);
   if (model.unfolding_sensitivity)
-    return written_out_phi<kVariationColumns + 1>(model, compliances, state_rhs, y0, s0, s1, options);
-  return written_out_phi<kVariationColumns>(model, compliances, state_rhs, y0, s0, s1, options);
+    return written_out_phi<kVariationColumns + 1>(model, compliances, state_rhs, y0, s0, s1, options, &ds);
+  return written_out_phi<kVariationColumns>(model, compliances, state_rhs, y0, s0, s1, options, &ds);
 }
 
 // written_out_directions with C the first of Cs (ascending) that holds the columns; false when none does.
@@ -271,24 +273,14 @@ DirectionalFlow written_out_directional_flow(const RodModel& model, const Compli
   DirectionalFlow out;
   if (!written_out_directions_fitting<Cs...>(model, compliances, state_rhs, y0, directions, s0, s1, carried_options,
                                              &carried->directions, &out)) {
-    Eigen::MatrixXd seeds = Eigen::MatrixXd::Zero(kSpatialStateSize, kVariationColumns);
-    for (int j = 0; j < kVariationColumns; ++j) seeds(kVariationColumnOf[j], j) = 1.0;
-    out = written_out_directions<kVariationColumns>(model, compliances, state_rhs, y0, seeds, s0, s1, carried_options,
-                                                    &carried->directions);
-    Eigen::MatrixXd Phi = Eigen::MatrixXd::Identity(kSpatialStateSize, kSpatialStateSize);
-    for (int j = 0; j < kVariationColumns; ++j) Phi.col(kVariationColumnOf[j]) = out.directions.col(j);
-    out.directions = Phi * directions;
+    SegmentFlow phi = written_out_phi<kVariationColumns>(model, compliances, state_rhs, y0, s0, s1, carried_options,
+                                                         &carried->directions);
+    out.y = std::move(phi.y);
+    out.directions = phi.Phi * directions;
+    out.steps = phi.steps;
+    out.rhs_evaluations = phi.rhs_evaluations;
   }
-  if (!loose) return out;
-  std::array<double, kSpatialStateSize> state;
-  for (int i = 0; i < kSpatialStateSize; ++i) state[i] = y0[i];
-  auto state_system = [&](const std::array<double, kSpatialStateSize>& y, std::array<double, kSpatialStateSize>& dy,
-                          double s) {
-    ++out.rhs_evaluations;
-    state_rhs(y.data(), dy.data(), s);
-  };
-  out.steps += march_carrying(state, s0, s1, state_system, options, &carried->state);
-  out.y = Eigen::Map<const Eigen::Matrix<double, kSpatialStateSize, 1>>(state.data());
+  if (loose) carry_state_alone<kSpatialStateSize>(state_rhs, y0, s0, s1, options, carried, &out);
   return out;
 }
 
