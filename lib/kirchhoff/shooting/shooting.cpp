@@ -322,11 +322,10 @@ bool ShootingProblem::evaluate_with(const Eigen::VectorXd& x, Eigen::VectorXd* F
   // A parameter that only enters the boundary conditions moves only their rows, which are
   // closed-form in the end states: no re-integration is needed for it.
   const int offset = segments() * state_size_;
-  auto& b = workspace_.buffers();
   for (size_t j = 0; j < unknown_index_.size(); ++j) {
     if (static_cast<int>(j) == from_flows) continue;
-    const double h = kParameterStep * (1.0 + std::abs(x[offset + j]));
     if (moves_beyond_conditions(static_cast<int>(j))) {
+      const double h = kParameterStep * (1.0 + std::abs(x[offset + j]));
       Eigen::VectorXd xp = x, xm = x, Fp, Fm;
       xp[offset + j] += h;
       xm[offset + j] -= h;
@@ -334,12 +333,19 @@ bool ShootingProblem::evaluate_with(const Eigen::VectorXd& x, Eigen::VectorXd* F
       if (!residual(xm, parameters_at(xm), &Fm, nullptr, failure)) return false;
       J->col(offset + j) = (Fp - Fm) / (2.0 * h);
     } else {
-      parameters_into(x, &b.plus, static_cast<int>(j), h);
-      parameters_into(x, &b.minus, static_cast<int>(j), -h);
-      condition_column(x, y_end, b.plus, b.minus, h, J->col(offset + static_cast<Eigen::Index>(j)));
+      unknown_condition_column(x, y_end, static_cast<int>(j), J->col(offset + static_cast<Eigen::Index>(j)));
     }
   }
   return true;
+}
+
+void ShootingProblem::unknown_condition_column(const Eigen::VectorXd& x, const Eigen::VectorXd& y_end, int unknown,
+                                               Eigen::Ref<Eigen::VectorXd> column) const {
+  auto& b = workspace_.buffers();
+  const double h = kParameterStep * (1.0 + std::abs(x[segments() * state_size_ + unknown]));
+  parameters_into(x, &b.plus, unknown, h);
+  parameters_into(x, &b.minus, unknown, -h);
+  condition_column(x, y_end, b.plus, b.minus, h, column);
 }
 
 int ShootingProblem::unfolding_column_from_flows(const Eigen::VectorXd& x, const Parameters& p,
@@ -354,12 +360,8 @@ int ShootingProblem::unfolding_column_from_flows(const Eigen::VectorXd& x, const
   for (const SegmentFlow& flow : flows)
     if (flow.dy_dunfolding.size() != n) return -1;
   // Where the conditions name the parameter: their rows' closed-form difference, the states held.
-  auto& b = workspace_.buffers();
-  const double h = kParameterStep * (1.0 + std::abs(x[offset + j]));
-  parameters_into(x, &b.plus, j, h);
-  parameters_into(x, &b.minus, j, -h);
   Eigen::Ref<Eigen::VectorXd> column = J->col(offset + j);
-  condition_column(x, y_end, b.plus, b.minus, h, column);
+  unknown_condition_column(x, y_end, j, column);
   // Through the flows: the continuity rows y_i(s_{i+1}) - x_{i+1}, then the end rows G(y(L)).
   int row = gauge_count_ + start_condition_count_;
   for (int i = 0; i + 1 < M; ++i, row += n) column.segment(row, n) += flows[i].dy_dunfolding;
@@ -696,8 +698,7 @@ bool singular_at_solution(const ShootingProblem& problem, const Eigen::VectorXd&
   Eigen::MatrixXd J;
   std::string failure;
   const double step_tolerance = problem.definition().options.newton.step_matrix_tolerance;
-  if (step_tolerance > 0 && problem.has_step_matrices(step_tolerance) &&
-      problem.evaluate_for_step(x, &F, &J, step_tolerance, &failure) &&
+  if (problem.has_step_matrices(step_tolerance) && problem.evaluate_for_step(x, &F, &J, step_tolerance, &failure) &&
       JacobianLU(J).reciprocal_condition() > std::max(kClearlyRegular * step_tolerance, threshold))
     return false;
   return problem.evaluate(x, &F, &J, &failure) && !(JacobianLU(J).reciprocal_condition() > threshold);

@@ -227,6 +227,9 @@ class ShootingProblem final : public NonlinearSystem {
   // states held), zero elsewhere.
   void condition_column(const Eigen::VectorXd& x, const Eigen::VectorXd& y_end, const Parameters& plus,
                         const Parameters& minus, double h, Eigen::Ref<Eigen::VectorXd> column) const;
+  // condition_column of the `unknown`-th unknown parameter at x (its step kParameterStep (1 + |value|)).
+  void unknown_condition_column(const Eigen::VectorXd& x, const Eigen::VectorXd& y_end, int unknown,
+                                Eigen::Ref<Eigen::VectorXd> column) const;
   // Whether an unknown parameter enters the rod model or moves an obstacle (its column then needs
   // whole residuals, not only the boundary-condition rows).
   bool moves_beyond_conditions(int unknown) const;

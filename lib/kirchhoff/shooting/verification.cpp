@@ -81,13 +81,12 @@ std::string zero_iteration_failure(const ShootingProblem& problem, const Shootin
   Eigen::VectorXd F;
   Eigen::MatrixXd J;
   std::string failure;
-  // The step matrix where there is one: the correction is compared with a bound (1e-4 of the
-  // unknowns) far above its relative error (the matrix's tolerance, 1e-8, times its condition).
+  // The step matrix where there is one (evaluate_for_step gives the exact one where not): the
+  // correction is compared with a bound (1e-4 of the unknowns) far above its relative error (the
+  // matrix's tolerance, 1e-8, times its condition).
   const double step_tolerance = problem.definition().options.newton.step_matrix_tolerance;
-  const bool evaluated = step_tolerance > 0 && problem.has_step_matrices(step_tolerance)
-                             ? problem.evaluate_for_step(result.x, &F, &J, step_tolerance, &failure)
-                             : problem.evaluate(result.x, &F, &J, &failure);
-  if (!evaluated || !J.allFinite()) return {};  // unknowns_failure's job
+  if (!problem.evaluate_for_step(result.x, &F, &J, step_tolerance, &failure) || !J.allFinite())
+    return {};  // unknowns_failure's job
   const Eigen::VectorXd correction = equilibrated_newton_correction(J, F);
   if (!correction.allFinite()) return {};  // singular even when equilibrated: a branch point, say
   const double size = 1.0 + result.x.lpNorm<Eigen::Infinity>();
