@@ -1033,7 +1033,7 @@ std::string StabilityAnalysis::carry_across(Frame* f, const std::vector<PointCon
 }
 
 // The index from the fields at s = L: the conjugate points inside, the end's terms, the
-// isoperimetric correction and the zero modes; false (report->reason set) where it is not defined.
+// isoperimetric correction and the zero modes; report->reason set (no index) where it is not defined.
 void StabilityAnalysis::count_at_end(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start_phases,
                                      const Held& start, const Held& end, const Eigen::MatrixXd& constraints,
                                      StabilityReport* report) const {
