@@ -86,22 +86,9 @@ int load_and_solve(const std::string& case_path, const std::vector<std::string>&
   CaseSolve& solved = out->solved;
   try {
     solved = solve_case(c, options);
-  } catch (const InfeasibleContact& e) {
-    std::cerr << "error: " << c.path << ": infeasible: " << e.what() << "\n";
-    if (json) std::cout << failure_json(c, "infeasible", 0, INFINITY, e.what()).dump(2) << "\n";
-    return kExitNotConverged;
-  } catch (const IntegrationError& e) {
-    std::cerr << "error: " << c.path << ": the initial guess cannot be integrated: " << e.what() << "\n";
-    if (json) std::cout << failure_json(c, "integration_failed", 0, INFINITY, e.what()).dump(2) << "\n";
-    return kExitNotConverged;
-  } catch (const std::invalid_argument& e) {
-    // Only the seed refuses a case here (one it does not model).
+  } catch (const std::invalid_argument& e) {  // a case the Ipopt seed does not model
     std::cerr << "error: " << c.path << ": --seed ipopt: " << e.what() << "\n";
     return kExitBadInput;
-  } catch (const std::runtime_error& e) {
-    std::cerr << "error: " << c.path << ": --seed ipopt: " << e.what() << "\n";
-    if (json) std::cout << failure_json(c, "seed_failed", 0, INFINITY, e.what()).dump(2) << "\n";
-    return kExitNotConverged;
   }
   if (!solved.path.seed_summary.empty()) std::cerr << "seed: " << solved.path.seed_summary << "\n";
   if (!solved.failure.empty()) {

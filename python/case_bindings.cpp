@@ -34,55 +34,37 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
 
   PySolution out;
   CaseSolve solved;
-  bool integration_failed = false;
-  ShootingResult failed;
   {
     py::gil_scoped_release release;
     try {
       // The library's solve of a case, as the CLI's: homotopy from the file's values when
       // parameters changed (or direct), the active-set loop with obstacles, Ipopt's seed; then
-      // the solution at `samples` points, its checks, and its stability.
+      // the solution at `samples` points, its checks, and its stability. A solve that cannot
+      // start, or a path that stopped short, is a failure with the CLI's status word.
       CaseSolveOptions options;
       options.direct = direct;
       options.seed.ipopt = seed == "ipopt";
       options.seed.segments = seed_segments;
       options.samples = samples;
       solved = solve_case(c, options);
-      if (!solved.failure.empty()) {
-        integration_failed = true;
-        failed.summary = solved.solved.result.summary;  // the failed start solve's, or no residual
-        failed.summary.message = solved.message;
-      } else if (!solved.converged()) {  // Newton's verdict, or the profile's checks' (verification.hpp)
-        failed = solved.solution ? solved.solution->result : solved.solved.result;
-      }
-    } catch (const InfeasibleContact& e) {
-      integration_failed = true;
-      failed.summary.status = SolverStatus::MaxIterations;
-      failed.summary.residual_norm = INFINITY;
-      failed.summary.message = std::string("infeasible: ") + e.what();
-    } catch (const IntegrationError& e) {
-      integration_failed = true;
-      failed.summary.status = SolverStatus::IntegrationFailed;
-      failed.summary.iterations = 0;
-      failed.summary.residual_norm = INFINITY;
-      failed.summary.message = std::string("the initial guess cannot be integrated: ") + e.what();
     } catch (const std::invalid_argument& e) {  // a case the Ipopt seed does not model
       seed_refused = e.what();
-    } catch (const std::runtime_error& e) {     // the seed's Ipopt did not converge
-      integration_failed = true;
-      failed.summary.status = SolverStatus::MaxIterations;
-      failed.summary.residual_norm = INFINITY;
-      failed.summary.message = e.what();
     }
   }
+  if (!seed_refused.empty()) throw py::value_error(seed_refused);
   const std::unique_ptr<ShootingProblem>& problem = solved.solved.problem;
-  const Solution* sol = !integration_failed && seed_refused.empty() && solved.converged() ? &*solved.solution : nullptr;
-  const std::string& path_failure = solved.failure;  // a homotopy that stopped short: its status word
+  const Solution* sol = solved.converged() ? &*solved.solution : nullptr;
+  ShootingResult failed;  // Newton's verdict, the profile's checks' (verification.hpp), or the failure's
+  if (!solved.failure.empty()) {
+    failed.summary = solved.solved.result.summary;
+    failed.summary.message = solved.message;
+  } else if (!sol) {
+    failed = solved.solution ? solved.solution->result : solved.solved.result;
+  }
   // As the CLI's JSON "path" (one builder for both).
   out.path = python_object(path_json(solved.path));
-  if (!seed_refused.empty()) throw py::value_error(seed_refused);
   const ShootingResult& r = sol ? sol->result : failed;
-  out.status = path_failure.empty() ? to_string(r.summary.status) : path_failure;
+  out.status = solved.failure.empty() ? to_string(r.summary.status) : solved.failure;
   out.converged = r.summary.converged();
   out.iterations = r.summary.iterations;
   out.residual = r.summary.residual_norm;

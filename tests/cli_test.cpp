@@ -413,6 +413,20 @@ TEST_F(CliTest, RodBeyondItsSoftWallIsNotConverged) {
   EXPECT_THAT(j["message"].get<std::string>(), HasSubstr("soft wall"));
 }
 
+// An end imposed inside an obstacle: the status word Python's solve() also gives (one library
+// solve behind both), exit 1, no iterate and so no residual.
+TEST_F(CliTest, EndImposedInsideAnObstacleIsInfeasible) {
+  const CliRun r = run("solve " + quoted(case_path("wall.toml")) + " --set a=-0.01 --json --direct");
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  const json j = parse(r);
+  EXPECT_EQ(j["status"], "infeasible") << r.out;
+  EXPECT_EQ(j["iterations"], 0);
+  EXPECT_TRUE(j["residual"].is_null());
+  EXPECT_EQ(j["path"]["method"], "direct");
+  EXPECT_THAT(j["message"].get<std::string>(), HasSubstr("inside obstacle 'wall'"));
+  EXPECT_THAT(r.err, HasSubstr("infeasible: the rod's start is imposed inside obstacle"));
+}
+
 TEST_F(CliTest, IpoptSeedSolvesWhatTheGuessCannot) {
   const std::string args = "solve " + quoted(case_path("cavity.toml")) + " --set Delta=0.05";
   const CliRun plain = run(args + " --direct");

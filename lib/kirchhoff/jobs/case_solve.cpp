@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "kirchhoff/analysis/discrete_seed.hpp"
+#include "kirchhoff/equations/integrator.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -68,9 +69,16 @@ CaseSolve by_homotopy(const Case& c, std::vector<ParameterChange> changes, Homot
   return out;
 }
 
+// How the equilibrium is reached: "ipopt_seed", "homotopy" or "direct" (SolvePath::method).
+std::string solve_method(const Case& c, const CaseSolveOptions& options) {
+  if (options.seed.ipopt) return "ipopt_seed";
+  return !options.direct && !homotopy_changes(c).empty() ? "homotopy" : "direct";
+}
+
 // The equilibrium reached, by the seed, the homotopy or directly (the options' choice).
 CaseSolve reach_equilibrium(const Case& c, const CaseSolveOptions& options) {
-  if (options.seed.ipopt) {
+  const std::string method = solve_method(c, options);
+  if (method == "ipopt_seed") {
     CaseSolve out;
     out.path.method = "ipopt_seed";
     DiscreteSeed seed;
@@ -79,15 +87,25 @@ CaseSolve reach_equilibrium(const Case& c, const CaseSolveOptions& options) {
     out.path.seed_summary = seed.summary;
     return out;
   }
-  std::vector<ParameterChange> changes = homotopy_changes(c);
-  if (!options.direct && !changes.empty()) {
+  if (method == "homotopy") {
     HomotopyOptions homotopy = options.homotopy;
     homotopy.deadline = std::min(homotopy.deadline, c.definition.options.newton.deadline);
-    return by_homotopy(c, std::move(changes), homotopy);
+    return by_homotopy(c, homotopy_changes(c), homotopy);
   }
   CaseSolve out;
   out.path.method = "direct";
   out.solved = solve_definition(c.definition, c.start_guess);
+  return out;
+}
+
+// A solve that stopped before Newton's first iteration: no iterate, so no residual to report.
+CaseSolve stopped_before_newton(const std::string& method, const std::string& status, const std::string& message) {
+  CaseSolve out;
+  out.path.method = method;
+  out.failure = status;
+  out.message = message;
+  out.solved.result.summary.iterations = 0;
+  out.solved.result.summary.residual_norm = INFINITY;
   return out;
 }
 
@@ -127,7 +145,17 @@ std::vector<ParameterChange> homotopy_changes(const Case& c) {
 }
 
 CaseSolve solve_case(const Case& c, const CaseSolveOptions& options) {
-  CaseSolve out = reach_equilibrium(c, options);
+  CaseSolve out;
+  try {
+    out = reach_equilibrium(c, options);
+  } catch (const InfeasibleContact& e) {
+    return stopped_before_newton(solve_method(c, options), "infeasible", e.what());
+  } catch (const IntegrationError& e) {
+    return stopped_before_newton(solve_method(c, options), "integration_failed", std::string("the initial guess cannot be integrated: ") + e.what());
+  } catch (const std::runtime_error& e) {
+    if (!options.seed.ipopt) throw;
+    return stopped_before_newton(solve_method(c, options), "seed_failed", e.what());  // Ipopt's minimisation did not converge
+  }
   if (out.failure.empty() && out.solved.result.summary.converged()) analyse(c, options, &out);
   return out;
 }

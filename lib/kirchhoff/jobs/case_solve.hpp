@@ -54,13 +54,14 @@ struct SolvePath {
 
 struct CaseSolve {
   // The problem at the requested values and its solve; the problem is null when a homotopy
-  // stopped before reaching them (the summary is then the failed start solve's, or has an
-  // infinite residual when the path itself stopped).
+  // stopped before reaching them or the solve could not start (the summary is then the failed
+  // start solve's, or has an infinite residual when the path itself stopped or never started).
   DefinitionSolve solved;
   SolvePath path;
-  // Empty, or the status word of a path that stopped short ("fold", "step_too_small", ..., or
-  // the Newton status of the case's own solve it starts from) with its message (where it
-  // stopped, and what to do).
+  // Empty, or the status word of a solve that could not start ("infeasible",
+  // "integration_failed", "seed_failed") or of a path that stopped short ("fold",
+  // "step_too_small", ..., or the Newton status of the case's own solve it starts from) with its
+  // message (what stopped it, where, and what to do).
   std::string failure;
   std::string message;
   // Once Newton converged (and no failure): the solution made from solved.result (a copy; its
@@ -77,8 +78,10 @@ struct CaseSolve {
   bool converged() const { return failure.empty() && summary().converged(); }
 };
 
-// Throws what solve_definition and solve_from_discrete_seed throw (IntegrationError,
-// InfeasibleContact; std::invalid_argument / std::runtime_error from the seed).
+// A solve that cannot start is a failure with its status word, as the front ends report it:
+// "infeasible" (an end imposed inside an obstacle), "integration_failed" (the guess cannot be
+// integrated), "seed_failed" (Ipopt's minimisation did not converge). Throws
+// std::invalid_argument only for a case the Ipopt seed does not model (bad input).
 CaseSolve solve_case(const Case& c, const CaseSolveOptions& options = {});
 
 // The changes a homotopy makes for this case: its overrides of parameters that are not solved
