@@ -113,11 +113,13 @@ double spread_along(const Solution& sol, const PointFunction& f) {
 
 using In = DerivedInputs;
 
-// The table. A new quantity is one row here; its meaning says where it is NaN (the test
-// tests/derived_quantities_test.cpp accepts a NaN only from a quantity that says so). Built on
-// first use, not at static initialisation, which another file's statics may precede.
-const std::vector<DerivedQuantity>& quantities() {
-  static const std::vector<DerivedQuantity> table = {
+// The table, in three groups. A new quantity is one row in its group; its meaning says where it
+// is NaN (the test tests/derived_quantities_test.cpp accepts a NaN only from a quantity that says
+// so). Built on first use, not at static initialisation, which another file's statics may precede.
+
+// The rod's ends, loads and shape.
+std::vector<DerivedQuantity> shape_and_load_quantities() {
+  return {
     {"P", "compressive end load -n_x(0)", [](In& in) { return -in.start().n.x(); }},
     {"theta0", "angle of the tangent d3(0) to the x axis, in the (x, y) plane",
      [](In& in) { return in.planar() ? in.start().turn_angle : tangent_angle(in.start()); }},
@@ -137,14 +139,31 @@ const std::vector<DerivedQuantity>& quantities() {
     {"n_y", "n_y(0)", [](In& in) { return in.start().n.y(); }},
     {"n_z", "n_z(0)", [](In& in) { return in.start().n.z(); }},
     {"m_start", "|m(0)|, the moment at the start (clamping moment)", [](In& in) { return in.start().m.norm(); }},
-    {"H", "mean of the arclength Hamiltonian H = n.v + m.u - V along the rod (eq. 29)",
-     [](In& in) { return in.sol.invariants.H.mean; }},
-    {"H_spread", "max - min of H along the rod", [](In& in) { return in.sol.invariants.H.spread; }},
+    {"kappa_mid", "curvature u2 at s = L/2 (signed, planar)",
+     [](In& in) { return in.problem.sample(in.x(), {0.5 * in.end().s}).front().u[1]; }},
+    {"kappa_end", "curvature u2 at s = L (signed, planar)", [](In& in) { return in.end().u[1]; }},
+    {"kappa_start", "curvature u2 at s = 0 (signed, planar)", [](In& in) { return in.start().u[1]; }},
     {"stretch_max", "largest axial strain |v3 - 1| along the rod",
      [](In& in) {
        double worst = 0.0;
        for (const auto& p : in.sol.profile) worst = std::max(worst, std::abs(p.v[2] - 1.0));
        return worst;
+     }},
+  };
+}
+
+// The Hamiltonian, the energies and the external field.
+std::vector<DerivedQuantity> energy_quantities() {
+  return {
+    {"H", "mean of the arclength Hamiltonian H = n.v + m.u - V along the rod (eq. 29)",
+     [](In& in) { return in.sol.invariants.H.mean; }},
+    {"H_spread", "max - min of H along the rod", [](In& in) { return in.sol.invariants.H.spread; }},
+    {"H_start", "H at s = 0", [](In& in) { return hamiltonian(in.model(), in.start()); }},
+    {"H_end", "H at s = L", [](In& in) { return hamiltonian(in.model(), in.end()); }},
+    {"h_spread", "max - min of h = H + W_ext (eq. 67), not invariant under a field",
+     [](In& in) {
+       const RodModel& model = in.model();
+       return spread_along(in.sol, [&](const RodPoint& p) { return hamiltonian_without_field(model, p); });
      }},
     {"E_wall", "integral of the external potential along the rod (eq. 69 for the soft wall)",
      [](In& in) {
@@ -167,12 +186,12 @@ const std::vector<DerivedQuantity>& quantities() {
      }},
     {"ny_jump", "n_y(L) - n_y(0): the wall's total reaction (eq. 66)",
      [](In& in) { return in.end().n.y() - in.start().n.y(); }},
-    {"kappa_mid", "curvature u2 at s = L/2 (signed, planar)",
-     [](In& in) { return in.problem.sample(in.x(), {0.5 * in.end().s}).front().u[1]; }},
-    {"kappa_end", "curvature u2 at s = L (signed, planar)", [](In& in) { return in.end().u[1]; }},
-    {"kappa_start", "curvature u2 at s = 0 (signed, planar)", [](In& in) { return in.start().u[1]; }},
-    {"H_start", "H at s = 0", [](In& in) { return hamiltonian(in.model(), in.start()); }},
-    {"H_end", "H at s = L", [](In& in) { return hamiltonian(in.model(), in.end()); }},
+  };
+}
+
+// The contacts with obstacles.
+std::vector<DerivedQuantity> contact_quantities() {
+  return {
     {"contact_force", "sum of the point-contact forces",
      [](In& in) {
        double total = 0.0;
@@ -231,12 +250,18 @@ const std::vector<DerivedQuantity>& quantities() {
        if (in.problem.definition().obstacles.empty()) return kNaN;
        return closest_approach(in.problem, in.x(), static_cast<int>(in.sol.profile.size())).gap;
      }},
-    {"h_spread", "max - min of h = H + W_ext (eq. 67), not invariant under a field",
-     [](In& in) {
-       const RodModel& model = in.model();
-       return spread_along(in.sol, [&](const RodPoint& p) { return hamiltonian_without_field(model, p); });
-     }},
   };
+}
+
+const std::vector<DerivedQuantity>& quantities() {
+  static const std::vector<DerivedQuantity> table = [] {
+    std::vector<DerivedQuantity> all;
+    for (auto group : {shape_and_load_quantities, energy_quantities, contact_quantities}) {
+      std::vector<DerivedQuantity> part = group();
+      all.insert(all.end(), std::make_move_iterator(part.begin()), std::make_move_iterator(part.end()));
+    }
+    return all;
+  }();
   return table;
 }
 
