@@ -25,39 +25,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The arguments that decide a run's points, in one line: a state file records them, and a
-// resume with other ones is refused (it would not continue the same run). The output paths,
-// --checkpoint and --resume itself are not among them.
-// The case is named by its canonical path and its content's FNV-1a hash (an edited case file is
-// another run too).
-std::string run_arguments(const ContinueArguments& a) {
-  std::ifstream in(a.case_path, std::ios::binary);
-  std::uint64_t hash = 14695981039346656037ull;
-  for (char ch; in.get(ch);) hash = (hash ^ static_cast<unsigned char>(ch)) * 1099511628211ull;
-  std::error_code ec;
-  const fs::path canonical = fs::weakly_canonical(a.case_path, ec);
-  std::ostringstream o;
-  o << std::setprecision(17) << "case=" << (ec ? fs::path(a.case_path) : canonical).string() << " case_hash=" << std::hex
-    << hash << std::dec << " param=" << a.parameter;
-  for (const auto& s : a.overrides) o << " set=" << s;
-  for (const auto& s : a.solver) o << " solver=" << s;  // none: the line older state files hold
-  o << " phase=" << a.phase_condition << " to=";
-  if (a.has_to)
-    o << a.to;
-  else
-    o << "none";
-  o << " step=" << a.step
-    << " min_step=" << a.min_step << " max_step=" << a.max_step << " max_points=" << a.max_points
-    << " switch_at_bp=" << a.switch_at_bp << " side=" << a.switch_side << " branch_points=" << !a.no_branch_points << " stability=" << !a.no_stability;
-  for (const auto& e : a.stop_events) o << " event=" << e;
-  for (const auto& e : a.record_events) o << " record=" << e;
-  // (Only when given, so that the line of a run without it is the one older state files hold.)
-  if (!a.start_from.empty()) o << " start_from=" << fs::weakly_canonical(a.start_from, ec).string();
-  o << " samples=" << a.samples << " seed=" << (a.seed.ipopt ? "ipopt" : "guess");
-  if (a.seed.ipopt) o << " seed_segments=" << a.seed.segments << " seed_amplitude=" << a.seed.amplitude;
-  return o.str();
-}
-
 // For tests and tests/resume_soak.sh: KIRCHHOFF_TEST_KILL_AFTER_ROW=K makes the run kill itself
 // with SIGKILL right after row K is written and flushed, before the state is saved for it (the
 // narrowest window a real kill can hit: the row is on disk, the state is the previous point's,
@@ -203,7 +170,6 @@ int run_continue(const ContinueArguments& args) {
   request.deflate = args.deflate;
   request.deflate_max = args.deflate_max;
   request.seed = args.seed;
-  request.identity = run_arguments(args);
   RunPlanInputs inputs;
   inputs.case_path = args.case_path;
   inputs.phase_condition = args.phase_condition;

@@ -67,7 +67,8 @@ ParameterOverrides parse_overrides(const std::vector<std::string>& texts) {
 
 int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
                    const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed,
-                   double max_seconds, bool direct, const std::vector<std::string>& solver, bool analyse) {
+                   double max_seconds, bool direct, const std::vector<std::string>& solver, bool analyse,
+                   const std::function<std::string(const Case&)>& refusal) {
   Case& c = out->c;
   try {
     c = load_case(case_path, parse_overrides(overrides), phase_condition, parse_solver_overrides(solver));
@@ -77,6 +78,10 @@ int load_and_solve(const std::string& case_path, const std::vector<std::string>&
     return kExitBadInput;
   } catch (const std::invalid_argument& e) {
     std::cerr << "error: --max-seconds: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  if (const std::string why = refusal ? refusal(c) : ""; !why.empty()) {
+    std::cerr << "error: " << c.path << ": " << why << "\n";
     return kExitBadInput;
   }
   CaseSolveOptions options;

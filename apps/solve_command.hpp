@@ -1,6 +1,7 @@
 // The CLI's commands; each returns the process exit status.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -40,10 +41,13 @@ struct SolvedCase {
 // Loads and solves; on failure prints the reason (and, with json, a failure object on stdout)
 // and returns the exit status, else kExitOk. With `analyse` (solve's own), the solution, its
 // checks and its stability are made too (CaseSolveOptions); without, only the equilibrium.
+// `refusal`, when given, says of the loaded case why the command cannot run on it ("" when it
+// can): said as bad input before anything is solved.
 int load_and_solve(const std::string& case_path, const std::vector<std::string>& overrides,
                    const std::string& phase_condition, bool json, SolvedCase* out, const StartSeed& seed = {},
                    double max_seconds = kDefaultSolveSeconds, bool direct = false,
-                   const std::vector<std::string>& solver = {}, bool analyse = true);
+                   const std::vector<std::string>& solver = {}, bool analyse = true,
+                   const std::function<std::string(const Case&)>& refusal = {});
 // Prints why a solve is not a trustworthy equilibrium (and, with json, the failure object) and
 // returns kExitNotConverged.
 int report_not_converged(const Case& c, const NewtonSummary& summary, bool json);

@@ -99,20 +99,18 @@ void print_table(const Case& c, const VibrationAnalysis& analysis) {
 }  // namespace
 
 int run_vibrate(const VibrateArguments& args) {
-  SolvedCase solved;
-  // The equilibrium alone: the vibration analysis needs no profile and no stability index.
-  if (const int status = load_and_solve(args.case_path, args.overrides, "", args.json, &solved, {}, kDefaultSolveSeconds, false,
-                                        args.solver, false); status != kExitOk)
-    return status;
-  if (solved.c.definition.kind != RodKind::Planar) {
-    std::cerr << "error: " << args.case_path
-              << ": vibrate handles planar rods only (the vibration equations B.4 are planar); this case is spatial\n";
-    return kExitBadInput;
-  }
-  const DefinitionSolve& equilibrium = solved.solved.solved;
   VibrationOptions options;
   options.modes = args.modes;
   options.rho_s = args.rho_s;
+  SolvedCase solved;
+  // The equilibrium alone: the vibration analysis needs no profile and no stability index. A
+  // spatial case or bad options are refused before it is solved for.
+  const auto refusal = [&](const Case& c) { return vibration_refusal(c.definition, options); };
+  if (const int status = load_and_solve(args.case_path, args.overrides, "", args.json, &solved, {}, kDefaultSolveSeconds,
+                                        false, args.solver, false, refusal);
+      status != kExitOk)
+    return status;
+  const DefinitionSolve& equilibrium = solved.solved.solved;
   VibrationAnalysis analysis;
   try {
     analysis = VibrationProblem(*equilibrium.problem, equilibrium.result.x, options).analyse();

@@ -105,14 +105,15 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
 
 // Vibrations about the case's equilibrium (the CLI's `vibrate`).
 py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
-  const Case& c = pc.c;
-  if (c.definition.kind != RodKind::Planar)
-    throw py::value_error(c.path + ": vibrate handles planar rods only (eqs. B.4); this case is spatial");
+  Case c = pc.c;
   VibrationOptions options;
   options.modes = modes;
   options.rho_s = rho_s;
   options.profile_samples = samples;
-  if (std::string e = options.validate(); !e.empty()) throw py::value_error(e);
+  // Refused before the equilibrium is solved for, as the CLI's `vibrate`, which also limits the
+  // solve to its default wall clock.
+  if (std::string why = vibration_refusal(c.definition, options); !why.empty()) throw py::value_error(c.path + ": " + why);
+  limit_wall_clock(c.definition.options, kDefaultSolveSeconds);
   VibrationAnalysis analysis;
   Parameters at;  // the equilibrium's parameters, solved-for ones included
   {

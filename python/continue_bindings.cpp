@@ -19,25 +19,6 @@ class CollectingSink : public ContinueSink {
   }
 };
 
-// What identifies a run for resume=True (ContinueRequest::identity; the CLI's run_arguments): the
-// case file (path and content hash), how it was loaded, and the arguments that decide the points.
-std::string python_run_identity(const PyCase& pc, const ContinueRequest& r, const std::string& start_from) {
-  std::ifstream in(pc.path, std::ios::binary);
-  std::uint64_t hash = 14695981039346656037ull;  // FNV-1a, as the CLI's
-  for (char ch; in.get(ch);) hash = (hash ^ static_cast<unsigned char>(ch)) * 1099511628211ull;
-  std::ostringstream o;
-  o << std::setprecision(17) << "python case=" << pc.path << " case_hash=" << std::hex << hash << std::dec;
-  for (const auto& entry : pc.overrides) o << " set=" << entry.first << "=" << entry.second;
-  for (const auto& entry : pc.solver) o << " solver=" << entry.first << "=" << entry.second;
-  o << " phase=" << pc.phase_condition << " param=" << r.parameter << " to=" << r.target << " direction=" << r.direction
-    << " step=" << r.initial_step << " min_step=" << r.min_step << " max_step=" << r.max_step
-    << " max_points=" << r.max_points << " switch_at_bp=" << r.switch_at_bp << " side=" << r.switch_side
-    << " branch_points=" << r.detect_branch_points << " stability=" << r.compute_stability << " samples=" << r.samples;
-  for (const auto& e : r.events) o << (e.stop ? " event=" : " record=") << e.quantity << "=" << e.value;
-  if (!start_from.empty()) o << " start_from=" << start_from;
-  return o.str();
-}
-
 // The CLI's `continue` (continue_case: the same statuses and messages), its points in memory.
 PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::object& to, double step,
                      double min_step, double max_step, int max_points, const py::object& events,
@@ -66,7 +47,6 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
   request.max_seconds = max_seconds;
   const std::string state_path = path_text(state), from = path_text(start_from);
   if (deflate && !state_path.empty()) throw CaseError("state: a deflate run is not resumable, so it saves no state");
-  request.identity = python_run_identity(pc, request, from);
   RunPlanInputs inputs;  // the case loaded again where the run's parameter values differ from pc's
   inputs.case_path = pc.path;
   inputs.overrides = pc.overrides;

@@ -545,6 +545,39 @@ class ContinueRunControlTest(unittest.TestCase):
             with self.assertRaises(ValueError):
                 case.continue_("theta0", to=1.2, max_seconds=-1)
 
+    @unittest.skipUnless(os.environ.get("KIRCHHOFF_CLI"), "needs the CLI's path in KIRCHHOFF_CLI (ctest sets it)")
+    def test_python_resumes_a_run_the_cli_started(self):
+        # One run identity for both front ends (run_identity): a CLI run killed after its third
+        # row is resumed from Python with the same arguments, and ends on the points of Python's
+        # uninterrupted run. The case is named by another path to the same file.
+        path = case_path("simply_supported.toml")
+        other_path = str(CASES / ".." / CASES.name / "simply_supported.toml")
+        with tempfile.TemporaryDirectory() as tmp:
+            csv = pathlib.Path(tmp) / "b.csv"
+            killed = subprocess.run([os.environ["KIRCHHOFF_CLI"], "continue", path, "--param", "theta0", "--to", "1.5",
+                                     "--set", "theta0=1.0", "--event", "theta_end=-1.4", "--checkpoint", "0",
+                                     "--out", str(csv)],
+                                    env=dict(os.environ, KIRCHHOFF_TEST_KILL_AFTER_ROW="3"), capture_output=True)
+            self.assertNotEqual(killed.returncode, 0)
+            case = kirchhoff.load_case(other_path, set={"theta0": 1})
+            rest = case.continue_("theta0", to=1.5, events={"theta_end": -1.4}, state=str(csv) + ".state.json",
+                                  resume=True)
+            whole = case.continue_("theta0", to=1.5, events={"theta_end": -1.4})
+            self.assertEqual(rest.reason, whole.reason)
+            self.assertGreater(rest.points["index"][0], 0)
+            n = len(rest.points["index"])
+            np.testing.assert_array_equal(rest.points["index"], whole.points["index"][-n:])
+            np.testing.assert_array_equal(rest.points["parameter"], whole.points["parameter"][-n:])
+
+    def test_an_event_value_that_cannot_be_crossed_is_refused(self):
+        case = kirchhoff.load_case(case_path("simply_supported.toml"))
+        for value in (math.nan, math.inf, 1e300):
+            with self.assertRaisesRegex(kirchhoff.CaseError, "theta_end's value must be finite"):
+                case.continue_("theta0", to=1.2, events={"theta_end": value})
+        with self.assertRaisesRegex(kirchhoff.CaseError, "the state file cannot be read"):
+            with tempfile.TemporaryDirectory() as tmp:
+                case.continue_("theta0", to=1.2, state=tmp, resume=True)  # a folder
+
     def test_start_from_another_runs_last_point(self):
         # From the end of a run in theta0 to 1.5, on to 2: the run starts at theta0 = 1.5 (its
         # first point, type 'start') and reaches the elliptic load 4 K(k)^2 EI/L^2 at theta0 = 2
@@ -635,6 +668,12 @@ class VibrateTest(unittest.TestCase):
             kirchhoff.load_case(case_path("twisted_clamped.toml")).vibrate()
         with self.assertRaises(ValueError):
             kirchhoff.load_case(case_path("euler_column.toml")).vibrate(rho_s=-1.0)
+        # Refused before the equilibrium is solved for, with the CLI's reasons, also where the
+        # solve would fail (an end inside the wall).
+        with self.assertRaisesRegex(ValueError, "planar rods only"):
+            kirchhoff.load_case(case_path("twisted_ribbon_pole.toml"), set={"pole_x": 0, "pole_z": 0}).vibrate()
+        with self.assertRaisesRegex(ValueError, "rho_s"):
+            kirchhoff.load_case(case_path("wall.toml"), set={"a": -0.01}).vibrate(rho_s=math.nan)
 
 
 class UnstableVibrationTest(unittest.TestCase):

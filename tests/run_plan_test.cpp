@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <string>
 
@@ -98,6 +99,38 @@ TEST_F(RunPlanTest, ResumeWithoutStateAndAtMostTheStartRowStartsAgain) {
   EXPECT_FALSE(request_.resume.has_value());
   ASSERT_EQ(plan.notes.size(), 1u);
   EXPECT_NE(plan.notes[0].find("starts from the beginning"), std::string::npos) << plan.notes[0];
+}
+
+// One identity for the CLI and Python: the case by its canonical path, the values as numbers;
+// everything that decides the points changes it.
+TEST_F(RunPlanTest, RunIdentityNamesTheRunNotHowItWasTyped) {
+  request_.identity.clear();
+  in_.overrides = {{"theta0", 1.0}};
+  const std::string identity = run_identity(in_, request_);
+  RunPlanInputs other = in_;
+  other.case_path = std::string(KIRCHHOFF_CASES_DIR) + "/../cases/simply_supported.toml";
+  EXPECT_EQ(run_identity(other, request_), identity);
+  plan_run(in_, &request_);
+  EXPECT_EQ(request_.identity, identity);  // plan_run fills it when the caller did not
+  for (auto change : std::vector<std::function<void(RunPlanInputs*, ContinueRequest*)>>{
+           [](RunPlanInputs* i, ContinueRequest*) { i->overrides = {{"theta0", 1.1}}; },
+           [](RunPlanInputs* i, ContinueRequest*) { i->solver = {{"tolerance", "1e-10"}}; },
+           [](RunPlanInputs*, ContinueRequest* r) { r->target = 1.3; },
+           [](RunPlanInputs*, ContinueRequest* r) { r->max_step = 0.1; },
+           [](RunPlanInputs*, ContinueRequest* r) { r->events.push_back({"theta_end", -1.0, true, ""}); },
+           [](RunPlanInputs*, ContinueRequest* r) { r->seed.ipopt = true; }}) {
+    RunPlanInputs i = in_;
+    ContinueRequest r = request_;
+    change(&i, &r);
+    EXPECT_NE(run_identity(i, r), identity);
+  }
+}
+
+// A state file that cannot be read is bad input (CaseError) for both front ends.
+TEST_F(RunPlanTest, UnreadableStateFileIsACaseError) {
+  in_.resume = true;
+  in_.state_path = dir_;  // a folder
+  EXPECT_NE(refusal().find("the state file cannot be read"), std::string::npos) << refusal();
 }
 
 TEST_F(RunPlanTest, ResumeAndStartFromARunsStateFile) {

@@ -157,6 +157,12 @@ double eq97_terms(double EI, double rho_s, double omega2, double P, const Column
 
 }  // namespace
 
+std::string vibration_refusal(const ProblemDefinition& definition, const VibrationOptions& options) {
+  if (definition.kind != RodKind::Planar)
+    return "vibrate handles planar rods only (the vibration equations B.4 are planar); this case is spatial";
+  return options.validate();
+}
+
 std::string VibrationOptions::validate() const {
   if (modes < 1) return "modes must be >= 1, got " + std::to_string(modes);
   if (!(rho_s > 0.0) || !std::isfinite(rho_s)) return "rho_s (mass per unit length) must be > 0, got " + format(rho_s);

@@ -102,6 +102,11 @@ struct VibrationOptions {
   std::string validate() const;  // empty when valid, else the reason
 };
 
+// Why the vibrations of this problem cannot be analysed with these options ("" when they can),
+// said before its equilibrium is solved for: a spatial rod (the vibration equations B.4 are
+// planar), or the options' own reason (VibrationOptions::validate). Bad input for both front ends.
+std::string vibration_refusal(const ProblemDefinition& definition, const VibrationOptions& options);
+
 struct VibrationMode {
   double omega = 0.0;   // sqrt(omega2); 0 for an unstable mode (omega2 < 0)
   double omega2 = 0.0;  // omega^2, negative for an unstable mode

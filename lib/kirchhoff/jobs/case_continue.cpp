@@ -1,6 +1,7 @@
 #include "kirchhoff/jobs/case_continue.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <sstream>
 
@@ -325,9 +326,13 @@ std::string ContinueRequest::validate(const Case& c) const {
   if (switch_at_bp < 0) return "switch_at_bp must be >= 0";
   if (switch_at_bp > 0 && !detect_branch_points)
     return "--switch-at-bp needs branch points: drop --no-branch-points (Python: branch_points=True)";
-  for (const auto& e : events)
+  for (const auto& e : events) {
     if (!derived_catalogue().count(e.quantity))
       return "--event/--record: '" + e.quantity + "' is not a derived quantity";
+    // (A NaN would never be crossed: the event could not fire, and the run would not say so.)
+    if (!std::isfinite(e.value) || std::abs(e.value) > case_limits::kMaxMagnitude)
+      return "--event/--record: " + e.quantity + "'s value must be finite, within +-1e100";
+  }
   return options_for(c, *this).validate();
 }
 

@@ -1,6 +1,10 @@
 #include "kirchhoff/jobs/run_plan.hpp"
 
+#include <cmath>
+#include <cstdint>
 #include <fstream>
+#include <iomanip>
+#include <sstream>
 
 namespace kirchhoff {
 namespace {
@@ -34,7 +38,53 @@ bool resumes(const RunPlanInputs& in, std::vector<std::string>* notes) {
   return false;
 }
 
+// A path as the identity holds it: canonical where it exists, so that "cases/../cases/x.toml"
+// and "cases/x.toml" name the same run.
+std::string canonical_text(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(path, ec);
+  return (ec ? std::filesystem::path(path) : canonical).string();
+}
+
+// A state file read: what cannot be read (a directory, a truncated file) is bad input, said as a
+// CaseError by both front ends; CaseError and std::invalid_argument (refusals) pass as they are.
+template <class Read>
+auto reading_state(const std::string& path, Read&& read) {
+  try {
+    return read();
+  } catch (const std::invalid_argument&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw CaseError(path + ": the state file cannot be read: " + e.what());
+  }
+}
+
 }  // namespace
+
+std::string run_identity(const RunPlanInputs& in, const ContinueRequest& r) {
+  std::ifstream file(in.case_path, std::ios::binary);
+  std::uint64_t hash = 14695981039346656037ull;  // FNV-1a of the case file's bytes
+  for (char ch; file.get(ch);) hash = (hash ^ static_cast<unsigned char>(ch)) * 1099511628211ull;
+  std::ostringstream o;
+  o << std::setprecision(17) << "case=" << canonical_text(in.case_path) << " case_hash=" << std::hex << hash
+    << std::dec << " param=" << r.parameter;
+  for (const auto& [name, value] : in.overrides) o << " set=" << name << "=" << value;
+  for (const auto& [key, value] : in.solver) o << " solver=" << key << "=" << value;
+  o << " phase=" << (in.phase_condition.empty() ? "none" : in.phase_condition) << " to=";
+  if (std::isnan(r.target))
+    o << "none";
+  else
+    o << r.target;
+  o << " direction=" << r.direction << " step=" << r.initial_step << " min_step=" << r.min_step
+    << " max_step=" << r.max_step << " max_points=" << r.max_points << " switch_at_bp=" << r.switch_at_bp
+    << " side=" << r.switch_side << " branch_points=" << r.detect_branch_points
+    << " stability=" << r.compute_stability << " samples=" << r.samples;
+  for (const auto& e : r.events) o << (e.stop ? " event=" : " record=") << e.quantity << "=" << e.value;
+  if (!in.start_from.empty()) o << " start_from=" << canonical_text(in.start_from);
+  o << " seed=" << (r.seed.ipopt ? "ipopt" : "guess");
+  if (r.seed.ipopt) o << " seed_segments=" << r.seed.segments << " seed_amplitude=" << r.seed.amplitude;
+  return o.str();
+}
 
 int branch_csv_rows(const std::filesystem::path& path) {
   std::ifstream in(path);
@@ -51,15 +101,17 @@ RunPlan plan_run(const RunPlanInputs& in, ContinueRequest* request, const Case* 
   if (request->deflate && (in.resume || !in.start_from.empty())) throw CaseError(kDeflateRefusal);
   if (!in.start_from.empty() && request->seed.ipopt) throw CaseError("--start-from does not combine with --seed");
   RunPlan plan;
+  if (request->identity.empty()) request->identity = run_identity(in, *request);
   ParameterOverrides overrides = in.overrides;
   bool reload = loaded == nullptr;
   if (const bool resuming = in.resume && resumes(in, &plan.notes); resuming) {
-    request->resume = resumable_state(in.state_path.string(), request->identity);
+    const std::string path = in.state_path.string();
+    request->resume = reading_state(path, [&] { return resumable_state(path, request->identity); });
     // A run started from another one keeps the values it started with (the other run's, which
     // its arguments do not hold).
     if (request->resume->has_set_parameters) overrides = request->resume->set_parameters, reload = true;
   } else if (!in.start_from.empty()) {
-    plan.start = plan_start_from(in.start_from, in.start_param, overrides);
+    plan.start = reading_state(in.start_from, [&] { return plan_start_from(in.start_from, in.start_param, overrides); });
     refuse_foreign_parameters(*plan.start, in);
     overrides = plan.start->parameters, reload = true;
     request->start = plan.start->at;

@@ -38,11 +38,19 @@ struct RunPlan {
   std::vector<std::string> notes; // what the front end says before the run (a resume that restarts)
 };
 
-// Fills request->resume / start / start_name / set_parameters and validates the request on the
-// loaded case. `loaded`, when given, is the case as the front end loaded it with `overrides`:
+// Fills request->identity (run_identity, unless the caller gave one), request->resume / start /
+// start_name / set_parameters and validates the request on the loaded case. `loaded`, when given, is the case as the front end loaded it with `overrides`:
 // used as is where the run keeps those values. Throws CaseError (or std::invalid_argument for a
-// state file that cannot be used) with the reason; the front ends report it as bad input.
+// state file that cannot be used, a CaseError for one that cannot be read) with the reason; the
+// front ends report it as bad input.
 RunPlan plan_run(const RunPlanInputs& in, ContinueRequest* request, const Case* loaded = nullptr);
+
+// What identifies a run (ContinueRequest::identity, recorded in its state; a resume whose state
+// records another is refused): the case file (its canonical path and a hash of its bytes), the
+// values and solver settings it was given (as numbers: "P=1" and "P=1.0" are one run), and every
+// field of the request that decides its points. The same for the CLI and Python, so that either
+// can resume a run the other started.
+std::string run_identity(const RunPlanInputs& in, const ContinueRequest& request);
 
 // The data rows of a branch CSV (0 when there is none).
 int branch_csv_rows(const std::filesystem::path& path);
