@@ -156,10 +156,9 @@ int run_equilibria(const EquilibriaArguments& args) {
   EquilibriaOptions options;
   try {
     c = load_case(args.case_path, parse_overrides(args.overrides), "", parse_solver_overrides(args.solver));
-    if (args.max_equilibria < 1) throw CaseError("--max: at least 1");
-    if (!(args.max_seconds >= 0)) throw CaseError("--max-seconds: not negative");
     options.max_equilibria = args.max_equilibria;
     options.max_seconds = args.max_seconds;
+    if (const std::string why = options.validate(); !why.empty()) throw CaseError(why);
   } catch (const CaseError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;

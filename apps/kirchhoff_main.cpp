@@ -179,9 +179,9 @@ CLI::App* add_equilibria_command(CLI::App& app, EquilibriaArguments* args) {
       "  kirchhoff equilibria cases/euler_column.toml --set P=50\n"
       "  kirchhoff equilibria cases/wall.toml --set Delta=0.033 --max 6 --json --profiles wall_eq/");
   add_case_options(command, args);
-  command->add_option("--max", args->max_equilibria, "Stop once this many distinct equilibria are found")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+  // (Its range, [1, 1000], is the library's check: EquilibriaOptions::validate, as Python's.)
+  command->add_option("--max", args->max_equilibria, "Stop once this many distinct equilibria are found (1 to 1000)")
+      ->capture_default_str();
   command->add_flag("--json", args->json,
                     "Print JSON: {\"equilibria\": [solve's object with \"energy\", \"rank\", \"found_by\"], "
                     "\"rejected\", \"stopped_because\", \"log\"}");

@@ -29,7 +29,6 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   if (samples < 2 || samples > 100000)  // as a case file's [output] samples
     throw py::value_error("samples must be in [2, 100000] (got " + std::to_string(samples) + ")");
   if (seed != "guess" && seed != "ipopt") throw py::value_error("seed must be 'guess' or 'ipopt' (got '" + seed + "')");
-  if (seed_segments < 4) throw py::value_error("seed_segments must be >= 4");
   std::string seed_refused;  // raised as ValueError once the GIL is back
 
   PySolution out;
@@ -191,11 +190,10 @@ py::list py_equilibria(const PyCase& pc, int max, double max_seconds, const py::
   const Case& c = pc.c;
   const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
   if (samples < 2 || samples > 100000) throw py::value_error("samples must be in [2, 100000]");
-  if (max < 1) throw py::value_error("max must be >= 1");
-  if (!(max_seconds >= 0)) throw py::value_error("max_seconds must be >= 0");
   EquilibriaOptions options;
   options.max_equilibria = max;
   options.max_seconds = max_seconds;
+  if (const std::string why = options.validate(); !why.empty()) throw py::value_error(why);
   EquilibriaSearch search;
   {
     py::gil_scoped_release release;
@@ -203,6 +201,13 @@ py::list py_equilibria(const PyCase& pc, int max, double max_seconds, const py::
   }
   py::list out;
   for (const auto& e : search.equilibria) out.append(equilibrium_solution(c, e));
+  // None found is the CLI's failure (exit 1): here an empty list, with the CLI's message and the
+  // search's last word as a warning, so that it is not silent.
+  if (search.equilibria.empty()) {
+    std::string message = c.path + ": no equilibrium found (" + search.stopped_because + ")";
+    if (!search.log.empty()) message += "; the search's last line: " + search.log.back();
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, message.c_str(), 1) != 0) throw py::error_already_set();
+  }
   return out;
 }
 

@@ -385,6 +385,10 @@ TEST_F(CliTest, MaxSecondsEndsASolveWithTimeLimit) {
   EXPECT_TRUE(j["residual"].is_number());
   EXPECT_LT(elapsed, 20.0);  // the limit plus one evaluation, with a wide margin for a loaded machine
   EXPECT_EQ(run("solve " + quoted(case_path("simply_supported.toml")) + " --max-seconds -1").status, 2);
+  // The library's checks, with Python's words (EquilibriaOptions::validate).
+  const CliRun equilibria = run("equilibria " + quoted(case_path("clamped_clamped.toml")) + " --max-seconds -1");
+  EXPECT_EQ(equilibria.status, 2);
+  EXPECT_THAT(equilibria.err, HasSubstr("max_seconds must be in [0, 1e9]"));
   // By homotopy the branch approaches the closed loop at theta0 = pi (P -> infinity), where its
   // steps shrink: the path ends there at the limit or with its step too small, whichever comes
   // first, says where it got to, and reports no residual at 1e6 (none was computed).

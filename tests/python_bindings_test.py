@@ -868,9 +868,23 @@ class EquilibriaTest(unittest.TestCase):
         self.assertIsNone(kirchhoff.load_case(case_path("clamped_clamped.toml")).equilibria(max=1)[0].family)
 
     def test_bad_options_raise(self):
+        # The library's checks (EquilibriaOptions::validate, StartSeed::validate), as the CLI's.
         c = kirchhoff.load_case(case_path("clamped_clamped.toml"))
-        with self.assertRaises(ValueError):
+        with self.assertRaisesRegex(ValueError, r"max \(equilibria\) must be in \[1, 1000\]"):
             c.equilibria(max=0)
+        with self.assertRaisesRegex(ValueError, r"must be in \[1, 1000\]"):
+            c.equilibria(max=1001)
+        with self.assertRaisesRegex(ValueError, "max_seconds must be in"):
+            c.equilibria(max_seconds=-1)
+        with self.assertRaisesRegex(ValueError, r"seed segments must be in \[4, 100000\]"):
+            c.solve(seed="ipopt", seed_segments=200000)
+
+    def test_no_equilibrium_found_warns_with_the_search_s_reason(self):
+        # An end inside the wall: the CLI exits 1 with "no equilibrium found (...)"; Python returns
+        # an empty list and says the same in a RuntimeWarning.
+        case = kirchhoff.load_case(case_path("wall.toml"), set={"a": -0.01})
+        with self.assertWarnsRegex(RuntimeWarning, "no equilibrium found"):
+            self.assertEqual(case.equilibria(max=2, max_seconds=60), [])
 
     def test_continue_deflate_follows_every_branch_from_the_start(self):
         # The Euler column's five equilibria at P = 50, each followed to P = 60 (as the CLI's

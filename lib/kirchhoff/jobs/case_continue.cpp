@@ -315,7 +315,8 @@ ContinueRunResult Run::with_contacts(const Eigen::VectorXd& start_point, bool re
 
 std::string ContinueRequest::validate(const Case& c) const {
   if (deflate && (resume || start || switch_at_bp > 0 || seed.ipopt)) return kDeflateRefusal;
-  if (deflate && deflate_max < 1) return "deflate_max must be >= 1";
+  if (deflate && (deflate_max < 1 || deflate_max > 1000)) return "deflate_max must be in [1, 1000]";
+  if (const std::string why = seed.validate(); !why.empty()) return why;
   if (start && seed.ipopt) return "--start-from does not combine with --seed";
   if (!c.definition.parameters.contains(parameter))
     return c.path + ": --param " + parameter + ": not a parameter of the case";

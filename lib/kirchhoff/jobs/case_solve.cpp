@@ -144,7 +144,15 @@ std::vector<ParameterChange> homotopy_changes(const Case& c) {
   return changes;
 }
 
+std::string StartSeed::validate() const {
+  if (segments < 4 || segments > 100000) return "seed segments must be in [4, 100000]";
+  if (!std::isfinite(amplitude) || std::abs(amplitude) > 1.0)
+    return "seed amplitude must be finite, within +-1 (a fraction of the rod's length)";
+  return "";
+}
+
 CaseSolve solve_case(const Case& c, const CaseSolveOptions& options) {
+  if (const std::string why = options.seed.validate(); !why.empty()) throw std::invalid_argument(why);
   CaseSolve out;
   try {
     out = reach_equilibrium(c, options);

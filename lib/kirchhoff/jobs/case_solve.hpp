@@ -31,6 +31,8 @@ struct StartSeed {
   bool ipopt = false;
   int segments = 200;
   double amplitude = 0.05;  // the first mode's amplitude Ipopt starts from (its sign: the side)
+
+  std::string validate() const;  // "" when valid, else the reason (bad input)
 };
 
 struct CaseSolveOptions {
@@ -81,7 +83,8 @@ struct CaseSolve {
 // A solve that cannot start is a failure with its status word, as the front ends report it:
 // "infeasible" (an end imposed inside an obstacle), "integration_failed" (the guess cannot be
 // integrated), "seed_failed" (Ipopt's minimisation did not converge). Throws
-// std::invalid_argument only for a case the Ipopt seed does not model (bad input).
+// std::invalid_argument only for a case the Ipopt seed does not model or a seed whose settings
+// are invalid (StartSeed::validate): bad input.
 CaseSolve solve_case(const Case& c, const CaseSolveOptions& options = {});
 
 // The changes a homotopy makes for this case: its overrides of parameters that are not solved

@@ -619,6 +619,12 @@ class Search {
 
 }  // namespace
 
+std::string EquilibriaOptions::validate() const {
+  if (max_equilibria < 1 || max_equilibria > 1000) return "max (equilibria) must be in [1, 1000]";
+  if (!(max_seconds >= 0 && max_seconds <= 1e9)) return "max_seconds must be in [0, 1e9] (0: no limit)";
+  return "";
+}
+
 EquilibriaSearch find_equilibria(const ProblemDefinition& definition, const RodPoint& guess,
                                  const std::vector<std::string>& derived_names, int samples,
                                  const EquilibriaOptions& options) {

@@ -77,6 +77,10 @@ struct EquilibriaOptions {
   double force_tolerance = 1e-9;
   double max_seconds = 120.0;  // wall-clock limit of the whole search (0: none)
   DeflatedNewtonOptions deflation;  // residual_tolerance is taken from the case's Newton options
+
+  // "" when the user's settings (max_equilibria, max_seconds) are valid, else the reason (bad
+  // input for both front ends).
+  std::string validate() const;
 };
 
 struct Equilibrium {
