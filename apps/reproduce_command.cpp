@@ -13,6 +13,9 @@ int run_reproduce(const std::string& out_dir, const std::string& cases_dir, bool
   ReproduceResult result;
   try {
     result = reproduce({out_dir, cases_dir, full}, [](const std::string& line) { std::cerr << "  " << line << std::endl; });
+  } catch (const CaseError& e) {  // a case file missing or refused: bad input, as Python's CaseError
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitNotConverged;

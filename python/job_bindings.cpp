@@ -77,8 +77,6 @@ py::dict py_plectonemes(const std::string& out, const std::vector<double>& slend
   args.resume = resume;
   args.sensitivity_tol = sensitivity_tol;
   args.progress = [](const std::string& line) { std::cerr << line << "\n"; };  // as the CLI's
-  if (hard_from < 0) throw CaseError("hard_from must be >= 0 (got " + std::to_string(hard_from) + ")");
-  if (sensitivity_tol < 0) throw CaseError("sensitivity_tol must be >= 0");
   // Ctrl-C stops the sweep after its next point (the KeyboardInterrupt stays pending until the
   // GIL is back); resume=True then continues it.
   args.after_point = [] {
@@ -88,8 +86,7 @@ py::dict py_plectonemes(const std::string& out, const std::vector<double>& slend
   PlectonemeSweep sweep;
   try {
     py::gil_scoped_release release;
-    (void)load_case(args.case_path, {});  // a case file that cannot be used is a CaseError
-    sweep = sweep_plectonemes(args, std::cout);  // so are arguments it refuses
+    sweep = sweep_plectonemes(args, std::cout);  // CaseError: a case file or arguments it refuses
   } catch (const SweepStopped&) {
     throw py::error_already_set();
   }
@@ -150,6 +147,7 @@ Returns:
     status ('pass', 'FAIL' or 'info'), stability, note.
 
 Raises:
+    CaseError (ValueError): a case file missing from `cases` or refused (the CLI's exit 2).
     RuntimeError: a result that could not be computed (the report is then not written).)doc");
 
   m.def("sweep", &py_sweep, py::arg("spec"), py::arg("out"), py::kw_only(), py::arg("resume") = false,

@@ -431,6 +431,14 @@ TEST_F(CliTest, EndImposedInsideAnObstacleIsInfeasible) {
   EXPECT_THAT(r.err, HasSubstr("infeasible: the rod's start is imposed inside obstacle"));
 }
 
+// A cases folder without the case files reproduce reads is bad input (exit 2), as Python's
+// CaseError; it was reported as a failed computation (exit 1).
+TEST_F(CliTest, ReproduceWithoutItsCaseFilesIsBadInput) {
+  const CliRun r = run("reproduce --cases " + quoted(dir_.string()) + " --out " + quoted((dir_ / "out").string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("cannot open the file"));
+}
+
 TEST_F(CliTest, IpoptSeedSolvesWhatTheGuessCannot) {
   const std::string args = "solve " + quoted(case_path("cavity.toml")) + " --set Delta=0.05";
   const CliRun plain = run(args + " --direct");

@@ -3,6 +3,7 @@
 // repeat, the branch ends where the uninterrupted one ends, and a finished branch is left alone.
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -201,4 +202,24 @@ TEST_F(PlectonemesCli, RefusesAnExactPlyFromASlendernessThatHasNone) {
       << log;
   EXPECT_NE(log.find("--hard-from 5 must be below its --turns 4"), std::string::npos) << log;
   EXPECT_FALSE(fs::exists(out));  // nothing was computed or written
+}
+
+// A case file that cannot be used and a slenderness of 0 are bad input (exit 2, Python's
+// CaseError), refused before anything runs; they were a failed branch (exit 1).
+TEST_F(PlectonemesCli, RefusesABrokenCaseFileAndANonPositiveSlenderness) {
+  const fs::path broken = dir_ / "broken.toml";
+  {
+    std::ofstream file(broken);
+    file << "title = \"x\"\nmodel =\n";
+  }
+  const fs::path out = dir_ / "refused";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "plectonemes", "--case", broken.string(), "--slenderness", "100", "--turns", "1",
+                        "--out", out.string()},
+                       dir_ / "broken.log", true),
+            2);
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "plectonemes", "--slenderness", "0", "--turns", "1", "--out", out.string()},
+                       dir_ / "zero.log", true),
+            2);
+  EXPECT_NE(lines_of(dir_ / "zero.log").front().find("--slenderness must be > 0"), std::string::npos);
+  EXPECT_FALSE(fs::exists(out));
 }

@@ -748,6 +748,18 @@ class PlectonemesTest(unittest.TestCase):
             again = kirchhoff.plectonemes(tmp, [100], [0.25], resume=True)
             self.assertEqual(again["points"], 0)
 
+    def test_plectonemes_refuses_bad_arguments_before_running(self):
+        # The library's checks (plectoneme_sweep.cpp), with the CLI's words and its exit 2.
+        with tempfile.TemporaryDirectory() as tmp:
+            out = pathlib.Path(tmp) / "out"
+            with self.assertRaisesRegex(kirchhoff.CaseError, "--slenderness must be > 0"):
+                kirchhoff.plectonemes(str(out), [0], [1])
+            with self.assertRaisesRegex(kirchhoff.CaseError, "hard_from must be >= 0"):
+                kirchhoff.plectonemes(str(out), [100], [1], hard_from=-1)
+            with self.assertRaisesRegex(kirchhoff.CaseError, "sensitivity_tol must be in"):
+                kirchhoff.plectonemes(str(out), [100], [1], sensitivity_tol=math.nan)
+            self.assertFalse(out.exists())
+
     def test_interrupted_sweep_resumes_without_losing_rows(self):
         # Ctrl-C (interrupt_main, 2 s into L/2R = 100 to 3 turns, a ~6 s run) raises
         # KeyboardInterrupt after the point being written; the CSV keeps its rows, and resume=True

@@ -722,6 +722,13 @@ bool has_exact_ply(const PlectonemesArguments& args, size_t k) {
 // Why `args` cannot make a sweep (checked before anything runs), or "".
 std::string plectonemes_input_error(const PlectonemesArguments& args) {
   if (args.slenderness.size() != args.turns.size()) return "--slenderness and --turns need the same number of values";
+  for (size_t k = 0; k < args.slenderness.size(); ++k)
+    if (!(args.slenderness[k] > 0 && args.slenderness[k] <= 1e9) || !std::isfinite(args.turns[k]))
+      return "--slenderness must be > 0 and --turns finite (value " + std::to_string(k + 1) + ")";
+  if (!(args.hard_from >= 0 && std::isfinite(args.hard_from)))
+    return "hard_from must be >= 0 (got " + std::to_string(args.hard_from) + ")";
+  if (!(args.sensitivity_tol >= 0 && args.sensitivity_tol < 1))
+    return "sensitivity_tol must be in [0, 1) (0: the state's tolerance)";
   for (size_t k = 0; k < args.slenderness.size(); ++k) {
     if (!reached_from_ply(args, k)) continue;
     const double sl = args.slenderness[k];
@@ -744,6 +751,7 @@ std::string plectonemes_input_error(const PlectonemesArguments& args) {
 
 PlectonemeSweep sweep_plectonemes(const PlectonemesArguments& args, std::ostream& report) {
   if (const std::string e = plectonemes_input_error(args); !e.empty()) throw CaseError(e);
+  (void)load_case(args.case_path, {});  // a case file that cannot be used: refused before anything runs
   std::filesystem::create_directories(args.out_dir);
   const auto started = std::chrono::steady_clock::now();
   const auto csv_of = [&](double sl) {
