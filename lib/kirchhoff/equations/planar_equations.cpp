@@ -61,29 +61,21 @@ class PlanarEquations final : public RodEquations {
     dy[kMoment] = y[kNx] * dyy - y[kNy] * dx;
   }
 
-  void flow_state_into(const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options,
-                       SegmentFlow* out) const override {
+  void flow_into(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities, const IntegratorOptions& options,
+                 SegmentFlow* out) const override {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
-    detail::flow_state_into<kStateSize>(f, y0, s0, s1, options, out);
-  }
-
-  SegmentFlow flow(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities,
-                   const IntegratorOptions& options) const override {
-    auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
-    if (!sensitivities) return detail::flow_state<kStateSize>(f, y0, s0, s1, options);
-    if (model_.field) return detail::flow_with_sensitivities<kStateSize>(f, y0, s0, s1, options);
+    if (!sensitivities) return detail::flow_state_into<kStateSize>(f, y0, s0, s1, options, out);
+    if (model_.field) {
+      constexpr std::array<int, kStateSize> kAll{kX, kY, kTheta, kNx, kNy, kMoment};
+      return detail::flow_with_seeded_sensitivities_into<kStateSize, kStateSize>(f, y0, s0, s1, options, kAll, out);
+    }
     if (options.sensitivity_tol > options.abs_tol)
-      return detail::flow_with_loose_pass<kStateSize>(
-          f, y0, s0, s1, options, [&](const IntegratorOptions& loose) { return variations_pass(y0, s0, s1, loose); });
+      return detail::flow_with_loose_pass_into<kStateSize>(
+          f, y0, s0, s1, options,
+          [&](const IntegratorOptions& loose, SegmentFlow* o) { variations_pass_into(y0, s0, s1, loose, o); }, out);
     // Without a field nothing depends on x(s0), y(s0): their columns of Phi are unit vectors.
     constexpr std::array<int, 4> kSeeds{kTheta, kNx, kNy, kMoment};
-    SegmentFlow partial = detail::flow_with_partial_sensitivities<kStateSize, 4>(f, y0, s0, s1, options, kSeeds);
-    Eigen::MatrixXd Phi = Eigen::MatrixXd::Zero(kStateSize, kStateSize);
-    for (int j = 0; j < 4; ++j) Phi.col(kSeeds[j]) = partial.Phi.col(j);
-    Phi(kX, kX) = 1.0;
-    Phi(kY, kY) = 1.0;
-    partial.Phi = std::move(Phi);
-    return partial;
+    detail::flow_with_seeded_sensitivities_into<kStateSize, 4>(f, y0, s0, s1, options, kSeeds, out);
   }
 
   DirectionalFlow flow_directions(const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions, double s0, double s1,
@@ -176,7 +168,7 @@ class PlanarEquations final : public RodEquations {
   // the other columns (theta, n_x, n_y, m) are written out for the rows x, y, theta and m: 16
   // entries beside the state, sin and cos shared, where Dual<4> carries four derivatives through
   // every operation and its sin and cos. Used for the looser matrices only (sensitivity_tol, the
-  // state in its own pass: detail::flow_with_loose_pass); the exact pass keeps the dual numbers,
+  // state in its own pass: detail::flow_with_loose_pass_into); the exact pass keeps the dual numbers,
   // whose round-off the contact legs and their tests were computed with.
   static constexpr int kRows = 4;     // rows x, y, theta, m of Phi
   static constexpr int kColumns = 4;  // columns theta, n_x, n_y, m
@@ -227,22 +219,23 @@ class PlanarEquations final : public RodEquations {
   }
 
   // Phi by rhs_with_variations (every component under error control, as the dual numbers have
-  // it) at `options`: the looser pass of detail::flow_with_loose_pass.
-  SegmentFlow variations_pass(const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options) const {
+  // it) at `options`: the looser pass of detail::flow_with_loose_pass_into.
+  void variations_pass_into(const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options,
+                            SegmentFlow* out) const {
     std::array<double, kAugmented> x{};
     for (int i = 0; i < kStateSize; ++i) x[i] = y0[i];
     for (int r = 0; r < kRows; ++r)
       for (int j = 0; j < kColumns; ++j) x[kStateSize + r * kColumns + j] = kRowOf[r] == kColumnOf[j] ? 1.0 : 0.0;
-    SegmentFlow out;
+    out->rhs_evaluations = 0;
     auto system = [&](const std::array<double, kAugmented>& y, std::array<double, kAugmented>& dy, double s) {
-      ++out.rhs_evaluations;
+      ++out->rhs_evaluations;
       rhs_with_variations(y.data(), dy.data(), s);
     };
-    out.steps = detail::march(x, s0, s1, system, options);
-    out.Phi = Eigen::MatrixXd::Identity(kStateSize, kStateSize);
+    out->steps = detail::march(x, s0, s1, system, options);
+    out->Phi.setIdentity(kStateSize, kStateSize);
     for (int r = 0; r < kRows; ++r)
-      for (int j = 0; j < kColumns; ++j) out.Phi(kRowOf[r], kColumnOf[j]) = x[kStateSize + r * kColumns + j];
-    return out;
+      for (int j = 0; j < kColumns; ++j) out->Phi(kRowOf[r], kColumnOf[j]) = x[kStateSize + r * kColumns + j];
+    out->dy_dunfolding.resize(0);
   }
 
   RodModel model_;

@@ -58,14 +58,19 @@ class RodEquations {
   virtual const RodModel& model() const = 0;
   virtual bool is_planar() const = 0;
 
-  // Flow over [s0, s1]; throws IntegrationError when the integrator gives up.
-  virtual SegmentFlow flow(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities,
-                           const IntegratorOptions& options) const = 0;
-  // flow() without sensitivities, into *out: its storage reused, so that a residual evaluation
-  // allocates nothing once its buffers have their sizes (ShootingWorkspace::buffers).
-  virtual void flow_state_into(const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options,
-                               SegmentFlow* out) const {
-    *out = flow(y0, s0, s1, false, options);
+  // Flow over [s0, s1] into *out: the state, and with `sensitivities` Phi = dy(s1)/dy(s0) (and
+  // dy/dmu where the equations carry it, SegmentFlow::dy_dunfolding); without, Phi and
+  // dy_dunfolding are left empty. Its storage is reused, so that a residual or Jacobian
+  // evaluation allocates nothing once its buffers have their sizes (ShootingWorkspace::buffers).
+  // Throws IntegrationError when the integrator gives up.
+  virtual void flow_into(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities,
+                         const IntegratorOptions& options, SegmentFlow* out) const = 0;
+  // flow_into a new SegmentFlow.
+  SegmentFlow flow(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities,
+                   const IntegratorOptions& options) const {
+    SegmentFlow out;
+    flow_into(y0, s0, s1, sensitivities, options, &out);
+    return out;
   }
   // The state and the columns of `directions` (state perturbations at s0) carried to s1 by the
   // variational equations, Phi directions, without forming Phi when there are fewer directions

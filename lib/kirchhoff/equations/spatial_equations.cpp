@@ -108,42 +108,26 @@ class SpatialEquations final : public RodEquations {
     dy[kChi] = 2.0 * (w * dy[kQ + 3] - qz * dy[kQ]) / (w * w + qz * qz);
   }
 
-  // The full Phi from the seeded columns of a partial flow; the others are unit vectors.
-  template <std::size_t K>
-  static SegmentFlow with_unit_columns(SegmentFlow partial, const std::array<int, K>& seeds) {
-    Eigen::MatrixXd Phi = Eigen::MatrixXd::Identity(kStateSize, kStateSize);
-    for (std::size_t j = 0; j < K; ++j) Phi.col(seeds[j]) = partial.Phi.col(static_cast<Eigen::Index>(j));
-    partial.Phi = std::move(Phi);
-    return partial;
-  }
-
-  void flow_state_into(const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options,
-                       SegmentFlow* out) const override {
+  void flow_into(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities, const IntegratorOptions& options,
+                 SegmentFlow* out) const override {
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
-    detail::flow_state_into<kStateSize>(f, y0, s0, s1, options, out);
-  }
-
-  SegmentFlow flow(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities,
-                   const IntegratorOptions& options) const override {
-    auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
-    if (!sensitivities) return detail::flow_state<kStateSize>(f, y0, s0, s1, options);
+    if (!sensitivities) return detail::flow_state_into<kStateSize>(f, y0, s0, s1, options, out);
     // A rod without field or cylinder: the variational equations written out
     // (spatial_variations.hpp) instead of dual numbers, the looser matrices in a pass of their own.
     if (detail::has_written_out_variations(model_, support_.has_value())) {
       auto state_rhs = [this](const double* y, double* dy, double s) { rhs(y, dy, s); };
-      auto pass = [&](const IntegratorOptions& at) {
-        return detail::written_out_variations_pass(model_, compliances_, state_rhs, y0, s0, s1, at);
+      auto pass = [&](const IntegratorOptions& at, SegmentFlow* o) {
+        detail::written_out_variations_pass_into(model_, compliances_, state_rhs, y0, s0, s1, at, o);
       };
       if (options.sensitivity_tol > options.abs_tol)
-        return detail::flow_with_loose_pass<kStateSize>(f, y0, s0, s1, options, pass);
-      return pass(options);
+        return detail::flow_with_loose_pass_into<kStateSize>(f, y0, s0, s1, options, pass, out);
+      return pass(options, out);
     }
     // With a field (self-contact, gravity) or a cylinder, on dual numbers. Nothing depends on
     // chi(s0): its column of Phi is a unit vector, and the 13 others are carried.
     constexpr std::array<int, 13> kSeeds{kR,     kR + 1, kR + 2, kQ,     kQ + 1, kQ + 2, kQ + 3,
                                          kN,     kN + 1, kN + 2, kM,     kM + 1, kM + 2};
-    return with_unit_columns(detail::flow_with_partial_sensitivities<kStateSize, 13>(f, y0, s0, s1, options, kSeeds),
-                             kSeeds);
+    detail::flow_with_seeded_sensitivities_into<kStateSize, 13>(f, y0, s0, s1, options, kSeeds, out);
   }
 
   DirectionalFlow flow_directions(const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions, double s0, double s1,

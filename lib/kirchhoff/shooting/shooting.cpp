@@ -214,10 +214,7 @@ bool ShootingProblem::integrate_segments(const Eigen::VectorXd& x, const Paramet
   try {
     for_each_segment(p, [w = &work](int i, const RodEquations& equations) {
       const double s0 = w->L * i / w->M, s1 = w->L * (i + 1) / w->M;
-      if (w->sensitivities)
-        w->flows[i] = equations.flow(w->starts[i], s0, s1, true, w->integrator);
-      else
-        equations.flow_state_into(w->starts[i], s0, s1, w->integrator, &w->flows[i]);
+      equations.flow_into(w->starts[i], s0, s1, w->sensitivities, w->integrator, &w->flows[i]);
     });
   } catch (const IntegrationError& e) {
     if (failure) *failure = e.what();
@@ -355,7 +352,7 @@ int ShootingProblem::unfolding_column_from_flows(const Eigen::VectorXd& x, const
   int j = -1;
   for (size_t k = 0; k < unknown_index_.size(); ++k)
     if (is_unfolding_parameter(definition_.parameters.names()[unknown_index_[k]])) j = static_cast<int>(k);
-  const std::vector<SegmentFlow>& flows = workspace_.buffers().flows;
+  const std::vector<SegmentFlow>& flows = workspace_.buffers().sensitivity_flows;  // (the Jacobian's, just made)
   if (j < 0 || static_cast<int>(flows.size()) != M) return -1;
   for (const SegmentFlow& flow : flows)
     if (flow.dy_dunfolding.size() != n) return -1;
@@ -399,7 +396,7 @@ int ShootingProblem::start_rows(const RodEquations& eq, const Eigen::VectorXd& y
   const int n = state_size_;
   F->resize(residual_count_);
   if (J) J->setZero(residual_count_, size());
-  Eigen::MatrixXd Jg;
+  Eigen::MatrixXd& Jg = workspace_.buffers().gauge_jacobian;
   const GaugeRows g = eq.gauge_residual(y0, J ? &Jg : nullptr);
   F->head(g.size()) = g;
   if (J) J->block(0, 0, g.size(), n) = Jg;
@@ -450,7 +447,7 @@ bool ShootingProblem::residual(const Eigen::VectorXd& x, const Parameters& p, Ei
     return segments() > 1 ? residual_pieces(x, p, F, J, failure, y_end)
                           : residual_with_contacts(x, p, F, J, failure, y_end);
   const int n = state_size_, M = segments();
-  std::vector<SegmentFlow>& flows = workspace_.buffers().flows;
+  std::vector<SegmentFlow>& flows = J ? workspace_.buffers().sensitivity_flows : workspace_.buffers().flows;
   if (!integrate_segments(x, p, J != nullptr, integrator ? *integrator : definition_.options.integrator, &flows,
                           failure))
     return false;

@@ -54,7 +54,11 @@ class ShootingWorkspace {
     Parameters parameters;                // at the unknowns (evaluate)
     Eigen::VectorXd y_end;                // the last segment's end state (evaluate)
     std::vector<Eigen::VectorXd> starts;  // each segment's start state, out of the unknowns
-    std::vector<SegmentFlow> flows;       // each segment's flow
+    std::vector<SegmentFlow> flows;       // each segment's flow (a residual's)
+    // Each segment's flow with its sensitivities (a Jacobian's), apart from `flows` so that the
+    // matrices keep their storage from one Jacobian to the next, residuals evaluated between.
+    std::vector<SegmentFlow> sensitivity_flows;
+    Eigen::MatrixXd gauge_jacobian;                // the gauge conditions' rows (start_rows)
     std::vector<double> start_values, end_values;  // the end conditions' rows
     std::vector<StateRow> start_jacobian, end_jacobian;
     // A Jacobian's columns of parameters that enter the end conditions only (evaluate).

@@ -82,93 +82,79 @@ struct DualSystem {
   }
 };
 
+// Integrates the state alone from y0 into *y (its storage kept once it has the state's size);
+// returns the steps taken and adds the right-hand sides evaluated to *evaluations.
+template <int N, class Rhs>
+long march_state_into(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& opt,
+                      Eigen::VectorXd* y, long* evaluations) {
+  using State = std::array<double, N>;
+  State x;
+  for (int i = 0; i < N; ++i) x[i] = y0[i];
+  auto system = [&](const State& state, State& dy, double s) {
+    ++*evaluations;
+    rhs(state.data(), dy.data(), s);
+  };
+  const long steps = march(x, s0, s1, system, opt);
+  *y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
+  return steps;
+}
+
 // Integrates the state alone, into *out (whose y keeps its storage: nothing is allocated once it
 // has the state's size; Phi and dy_dunfolding are left empty).
 template <int N, class Rhs>
 void flow_state_into(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& opt,
                      SegmentFlow* out) {
-  using State = std::array<double, N>;
-  State x;
-  for (int i = 0; i < N; ++i) x[i] = y0[i];
-  long evaluations = 0;
-  auto system = [&](const State& y, State& dy, double s) {
-    ++evaluations;
-    rhs(y.data(), dy.data(), s);
-  };
-  out->steps = march(x, s0, s1, system, opt);
-  out->y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
+  out->rhs_evaluations = 0;
+  out->steps = march_state_into<N>(rhs, y0, s0, s1, opt, &out->y, &out->rhs_evaluations);
   out->Phi.resize(0, 0);
   out->dy_dunfolding.resize(0);  // (no sensitivities: none left from a previous flow into *out)
-  out->rhs_evaluations = evaluations;
 }
 
-template <int N, class Rhs>
-SegmentFlow flow_state(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
-                       const IntegratorOptions& opt) {
-  SegmentFlow out;
-  flow_state_into<N>(rhs, y0, s0, s1, opt, &out);
-  return out;
-}
-
-// Integrates the state together with the variational equations Phi' = (df/dy) Phi, Phi(s0) = I,
-// by evaluating the right-hand side on Dual<K> seeded with K of the N columns of Phi (the others
-// may be known in closed form by the caller): cheaper by about (N/K)^2 in the derivative
-// arithmetic. Returns Phi restricted to those columns (N x K) in out.Phi.
-template <int N, int K, class Rhs>
-SegmentFlow flow_with_partial_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
-                                            const IntegratorOptions& opt, const std::array<int, K>& seeds);
-
-// Phi at opt.sensitivity_tol by phi_pass(the looser options), the state at the state's own
-// tolerance (IntegratorOptions) in a pass of its own, so F is bit for bit a residual's alone.
+// Phi at opt.sensitivity_tol by phi_pass(the looser options, out), which fills out's Phi (and
+// dy_dunfolding), steps and right-hand sides; then the state at the state's own tolerance
+// (IntegratorOptions) in a pass of its own into out->y, so F is bit for bit a residual's alone.
 template <int N, class Rhs, class PhiPass>
-SegmentFlow flow_with_loose_pass(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
-                                 const IntegratorOptions& opt, const PhiPass& phi_pass) {
+void flow_with_loose_pass_into(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                               const IntegratorOptions& opt, const PhiPass& phi_pass, SegmentFlow* out) {
   IntegratorOptions loose = opt;
   loose.abs_tol = loose.rel_tol = opt.sensitivity_tol;
   loose.sensitivity_tol = 0.0;
-  SegmentFlow out = phi_pass(loose);
-  const SegmentFlow state = flow_state<N>(rhs, y0, s0, s1, opt);
-  out.y = state.y;
-  out.steps += state.steps;
-  out.rhs_evaluations += state.rhs_evaluations;
-  return out;
+  phi_pass(loose, out);
+  out->steps += march_state_into<N>(rhs, y0, s0, s1, opt, &out->y, &out->rhs_evaluations);
 }
 
-// Phi's seeded columns on dual numbers at opt.sensitivity_tol (flow_with_loose_pass).
+// Integrates the state together with the variational equations Phi' = (df/dy) Phi, Phi(s0) = I,
+// into *out (its storage reused), by evaluating the right-hand side on Dual<K> seeded with K of
+// the N columns of Phi: cheaper by about (N/K)^2 in the derivative arithmetic. The other columns
+// are unit vectors (the caller seeds every component the flow depends on at s0), so out->Phi is
+// the whole N x N matrix. With opt.sensitivity_tol looser than abs_tol: the seeded columns at
+// that tolerance, the state at its own (flow_with_loose_pass_into).
 template <int N, int K, class Rhs>
-SegmentFlow flow_with_loose_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
-                                          const IntegratorOptions& opt, const std::array<int, K>& seeds) {
-  return flow_with_loose_pass<N>(rhs, y0, s0, s1, opt, [&](const IntegratorOptions& loose) {
-    return flow_with_partial_sensitivities<N, K>(rhs, y0, s0, s1, loose, seeds);
-  });
-}
-
-template <int N, int K, class Rhs>
-SegmentFlow flow_with_partial_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
-                                            const IntegratorOptions& opt, const std::array<int, K>& seeds) {
-  if (opt.sensitivity_tol > opt.abs_tol)  // (abs_tol > 0, so 0 keeps the one pass)
-    return flow_with_loose_sensitivities<N, K>(rhs, y0, s0, s1, opt, seeds);
+void flow_with_seeded_sensitivities_into(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                         const IntegratorOptions& opt, const std::array<int, K>& seeds,
+                                         SegmentFlow* out) {
+  if (opt.sensitivity_tol > opt.abs_tol) {  // (abs_tol > 0, so 0 keeps the one pass)
+    flow_with_loose_pass_into<N>(
+        rhs, y0, s0, s1, opt,
+        [&](const IntegratorOptions& loose, SegmentFlow* o) {
+          flow_with_seeded_sensitivities_into<N, K>(rhs, y0, s0, s1, loose, seeds, o);
+        },
+        out);
+    return;
+  }
   using State = typename DualSystem<N, K, Rhs>::State;  // y, then the N x K block row-major
   State x{};
   for (int i = 0; i < N; ++i) x[i] = y0[i];
   for (int j = 0; j < K; ++j) x[N + seeds[j] * K + j] = 1.0;
   long evaluations = 0;
   const DualSystem<N, K, Rhs> system{rhs, &evaluations};
-  SegmentFlow out;
-  out.steps = march(x, s0, s1, system, opt);
-  out.y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
-  out.Phi = Eigen::Map<const Eigen::Matrix<double, N, K, Eigen::RowMajor>>(x.data() + N);
-  out.rhs_evaluations = evaluations;
-  return out;
-}
-
-// All N directions seeded: the full state-transition matrix.
-template <int N, class Rhs>
-SegmentFlow flow_with_sensitivities(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
-                                    const IntegratorOptions& opt) {
-  std::array<int, N> all;
-  for (int i = 0; i < N; ++i) all[i] = i;
-  return flow_with_partial_sensitivities<N, N>(rhs, y0, s0, s1, opt, all);
+  out->steps = march(x, s0, s1, system, opt);
+  out->y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
+  const Eigen::Map<const Eigen::Matrix<double, N, K, Eigen::RowMajor>> seeded(x.data() + N);
+  out->Phi.setIdentity(N, N);
+  for (int j = 0; j < K; ++j) out->Phi.col(seeds[j]) = seeded.col(j);
+  out->dy_dunfolding.resize(0);  // (not carried on dual numbers: the caller differences)
+  out->rhs_evaluations = evaluations;
 }
 
 // The state alone carried from s0 to s1 at opt's own tolerance, continuing the step sizes in
@@ -189,7 +175,7 @@ void carry_state_alone(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, dou
 
 // The state and the columns of `directions` (at most K; fewer are padded with zero columns, which
 // stay zero) carried from s0 to s1, continuing from the step sizes in *carried and leaving there
-// those proposed next. With opt.sensitivity_tol looser than abs_tol, as flow_with_loose_sensitivities:
+// those proposed next. With opt.sensitivity_tol looser than abs_tol, as flow_with_loose_pass_into:
 // the directions at sensitivity_tol, the state at its own tolerance in a pass of its own.
 template <int N, int K, class Rhs>
 DirectionalFlow flow_directions(const Rhs& rhs, const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions,

@@ -1,6 +1,6 @@
 // Internal: the variational equations of the spatial rod (spatial_equations.cpp) written out: its
 // matrices (exact, and looser with IntegratorOptions::sensitivity_tol, the state then in a pass of
-// its own: detail::flow_with_loose_pass), the directions of RodEquations::flow_directions (the
+// its own: detail::flow_with_loose_pass_into), the directions of RodEquations::flow_directions (the
 // stability index's Jacobi fields) and, where the unfolding couple mu is an unknown
 // (RodModel::unfolding_sensitivity), the state's sensitivity to it (SegmentFlow::dy_dunfolding).
 //
@@ -199,13 +199,14 @@ DirectionalFlow written_out_directions(const RodModel& model, const Compliances&
 }
 
 // The columns of Phi that are not unit vectors (kVariationColumnOf) by march_written_out, the
-// others unit vectors: the whole of Phi over [s0, s1]; C = kVariationColumns + 1 adds the forced
-// column of the unfolding couple's sensitivity (SegmentFlow::dy_dunfolding).
-// Continues from the step size *ds and leaves there the one proposed next.
+// others unit vectors: the whole of Phi over [s0, s1], into *out (its storage reused); C =
+// kVariationColumns + 1 adds the forced column of the unfolding couple's sensitivity
+// (SegmentFlow::dy_dunfolding). Continues from the step size *ds and leaves there the one
+// proposed next.
 template <int C, class StateRhs>
-SegmentFlow written_out_phi(const RodModel& model, const Compliances& compliances, const StateRhs& state_rhs,
-                            const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options,
-                            double* ds) {
+void written_out_phi_into(const RodModel& model, const Compliances& compliances, const StateRhs& state_rhs,
+                          const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& options,
+                          double* ds, SegmentFlow* out) {
   static_assert(C == kVariationColumns || C == kVariationColumns + 1);
   constexpr bool with_unfolding = C > kVariationColumns;
   std::array<double, kVariedStateSize<C>> x{};
@@ -215,31 +216,33 @@ SegmentFlow written_out_phi(const RodModel& model, const Compliances& compliance
     for (int j = 0; j < kVariationColumns; ++j)
       x[kSpatialStateSize + r * C + j] = kVariationRowOf[r] == kVariationColumnOf[j];
   for (int a = 0; a < 3; ++a) dn[a][kColumnN + a] = 1.0;
-  SegmentFlow out;
   const int forced = with_unfolding ? kVariationColumns : -1;
-  out.steps =
-      march_written_out<C>(model, compliances, state_rhs, dn, forced, x, s0, s1, options, ds, &out.rhs_evaluations);
-  out.y = Eigen::Map<const Eigen::Matrix<double, kSpatialStateSize, 1>>(x.data());
-  out.Phi = Eigen::MatrixXd::Identity(kSpatialStateSize, kSpatialStateSize);
+  out->rhs_evaluations = 0;
+  out->steps =
+      march_written_out<C>(model, compliances, state_rhs, dn, forced, x, s0, s1, options, ds, &out->rhs_evaluations);
+  out->y = Eigen::Map<const Eigen::Matrix<double, kSpatialStateSize, 1>>(x.data());
+  out->Phi.setIdentity(kSpatialStateSize, kSpatialStateSize);
   for (int r = 0; r < kVariationRows; ++r)
     for (int j = 0; j < kVariationColumns; ++j)
-      out.Phi(kVariationRowOf[r], kVariationColumnOf[j]) = x[kSpatialStateSize + r * C + j];
+      out->Phi(kVariationRowOf[r], kVariationColumnOf[j]) = x[kSpatialStateSize + r * C + j];
   if (with_unfolding) {  // (zero at s0 and in the rows n, which mu does not move)
-    out.dy_dunfolding = Eigen::VectorXd::Zero(kSpatialStateSize);
+    out->dy_dunfolding.setZero(kSpatialStateSize);
     for (int r = 0; r < kVariationRows; ++r)
-      out.dy_dunfolding[kVariationRowOf[r]] = x[kSpatialStateSize + r * C + forced];
+      out->dy_dunfolding[kVariationRowOf[r]] = x[kSpatialStateSize + r * C + forced];
+  } else {
+    out->dy_dunfolding.resize(0);
   }
-  return out;
 }
 
+// Phi (and dy/dmu where the model carries it) over [s0, s1] into *out, from the options' initial step.
 template <class StateRhs>
-SegmentFlow written_out_variations_pass(const RodModel& model, const Compliances& compliances,
-                                        const StateRhs& state_rhs, const Eigen::VectorXd& y0, double s0, double s1,
-                                        const IntegratorOptions& options) {
+void written_out_variations_pass_into(const RodModel& model, const Compliances& compliances,
+                                      const StateRhs& state_rhs, const Eigen::VectorXd& y0, double s0, double s1,
+                                      const IntegratorOptions& options, SegmentFlow* out) {
   double ds = options.initial_step * (s1 - s0);
   if (model.unfolding_sensitivity)
-    return written_out_phi<kVariationColumns + 1>(model, compliances, state_rhs, y0, s0, s1, options, &ds);
-  return written_out_phi<kVariationColumns>(model, compliances, state_rhs, y0, s0, s1, options, &ds);
+    return written_out_phi_into<kVariationColumns + 1>(model, compliances, state_rhs, y0, s0, s1, options, &ds, out);
+  written_out_phi_into<kVariationColumns>(model, compliances, state_rhs, y0, s0, s1, options, &ds, out);
 }
 
 // written_out_directions with C the first of Cs (ascending) that holds the columns; false when none does.
@@ -273,8 +276,9 @@ DirectionalFlow written_out_directional_flow(const RodModel& model, const Compli
   DirectionalFlow out;
   if (!written_out_directions_fitting<Cs...>(model, compliances, state_rhs, y0, directions, s0, s1, carried_options,
                                              &carried->directions, &out)) {
-    SegmentFlow phi = written_out_phi<kVariationColumns>(model, compliances, state_rhs, y0, s0, s1, carried_options,
-                                                         &carried->directions);
+    SegmentFlow phi;
+    written_out_phi_into<kVariationColumns>(model, compliances, state_rhs, y0, s0, s1, carried_options,
+                                            &carried->directions, &phi);
     out.y = std::move(phi.y);
     out.directions = phi.Phi * directions;
     out.steps = phi.steps;
