@@ -969,7 +969,9 @@ Counts count(const Spectrum& s, double zero_tolerance) {
 }
 
 // The self-checks of discrete_stability.hpp, in order; "" when all pass.
-std::string self_check(const Spectrum& fine, const Spectrum& coarse, double zero_tolerance) {
+// The first half of self_check: the discrete equilibria are the shooting one, resolved, and the
+// lift-off eigenvalue's sign (where a part lies on an obstacle with zero force) is decided.
+std::string solution_check(const Spectrum& fine, const Spectrum& coarse, double zero_tolerance) {
   for (const Spectrum* s : {&fine, &coarse})
     if (!(s->kkt_residual <= kDiscreteStabilityKktTolerance))
       return "the discrete KKT residual is " + format(s->kkt_residual) + " (tolerance " +
@@ -996,6 +998,12 @@ std::string self_check(const Spectrum& fine, const Spectrum& coarse, double zero
       return "the lift-off eigenvalue of the part lying on the obstacle with zero force is " + format(mu) +
              " at N elements and " + format(coarse.lift_off) + " at N/2: its sign is not decided";
   }
+  return "";
+}
+
+// The second half of self_check: the two resolutions count the same index and zero modes, and
+// every eigenvalue up to the first above them is resolved with its sign decided.
+std::string spectrum_check(const Spectrum& fine, const Spectrum& coarse, double zero_tolerance) {
   const Counts a = count(fine, zero_tolerance), b = count(coarse, zero_tolerance);
   if (a.index != b.index || a.zero != b.zero)
     return "N and N/2 elements disagree: index " + std::to_string(a.index) + " / " + std::to_string(b.index) +
@@ -1022,6 +1030,12 @@ std::string self_check(const Spectrum& fine, const Spectrum& coarse, double zero
              ") is within its discretisation error of zero: its sign, and the index, are not decided";
   }
   return "";
+}
+
+// "" when the discrete index can be believed, else the first check that failed.
+std::string self_check(const Spectrum& fine, const Spectrum& coarse, double zero_tolerance) {
+  if (std::string why = solution_check(fine, coarse, zero_tolerance); !why.empty()) return why;
+  return spectrum_check(fine, coarse, zero_tolerance);
 }
 
 }  // namespace
@@ -1110,13 +1124,19 @@ DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen
   out.trustworthy = out.check_message.empty();
   if (out.trustworthy) out.check_message = "passed";
   // A part lying on the obstacle with zero force that lifts off with lower energy: unstable, and
-  // the perturbations that lower the energy form a cone, whose count is not an index.
-  if (out.trustworthy && fine.lift_off < -out.zero_tolerance) {
+  // the perturbations that lower the energy form a cone, whose count is not an index. That needs
+  // the discrete equilibria to be the shooting one and the lift-off's sign decided
+  // (solution_check), not the rest of the spectrum: an admissible perturbation that lowers the
+  // energy makes the equilibrium unstable whatever the other eigenvalues' signs.
+  const bool lift_off_decided = fine.weak_nodes > 0 && solution_check(fine, coarse, out.zero_tolerance).empty();
+  if (lift_off_decided && fine.lift_off < -out.zero_tolerance) {
     out.index.reset();
+    out.unstable = fine.lift_one_signed;
     out.reason = fine.lift_one_signed
                      ? "unstable: the part lying on the obstacle with zero contact force lifts off with lower energy "
-                       "(lift-off eigenvalue " + format(fine.lift_off) + ": a strut clamped by the obstacle past its "
-                       "Euler load); the lowering perturbations form a cone, not a space, so no index is given"
+                       "(lift-off eigenvalue " + format(fine.lift_off) + " at N elements, " +
+                           format(coarse.lift_off) + " at N/2: a strut clamped by the obstacle past its Euler "
+                           "load); the lowering perturbations form a cone, not a space, so no index is given"
                      : "the part lying on the obstacle with zero contact force has a negative strut mode that does not "
                        "lift it everywhere (lift-off eigenvalue " + format(fine.lift_off) + "): not decided here";
   }

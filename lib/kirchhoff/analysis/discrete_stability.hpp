@@ -121,6 +121,11 @@ struct DiscreteStability {
   int newton_iterations = 0;  // at N
   bool trustworthy = false;
   std::string check_message;  // "passed", or the first self-check that failed
+  // No index, but unstable (reason): a part lying on the obstacle with zero force lifts off with
+  // lower energy, its lift-off eigenvalue negative beyond its discretisation error at N and N/2
+  // and its mode lifting the rod everywhere there; decided whatever the self-check says of the
+  // rest of the spectrum.
+  bool unstable = false;
   bool defined() const { return index.has_value(); }
 };
 

@@ -1186,7 +1186,7 @@ StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::V
 }
 
 std::string describe(const StabilityReport& report) {
-  if (!report.index) return "index undefined: " + report.reason;
+  if (!report.index) return (report.unstable ? "unstable, no index: " : "index undefined: ") + report.reason;
   std::ostringstream out;
   out << (*report.index == 0 ? "stable" : "unstable (index " + std::to_string(*report.index) + ")");
   if (report.zero_modes > 0) out << ", " << report.zero_modes << " zero mode" << (report.zero_modes > 1 ? "s" : "");

@@ -141,6 +141,10 @@ struct StabilityReport {
   std::optional<int> fixed_length_index;
   std::optional<double> reduced_energy_curvature;
   long rhs_evaluations = 0;
+  // No index, but unstable all the same (reason says why): a part lying on an obstacle with zero
+  // contact force lifts off with lower energy, where the lowering perturbations form a cone, not
+  // a space (detail/stability_extended_contact.hpp).
+  bool unstable = false;
   bool defined() const { return index.has_value(); }
   bool stable() const { return index && *index == 0; }
 };
@@ -150,7 +154,8 @@ struct StabilityReport {
 StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::VectorXd& x,
                                   const StabilityOptions& options = {});
 
-// "stable", "unstable (index k)", or "index undefined: reason".
+// "stable", "unstable (index k)", "unstable, no index: reason" (StabilityReport::unstable), or
+// "index undefined: reason".
 std::string describe(const StabilityReport& report);
 
 }  // namespace kirchhoff

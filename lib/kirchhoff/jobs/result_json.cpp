@@ -55,7 +55,8 @@ nlohmann::json path_json(const SolvePath& path) {
 nlohmann::json stability_json(const StabilityReport& st, const DiscreteStability* discrete) {
   nlohmann::json j;
   j["index"] = st.index ? nlohmann::json(*st.index) : nlohmann::json();
-  j["stable"] = st.index ? nlohmann::json(st.stable()) : nlohmann::json();
+  // (false without an index where an admissible perturbation is known to lower the energy.)
+  j["stable"] = st.index ? nlohmann::json(st.stable()) : st.unstable ? nlohmann::json(false) : nlohmann::json();
   j["zero_modes"] = st.zero_modes;
   j["conjugate_points"] = st.conjugate_points;
   // The conjugate-point count gives no eigenvalues; the planar discretised check does, once it

@@ -24,6 +24,11 @@ StabilityReport extended_contact_stability(const ShootingProblem& problem, const
                          "checked at two resolutions";
   // 800 elements (kDiscreteStabilityLyingElements) and 400 for the self-check.
   const DiscreteStability d = discrete_stability(problem, x);
+  if (d.unstable) {  // no index, but a verdict: the flat part lifts off (discrete_stability.hpp)
+    report.unstable = true;
+    report.reason = d.reason;
+    return report;
+  }
   if (!d.defined()) {
     report.reason = "an extended contact (the rod lying on the obstacle), whose index comes from the discretised "
                     "energy: " + d.reason;
