@@ -1,10 +1,11 @@
 // What evaluating a ShootingProblem changes, apart from its description (Pinocchio's Data beside
-// its Model): the equations built for the model parameters' last values, the copies its worker
+// its Model): the equations built for the model parameters' last few values, the copies its worker
 // threads integrate with, and the count of right-hand sides. A problem holds one; a copy of the
 // problem copies it (the equations are immutable and shared), so each thread that evaluates a
 // problem of its own has its own workspace, as before.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -19,22 +20,29 @@ class ShootingWorkspace {
   using Build = std::function<std::shared_ptr<const RodEquations>()>;
 
   // The equations for the model parameters' values, which for_each_value(visit) hands to visit
-  // one by one: those built last if the values are unchanged (compared in place, so that an
-  // unchanged key allocates nothing), else build()'s (and the workers' copies are dropped).
+  // one by one: those built for the same values if one of the last kKept builds was (compared in
+  // place, so that a known key allocates nothing), else build()'s in place of the least recently
+  // used. Kept three: a Jacobian's column of a model parameter (the unfolding couple) asks for
+  // the equations at the parameter's plus and minus values between two uses of its own. The
+  // workers' copies are those of the equations handed out last, dropped when they change.
   template <class ForEachValue>
   std::shared_ptr<const RodEquations> equations(ForEachValue&& for_each_value, const Build& build) {
-    size_t count = 0;
-    bool same = equations_ != nullptr;
-    for_each_value([&](double v) {
-      same = same && count < key_.size() && key_[count] == v;
-      ++count;
-    });
-    if (same && count == key_.size()) return equations_;
-    key_.clear();
-    for_each_value([&](double v) { key_.push_back(v); });
-    equations_ = build();
-    workers_.clear();
-    return equations_;
+    int use = -1;
+    for (int k = 0; k < kKept && use < 0; ++k)
+      if (kept_[k].equations && same_key(kept_[k].key, for_each_value)) use = k;
+    const bool rebuilt = use < 0;
+    if (rebuilt) {
+      use = 0;
+      for (int k = 1; k < kKept; ++k)
+        if (kept_[k].last_used < kept_[use].last_used) use = k;
+      kept_[use].key.clear();
+      for_each_value([&](double v) { kept_[use].key.push_back(v); });
+      kept_[use].equations = build();
+    }
+    kept_[use].last_used = ++uses_;
+    if (rebuilt || use != current_) workers_.clear();
+    current_ = use;
+    return kept_[use].equations;
   }
 
   // At least `count` copies of the equations for the extra worker threads (worker w >= 1 takes
@@ -72,8 +80,25 @@ class ShootingWorkspace {
   long rhs_evaluations() const { return rhs_evaluations_; }
 
  private:
-  std::vector<double> key_;
-  std::shared_ptr<const RodEquations> equations_;
+  struct Kept {
+    std::vector<double> key;  // the model parameters' values
+    std::shared_ptr<const RodEquations> equations;
+    long last_used = 0;
+  };
+  template <class ForEachValue>
+  static bool same_key(const std::vector<double>& key, ForEachValue&& for_each_value) {
+    size_t count = 0;
+    bool same = true;
+    for_each_value([&](double v) {
+      same = same && count < key.size() && key[count] == v;
+      ++count;
+    });
+    return same && count == key.size();
+  }
+  static constexpr int kKept = 3;
+  std::array<Kept, kKept> kept_;
+  int current_ = -1;  // the one equations() handed out last (the workers' copies are of it)
+  long uses_ = 0;
   std::vector<std::shared_ptr<const RodEquations>> workers_;
   long rhs_evaluations_ = 0;
   Buffers buffers_;
