@@ -838,6 +838,22 @@ class SweepTest(unittest.TestCase):
                 kirchhoff.sweep(str(spec), out)
             self.assertEqual(kirchhoff.sweep(str(spec), out, resume=True), index)
 
+    def test_serial_sweep_refuses_to_be_one_of_several_mpi_copies(self):
+        # Under mpirun each copy of the serial sweep would run every job into the same folder:
+        # the library refuses (as the CLI built without MPI does), before anything is written.
+        with tempfile.TemporaryDirectory() as d:
+            spec = pathlib.Path(d) / "sweep.toml"
+            spec.write_text(f'case = "{pathlib.Path(case_path("simply_supported.toml")).resolve()}"\n'
+                            '[[jobs]]\nkind = "solve"\ngrid = { theta0 = [0.5] }\n')
+            out = pathlib.Path(d) / "out"
+            os.environ["OMPI_COMM_WORLD_SIZE"] = "2"
+            try:
+                with self.assertRaisesRegex(kirchhoff.CaseError, "one of 2 MPI processes"):
+                    kirchhoff.sweep(str(spec), str(out))
+            finally:
+                del os.environ["OMPI_COMM_WORLD_SIZE"]
+            self.assertFalse((out / "jobs").exists())
+
     def test_bad_sweep_file_raises_case_error_with_line_and_key(self):
         with tempfile.TemporaryDirectory() as d:
             spec = pathlib.Path(d) / "bad.toml"

@@ -455,6 +455,12 @@ std::string describe_job_end(const SweepJob& job, const JobOutcome& outcome, int
 }
 
 SweepSummary run_sweep(const SweepSpec& spec, const SweepRunOptions& options) {
+  // K copies of the serial sweep started by an MPI launcher would each run the whole sweep into
+  // the same folder (the CLI built with MPI shares the jobs out instead: sweep_mpi.hpp).
+  if (const int launched = launcher_process_count(); launched > 1)
+    throw SweepError("started as one of " + std::to_string(launched) +
+                     " MPI processes, but this is the serial sweep: each would run the whole sweep into the same "
+                     "folder. Run the CLI's sweep built with MPI (libopenmpi-dev) under mpirun, or run it without");
   const std::vector<int> to_run = prepare_sweep_folder(spec, options.out_dir, options.resume);
   SweepSummary summary;
   summary.jobs = static_cast<int>(spec.jobs.size());

@@ -86,7 +86,8 @@ struct SweepSummary {
   int dispatches = 0;
 };
 
-// The serial sweep: every job to run, in job order, then the index.
+// The serial sweep: every job to run, in job order, then the index. Throws SweepError (bad
+// input) when this process is one of several an MPI launcher started (launcher_process_count).
 SweepSummary run_sweep(const SweepSpec& spec, const SweepRunOptions& options);
 
 // "[k/n] id a=0.1 Delta=0.02: status (1.2 s)" as progress lines say it.
@@ -94,8 +95,8 @@ std::string describe_job_end(const SweepJob& job, const JobOutcome& outcome, int
 
 // The number of processes an MPI launcher started this one among (mpirun, mpiexec, srun), from
 // the variables they set (OMPI_COMM_WORLD_SIZE, PMI_SIZE, SLURM_STEP_NUM_TASKS); 0 when
-// none is set. The CLI uses it to choose the MPI scheduler, and to refuse to run K copies of the
-// serial sweep into one folder when built without MPI.
+// none is set. The CLI uses it to choose the MPI scheduler; run_sweep (the serial sweep, the CLI's
+// without MPI and Python's) refuses to run as one of K > 1 copies into one folder.
 int launcher_process_count();
 
 }  // namespace kirchhoff
