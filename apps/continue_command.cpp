@@ -13,6 +13,7 @@
 #include <optional>
 #include <sstream>
 
+#include "kirchhoff/analysis/point_record.hpp"
 #include "kirchhoff/jobs/case_continue.hpp"
 #include "kirchhoff/jobs/case_file.hpp"
 #include "kirchhoff/jobs/continue_outputs.hpp"
@@ -56,12 +57,12 @@ class TerminalSink : public ContinueSink {
     line << "branch " << rp.branch << "  point " << rp.row << "  " << parameter_ << " = " << std::setprecision(10)
          << p.parameter << "  step " << std::setprecision(3) << p.step;
     if (p.type != PointType::Regular && p.type != PointType::Start) line << "  [" << to_string(p.type) << "]";
-    if (!p.H_flat) line << "  [H not flat]";
+    if (!H_is_flat(p)) line << "  [H not flat]";
     if (p.stability_index) line << (*p.stability_index == 0 ? "  stable" : "  index " + std::to_string(*p.stability_index));
     if (tty_) {
       std::cerr << "\r" << line.str() << "\033[K" << std::flush;
       open_line_ = true;
-    } else if (rp.row % 10 == 0 || p.type != PointType::Regular || !p.H_flat) {
+    } else if (rp.row % 10 == 0 || p.type != PointType::Regular || !H_is_flat(p)) {
       std::cerr << line.str() << "\n";
     }
   }

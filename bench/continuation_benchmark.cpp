@@ -74,6 +74,7 @@
 #include <unistd.h>
 
 #include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/analysis/point_record.hpp"
 #include "kirchhoff/analysis/solution.hpp"
 #include "kirchhoff/continuation/continuation.hpp"
 #include "kirchhoff/continuation/rod_continuation.hpp"
@@ -639,13 +640,13 @@ TwistInvariants twist_invariants(const ContinuationResult& r) {
   double previous_dphi = 0;
   for (size_t i = 0; i < r.points.size(); ++i) {
     const auto& p = r.points[i];
-    const auto& inv = p.invariants;
+    const auto& inv = invariants_of(p);
     t.m3 = std::max(t.m3, inv.m3.spread);
     t.m3_rel = std::max(t.m3_rel, inv.m3.spread / std::max(1.0, inv.m3.scale));
     t.nm = std::max(t.nm, inv.n_dot_m.spread);
     t.nm_rel = std::max(t.nm_rel, inv.n_dot_m.spread / std::max(1.0, inv.n_dot_m.scale));
     t.H_rel = std::max(t.H_rel, inv.H.spread / std::max(1.0, inv.H.scale));
-    if (!p.H_flat) ++t.H_not_flat;
+    if (!H_is_flat(p)) ++t.H_not_flat;
     if (p.x.size() > 0) t.unfolding = std::max(t.unfolding, std::abs(p.x[p.x.size() - 1]));
     t.phi_min = std::min(t.phi_min, p.parameter);
     t.phi_max = std::max(t.phi_max, p.parameter);

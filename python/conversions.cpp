@@ -1,6 +1,7 @@
 // Conversions of the library's results into Python dicts and numpy arrays, and of Python
 // arguments into the library's (bindings.hpp).
 #include "bindings.hpp"
+#include "kirchhoff/analysis/point_record.hpp"
 
 namespace kirchhoff::python_bindings {
 // None, a mapping (its items()) or an iterable of (name, value) pairs.
@@ -164,11 +165,11 @@ py::dict branch_points_dict(const std::vector<BranchPoint>& pts, const std::vect
       return it == dv.end() ? std::numeric_limits<double>::quiet_NaN() : it->second;
     });
   // Absolute spread (the catalogue's H_spread) and the relative spreads of the CLI's CSV.
-  f("H_spread", [](const ContinuationPoint& p) { return p.invariants.H.spread; });
-  f("H_relative_spread", [](const ContinuationPoint& p) { return p.invariants.H.relative_spread() + 0.0; });
-  f("m3_relative_spread", [](const ContinuationPoint& p) { return p.invariants.m3.relative_spread() + 0.0; });
-  f("n_dot_m_relative_spread", [](const ContinuationPoint& p) { return p.invariants.n_dot_m.relative_spread() + 0.0; });
-  d["H_flat"] = column<bool>(n, [&](size_t k) { return pts[k].point.H_flat; });
+  f("H_spread", [](const ContinuationPoint& p) { return invariants_of(p).H.spread; });
+  f("H_relative_spread", [](const ContinuationPoint& p) { return invariants_of(p).H.relative_spread() + 0.0; });
+  f("m3_relative_spread", [](const ContinuationPoint& p) { return invariants_of(p).m3.relative_spread() + 0.0; });
+  f("n_dot_m_relative_spread", [](const ContinuationPoint& p) { return invariants_of(p).n_dot_m.relative_spread() + 0.0; });
+  d["H_flat"] = column<bool>(n, [&](size_t k) { return H_is_flat(pts[k].point); });
   py::list types, events;
   for (const auto& b : pts) {
     types.append(py::str(to_string(b.point.type)));

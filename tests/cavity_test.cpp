@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/analysis/point_record.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {
@@ -59,7 +60,7 @@ TEST_F(Cavity, PointContactThenExtendedContactThenHangingFold) {
 TEST_F(Cavity, HIsTheSameOnBothSidesOfEveryContactAndTheForcesPush) {
   for (size_t i = 0; i < branch->points.size(); ++i) {
     const ContinuationPoint& p = branch->points[i];
-    EXPECT_LE(p.invariants.H.relative_spread(), 1e-9) << p.parameter;
+    EXPECT_LE(invariants_of(p).H.relative_spread(), 1e-9) << p.parameter;
     // (The contact-appearance event is located where min_gap = -1e-9, the loop's tolerance.)
     EXPECT_GE(p.derived.at("min_gap"), -1.01e-9) << p.parameter;
     for (const auto& c : branch->contacts(i)) {

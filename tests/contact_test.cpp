@@ -6,6 +6,7 @@
 
 #include "kirchhoff/analysis/analytic.hpp"
 #include "kirchhoff/analysis/discrete_elastica.hpp"
+#include "kirchhoff/analysis/point_record.hpp"
 #include "kirchhoff/contact/contact.hpp"
 #include "test_support.hpp"
 
@@ -149,7 +150,7 @@ TEST(ContactContinuation, FromTheFreeArchThroughFirstContact) {
   // The corrector stops at |F| <= 1e-10: P to ~1e-10 relative.
   EXPECT_NEAR(last.derived.at("P") / exact.P, 1.0, 1e-8);
   EXPECT_NEAR(last.derived.at("contact_force") / exact.contact_force, 1.0, 1e-8);
-  for (const auto& p : r.result.points) EXPECT_TRUE(p.H_flat) << "Delta = " << p.parameter;
+  for (const auto& p : r.result.points) EXPECT_TRUE(H_is_flat(p)) << "Delta = " << p.parameter;
 }
 
 TEST(ContactContinuation, PointContactFlattensIntoAnExtendedContact) {
@@ -174,7 +175,7 @@ TEST(ContactContinuation, PointContactFlattensIntoAnExtendedContact) {
   // Section 7.2: on the flat part kappa = 0 and theta = 0, so H = -P there, and H is the same
   // everywhere: H = -P to the corrector's tolerance.
   EXPECT_NEAR(at.derived.at("H"), -at.derived.at("P"), 1e-9 * at.derived.at("P"));
-  EXPECT_TRUE(at.H_flat);
+  EXPECT_TRUE(H_is_flat(at));
 }
 
 // The active-set loop from the free arch at Delta = 0.032 adds a contact at mid-span, then a
@@ -419,7 +420,7 @@ TEST_F(HangingFold, IsSymmetricWithPushingContactsAndOneH) {
     EXPECT_GE(p.derived.at("min_contact_force"), 0.0) << p.parameter;
     EXPECT_GE(p.derived.at("min_gap"), -1e-9) << p.parameter;
     // H is the same everywhere (the profile) and on both sides of each contact.
-    EXPECT_LE(p.invariants.H.relative_spread(), 1e-9) << p.parameter;
+    EXPECT_LE(invariants_of(p).H.relative_spread(), 1e-9) << p.parameter;
     for (const auto& contact : c) {
       const auto [before, after] = testing::hamiltonian_across(*branch->problems[i], p.x, contact.s);
       EXPECT_NEAR(before, after, 1e-9 * std::abs(before)) << p.parameter;

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/analysis/point_record.hpp"
 #include "kirchhoff/contact/plectoneme.hpp"
 #include "kirchhoff/contact/self_contact.hpp"
 #include "kirchhoff/contact/self_passage.hpp"
@@ -155,7 +156,7 @@ TEST(Plectoneme, TwistingWindsAPlyThatFollowsTheHelixFormulas) {
     // Against |m|, the size of the terms m3 is read from: RK78 at 1e-12 to 1e-13 per step on
     // states whose forces reach ~50-500, over ~1e3 steps, leaves ~1e-9 of it; the bar is ten
     // times that.
-    EXPECT_LT(p.invariants.m3.relative_spread(), 1e-8) << "turns " << p.parameter;
+    EXPECT_LT(invariants_of(p).m3.relative_spread(), 1e-8) << "turns " << p.parameter;
     const double H_A = p.derived.at("H_A"), H_B = p.derived.at("H_B");
     if (std::isnan(H_A)) continue;
     ++in_contact;

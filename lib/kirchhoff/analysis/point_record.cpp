@@ -1,6 +1,7 @@
 #include "kirchhoff/analysis/point_record.hpp"
 
 #include <algorithm>
+#include <any>
 
 #include "kirchhoff/analysis/solution.hpp"
 #include "kirchhoff/analysis/stability.hpp"
@@ -12,7 +13,17 @@ namespace {
 // H is flagged as not flat above this fraction of its scale (the standard).
 constexpr double kFlatH = 1e-9;
 
+const RodPointInvariants& kept(const PointRecord& point) {
+  static const RodPointInvariants none;
+  const auto* rod = std::any_cast<RodPointInvariants>(&point.extra);
+  return rod ? *rod : none;
+}
+
 }  // namespace
+
+const InvariantReport& invariants_of(const PointRecord& point) { return kept(point).invariants; }
+
+bool H_is_flat(const PointRecord& point) { return kept(point).H_flat; }
 
 PointRecorder rod_point_recorder(const ContinuationOptions& options) {
   PointRecorder recorder;
@@ -31,8 +42,8 @@ PointRecorder rod_point_recorder(const ContinuationOptions& options) {
       p.derived = s.derived;
       // Parameters solved for belong on the branch too (e.g. the load of a displacement-controlled run).
       for (const auto& name : problem.definition().unknown_parameters) p.derived[name] = at.get(name);
-      p.invariants = s.invariants;
-      p.H_flat = !s.invariants.H.applies || s.invariants.H.spread <= kFlatH * std::max(1.0, s.invariants.H.scale);
+      p.extra = RodPointInvariants{
+          s.invariants, !s.invariants.H.applies || s.invariants.H.spread <= kFlatH * std::max(1.0, s.invariants.H.scale)};
     };
   if (options.compute_stability)
     recorder.record = [field_tolerance = options.stability_field_tolerance](ParameterisedSystem& system,

@@ -9,13 +9,26 @@
 #pragma once
 
 #include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/equations/invariants.hpp"
 
 namespace kirchhoff {
+
+// What the rod layer keeps of a point beside the engine's fields (PointRecord::extra): the
+// invariants along the rod and whether H is flat.
+struct RodPointInvariants {
+  InvariantReport invariants;
+  bool H_flat = true;  // false flags a point whose H spread exceeds 1e-9 of its scale
+};
+
+// A point's invariants (none - every one not applying - where the recorder kept none, e.g. with
+// compute_invariants off) and whether its H is flat (true where none were kept).
+const InvariantReport& invariants_of(const PointRecord& point);
+bool H_is_flat(const PointRecord& point);
 
 // The recorder a Continuation uses when its options give none, from the options' rod fields:
 //   describe (once per corrected point, when compute_invariants or derived is set): one
 //     make_solution with `samples` profile points -> derived (and the parameters solved for),
-//     invariants, H_flat, check_failure;
+//     the invariants and H's flatness (RodPointInvariants, in extra), check_failure;
 //   record (once per point on the branch, with compute_stability): stability_index, zero_modes.
 PointRecorder rod_point_recorder(const ContinuationOptions& options);
 

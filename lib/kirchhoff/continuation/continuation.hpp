@@ -18,6 +18,7 @@
 //   - events: a derived quantity crosses a given value.
 #pragma once
 
+#include <any>
 #include <chrono>
 #include <functional>
 #include <limits>
@@ -28,7 +29,6 @@
 #include <vector>
 
 #include "kirchhoff/continuation/parameterised_system.hpp"
-#include "kirchhoff/equations/invariants.hpp"
 
 namespace kirchhoff {
 
@@ -193,14 +193,15 @@ const char* to_string(PointType type);
 // default fills every field (rod_point_recorder).
 struct PointRecord {
   std::map<std::string, double> derived;  // named quantities (events read theirs here)
-  InvariantReport invariants;
-  bool H_flat = true;       // false flags a point whose H spread exceeds 1e-9 of its scale
   // With compute_stability: the index (empty where it is not defined) and the zero modes.
   std::optional<int> stability_index;
   int zero_modes = 0;
   // Why the point failed the checks of a solution (verification.hpp: a profile with NaN, a rod
   // beyond its soft wall), "" when it passed. Such a point is never put on a branch.
   std::string check_failure;
+  // Whatever else the recorder keeps of the point, which the engine carries without reading: a
+  // rod's invariants and the flatness of its H (analysis/point_record.hpp: invariants_of, H_is_flat).
+  std::any extra;
 };
 
 struct ContinuationPoint : PointRecord {

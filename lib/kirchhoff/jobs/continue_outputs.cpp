@@ -1,3 +1,4 @@
+#include "kirchhoff/analysis/point_record.hpp"
 #include "kirchhoff/jobs/continue_outputs.hpp"
 
 #include <algorithm>
@@ -47,10 +48,10 @@ void BranchCsvSink::point(const RunPoint& rp) {
     const auto it = p.derived.find(d);
     out_ << ',' << (it != p.derived.end() ? it->second : NAN);
   }
-  const auto& inv = p.invariants;
+  const auto& inv = invariants_of(p);
   // + 0.0 prints a zero spread as 0, not -0.
   out_ << ',' << inv.H.relative_spread() + 0.0 << ',' << inv.m3.relative_spread() + 0.0 << ','
-       << inv.n_dot_m.relative_spread() + 0.0 << ',' << (p.H_flat ? 1 : 0) << ',' << to_string(p.type) << ','
+       << inv.n_dot_m.relative_spread() + 0.0 << ',' << (H_is_flat(p) ? 1 : 0) << ',' << to_string(p.type) << ','
        << p.multiplicity << ',' << p.event << ',' << p.newton_iterations << ',';
   // Empty where the index is not defined (or not computed): never a guessed number.
   if (p.stability_index) out_ << *p.stability_index;
