@@ -111,7 +111,8 @@ py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
   options.profile_samples = samples;
   // Refused before the equilibrium is solved for, as the CLI's `vibrate`, which also limits the
   // solve to its default wall clock.
-  if (std::string why = vibration_refusal(c.definition, options); !why.empty()) throw py::value_error(c.path + ": " + why);
+  if (std::string why = vibration_refusal(c.definition, options); !why.empty())
+    throw py::value_error(c.path + ": " + why);
   limit_wall_clock(c.definition.options, kDefaultSolveSeconds);
   VibrationAnalysis analysis;
   Parameters at;  // the equilibrium's parameters, solved-for ones included

@@ -42,8 +42,8 @@ PointRecorder rod_point_recorder(const ContinuationOptions& options) {
       p.derived = s.derived;
       // Parameters solved for belong on the branch too (e.g. the load of a displacement-controlled run).
       for (const auto& name : problem.definition().unknown_parameters) p.derived[name] = at.get(name);
-      p.extra = RodPointInvariants{
-          s.invariants, !s.invariants.H.applies || s.invariants.H.spread <= kFlatH * std::max(1.0, s.invariants.H.scale)};
+      const InvariantStats& H = s.invariants.H;
+      p.extra = RodPointInvariants{s.invariants, !H.applies || H.spread <= kFlatH * std::max(1.0, H.scale)};
     };
   if (options.compute_stability)
     recorder.record = [field_tolerance = options.stability_field_tolerance](ParameterisedSystem& system,

@@ -159,10 +159,11 @@ CaseSolve solve_case(const Case& c, const CaseSolveOptions& options) {
   } catch (const InfeasibleContact& e) {
     return stopped_before_newton(solve_method(c, options), "infeasible", e.what());
   } catch (const IntegrationError& e) {
-    return stopped_before_newton(solve_method(c, options), "integration_failed", std::string("the initial guess cannot be integrated: ") + e.what());
-  } catch (const std::runtime_error& e) {
+    return stopped_before_newton(solve_method(c, options), "integration_failed",
+                                 std::string("the initial guess cannot be integrated: ") + e.what());
+  } catch (const std::runtime_error& e) {  // from the seed alone: Ipopt's minimisation did not converge
     if (!options.seed.ipopt) throw;
-    return stopped_before_newton(solve_method(c, options), "seed_failed", e.what());  // Ipopt's minimisation did not converge
+    return stopped_before_newton(solve_method(c, options), "seed_failed", e.what());
   }
   if (out.failure.empty() && out.solved.result.summary.converged()) analyse(c, options, &out);
   return out;

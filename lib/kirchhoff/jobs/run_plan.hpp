@@ -39,10 +39,11 @@ struct RunPlan {
 };
 
 // Fills request->identity (run_identity, unless the caller gave one), request->resume / start /
-// start_name / set_parameters and validates the request on the loaded case. `loaded`, when given, is the case as the front end loaded it with `overrides`:
-// used as is where the run keeps those values. Throws CaseError (or std::invalid_argument for a
-// state file that cannot be used, a CaseError for one that cannot be read) with the reason; the
-// front ends report it as bad input.
+// start_name / set_parameters and validates the request on the loaded case. `loaded`, when
+// given, is the case as the front end loaded it with `overrides`: used as is where the run keeps
+// those values. Throws CaseError (or std::invalid_argument for a state file that cannot be used,
+// a CaseError for one that cannot be read) with the reason; the front ends report it as bad
+// input.
 RunPlan plan_run(const RunPlanInputs& in, ContinueRequest* request, const Case* loaded = nullptr);
 
 // What identifies a run (ContinueRequest::identity, recorded in its state; a resume whose state
