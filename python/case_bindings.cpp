@@ -24,11 +24,16 @@ namespace {
 PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::string& seed, int seed_segments,
                     double max_seconds, bool direct) {
   Case c = pc.c;
-  limit_wall_clock(c.definition.options, max_seconds);  // std::invalid_argument (ValueError) outside [0, 1e9]
+  // Bad arguments are CaseError (a ValueError), as the module's other bad input.
+  try {
+    limit_wall_clock(c.definition.options, max_seconds);
+  } catch (const std::invalid_argument& e) {
+    throw CaseError(std::string("max_seconds: ") + e.what());
+  }
   const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
   if (samples < 2 || samples > 100000)  // as a case file's [output] samples
-    throw py::value_error("samples must be in [2, 100000] (got " + std::to_string(samples) + ")");
-  if (seed != "guess" && seed != "ipopt") throw py::value_error("seed must be 'guess' or 'ipopt' (got '" + seed + "')");
+    throw CaseError("samples must be in [2, 100000] (got " + std::to_string(samples) + ")");
+  if (seed != "guess" && seed != "ipopt") throw CaseError("seed must be 'guess' or 'ipopt' (got '" + seed + "')");
   std::string seed_refused;  // raised as ValueError once the GIL is back
 
   PySolution out;
@@ -50,7 +55,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
       seed_refused = e.what();
     }
   }
-  if (!seed_refused.empty()) throw py::value_error(seed_refused);
+  if (!seed_refused.empty()) throw CaseError(seed_refused);
   const std::unique_ptr<ShootingProblem>& problem = solved.solved.problem;
   const Solution* sol = solved.converged() ? &*solved.solution : nullptr;
   ShootingResult failed;  // Newton's verdict, the profile's checks' (verification.hpp), or the failure's
@@ -112,7 +117,7 @@ py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
   // Refused before the equilibrium is solved for, as the CLI's `vibrate`, which also limits the
   // solve to its default wall clock.
   if (std::string why = vibration_refusal(c.definition, options); !why.empty())
-    throw py::value_error(c.path + ": " + why);
+    throw CaseError(c.path + ": " + why);
   limit_wall_clock(c.definition.options, kDefaultSolveSeconds);
   VibrationAnalysis analysis;
   Parameters at;  // the equilibrium's parameters, solved-for ones included
@@ -190,11 +195,11 @@ PySolution equilibrium_solution(const Case& c, const Equilibrium& e) {
 py::list py_equilibria(const PyCase& pc, int max, double max_seconds, const py::object& samples_arg) {
   const Case& c = pc.c;
   const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
-  if (samples < 2 || samples > 100000) throw py::value_error("samples must be in [2, 100000]");
+  if (samples < 2 || samples > 100000) throw CaseError("samples must be in [2, 100000]");
   EquilibriaOptions options;
   options.max_equilibria = max;
   options.max_seconds = max_seconds;
-  if (const std::string why = options.validate(); !why.empty()) throw py::value_error(why);
+  if (const std::string why = options.validate(); !why.empty()) throw CaseError(why);
   EquilibriaSearch search;
   {
     py::gil_scoped_release release;

@@ -896,8 +896,13 @@ class EquilibriaTest(unittest.TestCase):
         self.assertIsNone(kirchhoff.load_case(case_path("clamped_clamped.toml")).equilibria(max=1)[0].family)
 
     def test_bad_options_raise(self):
-        # The library's checks (EquilibriaOptions::validate, StartSeed::validate), as the CLI's.
+        # The library's checks (EquilibriaOptions::validate, StartSeed::validate), as the CLI's,
+        # raised as CaseError like every other bad input of a case.
         c = kirchhoff.load_case(case_path("clamped_clamped.toml"))
+        for bad in (lambda: c.equilibria(max=0), lambda: c.solve(max_seconds=-1), lambda: c.solve(samples=1),
+                    lambda: c.vibrate(rho_s=-1.0)):
+            with self.assertRaises(kirchhoff.CaseError):
+                bad()
         with self.assertRaisesRegex(ValueError, r"max \(equilibria\) must be in \[1, 1000\]"):
             c.equilibria(max=0)
         with self.assertRaisesRegex(ValueError, r"must be in \[1, 1000\]"):
