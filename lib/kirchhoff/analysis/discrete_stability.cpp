@@ -608,7 +608,7 @@ struct Spectrum {
   // loads' part.
   std::vector<double> bending;
   std::string contact_problem;  // a contact whose discrete solve is not the shooting one's, else ""
-  bool contacts = false;        // the eigenvalues converge at first order only (see self_check)
+  bool contacts = false;        // the eigenvalues converge at first order only (see spectrum_check)
   // With a sliding length: the sliding direction's own second variation when it was negative (it
   // adds one to the index beside the eigenvalues), why it could not be eliminated (else ""), the
   // discrete d^2 E*/d ell^2, and |ell - ell_shooting| / ell.
@@ -968,9 +968,9 @@ Counts count(const Spectrum& s, double zero_tolerance) {
   return c;
 }
 
-// The self-checks of discrete_stability.hpp, in order; "" when all pass.
-// The first half of self_check: the discrete equilibria are the shooting one, resolved, and the
-// lift-off eigenvalue's sign (where a part lies on an obstacle with zero force) is decided.
+// The self-checks of discrete_stability.hpp, in order, in two halves; "" when all pass. The first:
+// the discrete equilibria are the shooting one, resolved, and the lift-off eigenvalue's sign
+// (where a part lies on an obstacle with zero force) is decided.
 std::string solution_check(const Spectrum& fine, const Spectrum& coarse, double zero_tolerance) {
   for (const Spectrum* s : {&fine, &coarse})
     if (!(s->kkt_residual <= kDiscreteStabilityKktTolerance))
@@ -1001,7 +1001,7 @@ std::string solution_check(const Spectrum& fine, const Spectrum& coarse, double 
   return "";
 }
 
-// The second half of self_check: the two resolutions count the same index and zero modes, and
+// The second: the two resolutions count the same index and zero modes, and
 // every eigenvalue up to the first above them is resolved with its sign decided.
 std::string spectrum_check(const Spectrum& fine, const Spectrum& coarse, double zero_tolerance) {
   const Counts a = count(fine, zero_tolerance), b = count(coarse, zero_tolerance);
@@ -1030,12 +1030,6 @@ std::string spectrum_check(const Spectrum& fine, const Spectrum& coarse, double 
              ") is within its discretisation error of zero: its sign, and the index, are not decided";
   }
   return "";
-}
-
-// "" when the discrete index can be believed, else the first check that failed.
-std::string self_check(const Spectrum& fine, const Spectrum& coarse, double zero_tolerance) {
-  if (std::string why = solution_check(fine, coarse, zero_tolerance); !why.empty()) return why;
-  return spectrum_check(fine, coarse, zero_tolerance);
 }
 
 }  // namespace
@@ -1120,7 +1114,8 @@ DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen
   out.weakly_active_nodes = fine.weak_nodes;
   out.lift_off_eigenvalue = fine.lift_off;
   out.coarse_lift_off_eigenvalue = coarse.lift_off;
-  out.check_message = self_check(fine, coarse, out.zero_tolerance);
+  const std::string solution_failure = solution_check(fine, coarse, out.zero_tolerance);
+  out.check_message = solution_failure.empty() ? spectrum_check(fine, coarse, out.zero_tolerance) : solution_failure;
   out.trustworthy = out.check_message.empty();
   if (out.trustworthy) out.check_message = "passed";
   // A part lying on the obstacle with zero force that lifts off with lower energy: unstable, and
@@ -1128,7 +1123,7 @@ DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen
   // the discrete equilibria to be the shooting one and the lift-off's sign decided
   // (solution_check), not the rest of the spectrum: an admissible perturbation that lowers the
   // energy makes the equilibrium unstable whatever the other eigenvalues' signs.
-  const bool lift_off_decided = fine.weak_nodes > 0 && solution_check(fine, coarse, out.zero_tolerance).empty();
+  const bool lift_off_decided = fine.weak_nodes > 0 && solution_failure.empty();
   if (lift_off_decided && fine.lift_off < -out.zero_tolerance) {
     out.index.reset();
     out.unstable = fine.lift_one_signed;

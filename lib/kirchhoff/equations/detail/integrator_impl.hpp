@@ -82,11 +82,12 @@ struct DualSystem {
   }
 };
 
-// Integrates the state alone from y0 into *y (its storage kept once it has the state's size);
+// Integrates the state alone from y0 into *y (its storage kept once it has the state's size),
+// continuing from the step size *ds and leaving there the one proposed next (march_carrying);
 // returns the steps taken and adds the right-hand sides evaluated to *evaluations.
 template <int N, class Rhs>
 long march_state_into(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& opt,
-                      Eigen::VectorXd* y, long* evaluations) {
+                      double* ds, Eigen::VectorXd* y, long* evaluations) {
   using State = std::array<double, N>;
   State x;
   for (int i = 0; i < N; ++i) x[i] = y0[i];
@@ -94,9 +95,17 @@ long march_state_into(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, doub
     ++*evaluations;
     rhs(state.data(), dy.data(), s);
   };
-  const long steps = march(x, s0, s1, system, opt);
+  const long steps = march_carrying(x, s0, s1, system, opt, ds);
   *y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data());
   return steps;
+}
+
+// The same over one interval on its own: the first trial step is opt.initial_step of it (march).
+template <int N, class Rhs>
+long march_state_into(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& opt,
+                      Eigen::VectorXd* y, long* evaluations) {
+  double ds = opt.initial_step * (s1 - s0);
+  return march_state_into<N>(rhs, y0, s0, s1, opt, &ds, y, evaluations);
 }
 
 // Integrates the state alone, into *out (whose y keeps its storage: nothing is allocated once it
@@ -163,14 +172,7 @@ void flow_with_seeded_sensitivities_into(const Rhs& rhs, const Eigen::VectorXd& 
 template <int N, class Rhs>
 void carry_state_alone(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1, const IntegratorOptions& opt,
                        CarriedSteps* carried, DirectionalFlow* out) {
-  std::array<double, N> state;
-  for (int i = 0; i < N; ++i) state[i] = y0[i];
-  auto state_system = [&](const std::array<double, N>& y, std::array<double, N>& dy, double s) {
-    ++out->rhs_evaluations;
-    rhs(y.data(), dy.data(), s);
-  };
-  out->steps += march_carrying(state, s0, s1, state_system, opt, &carried->state);
-  out->y = Eigen::Map<const Eigen::Matrix<double, N, 1>>(state.data());
+  out->steps += march_state_into<N>(rhs, y0, s0, s1, opt, &carried->state, &out->y, &out->rhs_evaluations);
 }
 
 // The state and the columns of `directions` (at most K; fewer are padded with zero columns, which
