@@ -145,7 +145,7 @@ const EulerSetup& euler_setup() {
     try {
       s.c = load_case(case_path("euler_column.toml"), {{"P", 1.0}, {"theta_guess", 0.0}});
       s.problem = std::make_unique<ShootingProblem>(s.c.definition);
-      ContinuationOptions o;
+      RodContinuationOptions o;
       o.parameter = "P";
       o.target = 12.0;
       o.initial_step = 0.5;
@@ -153,7 +153,7 @@ const EulerSetup& euler_setup() {
       o.samples = 21;
       o.derived = {"theta0", "end_to_end"};
       o.stop_at_branch_point = 1;
-      Continuation straight(*s.problem, o);
+      RodContinuation straight(*s.problem, o);
       const ContinuationResult r = straight.run(s.problem->initial_unknowns(s.c.start_guess));
       if (r.reason != StopReason::BranchPointStop)
         s.error = std::string("straight Euler column: no branch point (") + to_string(r.reason) + ") " + r.message;
@@ -170,7 +170,7 @@ const EulerSetup& euler_setup() {
 struct TwistSetup {
   Case c;
   std::unique_ptr<ShootingProblem> straight_problem;
-  std::unique_ptr<Continuation> straight;
+  std::unique_ptr<RodContinuation> straight;
   ContinuationPoint branch_point;
   SymmetricBranchStart start;
   std::unique_ptr<ShootingProblem> switched;  // with the axial phase condition
@@ -183,7 +183,7 @@ const TwistSetup& twist_setup() {
     try {
       s.c = load_case(case_path("twisted_clamped.toml"), {{"phi", 6.0}, {"tension", 0.0}});
       s.straight_problem = std::make_unique<ShootingProblem>(s.c.definition);
-      ContinuationOptions o;
+      RodContinuationOptions o;
       o.parameter = "phi";
       o.target = 15.0;
       o.initial_step = 0.5;
@@ -191,7 +191,7 @@ const TwistSetup& twist_setup() {
       o.samples = 41;
       o.derived = {"end_to_end", "M"};
       o.stop_at_branch_point = 1;
-      s.straight = std::make_unique<Continuation>(*s.straight_problem, o);
+      s.straight = std::make_unique<RodContinuation>(*s.straight_problem, o);
       const ContinuationResult r = s.straight->run(s.straight_problem->initial_unknowns(s.c.start_guess));
       if (r.reason != StopReason::BranchPointStop) {
         s.error = std::string("straight twisted rod: no branch point (") + to_string(r.reason) + ") " + r.message;
@@ -211,8 +211,8 @@ const TwistSetup& twist_setup() {
 // ---------------------------------------------------------------------------------------------
 // The timed runs
 
-ContinuationOptions euler_branch_options(bool invariants) {
-  ContinuationOptions o;
+RodContinuationOptions euler_branch_options(bool invariants) {
+  RodContinuationOptions o;
   o.parameter = "P";
   o.initial_step = 0.05;
   o.max_step = g_euler_max_step;
@@ -226,8 +226,8 @@ ContinuationOptions euler_branch_options(bool invariants) {
   return o;
 }
 
-ContinuationOptions twist_branch_options() {
-  ContinuationOptions o;
+RodContinuationOptions twist_branch_options() {
+  RodContinuationOptions o;
   o.parameter = "phi";
   o.initial_step = 0.05;
   o.max_step = g_twist_max_step;
@@ -250,7 +250,7 @@ struct Run {
 
 // One timed branch of `branch`: `go` runs it.
 template <class Go>
-Run timed(Continuation& branch, Go&& go) {
+Run timed(RodContinuation& branch, Go&& go) {
   Run run;
   const long rhs0 = branch.problem().rhs_evaluations();
   const Continuation::EvaluationCount e0 = branch.evaluations();
@@ -269,7 +269,7 @@ Run timed(Continuation& branch, Go&& go) {
 
 // A fixed step (fixed_step > 0): initial and max step fixed_step times the branch's max_step,
 // so the step never grows (it still shrinks where a corrector fails): the naive run of (4).
-void fix_step(ContinuationOptions& o, double fixed_step) {
+void fix_step(RodContinuationOptions& o, double fixed_step) {
   if (!(fixed_step > 0)) return;
   o.max_step *= fixed_step;
   o.initial_step = o.max_step;
@@ -285,10 +285,10 @@ Run euler_branch(bool invariants, double fixed_step = 0, Predictor predictor = P
     run.error = s.error;
     return run;
   }
-  ContinuationOptions o = euler_branch_options(invariants);
+  RodContinuationOptions o = euler_branch_options(invariants);
   fix_step(o, fixed_step);
   o.predictor = predictor;
-  Continuation branch(*s.problem, o);
+  RodContinuation branch(*s.problem, o);
   return timed(branch, [&] { return branch.switch_branch(s.branch_point); });
 }
 
@@ -299,10 +299,10 @@ Run twist_branch(double fixed_step = 0, Predictor predictor = Predictor::Quadrat
     run.error = s.error;
     return run;
   }
-  ContinuationOptions o = twist_branch_options();
+  RodContinuationOptions o = twist_branch_options();
   fix_step(o, fixed_step);
   o.predictor = predictor;
-  Continuation branch(*s.switched, o);
+  RodContinuation branch(*s.switched, o);
   return timed(branch, [&] {
     return branch.run_along(s.start.x, s.start.parameter, s.start.direction, PointType::BranchPoint);
   });

@@ -161,7 +161,7 @@ int measure_branch(const std::string& name, int runs) {
   // The index of each point alone: with the continuation's options (point_record.cpp), and with
   // its fields at the state's tolerance.
   const double points_kept = static_cast<double>(std::max<size_t>(1, keep.points.size()));
-  for (const double field_tolerance : {RecordOptions{}.stability_field_tolerance, 0.0}) {
+  for (const double field_tolerance : {RodRecordOptions{}.stability_field_tolerance, 0.0}) {
     StabilityOptions options;
     options.extended_contacts = false;
     options.field_tolerance = field_tolerance;

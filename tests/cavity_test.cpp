@@ -14,7 +14,7 @@ namespace {
 
 testing::ContactBranch follow_cavity(double target) {
   const Case c = load_case(testing::case_path("cavity.toml"));
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "Delta";
   o.target = target;
   o.max_step = 2.0;
@@ -127,7 +127,7 @@ TEST(CavityBeyond, FoldContactsLiftOffTogetherWhereTheSecondModeTouches) {
 TEST(CavityBadInput, ClampsOutsideTheCavityAreInfeasible) {
   // a < 0 swaps the walls: the clamps at y = 0 are inside both.
   const Case c = load_case(testing::case_path("cavity.toml"), {{"a", -0.05}});
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "Delta";
   o.target = 0.01;
   EXPECT_THROW(continue_with_contacts(c.definition, c.start_guess, o), InfeasibleContact);

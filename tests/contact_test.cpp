@@ -126,7 +126,7 @@ TEST(PointContact, MultipleShootingThroughTheContactAgreesWithSingleShooting) {
 
 ContactContinuationResult continue_wall(double to) {
   const Case c = load_case(testing::case_path("wall.toml"), {{"Delta", 0.005}, {"m_guess", 0.9}});
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "Delta";
   o.target = to;
   o.max_step = 2.0;
@@ -155,7 +155,7 @@ TEST(ContactContinuation, FromTheFreeArchThroughFirstContact) {
 
 TEST(ContactContinuation, PointContactFlattensIntoAnExtendedContact) {
   const Case c = load_case(testing::case_path("wall.toml"), {{"Delta", 0.005}, {"m_guess", 0.9}});
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "Delta";
   o.target = 0.04;
   o.max_step = 2.0;
@@ -197,7 +197,7 @@ TEST(FlatContact, TwoPointContactsWithTheRodFlatBetweenThemAreOneExtendedContact
   // As continuation finds it (its corrector stops at 1e-10: P to ~1e-10 relative; the ends of a
   // flat contact are contacts of higher order, located to ~1e-6 only, see above).
   const Case c = load_case(testing::case_path("wall.toml"));
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "Delta";
   o.target = 0.032;
   o.max_step = 2.0;
@@ -347,7 +347,7 @@ class HangingFold : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     const Case c = load_case(testing::case_path("wall.toml"), {{"Delta", 0.005}, {"m_guess", 0.9}});
-    ContinuationOptions o;
+    RodContinuationOptions o;
     o.parameter = "Delta";
     o.target = 0.07;
     o.max_step = 2.0;

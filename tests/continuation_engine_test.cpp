@@ -96,9 +96,9 @@ TEST(ContinuationEngine, FollowsACircleThroughBothFolds) {
   ASSERT_GE(folds.size(), 2u);
   EXPECT_NEAR(folds[0], 1.0, 1e-9);
   EXPECT_NEAR(folds[1], -1.0, 1e-9);
-  // Nothing of a rod is recorded: there is no recorder.
+  // Nothing of a rod is recorded: there is no recorder (and the engine has no rod to ask for:
+  // RodContinuation, rod_continuation.hpp, is the one that follows a shooting problem).
   EXPECT_TRUE(r.points.front().derived.empty());
-  EXPECT_THROW(run.problem(), std::logic_error);
 }
 
 TEST(ContinuationEngine, FindsThePitchforkAndSwitchesOntoTheParabola) {

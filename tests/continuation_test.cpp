@@ -27,21 +27,21 @@ std::vector<ContinuationPoint> of_type(const ContinuationResult& r, PointType ty
 struct BranchRun {
   Case c;
   std::unique_ptr<ShootingProblem> problem;
-  std::unique_ptr<Continuation> continuation;
+  std::unique_ptr<RodContinuation> continuation;
   ContinuationResult result;
 };
 
-BranchRun continue_case(const std::string& file, const ParameterOverrides& overrides, ContinuationOptions options) {
+BranchRun continue_case(const std::string& file, const ParameterOverrides& overrides, RodContinuationOptions options) {
   BranchRun run;
   run.c = load_case(testing::case_path(file), overrides);
   run.problem = std::make_unique<ShootingProblem>(run.c.definition);
-  run.continuation = std::make_unique<Continuation>(*run.problem, options);
+  run.continuation = std::make_unique<RodContinuation>(*run.problem, options);
   run.result = run.continuation->run(run.problem->initial_unknowns(run.c.start_guess));
   return run;
 }
 
-ContinuationOptions euler_options() {
-  ContinuationOptions o;
+RodContinuationOptions euler_options() {
+  RodContinuationOptions o;
   o.parameter = "P";
   o.target = 100.0;
   o.initial_step = 0.5;
@@ -68,9 +68,9 @@ TEST(EulerColumn, MultipleShootingContinuesTheSameWay) {
   Case c = load_case(testing::case_path("euler_column.toml"), {{"P", 1.0}, {"theta_guess", 0.0}});
   c.definition.options.segments = 3;
   const ShootingProblem problem(c.definition);
-  ContinuationOptions o = euler_options();
+  RodContinuationOptions o = euler_options();
   o.target = 45.0;
-  Continuation run(problem, o);
+  RodContinuation run(problem, o);
   const ContinuationResult r = run.run(problem.initial_unknowns(c.start_guess));
   const auto bps = of_type(r, PointType::BranchPoint);
   ASSERT_EQ(bps.size(), 2u);
@@ -79,8 +79,8 @@ TEST(EulerColumn, MultipleShootingContinuesTheSameWay) {
 }
 
 // Options for the column's first buckled branch, followed until theta0 reaches `theta_end`.
-ContinuationOptions buckled_options(double theta_end) {
-  ContinuationOptions o = euler_options();
+RodContinuationOptions buckled_options(double theta_end) {
+  RodContinuationOptions o = euler_options();
   o.target = NAN;
   o.initial_step = 0.05;
   o.max_step = 1.0;
@@ -90,14 +90,14 @@ ContinuationOptions buckled_options(double theta_end) {
 
 // The straight column up to its first branch point, then the branch bifurcating there (and the
 // evaluations that branch took, in `count`).
-ContinuationResult first_buckled_branch(const ContinuationOptions& buckled,
+ContinuationResult first_buckled_branch(const RodContinuationOptions& buckled,
                                         Continuation::EvaluationCount* count = nullptr) {
-  ContinuationOptions o = euler_options();
+  RodContinuationOptions o = euler_options();
   o.target = 12.0;
   o.stop_at_branch_point = 1;
   BranchRun run = continue_case("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, o);
   EXPECT_EQ(run.result.reason, StopReason::BranchPointStop);
-  Continuation branch(*run.problem, buckled);
+  RodContinuation branch(*run.problem, buckled);
   ContinuationResult r = branch.switch_branch(run.result.points.back());
   if (count) *count = branch.evaluations();
   return r;
@@ -136,7 +136,7 @@ TEST(EulerColumn, FirstBuckledBranchMatchesTheElasticaToThetaThree) {
 // branch-point detection locates nothing; here, with it, the touching ends cost 20 matrices
 // more with the noise stop and 44 more without it (measured): the bound 30 lies between.
 TEST(EulerColumn, SingularPointIsLocatedForAFewMatrices) {
-  ContinuationOptions without = buckled_options(3.0);
+  RodContinuationOptions without = buckled_options(3.0);
   without.detect_branch_points = false;
   Continuation::EvaluationCount with_count, without_count;
   const ContinuationResult a = first_buckled_branch(buckled_options(3.0), &with_count);
@@ -154,7 +154,7 @@ TEST(EulerColumn, SingularPointIsLocatedForAFewMatrices) {
 // Reusing the previous point's matrix where the corrector converged quickly on it changes the
 // tangents and chords, not the equilibria: every point is still on the elastica to kLocated.
 TEST(EulerColumn, ReusedJacobiansGiveTheSameBuckledBranch) {
-  ContinuationOptions buckled = buckled_options(2.5);
+  RodContinuationOptions buckled = buckled_options(2.5);
   buckled.reuse_jacobian_iterations = 6;
   EXPECT_NE(buckled.validate().find("detect_branch_points"), std::string::npos);
   buckled.detect_branch_points = false;
@@ -178,12 +178,12 @@ TEST(EulerColumn, ReusedJacobiansGiveTheSameBuckledBranch) {
 // more (cheap) iterations and fewer matrices, the equilibria are the same. Long steps (max_step
 // 4) make the chord on the previous point's matrix fail often, so Newton runs.
 TEST(EulerColumn, ModifiedNewtonTakesFewerMatricesForTheSameBranch) {
-  ContinuationOptions full = buckled_options(2.5);
+  RodContinuationOptions full = buckled_options(2.5);
   full.max_step = 4.0;
   full.grow_iterations = 8;
   full.shrink_iterations = 16;
   full.corrector_max_iterations = 20;
-  ContinuationOptions modified = full;
+  RodContinuationOptions modified = full;
   modified.modified_newton = true;
   Continuation::EvaluationCount full_count, modified_count;
   const ContinuationResult a = first_buckled_branch(full, &full_count);
@@ -217,7 +217,7 @@ TEST(EulerColumn, ModifiedNewtonTakesFewerMatricesForTheSameBranch) {
 // were used: differing by more than 1e-13 (round-off) and less than 1e-5 (a predictor that far off
 // would not change the corrector counts, which must agree, but the bound catches a wrong matrix).
 TEST(EulerColumn, LooserMarchMatricesGiveTheSameBuckledBranch) {
-  ContinuationOptions tight = buckled_options(3.0);
+  RodContinuationOptions tight = buckled_options(3.0);
   tight.march_sensitivity_tol = 0;
   const ContinuationResult a = first_buckled_branch(tight);
   const ContinuationResult b = first_buckled_branch(buckled_options(3.0));
@@ -250,7 +250,7 @@ TEST(EulerColumn, LooserMarchMatricesGiveTheSameBuckledBranch) {
 // The residual at the end is within the corrector's tolerance.
 TEST(SoftWall, TheEndPointIsExactlyOnTheTarget) {
   for (double target : {0.026, 0.0237}) {
-    ContinuationOptions o;
+    RodContinuationOptions o;
     o.parameter = "Delta";
     o.target = target;
     o.samples = 41;
@@ -273,7 +273,7 @@ TEST(SoftWall, TheEndPointIsExactlyOnTheTarget) {
 // (every accepted step within the limit, the same target reached); one that refuses every step
 // stops the run as inadmissible with its reason.
 TEST(EulerColumn, StepCheckShortensRefusedStepsOrStopsTheRun) {
-  ContinuationOptions o = euler_options();
+  RodContinuationOptions o = euler_options();
   o.detect_branch_points = false;
   o.step_check = [](const ContinuationPoint& from, const ContinuationPoint& to) {
     return std::abs(to.parameter - from.parameter) > 2.0 ? std::string("too long") : std::string();
@@ -298,7 +298,7 @@ TEST(EulerColumn, StepCheckShortensRefusedStepsOrStopsTheRun) {
 // point reached the sink after the last). It then walks the same branch: the same points as the
 // uninterrupted run to kLocated.
 TEST(EulerColumn, ResumedRunReportsEachPointAsItIsFound) {
-  ContinuationOptions o = euler_options();
+  RodContinuationOptions o = euler_options();
   o.target = 30.0;
   o.detect_branch_points = false;
   const BranchRun whole = continue_case("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, o);
@@ -308,7 +308,7 @@ TEST(EulerColumn, ResumedRunReportsEachPointAsItIsFound) {
 
   ShootingProblem problem = *whole.problem;
   problem.set_parameter("P", saved.parameter);
-  Continuation resumed(problem, o);
+  RodContinuation resumed(problem, o);
   int residuals_at_first_point = -1;
   std::vector<ContinuationPoint> reported;
   const ContinuationResult r = resumed.resume(saved, [&](const ContinuationPoint& p) {
@@ -326,8 +326,8 @@ TEST(EulerColumn, ResumedRunReportsEachPointAsItIsFound) {
     EXPECT_NEAR(reported[k].parameter, whole.result.points[3 + k].parameter, kLocated) << k;
 }
 
-ContinuationOptions twist_options() {
-  ContinuationOptions o;
+RodContinuationOptions twist_options() {
+  RodContinuationOptions o;
   o.parameter = "phi";
   o.target = 15.0;
   o.initial_step = 0.5;
@@ -363,9 +363,9 @@ TEST(TwistedRod, DoubleBranchPointAgreesWithTheClampedGreenhillCondition) {
 // of the step, so both agree to 1e-10 relative (measured: to the last bit of phi); two null
 // directions either way (the zero modes the stability test counts there).
 TEST(TwistedRod, DoubleBranchPointIsTheSameWithTheLooserMarchMatrices) {
-  ContinuationOptions tight = twist_options();
+  RodContinuationOptions tight = twist_options();
   tight.stop_at_branch_point = 1;
-  ContinuationOptions loose = tight;
+  RodContinuationOptions loose = tight;
   tight.march_sensitivity_tol = 0;
   const BranchRun a = continue_case("twisted_clamped.toml", {{"phi", 6.0}}, tight);
   const BranchRun b = continue_case("twisted_clamped.toml", {{"phi", 6.0}}, loose);
@@ -379,18 +379,18 @@ TEST(TwistedRod, DoubleBranchPointIsTheSameWithTheLooserMarchMatrices) {
 }
 
 TEST(TwistedRod, BuckledBranchKeepsItsInvariants) {
-  ContinuationOptions o = twist_options();
+  RodContinuationOptions o = twist_options();
   o.stop_at_branch_point = 1;
   BranchRun run = continue_case("twisted_clamped.toml", {{"phi", 6.0}}, o);
   ASSERT_EQ(run.result.reason, StopReason::BranchPointStop);
   const SymmetricBranchStart start = axial_symmetry_branch(*run.continuation, run.result.points.back());
   const ShootingProblem switched(start.definition);
-  ContinuationOptions b = twist_options();
+  RodContinuationOptions b = twist_options();
   b.target = NAN;
   b.initial_step = 0.05;
   b.max_step = 0.2;
   b.events = {{"end_to_end", 0.5, true}};
-  Continuation branch(switched, b);
+  RodContinuation branch(switched, b);
   const ContinuationResult r = branch.run_along(start.x, start.parameter, start.direction, PointType::BranchPoint);
   ASSERT_EQ(r.reason, StopReason::EventStop) << r.message;
   EXPECT_GT(r.points.size(), 20u);
@@ -410,7 +410,7 @@ TEST(TwistedRod, BuckledBranchKeepsItsInvariants) {
 }
 
 TEST(ShallowArch, SnapThroughFoldIsLocated) {
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "w";
   o.target = 120.0;
   o.max_step = 2.0;
@@ -431,7 +431,7 @@ TEST(ShallowArch, SnapThroughFoldIsLocated) {
 }
 
 TEST(TaperedColumn, BranchPointsAndTheTaperedIdentityAlongTheBuckledBranch) {
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "P";
   o.target = 20.0;
   o.max_step = 2.0;
@@ -443,13 +443,13 @@ TEST(TaperedColumn, BranchPointsAndTheTaperedIdentityAlongTheBuckledBranch) {
   // Between the Euler loads of uniform columns as stiff as the thin and the thick end.
   EXPECT_GT(P1, M_PI * M_PI);
   EXPECT_LT(P1, 2.0 * M_PI * M_PI);
-  ContinuationOptions b = o;
+  RodContinuationOptions b = o;
   b.target = NAN;
   b.stop_at_branch_point = 0;
   b.initial_step = 0.05;
   b.max_step = 0.5;
   b.max_points = 40;
-  Continuation branch(*run.problem, b);
+  RodContinuation branch(*run.problem, b);
   const ContinuationResult r = branch.switch_branch(run.result.points.back());
   ASSERT_GE(r.points.size(), 30u);
   ShootingProblem problem = *run.problem;
@@ -470,15 +470,15 @@ TEST(TaperedColumn, BranchPointsAndTheTaperedIdentityAlongTheBuckledBranch) {
 // branch through its branch point and a stopping event, so located points are among them), and
 // an empty recorder leaves the points with nothing but what the engine computes.
 TEST(Recorder, DescribesEachPointOnceAndRecordsEveryPointOnTheBranch) {
-  ContinuationOptions o = euler_options();
+  RodContinuationOptions o = euler_options();
   o.target = 12.0;
   o.stop_at_branch_point = 1;
   const BranchRun run = continue_case("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, o);
   ASSERT_EQ(run.result.reason, StopReason::BranchPointStop);
-  ContinuationOptions b = bifurcating_branch_options(euler_options());
+  RodContinuationOptions b = bifurcating_branch_options(euler_options());
   b.max_step = 1.0;
   b.events = {{"theta0", 1.0, true, ""}};
-  const PointRecorder rod = rod_point_recorder(b);
+  const PointRecorder rod = rod_point_recorder(b, {"theta0"});
   int described = 0, recorded = 0;
   PointRecorder counting;
   counting.describe = [&](ParameterisedSystem& system, ContinuationPoint* p) {
@@ -491,7 +491,7 @@ TEST(Recorder, DescribesEachPointOnceAndRecordsEveryPointOnTheBranch) {
     p->derived["record_calls"] += 1.0;
   };
   b.recorder = counting;
-  Continuation branch(*run.problem, b);
+  RodContinuation branch(*run.problem, b);
   const ContinuationResult r = branch.switch_branch(run.result.points.back());
   ASSERT_EQ(r.reason, StopReason::EventStop);
   EXPECT_EQ(recorded, static_cast<int>(r.points.size()));
@@ -505,7 +505,7 @@ TEST(Recorder, DescribesEachPointOnceAndRecordsEveryPointOnTheBranch) {
   b.recorder = PointRecorder{};
   b.events.clear();
   b.max_points = 10;
-  Continuation bare(*run.problem, b);
+  RodContinuation bare(*run.problem, b);
   const ContinuationResult plain = bare.switch_branch(run.result.points.back());
   ASSERT_GE(plain.points.size(), 10u);
   for (const auto& p : plain.points) {
@@ -515,10 +515,11 @@ TEST(Recorder, DescribesEachPointOnceAndRecordsEveryPointOnTheBranch) {
 }
 
 // The options come in groups that check themselves; ContinuationOptions reports the first group's
-// complaint, then the rule between groups (reused Jacobians need branch-point detection off). Each
-// case below breaks one rule only, so a group that missed it would let validate() return "".
-TEST(ContinuationOptions, EachGroupValidatesItself) {
-  ContinuationOptions good;
+// complaint, then the rule between groups (reused Jacobians need branch-point detection off), and
+// RodContinuationOptions the engine's, then its own. Each case below breaks one rule only, so a
+// group that missed it would let validate() return "".
+TEST(RodContinuationOptions, EachGroupValidatesItself) {
+  RodContinuationOptions good;
   good.parameter = "P";
   ASSERT_EQ(good.validate(), "");
   EXPECT_EQ(static_cast<const ContinuationRange&>(good).validate(), "");
@@ -526,29 +527,36 @@ TEST(ContinuationOptions, EachGroupValidatesItself) {
   EXPECT_EQ(static_cast<const CorrectorOptions&>(good).validate(), "");
   EXPECT_EQ(static_cast<const DetectionOptions&>(good).validate(), "");
   EXPECT_EQ(static_cast<const RecordOptions&>(good).validate(), "");
+  EXPECT_EQ(static_cast<const RodRecordOptions&>(good).validate(), "");
 
   const auto broken = [&](auto&& change) {
-    ContinuationOptions o = good;
+    RodContinuationOptions o = good;
     change(o);
     return o;
   };
-  const ContinuationOptions no_parameter = broken([](ContinuationOptions& o) { o.parameter.clear(); });
+  const RodContinuationOptions no_parameter = broken([](RodContinuationOptions& o) { o.parameter.clear(); });
   EXPECT_NE(static_cast<const ContinuationRange&>(no_parameter).validate(), "");
-  const ContinuationOptions steps = broken([](ContinuationOptions& o) { o.max_step = o.min_step / 2; });
+  const RodContinuationOptions steps = broken([](RodContinuationOptions& o) { o.max_step = o.min_step / 2; });
   EXPECT_NE(static_cast<const StepControl&>(steps).validate(), "");
-  const ContinuationOptions corrector = broken([](ContinuationOptions& o) { o.corrector_max_iterations = 0; });
+  const RodContinuationOptions corrector = broken([](RodContinuationOptions& o) { o.corrector_max_iterations = 0; });
   EXPECT_NE(static_cast<const CorrectorOptions&>(corrector).validate(), "");
-  const ContinuationOptions detection = broken([](ContinuationOptions& o) { o.branch_point_tolerance = 2.0; });
+  const RodContinuationOptions detection = broken([](RodContinuationOptions& o) { o.branch_point_tolerance = 2.0; });
   EXPECT_NE(static_cast<const DetectionOptions&>(detection).validate(), "");
-  const ContinuationOptions unnamed_event = broken([](ContinuationOptions& o) { o.events = {{"", 1.0, true, ""}}; });
+  const RodContinuationOptions unnamed_event = broken([](RodContinuationOptions& o) { o.events = {{"", 1.0, true, ""}}; });
   EXPECT_NE(static_cast<const DetectionOptions&>(unnamed_event).validate(), "");
-  const ContinuationOptions record = broken([](ContinuationOptions& o) { o.samples = 1; });
+  const RodContinuationOptions record = broken([](RodContinuationOptions& o) { o.derived = {""}; });
   EXPECT_NE(static_cast<const RecordOptions&>(record).validate(), "");
-  for (const ContinuationOptions* o : {&no_parameter, &steps, &corrector, &detection, &unnamed_event, &record})
+  const RodContinuationOptions rod_record = broken([](RodContinuationOptions& o) { o.samples = 1; });
+  EXPECT_NE(static_cast<const RodRecordOptions&>(rod_record).validate(), "");
+  EXPECT_EQ(static_cast<const ContinuationOptions&>(rod_record).validate(), "");
+  const RodContinuationOptions march = broken([](RodContinuationOptions& o) { o.march_sensitivity_tol = -1.0; });
+  EXPECT_EQ(static_cast<const ContinuationOptions&>(march).validate(), "");
+  for (const RodContinuationOptions* o :
+       {&no_parameter, &steps, &corrector, &detection, &unnamed_event, &record, &rod_record, &march})
     EXPECT_NE(o->validate(), "");
   EXPECT_EQ(steps.validate(), static_cast<const StepControl&>(steps).validate());
 
-  ContinuationOptions reuse = broken([](ContinuationOptions& o) { o.reuse_jacobian_iterations = 2; });
+  RodContinuationOptions reuse = broken([](RodContinuationOptions& o) { o.reuse_jacobian_iterations = 2; });
   EXPECT_NE(reuse.validate().find("detect_branch_points"), std::string::npos);
   reuse.detect_branch_points = false;
   EXPECT_EQ(reuse.validate(), "");
@@ -557,7 +565,7 @@ TEST(ContinuationOptions, EachGroupValidatesItself) {
   StepControl step;
   step.max_step = 2.0;
   step.initial_step = 0.1;
-  ContinuationOptions run = good;
+  RodContinuationOptions run = good;
   static_cast<StepControl&>(run) = step;
   EXPECT_EQ(run.max_step, 2.0);
   EXPECT_EQ(run.initial_step, 0.1);

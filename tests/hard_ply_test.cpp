@@ -39,7 +39,7 @@ struct HardPlyAtFiveTurns {
   HardPlyAtFiveTurns() {
     const ShootingResult start = solve(barrier, barrier.initial_unknowns(c.start_guess));
     if (!start.summary.converged()) throw std::runtime_error("the untwisted rod does not solve");
-    const ContinuationResult branch = Continuation(barrier, testing::plectoneme_turns_options(5.0, c.derived)).run(start.x);
+    const ContinuationResult branch = RodContinuation(barrier, testing::plectoneme_turns_options(5.0, c.derived)).run(start.x);
     if (branch.reason != StopReason::ReachedTarget) throw std::runtime_error(branch.message);
     point = branch.points.back();
     barrier.set_parameter("turns", point.parameter);
@@ -168,11 +168,11 @@ TEST(HardPly, SolvesFromTheBarrierPlyAndTouchesExactly) {
 TEST(HardPly, FollowedInTheEndRotation) {
   const HardPlyAtFiveTurns& h = hard_ply();
   ASSERT_TRUE(h.solved.summary.converged());
-  ContinuationOptions o = testing::plectoneme_turns_options(5.5, h.derived());
+  RodContinuationOptions o = testing::plectoneme_turns_options(5.5, h.derived());
   o.events = {{"min_contact_force", 0.0, true, "a contact lifts off"},
               {"min_wrap_pressure", 0.0, true, "the line contact's pressure vanishes"}};
   ASSERT_TRUE(guard_self_passage(*h.hard, &o));
-  const ContinuationResult branch = Continuation(*h.hard, o).run(h.solved.x);
+  const ContinuationResult branch = RodContinuation(*h.hard, o).run(h.solved.x);
   ASSERT_EQ(branch.reason, StopReason::ReachedTarget) << branch.message;
   double first = NAN, last = NAN;
   for (const auto& p : branch.points) {
@@ -201,12 +201,12 @@ TEST(HardPly, ThinnedInSlendernessAndResegmented) {
   const HardPlyAtFiveTurns& h = hard_ply();
   ASSERT_TRUE(h.solved.summary.converged());
   ShootingProblem moving = *h.hard;
-  ContinuationOptions o = testing::plectoneme_turns_options(150.0, h.derived());
+  RodContinuationOptions o = testing::plectoneme_turns_options(150.0, h.derived());
   o.parameter = "slenderness";
   o.events = {{"min_contact_force", 0.0, true, "a contact lifts off"},
               {"min_wrap_pressure", 0.0, true, "the line contact's pressure vanishes"}};
   ASSERT_TRUE(guard_self_passage(moving, &o));
-  const ContinuationResult thinned = Continuation(moving, o).run(h.solved.x);
+  const ContinuationResult thinned = RodContinuation(moving, o).run(h.solved.x);
   ASSERT_EQ(thinned.reason, StopReason::ReachedTarget) << thinned.message;
   moving.set_parameter("slenderness", 150.0);
   const Eigen::VectorXd& moved = thinned.points.back().x;

@@ -26,7 +26,7 @@ struct PlyAtFiveTurns {
     const ShootingResult start = solve(problem, problem.initial_unknowns(c.start_guess));
     if (!start.summary.converged()) throw std::runtime_error("the untwisted rod does not solve");
     const ContinuationResult branch =
-        Continuation(problem, testing::plectoneme_turns_options(5.0, c.derived)).run(start.x);
+        RodContinuation(problem, testing::plectoneme_turns_options(5.0, c.derived)).run(start.x);
     if (branch.reason != StopReason::ReachedTarget) throw std::runtime_error(branch.message);
     point = branch.points.back();
     problem.set_parameter("turns", point.parameter);

@@ -77,12 +77,12 @@ TEST(Homotopy, StopsAtAFoldAndSaysWhere) {
   // of the same branch, so other steps and another located point): both locate dw/dsigma = 0
   // by the secant method to ~1e-8 of the step; 1e-6 relative is far below the fold's value.
   const Case c = load_case(testing::case_path("shallow_arch.toml"));
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "w";
   o.target = 150.0;
   o.stop_at_fold = true;
   ShootingProblem problem(c.definition);
-  const ContinuationResult run = Continuation(problem, o).run(problem.initial_unknowns(c.start_guess));
+  const ContinuationResult run = RodContinuation(problem, o).run(problem.initial_unknowns(c.start_guess));
   ASSERT_EQ(run.reason, StopReason::FoldStop);
   EXPECT_NEAR(w_fold / run.points.back().parameter, 1.0, 1e-6);
   // Below the fold the same request is reached.

@@ -34,9 +34,9 @@ TEST(Link, FollowsTheTurnsAlongThePlectonemeBranch) {
   ShootingProblem problem(c.definition);
   const ShootingResult start = solve(problem, problem.initial_unknowns(c.start_guess));
   ASSERT_TRUE(start.summary.converged());
-  ContinuationOptions o = testing::plectoneme_turns_options(4.0, {});
+  RodContinuationOptions o = testing::plectoneme_turns_options(4.0, {});
   o.compute_invariants = false;
-  const ContinuationResult branch = Continuation(problem, o).run(start.x);
+  const ContinuationResult branch = RodContinuation(problem, o).run(start.x);
   ASSERT_EQ(branch.reason, StopReason::ReachedTarget) << branch.message;
   double largest_writhe = 0.0;
   int samples = 0;

@@ -158,7 +158,7 @@ TEST(DiscContact, ContinuationInTheIndentersHeightFromFirstContact) {
   const auto exact = analytic::three_point_bending(1.0, 1.0, kSupportSlope);
   Case c = load_case(testing::case_path("indenter.toml"), {{"rise", -0.02}});
   c.definition.contacts.clear();  // nothing touches the straight rod
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "rise";
   o.target = exact.rise;
   o.initial_step = 0.01;
@@ -258,8 +258,8 @@ TEST(DiscWrap, CaseAgreesWithTheEllipticSolution) {
   }
 }
 
-ContinuationOptions rising_indenter(double target) {
-  ContinuationOptions o;
+RodContinuationOptions rising_indenter(double target) {
+  RodContinuationOptions o;
   o.parameter = "rise";
   o.target = target;
   o.initial_step = 0.01;

@@ -137,7 +137,7 @@ TEST(Plectoneme, TwistingWindsAPlyThatFollowsTheHelixFormulas) {
   ShootingProblem problem(c.definition);
   ShootingResult start = solve(problem, problem.initial_unknowns(c.start_guess));
   ASSERT_TRUE(start.summary.converged());
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "turns";
   o.target = 5.0;
   o.initial_step = 1.0;
@@ -146,7 +146,7 @@ TEST(Plectoneme, TwistingWindsAPlyThatFollowsTheHelixFormulas) {
   o.derived = c.derived;
   o.samples = 1001;
   o.detect_branch_points = false;  // the barrier's stiffness makes the determinant's sign noise
-  Continuation run(problem, o);
+  RodContinuation run(problem, o);
   const ContinuationResult branch = run.run(start.x);
   ASSERT_EQ(branch.reason, StopReason::ReachedTarget) << branch.message;
   int folds = 0, in_contact = 0;
@@ -190,7 +190,7 @@ TEST(Plectoneme, SelfPassageGuardKeepsTheBranchAtTheSharpFold) {
   ShootingProblem problem(c.definition);
   const ShootingResult start = solve(problem, problem.initial_unknowns(c.start_guess));
   ASSERT_TRUE(start.summary.converged());
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "turns";
   o.initial_step = 1.0 * scale;
   o.max_step = 60.0 * scale;
@@ -209,9 +209,9 @@ TEST(Plectoneme, SelfPassageGuardKeepsTheBranchAtTheSharpFold) {
   // (turns = 1, just before this fold), which the corrector could exploit. With the twist gauged
   // modulo whole turns (spatial_equations.cpp) that jump is gone; what is checked here is that the
   // guarded run stays on the branch through the sharp fold and locates it.
-  ContinuationOptions guarded_options = o;
+  RodContinuationOptions guarded_options = o;
   ASSERT_TRUE(guard_self_passage(problem, &guarded_options));
-  const ContinuationResult guarded = Continuation(problem, guarded_options).run(start.x);
+  const ContinuationResult guarded = RodContinuation(problem, guarded_options).run(start.x);
   auto after_first_fold = [](const ContinuationResult& r) {
     std::vector<ContinuationPoint> out;
     bool folded = false;

@@ -134,12 +134,12 @@ void reissner(const Shipped& s) {
   ShootingProblem problem(start.definition);
   const ShootingResult at_zero = solve(problem, problem.initial_unknowns(start.start_guess));
   ASSERT_TRUE(at_zero.summary.converged());
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "F";
   o.target = 2.0;
   o.compute_invariants = false;
   o.detect_branch_points = false;
-  const ContinuationResult r = Continuation(problem, o).run(at_zero.x);
+  const ContinuationResult r = RodContinuation(problem, o).run(at_zero.x);
   ASSERT_EQ(r.reason, StopReason::ReachedTarget) << r.message;
   ShootingProblem at_two = problem;
   at_two.set_parameter("F", 2.0);
@@ -182,13 +182,13 @@ void soft_wall(const Shipped& s) {
   // It is Fig. 12's branch: followed to b = 1e-6 it closes in on the hard-wall solution, whose
   // contact force the elliptic solution gives; the remaining gap is O(b^(1/3)) (eqs. 66, 71a).
   ShootingProblem problem(*s.solved.problem);
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "log_b";
   o.target = -6.0;
   o.max_step = 0.5;
   o.compute_invariants = false;
   o.detect_branch_points = false;
-  const ContinuationResult r = Continuation(problem, o).run(s.sol.result.x);
+  const ContinuationResult r = RodContinuation(problem, o).run(s.sol.result.x);
   ASSERT_EQ(r.reason, StopReason::ReachedTarget) << r.message;
   problem.set_parameter("log_b", -6.0);
   ShootingResult end;

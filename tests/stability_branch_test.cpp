@@ -1,5 +1,5 @@
 // The stability index a continuation records at each point (point_record.cpp) integrates the
-// Jacobi fields to RecordOptions::stability_field_tolerance, looser than the state's. The index
+// Jacobi fields to RodRecordOptions::stability_field_tolerance, looser than the state's. The index
 // is a count (phase passages through pi, singular values against zero_tolerance = 1e-6), so the
 // looser fields must give the very same index and zero modes as the state's tolerance at every
 // point, through the branch points and folds where the index changes: checked here along
@@ -72,7 +72,7 @@ ContinueRequest towards(const std::string& parameter, double target, double max_
 
 TEST(StabilityAlongBranches, LooserFieldsAreLooserThanTheState) {
   // Otherwise the tests below compare a computation with itself.
-  EXPECT_GT(RecordOptions{}.stability_field_tolerance, IntegratorOptions{}.abs_tol);
+  EXPECT_GT(RodRecordOptions{}.stability_field_tolerance, IntegratorOptions{}.abs_tol);
 }
 
 TEST(StabilityAlongBranches, EulerColumnThroughItsFirstTwoBranchPoints) {

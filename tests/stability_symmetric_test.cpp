@@ -134,7 +134,7 @@ Comparison compare_along(const Case& c, const ContinuationResult& branch, size_t
 }
 
 ContinuationResult follow_turns(const ShootingProblem& problem, const Case& c, double target, int max_points) {
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "turns";
   o.target = target;
   o.initial_step = 0.5;
@@ -142,7 +142,7 @@ ContinuationResult follow_turns(const ShootingProblem& problem, const Case& c, d
   o.max_points = max_points;
   o.samples = 41;
   o.compute_stability = false;
-  Continuation run(problem, o);
+  RodContinuation run(problem, o);
   return run.run(problem.initial_unknowns(c.start_guess));
 }
 
@@ -225,7 +225,7 @@ TEST(StabilitySymmetric, PairEnergysSecondVariationOnEachHalf) {
 // plectoneme.toml followed in turns (its barrier on) from the planar arch through both folds where
 // the end loop forms (1.7704, back at 1.1492) onto the ply, to `turns`.
 ContinuationResult follow_onto_the_ply(const ShootingProblem& problem, const Case& c, double turns) {
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "turns";
   o.target = turns;
   o.initial_step = 0.05;
@@ -234,7 +234,7 @@ ContinuationResult follow_onto_the_ply(const ShootingProblem& problem, const Cas
   o.samples = 41;
   o.detect_branch_points = false;
   o.compute_stability = false;
-  Continuation run(problem, o);
+  RodContinuation run(problem, o);
   return run.run(problem.initial_unknowns(c.start_guess));
 }
 

@@ -143,7 +143,7 @@ TEST(Stability, TwistedStraightRodIndexTwoAboveTheGreenhillThreshold) {
 TEST(Stability, TwistedRodBuckledBranchIndexOneWithTheRotationZeroMode) {
   Case c = load_case(testing::case_path("twisted_clamped.toml"), {{"phi", 6.0}});
   ShootingProblem problem(c.definition);
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "phi";
   o.target = 15.0;
   o.initial_step = 0.5;
@@ -152,19 +152,19 @@ TEST(Stability, TwistedRodBuckledBranchIndexOneWithTheRotationZeroMode) {
   o.derived = {"end_to_end"};
   o.stop_at_branch_point = 1;
   o.compute_stability = true;
-  Continuation straight(problem, o);
+  RodContinuation straight(problem, o);
   const ContinuationResult to_bp = straight.run(problem.initial_unknowns(c.start_guess));
   ASSERT_EQ(to_bp.reason, StopReason::BranchPointStop);
   EXPECT_EQ(to_bp.points.back().zero_modes, 2);  // the double branch point
   const SymmetricBranchStart start = axial_symmetry_branch(straight, to_bp.points.back());
   const ShootingProblem switched(start.definition);
-  ContinuationOptions b = o;
+  RodContinuationOptions b = o;
   b.target = NAN;
   b.stop_at_branch_point = 0;
   b.initial_step = 0.05;
   b.max_step = 0.2;
   b.events = {{"end_to_end", 0.5, true}};
-  Continuation branch(switched, b);
+  RodContinuation branch(switched, b);
   const ContinuationResult r = branch.run_along(start.x, start.parameter, start.direction, PointType::BranchPoint);
   ASSERT_EQ(r.reason, StopReason::EventStop) << r.message;
   int checked = 0;
@@ -279,7 +279,7 @@ TEST(Stability, AsymmetricContactCoexistsWithTheStableSymmetricOne) {
   EXPECT_EQ(*unstable.index, 1);
 
   const Case c = load_case(testing::case_path("wall.toml"));
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "Delta";
   o.target = 0.0307;
   o.derived = c.derived;
@@ -540,14 +540,14 @@ TEST(Stability, SoftWallArchRegainsItsStabilityAtTheBranchPointTowardsTheHardWal
 
   Case c = load_case(testing::case_path("soft_wall.toml"));
   ShootingProblem problem(c.definition);
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "log_b";
   o.target = -2.5;
   o.initial_step = 0.2;
   o.max_step = 2.0;
   o.samples = 101;
   o.compute_stability = true;
-  Continuation run(problem, o);
+  RodContinuation run(problem, o);
   const ContinuationResult branch = run.run(problem.initial_unknowns(c.start_guess));
   ASSERT_EQ(branch.reason, StopReason::ReachedTarget) << branch.message;
   double bp = NAN;
@@ -633,7 +633,7 @@ TEST(Stability, DiscAboveTheRodLosesTheContactsStabilityAtTheBranchPoint) {
   }
 
   const Case c = disc_wall(0.5, 0.026);
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "Delta";
   o.target = 0.029;
   o.initial_step = 1.0;  // the arclength is mostly P's: dP/dDelta ~ 3e4

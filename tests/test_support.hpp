@@ -129,7 +129,7 @@ struct ContactBranch {
   std::vector<PointContact> contacts(size_t i) const { return problems[i]->contacts_at(points[i].x); }
 };
 
-inline ContactBranch follow_contacts(const Case& c, const ContinuationOptions& o) {
+inline ContactBranch follow_contacts(const Case& c, const RodContinuationOptions& o) {
   ContactBranch out;
   ProblemDefinition leg = c.definition;
   auto on_leg = [&](const std::vector<PointContact>& active) { leg.contacts = active; };
@@ -147,8 +147,8 @@ inline ContactBranch follow_contacts(const Case& c, const ContinuationOptions& o
 // How the plectoneme tests follow cases/plectoneme.toml in its end rotation, as the plectonemes
 // command does at L/2R = 100: long steps, modified Newton, a point whose chord iterations converged
 // keeping the previous matrix, no branch points.
-inline ContinuationOptions plectoneme_turns_options(double target, const std::vector<std::string>& derived) {
-  ContinuationOptions o;
+inline RodContinuationOptions plectoneme_turns_options(double target, const std::vector<std::string>& derived) {
+  RodContinuationOptions o;
   o.parameter = "turns";
   o.target = target;
   o.initial_step = 1.0;

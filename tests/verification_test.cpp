@@ -101,7 +101,7 @@ TEST(NewtonOptionsValidation, RefusesNonFiniteTimeLimit) {
 
 // continue --samples 1e9 or --max-points 1e12 ran out of memory instead of being refused.
 TEST(ContinuationOptionsValidation, BoundsSamplesAndPoints) {
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "P";
   EXPECT_EQ(o.validate(), "");
   o.samples = 100001;

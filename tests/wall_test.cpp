@@ -52,23 +52,23 @@ TEST(SoftWall, InvariantScalingAndHardWallLimit) {
   Case c = load_case(testing::case_path("soft_wall.toml"),
                      {{"log_b", -4.0}, {"Delta", 0.005}, {"P_guess", 40.0}, {"m_guess", 0.9}});
   ShootingProblem problem(c.definition);
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = "Delta";
   o.target = 0.026;
   o.max_step = 2.0;
   o.samples = 21;
   o.compute_invariants = false;
-  const ContinuationResult shortening = Continuation(problem, o).run(problem.initial_unknowns(c.start_guess));
+  const ContinuationResult shortening = RodContinuation(problem, o).run(problem.initial_unknowns(c.start_guess));
   ASSERT_EQ(shortening.reason, StopReason::ReachedTarget);
   problem.set_parameter("Delta", 0.026);
   std::vector<Solution> sweep;  // b = 1e-4, 1e-5, 1e-6
   Eigen::VectorXd x = shortening.points.back().x;
   for (double target : {-5.0, -6.0}) {
-    ContinuationOptions ob = o;
+    RodContinuationOptions ob = o;
     ob.parameter = "log_b";
     ob.target = target;
     ob.max_step = 0.5;
-    const ContinuationResult r = Continuation(problem, ob).run(x);
+    const ContinuationResult r = RodContinuation(problem, ob).run(x);
     ASSERT_EQ(r.reason, StopReason::ReachedTarget);
     for (const auto* p : {&r.points.front(), &r.points.back()}) {
       if (p == &r.points.front() && !sweep.empty()) continue;

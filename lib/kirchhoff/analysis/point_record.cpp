@@ -25,11 +25,10 @@ const InvariantReport& invariants_of(const PointRecord& point) { return kept(poi
 
 bool H_is_flat(const PointRecord& point) { return kept(point).H_flat; }
 
-PointRecorder rod_point_recorder(const ContinuationOptions& options) {
+PointRecorder rod_point_recorder(const RodRecordOptions& options, const std::vector<std::string>& derived) {
   PointRecorder recorder;
-  if (options.compute_invariants || !options.derived.empty())
-    recorder.describe = [samples = options.samples, derived = options.derived](ParameterisedSystem& system,
-                                                                               ContinuationPoint* point) {
+  if (options.compute_invariants || !derived.empty())
+    recorder.describe = [samples = options.samples, derived](ParameterisedSystem& system, ContinuationPoint* point) {
       ContinuationPoint& p = *point;
       const ShootingProblem& problem = shooting_problem_at(system, p.parameter);
       ShootingResult r;

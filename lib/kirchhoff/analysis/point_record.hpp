@@ -1,5 +1,5 @@
 // What a continuation of a rod records at each point: the rod layer's record hook
-// (ContinuationOptions::recorder; BifurcationKit's record_from_solution is the model).
+// (RecordOptions::recorder; BifurcationKit's record_from_solution is the model).
 //
 // The engine (continuation.hpp) knows the unknowns, the parameter and the tangent of a point, not
 // what they mean. This hook describes a point as a rod: its derived quantities (the events' test
@@ -8,7 +8,7 @@
 // index.
 #pragma once
 
-#include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/continuation/rod_continuation.hpp"
 #include "kirchhoff/equations/invariants.hpp"
 
 namespace kirchhoff {
@@ -25,11 +25,11 @@ struct RodPointInvariants {
 const InvariantReport& invariants_of(const PointRecord& point);
 bool H_is_flat(const PointRecord& point);
 
-// The recorder a Continuation uses when its options give none, from the options' rod fields:
-//   describe (once per corrected point, when compute_invariants or derived is set): one
-//     make_solution with `samples` profile points -> derived (and the parameters solved for),
-//     the invariants and H's flatness (RodPointInvariants, in extra), check_failure;
+// The recorder a RodContinuation uses when its options give none:
+//   describe (once per corrected point, when compute_invariants is set or `derived` names any
+//     quantity): one make_solution with `samples` profile points -> derived (and the parameters
+//     solved for), the invariants and H's flatness (RodPointInvariants, in extra), check_failure;
 //   record (once per point on the branch, with compute_stability): stability_index, zero_modes.
-PointRecorder rod_point_recorder(const ContinuationOptions& options);
+PointRecorder rod_point_recorder(const RodRecordOptions& options, const std::vector<std::string>& derived);
 
 }  // namespace kirchhoff

@@ -395,7 +395,7 @@ struct FoldStart {
   Eigen::VectorXd direction;  // unit, in (x, lambda)
   double step = 0.0;          // the first step along it
 };
-FoldStart fold_direction(Continuation& flat, const ContinuationPoint& onset, size_t k) {
+FoldStart fold_direction(RodContinuation& flat, const ContinuationPoint& onset, size_t k) {
   const ShootingProblem& problem = flat.problem();
   const std::string& parameter = flat.options().parameter;
   const Eigen::MatrixXd N = flat.bifurcation_directions(onset, 2);
@@ -423,13 +423,13 @@ FoldStart fold_direction(Continuation& flat, const ContinuationPoint& onset, siz
   return {v.normalized(), 1e-3 * l * v.norm() / 2.0};
 }
 
-ContinuationResult leave_flat_branch(const ShootingProblem& problem, ContinuationOptions leg,
+ContinuationResult leave_flat_branch(const ShootingProblem& problem, RodContinuationOptions leg,
                                      const ContinuationPoint& onset, size_t first_contact, const PointSink& sink) {
-  Continuation flat(problem, leg);
+  RodContinuation flat(problem, leg);
   const FoldStart start = fold_direction(flat, onset, first_contact);
   leg.initial_step = std::min(leg.initial_step, start.step);
-  ContinuationResult r = Continuation(problem, leg).run_along(onset.x, onset.parameter, start.direction,
-                                                             PointType::Event, sink);
+  ContinuationResult r = RodContinuation(problem, leg).run_along(onset.x, onset.parameter, start.direction,
+                                                                PointType::Event, sink);
   if (r.reason == StopReason::StartFailed) r.message = "the hanging fold could not be started: " + r.message;
   return r;
 }
@@ -608,10 +608,10 @@ const ContactChangeKind& kind_of(ContactChange change) { return kContactChanges[
 // A leg's options: the run's, with a stopping event for each change its active set d can undergo
 // after the caller's events (`changes` says which change each of those is, in order), and its
 // share of the run's max_points and branch points. bending_event: where contact_flattens is armed.
-ContinuationOptions leg_options(const ContinuationOptions& options, const ProblemDefinition& d,
+RodContinuationOptions leg_options(const RodContinuationOptions& options, const ProblemDefinition& d,
                                 const ContactOptions& contact, double bending_event,
                                 std::vector<ContactChange>* changes) {
-  ContinuationOptions leg = options;
+  RodContinuationOptions leg = options;
   changes->clear();
   const auto add = [&](ContactChange change, double value) {
     leg.events.push_back({kind_of(change).quantity, value, true, kind_of(change).label});
@@ -651,7 +651,7 @@ ContinuationOptions leg_options(const ContinuationOptions& options, const Proble
 // where the set changes; from unknowns x (a new run) or from a saved state (a resume).
 class LegMarch {
  public:
-  LegMarch(ProblemDefinition d, Eigen::VectorXd x, const ContactMarchState* resume_from, ContinuationOptions options,
+  LegMarch(ProblemDefinition d, Eigen::VectorXd x, const ContactMarchState* resume_from, RodContinuationOptions options,
            const PointSink& sink, const ContactOptions& contact, const ActiveSetSink& active_set_sink,
            const ContactStateSink& state_sink, const ContinuationPoint* switch_at, double side)
       : d_(std::move(d)),
@@ -692,7 +692,7 @@ class LegMarch {
     // After a contact shrank to a point, contact_flattens is armed at its g'' there.
     const double bending_event = resuming ? resume_from_->contact_bending_event : unwound_bending_.value_or(0.0);
     unwound_bending_.reset();
-    ContinuationOptions leg = leg_options(options_, d_, contact_, bending_event, &changes_);
+    RodContinuationOptions leg = leg_options(options_, d_, contact_, bending_event, &changes_);
     // (A later leg's start is the last point of the previous one, counted there.)
     leg.max_points =
         resuming ? resume_from_->leg_max_points : options_.max_points - reported_ + (run_first_leg_ ? 0 : 1);
@@ -725,10 +725,10 @@ class LegMarch {
           state_sink_({m, d_.contacts, bending_event, leg_max_points, reported_, run_first_leg_, branch_points_before_});
       };
     const bool switching = first_leg_ && switch_at_ && !resuming;
-    ContinuationResult r = resuming    ? Continuation(problem, leg).resume(resume_from_->march, leg_sink)
-                           : switching ? Continuation(problem, leg).switch_branch(*switch_at_, leg_sink, side_)
+    ContinuationResult r = resuming    ? RodContinuation(problem, leg).resume(resume_from_->march, leg_sink)
+                           : switching ? RodContinuation(problem, leg).switch_branch(*switch_at_, leg_sink, side_)
                            : fold_onset_ ? leave_flat_branch(problem, leg, *fold_onset_, fold_contact_, leg_sink)
-                                         : Continuation(problem, leg).run(x_, leg_sink);
+                                         : RodContinuation(problem, leg).run(x_, leg_sink);
     fold_onset_.reset();
     if (!first_leg_ && !r.points.empty()) r.points.erase(r.points.begin());
     // (The switched leg's start is the branch point switched at, not one found on this branch.)
@@ -783,7 +783,7 @@ class LegMarch {
   ProblemDefinition d_;  // the present leg's, with its active set
   Eigen::VectorXd x_;    // its starting unknowns
   const ContactMarchState* resume_from_;
-  const ContinuationOptions options_;
+  const RodContinuationOptions options_;
   const PointSink& sink_;
   const ContactOptions& contact_;
   const ActiveSetSink& active_set_sink_;
@@ -805,7 +805,7 @@ class LegMarch {
 };
 
 ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const ContactMarchState* resume_from,
-                                   ContinuationOptions options, const PointSink& sink, const ContactOptions& contact,
+                                   RodContinuationOptions options, const PointSink& sink, const ContactOptions& contact,
                                    const ActiveSetSink& active_set_sink, const ContactStateSink& state_sink,
                                    ContactContinuationResult out, const ContinuationPoint* switch_at = nullptr,
                                    double side = 1.0) {
@@ -816,7 +816,7 @@ ContactContinuationResult run_legs(ProblemDefinition d, Eigen::VectorXd x, const
 
 }  // namespace
 
-ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodPoint& guess, ContinuationOptions options,
+ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodPoint& guess, RodContinuationOptions options,
                                                  const PointSink& sink, const ContactOptions& contact,
                                                  const ActiveSetSink& active_set_sink,
                                                  const ContactStateSink& state_sink) {
@@ -833,7 +833,7 @@ ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodP
 }
 
 ContactContinuationResult continue_with_contacts_from(ProblemDefinition d, const Eigen::VectorXd& x,
-                                                      ContinuationOptions options, const PointSink& sink,
+                                                      RodContinuationOptions options, const PointSink& sink,
                                                       const ContactOptions& contact,
                                                       const ActiveSetSink& active_set_sink,
                                                       const ContactStateSink& state_sink) {
@@ -841,7 +841,7 @@ ContactContinuationResult continue_with_contacts_from(ProblemDefinition d, const
 }
 
 ContactContinuationResult switch_branch_with_contacts(ProblemDefinition d, const ContinuationPoint& branch_point,
-                                                      double side, ContinuationOptions options, const PointSink& sink,
+                                                      double side, RodContinuationOptions options, const PointSink& sink,
                                                       const ContactOptions& contact,
                                                       const ActiveSetSink& active_set_sink,
                                                       const ContactStateSink& state_sink) {
@@ -854,7 +854,7 @@ ContactContinuationResult switch_branch_with_contacts(ProblemDefinition d, const
 }
 
 ContactContinuationResult resume_with_contacts(ProblemDefinition d, const ContactMarchState& state,
-                                               ContinuationOptions options, const PointSink& sink,
+                                               RodContinuationOptions options, const PointSink& sink,
                                                const ContactOptions& contact, const ActiveSetSink& active_set_sink,
                                                const ContactStateSink& state_sink) {
   d.contacts = state.contacts;

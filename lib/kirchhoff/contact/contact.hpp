@@ -129,7 +129,7 @@ struct ContactMarchState {
 using ContactStateSink = std::function<void(const ContactMarchState&)>;
 
 ContactContinuationResult continue_with_contacts(ProblemDefinition definition, const RodPoint& guess,
-                                                 ContinuationOptions options, const PointSink& sink = {},
+                                                 RodContinuationOptions options, const PointSink& sink = {},
                                                  const ContactOptions& contact = {},
                                                  const ActiveSetSink& active_set_sink = {},
                                                  const ContactStateSink& state_sink = {});
@@ -138,7 +138,7 @@ ContactContinuationResult continue_with_contacts(ProblemDefinition definition, c
 // x is corrected at the definition's parameter values first; a start that breaks
 // complementarity ends the run as Inadmissible.
 ContactContinuationResult continue_with_contacts_from(ProblemDefinition definition, const Eigen::VectorXd& x,
-                                                      ContinuationOptions options, const PointSink& sink = {},
+                                                      RodContinuationOptions options, const PointSink& sink = {},
                                                       const ContactOptions& contact = {},
                                                       const ActiveSetSink& active_set_sink = {},
                                                       const ContactStateSink& state_sink = {});
@@ -152,7 +152,7 @@ ContactContinuationResult continue_with_contacts_from(ProblemDefinition definiti
 // axial phase condition, not implemented with contacts.
 ContactContinuationResult switch_branch_with_contacts(ProblemDefinition definition,
                                                       const ContinuationPoint& branch_point, double side,
-                                                      ContinuationOptions options, const PointSink& sink = {},
+                                                      RodContinuationOptions options, const PointSink& sink = {},
                                                       const ContactOptions& contact = {},
                                                       const ActiveSetSink& active_set_sink = {},
                                                       const ContactStateSink& state_sink = {});
@@ -160,7 +160,7 @@ ContactContinuationResult switch_branch_with_contacts(ProblemDefinition definiti
 // replaced by the state's), taking the same steps and active-set changes as the uninterrupted
 // run with the same options. The state's point is not reported again.
 ContactContinuationResult resume_with_contacts(ProblemDefinition definition, const ContactMarchState& state,
-                                               ContinuationOptions options, const PointSink& sink = {},
+                                               RodContinuationOptions options, const PointSink& sink = {},
                                                const ContactOptions& contact = {},
                                                const ActiveSetSink& active_set_sink = {},
                                                const ContactStateSink& state_sink = {});

@@ -22,6 +22,7 @@
 
 #include "kirchhoff/contact/self_contact.hpp"
 #include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/shooting/shooting.hpp"
 
 namespace kirchhoff {
 

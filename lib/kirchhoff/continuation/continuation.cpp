@@ -118,7 +118,6 @@ std::string StepControl::validate() const {
 std::string CorrectorOptions::validate() const {
   if (corrector_max_iterations < 1 || !(corrector_tolerance > 0 || std::isnan(corrector_tolerance)))
     return "corrector settings must be positive";
-  if (!(march_sensitivity_tol >= 0)) return "march_sensitivity_tol must be >= 0 (0: the problem's own)";
   return {};
 }
 
@@ -134,10 +133,8 @@ std::string DetectionOptions::validate() const {
 }
 
 std::string RecordOptions::validate() const {
-  // As a case file's [output] samples (case_file.hpp): 1e5 samples cost ~2 s per point already.
-  if (samples < 2 || samples > 100000) return "samples must be in [2, 100000]";
-  if (!(stability_field_tolerance >= 0 && stability_field_tolerance < 1e-3))
-    return "stability_field_tolerance must be in [0, 1e-3) (0: the state's tolerance)";
+  for (const std::string& name : derived)
+    if (name.empty()) return "a derived quantity needs a name";
   return {};
 }
 
@@ -151,11 +148,15 @@ std::string ContinuationOptions::validate() const {
 }
 
 Continuation::Continuation(std::unique_ptr<ParameterisedSystem> system, ContinuationOptions options)
+    : Continuation(std::move(system), std::move(options), {}) {}
+
+Continuation::Continuation(std::unique_ptr<ParameterisedSystem> system, ContinuationOptions options,
+                           const DefaultRecorder& default_recorder)
     : system_(std::move(system)), options_(std::move(options)) {
   if (!system_) throw std::invalid_argument("no system to continue");
   if (std::string e = options_.validate(); !e.empty()) throw std::invalid_argument(e);
   configure();
-  if (!options_.recorder) options_.recorder = PointRecorder{};
+  if (!options_.recorder) options_.recorder = default_recorder ? default_recorder(options_) : PointRecorder{};
 }
 
 void Continuation::configure() {

@@ -42,7 +42,6 @@ struct ContinuationEvent {
 
 struct ContinuationPoint;
 struct MarchState;
-class ShootingProblem;
 
 // What a run records of a point besides its unknowns, parameter, tangent and counts, supplied by
 // the layer that knows what the unknowns mean (BifurcationKit's record_from_solution is the
@@ -118,16 +117,6 @@ struct CorrectorOptions {
   // Where the matrix costs tens of residuals (the variational equations of long multiple-shooting
   // rods) this is far cheaper per point.
   bool modified_newton = false;
-  // The matrices [F_x F_lambda] of the march's steps (the correctors', and the tangents of the
-  // regular points they reach) with the variational equations held to this tolerance
-  // (IntegratorOptions::sensitivity_tol) instead of the state's: a chord or a tangent needs the
-  // matrix to a few digits only, and every point is corrected on the exact residual (the state
-  // keeps its tolerance). Located special points (branch points, folds, events, the end: their
-  // correctors and their own matrices) keep the problem's own: their test functions reach 1e-12.
-  // Not applied to problems with obstacles or contacts (their events and energy differences
-  // follow Newton's last iterates to better than the looser matrices' 1e-9; docs/performance.md)
-  // nor where the problem's own sensitivity_tol is already looser. 0: the problem's own everywhere.
-  double march_sensitivity_tol = 1e-8;
   // On max |F| and |arclength condition|; NaN: 1e-10, or the problem's Newton residual tolerance
   // (a case's [solver] tolerance) when that is looser - rods with large forces need it.
   double corrector_tolerance = std::numeric_limits<double>::quiet_NaN();
@@ -150,22 +139,13 @@ struct DetectionOptions {
   std::string validate() const;
 };
 
-// What a run records at each point: the recorder, and the rod layer's default recorder's settings.
+// What a run records at each point.
 struct RecordOptions {
-  std::vector<std::string> derived;   // computed at every point (and available to events)
-  int samples = 101;                  // profile points for invariants and derived quantities
-  bool compute_invariants = true;     // false skips sampling (derived from events need it)
-  // The stability index of every point (stability.hpp): about one Jacobian's worth of
-  // integration per point. Folds and branch points then show the exchange of stability.
-  bool compute_stability = false;
-  // The tolerance of the index's Jacobi fields at each point (StabilityOptions::field_tolerance;
-  // 0: the state's). The index counts phase passages and compares singular values with 1e-6, so
-  // fields to 1e-8 give the same indices and zero modes (stability_branch_test checks them along
-  // branches against the state's tolerance), with fewer steps where the tolerance, not the
-  // phases' turning, sets them (the Euler column: 560 right-hand sides per point, not 699).
-  double stability_field_tolerance = 1e-8;
-  // What is recorded at each point; nullopt: the rod layer's default from compute_invariants,
-  // samples, derived and compute_stability above (rod_point_recorder, point_record.hpp).
+  // Quantities the recorder computes at every point by name (derived, available to events; the
+  // events' own quantities are added to them).
+  std::vector<std::string> derived;
+  // What is recorded at each point; nullopt: the default of the layer that built the system (a
+  // rod's: rod_point_recorder, point_record.hpp; none for a plain system).
   std::optional<PointRecorder> recorder;
 
   std::string validate() const;
@@ -274,10 +254,8 @@ class Continuation {
   // Any system F(x, lambda) = 0, starting at its parameter(). Without a recorder in the options
   // its points carry what the engine computes (x, parameter, tangent, test functions) only.
   Continuation(std::unique_ptr<ParameterisedSystem> system, ContinuationOptions options);
-  // A rod's shooting problem (a ShootingSystem; the problem is copied, its value of
-  // options.parameter is the starting one). Without a recorder in the options its points are
-  // described by the rod layer's (rod_point_recorder). Defined in rod_continuation.cpp.
-  Continuation(const ShootingProblem& problem, ContinuationOptions options);
+  // (A rod's shooting problem: RodContinuation, rod_continuation.hpp.)
+  virtual ~Continuation() = default;
 
   // Starts from unknowns x0 (corrected at fixed lambda first).
   ContinuationResult run(const Eigen::VectorXd& x0, const PointSink& sink = {});
@@ -304,8 +282,6 @@ class Continuation {
   // Null vectors of [F_x F_lambda] at a point, orthonormal, orthogonal to its tangent.
   Eigen::MatrixXd bifurcation_directions(const ContinuationPoint& point, int count);
 
-  // The rod's shooting problem followed; throws std::logic_error for a system of another kind.
-  const ShootingProblem& problem() const;
   const ParameterisedSystem& system() const { return *system_; }
   const ContinuationOptions& options() const { return options_; }
   // Evaluations of F alone and of F with its matrix [F_x F_lambda] (the variational equations)
@@ -316,16 +292,23 @@ class Continuation {
   };
   const EvaluationCount& evaluations() const { return evaluations_; }
 
+ protected:
+  // As the public constructor, with the recorder used when the options give none, made from the
+  // options as configured (their derived list completed with the events' quantities).
+  using DefaultRecorder = std::function<PointRecorder(const ContinuationOptions& configured)>;
+  Continuation(std::unique_ptr<ParameterisedSystem> system, ContinuationOptions options,
+               const DefaultRecorder& default_recorder);
+
  private:
   // F at z = (x, lambda), with A = [F_x F_lambda] when A is given; with `march` the matrix may be
-  // the system's approximate one (march_sensitivity_tol).
+  // the system's approximate one (ParameterisedSystem::has_approximate_matrices).
   bool evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
                 bool march = false);
   // Newton on [F; normal.(z - z_predicted)] = 0. With `chord` (the Jacobian at a nearby point)
   // it first iterates with that fixed matrix, one integration without sensitivities per
   // iteration, and turns to (modified, with options_.modified_newton) Newton only if those
-  // iterations stop contracting. With `march` its matrices are the march's
-  // (march_sensitivity_tol).
+  // iterations stop contracting. With `march` its matrices are the march's (the system's
+  // approximate ones, where it has them).
   // Where it converges on a matrix evaluated at the final z (Newton's last iteration), that
   // matrix goes to *matrix_at_z, else it is left empty.
   bool correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
@@ -368,7 +351,7 @@ class Continuation {
   // tolerance of it. Empty if that corrector fails.
   std::optional<ContinuationPoint> at_parameter(const ContinuationPoint& located, double value);
   Eigen::VectorXd join(const Eigen::VectorXd& x, double lambda) const;
-  // What both constructors do once the system is there: the corrector's default tolerance, the
+  // What the constructor does once the system is there: the corrector's default tolerance, the
   // events' quantities among the derived ones, the size.
   void configure();
 

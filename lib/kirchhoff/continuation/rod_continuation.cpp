@@ -10,24 +10,44 @@ namespace {
 
 double sign_of(double v) { return v < 0 ? -1.0 : 1.0; }
 
+// The rod options checked before anything is built from them (the engine checks its own again).
+const RodContinuationOptions& validated(const RodContinuationOptions& options) {
+  if (std::string e = options.validate(); !e.empty()) throw std::invalid_argument(e);
+  return options;
+}
+
 }  // namespace
 
-Continuation::Continuation(const ShootingProblem& problem, ContinuationOptions options) : options_(std::move(options)) {
-  if (std::string e = options_.validate(); !e.empty()) throw std::invalid_argument(e);
-  system_ = std::make_unique<ShootingSystem>(problem, options_.parameter, options_.march_sensitivity_tol);
-  configure();
-  // What a rod's point records comes from the recorder, by default the rod layer's (it reads the
-  // derived list completed with the events' quantities in configure()).
-  if (!options_.recorder) options_.recorder = rod_point_recorder(options_);
+std::string RodRecordOptions::validate() const {
+  // As a case file's [output] samples (case_file.hpp): 1e5 samples cost ~2 s per point already.
+  if (samples < 2 || samples > 100000) return "samples must be in [2, 100000]";
+  if (!(stability_field_tolerance >= 0 && stability_field_tolerance < 1e-3))
+    return "stability_field_tolerance must be in [0, 1e-3) (0: the state's tolerance)";
+  return {};
 }
 
-const ShootingProblem& Continuation::problem() const {
-  const auto* shooting = dynamic_cast<const ShootingSystem*>(system_.get());
-  if (!shooting) throw std::logic_error("this continuation follows a system that is not a rod's shooting problem");
-  return shooting->problem();
+std::string RodContinuationOptions::validate() const {
+  if (std::string e = ContinuationOptions::validate(); !e.empty()) return e;
+  if (!(march_sensitivity_tol >= 0)) return "march_sensitivity_tol must be >= 0 (0: the problem's own)";
+  return RodRecordOptions::validate();
 }
 
-SymmetricBranchStart axial_symmetry_branch(Continuation& straight, const ContinuationPoint& bp, double sign) {
+RodContinuation::RodContinuation(const ShootingProblem& problem, const RodContinuationOptions& options)
+    : Continuation(std::make_unique<ShootingSystem>(problem, validated(options).parameter,
+                                                    options.march_sensitivity_tol),
+                   options,
+                   // The rod layer's recorder reads the derived list completed with the events'
+                   // quantities.
+                   [&options](const ContinuationOptions& configured) {
+                     return rod_point_recorder(options, configured.derived);
+                   }),
+      rod_options_(options) {}
+
+const ShootingProblem& RodContinuation::problem() const {
+  return static_cast<const ShootingSystem&>(system()).problem();
+}
+
+SymmetricBranchStart axial_symmetry_branch(RodContinuation& straight, const ContinuationPoint& bp, double sign) {
   const ShootingProblem& problem = straight.problem();
   const Eigen::MatrixXd N = straight.bifurcation_directions(bp, 2);
   // The phase condition m(0).e2 = 0, linearised: a row on the unknowns at s = 0.
@@ -57,26 +77,26 @@ SymmetricBranchStart axial_symmetry_branch(Continuation& straight, const Continu
   return start;
 }
 
-ContinuationOptions bifurcating_branch_options(ContinuationOptions options) {
+RodContinuationOptions bifurcating_branch_options(RodContinuationOptions options) {
   options.target = NAN;
   options.direction = 1.0;
   return options;
 }
 
-ContinuationResult follow_bifurcating_branch(Continuation& run, const ContinuationPoint& bp,
-                                             ContinuationOptions options, double side,
+ContinuationResult follow_bifurcating_branch(RodContinuation& run, const ContinuationPoint& bp,
+                                             RodContinuationOptions options, double side,
                                              const BranchSinkFactory& sink_for) {
   options = bifurcating_branch_options(std::move(options));
   if (bp.multiplicity == 2 && run.problem().definition().kind == RodKind::Spatial) {
     const SymmetricBranchStart start = axial_symmetry_branch(run, bp, side);
     const ShootingProblem switched(start.definition);
-    Continuation next(switched, options);
+    RodContinuation next(switched, options);
     return next.run_along(start.x, start.parameter, start.direction, PointType::BranchPoint,
                           sink_for(switched, true));
   }
   ShootingProblem at_bp = run.problem();
   at_bp.set_parameter(options.parameter, bp.parameter);
-  Continuation next(at_bp, options);
+  RodContinuation next(at_bp, options);
   return next.switch_branch(bp, sink_for(at_bp, false), side);
 }
 

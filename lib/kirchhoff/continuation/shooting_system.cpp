@@ -7,7 +7,7 @@ namespace kirchhoff {
 namespace {
 
 // Obstacles or contacts: their events and energy differences follow Newton's last iterates to
-// better than the looser matrices' 1e-9 (CorrectorOptions::march_sensitivity_tol).
+// better than the looser matrices' 1e-9 (RodContinuationOptions::march_sensitivity_tol).
 bool has_contact(const ProblemDefinition& d) {
   return !d.obstacles.empty() || d.moving_obstacles || !d.contacts.empty();
 }

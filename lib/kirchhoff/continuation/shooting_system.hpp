@@ -2,7 +2,7 @@
 // the problem's parameters, [F_x F_lambda] from the variational equations and
 // ShootingProblem::parameter_derivative. The march's own matrices (approximate = true) come from
 // a copy of the problem whose variational equations are held to march_sensitivity_tol
-// (CorrectorOptions) where that applies: not for problems with obstacles or contacts, nor where
+// (RodContinuationOptions) where that applies: not for problems with obstacles or contacts, nor where
 // the problem's own tolerance is already that loose.
 #pragma once
 

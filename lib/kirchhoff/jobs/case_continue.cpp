@@ -34,8 +34,8 @@ std::string text(double value) {
 
 // The continuation options of a request: the event quantities among the derived ones (the
 // columns every point has).
-ContinuationOptions options_for(const Case& c, const ContinueRequest& r) {
-  ContinuationOptions o;
+RodContinuationOptions options_for(const Case& c, const ContinueRequest& r) {
+  RodContinuationOptions o;
   o.parameter = r.parameter;
   o.target = r.target;
   o.direction = r.direction;
@@ -64,7 +64,7 @@ ProblemDefinition definition_for(const Case& c, const std::string& phase) {
 // A run in progress: its state, its sinks, and the points it reports.
 class Run {
  public:
-  Run(const Case& c, const ContinueRequest& r, ContinuationOptions options, const std::vector<ContinueSink*>& sinks)
+  Run(const Case& c, const ContinueRequest& r, RodContinuationOptions options, const std::vector<ContinueSink*>& sinks)
       : c_(c), r_(r), options_(std::move(options)), sinks_(sinks) {}
 
   RunState state;
@@ -104,7 +104,7 @@ class Run {
  private:
   const Case& c_;
   const ContinueRequest& r_;
-  ContinuationOptions options_;
+  RodContinuationOptions options_;
   const std::vector<ContinueSink*>& sinks_;
   const std::vector<PointContact> no_contacts_;
 };
@@ -216,12 +216,12 @@ ContinueRunResult Run::plain(const Eigen::VectorXd& start_point, bool resuming) 
   // too: branch 0 with the target, the self-passage guard and the stop at the K-th branch point
   // (the count of those passed is in the saved state), branch 1 with bifurcating_branch_options
   // (no target).
-  ContinuationOptions first = options_;
+  RodContinuationOptions first = options_;
   if (branch == 0 && guard_self_passage(*problem, &first)) note("self-contact: steps through the rod itself are refused");
   if (branch == 0 && r_.switch_at_bp > 0) first.stop_at_branch_point = r_.switch_at_bp;
   if (branch == 1) first = bifurcating_branch_options(options_);
   if (resuming) problem->set_parameter(r_.parameter, state.last.parameter);
-  Continuation run(*problem, first);
+  RodContinuation run(*problem, first);
   // (A resume never starts on a branch point: only points the march goes on from are saved.)
   ContinuationResult result = or_start_failed([&] {
     return resuming ? run.resume(march_state(state), sink_for(*problem, branch, state.phase_condition))
@@ -272,7 +272,7 @@ ContinueRunResult Run::with_contacts(const Eigen::VectorXd& start_point, bool re
   auto on_active_set = [&](const std::vector<PointContact>& contacts) { leg_contacts = contacts; };
   // As without obstacles: branch 0 to its target or the K-th branch point (counted over its
   // legs), branch 1 from there with no target.
-  ContinuationOptions first = branch == 1 ? bifurcating_branch_options(options_) : options_;
+  RodContinuationOptions first = branch == 1 ? bifurcating_branch_options(options_) : options_;
   if (branch == 0) first.stop_at_branch_point = r_.switch_at_bp;
   ContactContinuationResult r;
   r.result = or_start_failed([&] {
@@ -339,7 +339,7 @@ std::string ContinueRequest::validate(const Case& c) const {
 
 ContinueRunResult continue_case(Case c, const ContinueRequest& request, const std::vector<ContinueSink*>& sinks) {
   if (std::string why = request.validate(c); !why.empty()) throw CaseError(why);
-  ContinuationOptions options = options_for(c, request);
+  RodContinuationOptions options = options_for(c, request);
   if (request.max_seconds > 0) {
     // One deadline for the whole run: the first solve, every branch and every contact leg.
     limit_wall_clock(c.definition.options, request.max_seconds);

@@ -43,7 +43,7 @@ struct ContinueRequest {
   std::string parameter;  // the continued parameter: a [parameters] name, not a dependent one
   double target = std::numeric_limits<double>::quiet_NaN();  // stop on reaching it (NaN: none)
   double direction = 1.0;     // initial direction of the parameter (+1/-1) when there is no target
-  double initial_step = 0.05;  // pseudo-arclength steps (ContinuationOptions)
+  double initial_step = 0.05;  // pseudo-arclength steps (RodContinuationOptions)
   double min_step = 1e-7;
   double max_step = 0.5;
   int max_points = 500;

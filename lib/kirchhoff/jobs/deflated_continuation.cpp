@@ -8,7 +8,7 @@ namespace kirchhoff {
 
 EveryBranch continue_every_branch(const ProblemDefinition& definition, const RodPoint& guess,
                                   const std::vector<std::string>& derived_names, int samples,
-                                  const ContinuationOptions& options, const EquilibriaOptions& search,
+                                  const RodContinuationOptions& options, const EquilibriaOptions& search,
                                   const BranchSinkFor& sink_for) {
   EveryBranch out;
   out.search = find_equilibria(definition, guess, derived_names, samples, search);
@@ -26,7 +26,7 @@ EveryBranch continue_every_branch(const ProblemDefinition& definition, const Rod
       branch.result = std::move(legs.result);
       branch.contact_changes = std::move(legs.changes);
     } else {
-      branch.result = Continuation(*start.problem, options).run(x, sink);
+      branch.result = RodContinuation(*start.problem, options).run(x, sink);
     }
     out.branches.push_back(std::move(branch));
     if (std::chrono::steady_clock::now() > options.deadline) break;

@@ -10,7 +10,7 @@
 #include <functional>
 #include <vector>
 
-#include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/continuation/rod_continuation.hpp"
 #include "kirchhoff/jobs/equilibria.hpp"
 
 namespace kirchhoff {
@@ -33,7 +33,7 @@ using BranchSinkFor = std::function<PointSink(int rank, const Equilibrium& start
 // search's starting active set. Throws what find_equilibria throws.
 EveryBranch continue_every_branch(const ProblemDefinition& definition, const RodPoint& guess,
                                   const std::vector<std::string>& derived_names, int samples,
-                                  const ContinuationOptions& options, const EquilibriaOptions& search,
+                                  const RodContinuationOptions& options, const EquilibriaOptions& search,
                                   const BranchSinkFor& sink_for = {});
 
 }  // namespace kirchhoff

@@ -43,9 +43,9 @@ ProblemDefinition homotopy_definition(ProblemDefinition d, const std::vector<Par
   return d;
 }
 
-ContinuationOptions path_options(const ShootingProblem& problem, const std::string& t, const Eigen::VectorXd& x_start,
+RodContinuationOptions path_options(const ShootingProblem& problem, const std::string& t, const Eigen::VectorXd& x_start,
                                  const HomotopyOptions& options) {
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = t;
   // The arclength measures (dx, dt) together, and t spans only [0, 1] while the unknowns move by
   // amounts of their own size: longer steps where they are large (plectoneme.toml to its fold
@@ -148,13 +148,13 @@ HomotopyResult follow_homotopy(const ProblemDefinition& start, const Eigen::Vect
   const std::string t = fresh_name(start.parameters);
   const ProblemDefinition path = homotopy_definition(start, changes, t);
   const ShootingProblem problem(path);
-  const ContinuationOptions o = path_options(problem, t, x_start, options);
+  const RodContinuationOptions o = path_options(problem, t, x_start, options);
   HomotopyResult h;
   h.branch_points_checked = o.detect_branch_points;
   ContinuationResult run;
   std::vector<PointContact> contacts = start.contacts;
   if (start.obstacles.empty() && !start.moving_obstacles) {
-    Continuation continuation(problem, o);
+    RodContinuation continuation(problem, o);
     run = continuation.run(x_start);
     h.residual_evaluations = continuation.evaluations().residuals;
     h.jacobian_evaluations = continuation.evaluations().matrices;

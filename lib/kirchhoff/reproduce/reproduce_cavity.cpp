@@ -26,7 +26,7 @@ struct CavityPoint {
 
 std::vector<CavityPoint> follow_cavity(const fs::path& cases) {
   const Case c = load_case((cases / "cavity.toml").string());
-  ContinuationOptions o = report_continuation(
+  RodContinuationOptions o = report_continuation(
       "Delta", 0.2, 2.0, ReportPoints::Followed,
       {"P", "H", "contact_length", "contact_count", "kappa_contact", "contact_s", "min_gap", "min_contact_force"});
   o.max_points = 6000;  // the whole branch, through its contact changes to lift-off

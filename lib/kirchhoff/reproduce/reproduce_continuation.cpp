@@ -14,8 +14,8 @@ namespace {
 
 // The straight column continued in P to 100: its first three branch points against (k pi)^2.
 std::vector<ContinuationPoint> column_branch_points(const ShootingProblem& problem, const Case& column,
-                                                    const ContinuationOptions& o, std::vector<ReportRow>* rows) {
-  Continuation straight(problem, o);
+                                                    const RodContinuationOptions& o, std::vector<ReportRow>* rows) {
+  RodContinuation straight(problem, o);
   const ContinuationResult r = straight.run(problem.initial_unknowns(column.start_guess));
   std::vector<ContinuationPoint> bps;
   for (const auto& p : r.points)
@@ -32,11 +32,11 @@ std::vector<ContinuationPoint> column_branch_points(const ShootingProblem& probl
 // The first buckled branch, switched onto at the first branch point, to theta0 = 3: P(theta0)
 // against 4K(k)^2 at every regular point, into euler_buckled_branch.csv.
 void buckled_column(const Step& step, const ShootingProblem& problem, const ContinuationPoint& first) {
-  ContinuationOptions b = report_continuation("P", NAN, 1.0, ReportPoints::Located, {"theta0"});
+  RodContinuationOptions b = report_continuation("P", NAN, 1.0, ReportPoints::Located, {"theta0"});
   b.initial_step = 0.05;
   b.events = {{"theta0", 3.0, true, ""}};
   b.compute_stability = true;  // make_figures.py draws stable parts solid, unstable ones dashed
-  Continuation buckled(problem, b);
+  RodContinuation buckled(problem, b);
   const ContinuationResult branch = buckled.switch_branch(first);
   std::ofstream csv(step.out / "euler_buckled_branch.csv");
   csv.precision(15);
@@ -59,7 +59,7 @@ void buckled_column(const Step& step, const ShootingProblem& problem, const Cont
 void twisted_branch_point(const Step& step) {
   const Case twisted = load_case((step.cases / "twisted_clamped.toml").string(), {{"phi", 6.0}});
   const ShootingProblem rod(twisted.definition);
-  Continuation twist(rod, report_continuation("phi", 15.0, 1.0, ReportPoints::Located));
+  RodContinuation twist(rod, report_continuation("phi", 15.0, 1.0, ReportPoints::Located));
   const ContinuationResult tr = twist.run(rod.initial_unknowns(twisted.start_guess));
   for (const auto& p : tr.points)
     if (p.type == PointType::BranchPoint) {
@@ -76,7 +76,7 @@ void twisted_branch_point(const Step& step) {
 void continuation(const Step& step) {
   const Case column = load_case((step.cases / "euler_column.toml").string(), {{"P", 1.0}, {"theta_guess", 0.0}});
   const ShootingProblem problem(column.definition);
-  const ContinuationOptions o = report_continuation("P", 100.0, 5.0, ReportPoints::Located, {"theta0"});
+  const RodContinuationOptions o = report_continuation("P", 100.0, 5.0, ReportPoints::Located, {"theta0"});
   const std::vector<ContinuationPoint> bps = column_branch_points(problem, column, o, step.rows);
   buckled_column(step, problem, bps[0]);
   twisted_branch_point(step);

@@ -27,7 +27,7 @@ SoftWallSolutions follow_soft_wall(const Step& step) {
                            {{"log_b", -4.0}, {"Delta", 0.005}, {"P_guess", 40.0}, {"m_guess", 0.9}});
   SoftWallSolutions out{std::make_unique<ShootingProblem>(c.definition), {}};
   ShootingProblem& problem = *out.problem;
-  ContinuationResult shortening = Continuation(problem, report_continuation("Delta", 0.026, 2.0, ReportPoints::Followed))
+  ContinuationResult shortening = RodContinuation(problem, report_continuation("Delta", 0.026, 2.0, ReportPoints::Followed))
                                       .run(problem.initial_unknowns(c.start_guess));
   if (shortening.reason != StopReason::ReachedTarget) throw std::runtime_error("soft wall: continuation in Delta failed");
   problem.set_parameter("Delta", 0.026);
@@ -46,7 +46,7 @@ SoftWallSolutions follow_soft_wall(const Step& step) {
     for (double target : targets) {
       problem.set_parameter("log_b", from);
       const ContinuationResult r =
-          Continuation(problem, report_continuation("log_b", target, 0.5, ReportPoints::Followed)).run(x);
+          RodContinuation(problem, report_continuation("log_b", target, 0.5, ReportPoints::Followed)).run(x);
       if (r.reason != StopReason::ReachedTarget) throw std::runtime_error("soft wall: continuation in b failed");
       if (from == -4.0) record(r.points.front());
       record(r.points.back());

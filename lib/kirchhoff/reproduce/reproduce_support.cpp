@@ -20,9 +20,9 @@ Solved solve_for_report(const fs::path& file, const ParameterOverrides& override
   return out;
 }
 
-ContinuationOptions report_continuation(const std::string& parameter, double target, double max_step,
+RodContinuationOptions report_continuation(const std::string& parameter, double target, double max_step,
                                         ReportPoints points, const std::vector<std::string>& derived) {
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = parameter;
   o.target = target;
   o.max_step = max_step;

@@ -116,9 +116,9 @@ ProblemDefinition barrier_definition(ProblemDefinition d, double slenderness, co
 
 // How a ply of `problem` (at its current parameters) is followed in any parameter at this
 // slenderness (steps scaled with the forces), every step checked for passing the rod through itself.
-ContinuationOptions ply_continuation(const ShootingProblem& problem, const std::string& parameter, double target,
+RodContinuationOptions ply_continuation(const ShootingProblem& problem, const std::string& parameter, double target,
                                      double slenderness, const PlectonemeRunOptions& options) {
-  ContinuationOptions o;
+  RodContinuationOptions o;
   o.parameter = parameter;
   o.target = target;
   o.initial_step = 1.0 * force_scale(slenderness);
@@ -151,9 +151,9 @@ ContinuationOptions ply_continuation(const ShootingProblem& problem, const std::
 }
 
 // How a plectoneme branch is followed in `turns`, with the case's measures at every point.
-ContinuationOptions continuation_options(const ShootingProblem& problem, const Case& c, double slenderness,
+RodContinuationOptions continuation_options(const ShootingProblem& problem, const Case& c, double slenderness,
                                          double turns_max, const PlectonemeRunOptions& options) {
-  ContinuationOptions o = ply_continuation(problem, "turns", turns_max, slenderness, options);
+  RodContinuationOptions o = ply_continuation(problem, "turns", turns_max, slenderness, options);
   o.corrector_tolerance = std::max(1e-10, c.definition.options.newton.residual_tolerance) * force_scale(slenderness);
   o.derived = c.derived;
   o.samples = 10 * static_cast<int>(slenderness) + 1;  // R/10 apart on the half rod: the ply's pitch is 10-30 R
@@ -309,21 +309,21 @@ std::string stop_text(const ContinuationResult& r) {
 // the refused steps into *refused.
 std::string follow_up_and_down(ShootingProblem& problem, BranchCsv& csv, const ContinuationPoint& start,
                                double turns_min, double turns_max,
-                               const std::function<ContinuationOptions(double target)>& options_to, int* refused) {
+                               const std::function<RodContinuationOptions(double target)>& options_to, int* refused) {
   auto sink = [&](const ContinuationPoint& p) { csv(p); };
   const int first_leg = csv.resumed() ? csv.state().branch : 0;
   std::string stops;
   for (int leg = first_leg; leg < 2; ++leg) {
-    const ContinuationOptions o = options_to(leg == 0 ? turns_max : turns_min);
+    const RodContinuationOptions o = options_to(leg == 0 ? turns_max : turns_min);
     const bool resume_leg = csv.resumed() && leg == first_leg;
     csv.state().branch = leg;
     ContinuationResult r;
     if (resume_leg) {
       problem.set_parameter("turns", csv.state().last.parameter);
-      r = Continuation(problem, o).resume(csv.state().last, sink);
+      r = RodContinuation(problem, o).resume(csv.state().last, sink);
     } else {
       problem.set_parameter("turns", start.parameter);
-      r = Continuation(problem, o).run(start.x, sink);
+      r = RodContinuation(problem, o).run(start.x, sink);
     }
     stops += (stops.empty() ? "" : "; ") + std::string(leg == 0 ? "up: " : "down: ") + stop_text(r);
     *refused += r.refused_steps;
@@ -377,7 +377,7 @@ void follow_hard_legs(const Case& c, double slenderness, const RunState& start, 
   summary->hard_ply_stop = follow_up_and_down(
       problem, csv, start.last, turns_min, turns_max,
       [&](double target) {
-        ContinuationOptions o = continuation_options(problem, c, slenderness, target, options);
+        RodContinuationOptions o = continuation_options(problem, c, slenderness, target, options);
         o.max_step = options.ply_max_step * force_scale(slenderness);
         o.derived = kHardMeasured;
         o.events = complementarity_events();
@@ -454,11 +454,11 @@ ContinuationPoint stiffened_to(ShootingProblem& barrier, const ContinuationPoint
   ProblemDefinition loose = barrier.definition();
   if (options.sensitivity_tol > 0) loose.options.integrator.sensitivity_tol = options.sensitivity_tol;
   ShootingProblem moving(loose);
-  ContinuationOptions o = ply_continuation(moving, "log_softness", kStiffestLogSoftness, slenderness, options);
+  RodContinuationOptions o = ply_continuation(moving, "log_softness", kStiffestLogSoftness, slenderness, options);
   o.derived = {"self_distance"};
   o.samples = 10 * static_cast<int>(slenderness) + 1;  // R/10 apart, as on the branch
   o.events = {{"self_distance", gap, true, "the strands within the handover's gap"}};
-  const ContinuationResult r = Continuation(moving, o).run(at.x);
+  const ContinuationResult r = RodContinuation(moving, o).run(at.x);
   if (r.reason != StopReason::EventStop || r.points.empty()) {
     std::ostringstream e;
     e << "the barrier ply (self_distance " << distance << " at log_softness " << log_softness
@@ -550,12 +550,12 @@ PlectonemeBranchSummary follow_plectoneme_branch(const std::string& case_path, d
     if (hard && std::filesystem::exists(end_path)) end = load_state(end_path).last;
   } else {
     ShootingProblem problem(barrier_definition(c.definition, slenderness, options));
-    const ContinuationOptions o =
+    const RodContinuationOptions o =
         continuation_options(problem, c, slenderness, hard ? options.hard_from : turns_max, options);
     BranchCsv csv(csv_path, c.definition.parameters.get("EI"), slenderness, options, &summary);
     csv.follow_hard_contact(csv_path, problem);
     auto sink = [&](const ContinuationPoint& p) { csv(p); };
-    Continuation run(problem, o);
+    RodContinuation run(problem, o);
     ContinuationResult branch;
     if (csv.resumed()) {
       problem.set_parameter(o.parameter, csv.state().last.parameter);
@@ -595,7 +595,7 @@ namespace {
 ContinuationPoint move_ply(ShootingProblem& problem, const std::string& parameter, const Eigen::VectorXd& x,
                            double target, double slenderness, const PlectonemeRunOptions& options,
                            const std::vector<ContinuationEvent>& events = {}) {
-  ContinuationOptions o = ply_continuation(problem, parameter, target, slenderness, options);
+  RodContinuationOptions o = ply_continuation(problem, parameter, target, slenderness, options);
   o.samples = 11;
   // A chord iteration on an older point's matrix can throw the slenderness far off: from the
   // L/2R = 200 exact ply at 5 turns towards 500, one corrector iterate at 325.6 went to -222, where
@@ -613,7 +613,7 @@ ContinuationPoint move_ply(ShootingProblem& problem, const std::string& paramete
     if (options.progress_every > 0 && ++points % options.progress_every == 0)
       progress_line(options, "  ", parameter, " = ", std::setprecision(6), p.parameter);
   };
-  const ContinuationResult r = Continuation(problem, o).run(x, progress);
+  const ContinuationResult r = RodContinuation(problem, o).run(x, progress);
   if (r.reason != StopReason::ReachedTarget || r.points.empty())
     throw std::runtime_error("the ply did not reach " + parameter + " = " + std::to_string(target) + ": " +
                              stop_text(r));

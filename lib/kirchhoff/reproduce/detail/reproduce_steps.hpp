@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "kirchhoff/analysis/solution.hpp"
-#include "kirchhoff/continuation/continuation.hpp"
+#include "kirchhoff/continuation/rod_continuation.hpp"
 #include "kirchhoff/jobs/case_file.hpp"
 #include "kirchhoff/reproduce/reproduce.hpp"
 #include "kirchhoff/shooting/shooting.hpp"
@@ -53,7 +53,7 @@ enum class ReportPoints {
 // The continuations the groups run, all of one shape: `parameter` towards `target` (NaN: none; an
 // event or a branch switch ends the run) in pseudo-arclength steps up to `max_step` (each
 // branch's own scale), recording `derived` at every point as `points` says.
-ContinuationOptions report_continuation(const std::string& parameter, double target, double max_step,
+RodContinuationOptions report_continuation(const std::string& parameter, double target, double max_step,
                                         ReportPoints points, const std::vector<std::string>& derived = {});
 
 // 4 significant digits, as the notes print values.
