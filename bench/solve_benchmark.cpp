@@ -7,7 +7,8 @@
 // (relative, with a unit floor), which is what a continuation step sees. Variants: single vs
 // multiple shooting (4 segments, Elastica) and the Newton steps' matrices: variational with the
 // variational equations at NewtonOptions::step_matrix_tolerance (the default), variational
-// exact (step_matrix_tolerance = 0), finite-difference.
+// exact (step_matrix_tolerance = 0), finite-difference, and the default without Newton's coarse
+// phase (coarse_tolerance = 0: every evaluation to the integrator's own tolerance).
 //
 // Two modes:
 //   solve_benchmark [--benchmark_...]    Google Benchmark; counters per solve: rhs_evals
@@ -67,13 +68,14 @@ constexpr double kSpatialGoalUs = 1000.0;
 constexpr double kPerturbation = 1e-2;
 
 enum class Guess { Case, Perturbed };
-enum class Jacobian { Variational, ExactVariational, FiniteDifference };
+enum class Jacobian { Variational, ExactVariational, FiniteDifference, VariationalNoCoarse };
 
 const char* jacobian_name(Jacobian j) {
   switch (j) {
     case Jacobian::Variational: return "variational";
     case Jacobian::ExactVariational: return "exact_variational";
     case Jacobian::FiniteDifference: return "fd_jacobian";
+    case Jacobian::VariationalNoCoarse: return "variational_no_coarse";
   }
   return "?";
 }
@@ -120,6 +122,7 @@ std::vector<Scenario> scenarios() {
       out.push_back({&spec, 1, Jacobian::Variational, guess});
       out.push_back({&spec, 1, Jacobian::ExactVariational, guess});
       out.push_back({&spec, 1, Jacobian::FiniteDifference, guess});
+      out.push_back({&spec, 1, Jacobian::VariationalNoCoarse, guess});
       if (spec.planar) out.push_back({&spec, 4, Jacobian::Variational, guess});
     }
   return out;
@@ -159,6 +162,7 @@ Prepared& prepared(const Scenario& sc) {
     d.options.segments = sc.segments;
     d.options.newton.finite_difference_jacobian = sc.jacobian == Jacobian::FiniteDifference;
     if (sc.jacobian == Jacobian::ExactVariational) d.options.newton.step_matrix_tolerance = 0.0;
+    if (sc.jacobian == Jacobian::VariationalNoCoarse) d.options.newton.coarse_tolerance = 0.0;
     p.problem = std::make_unique<ShootingProblem>(std::move(d));
     p.case_guess = p.problem->initial_unknowns(p.c.start_guess);
     const ShootingResult r = solve(*p.problem, p.case_guess);
@@ -419,6 +423,17 @@ int run_summary(int runs_planar, int runs_3d) {
       std::printf("  %-28s %-16s time %.2f (%.1f / %.1f us)  rhs %.2f (%.0f / %.0f)  its %.2f / %.2f\n",
                   spec.label.c_str(), g == Guess::Case ? "case_guess" : "perturbed_guess", v.median_us / e.median_us,
                   v.median_us, e.median_us, v.rhs / e.rhs, v.rhs, e.rhs, v.iterations, e.iterations);
+    }
+
+  std::printf("\nWith / without Newton's coarse phase (NewtonOptions::coarse_tolerance; same process, single shooting):\n");
+  for (const CaseSpec& spec : case_specs())
+    for (Guess g : {Guess::Case, Guess::Perturbed}) {
+      const Stats& v = results[Scenario{&spec, 1, Jacobian::Variational, g}.name()];
+      const Stats& n = results[Scenario{&spec, 1, Jacobian::VariationalNoCoarse, g}.name()];
+      if (!v.ok || !n.ok) continue;
+      std::printf("  %-28s %-16s time %.2f (%.1f / %.1f us)  rhs %.2f (%.0f / %.0f)  its %.2f / %.2f\n",
+                  spec.label.c_str(), g == Guess::Case ? "case_guess" : "perturbed_guess", v.median_us / n.median_us,
+                  v.median_us, n.median_us, v.rhs / n.rhs, v.rhs, n.rhs, v.iterations, n.iterations);
     }
 
   std::printf("\nVariational / finite-difference Jacobian (same process, single shooting):\n");

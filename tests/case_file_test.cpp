@@ -647,6 +647,13 @@ TEST_F(CaseFileTest, SolverOverridesReplaceAndAddSolverKeys) {
   EXPECT_TRUE(o.newton.fallback_search);
   EXPECT_EQ(o.newton.max_iterations, 7);
   EXPECT_EQ(c.definition.unknown_parameters, std::vector<std::string>{"P"});
+  // Newton's coarse phase: off with 0, or another tolerance; refused beyond 1e-4 or negative.
+  EXPECT_EQ(load_case(write(kBase), {}, "", {{"coarse_tolerance", "0"}}).definition.options.newton.coarse_tolerance,
+            0.0);
+  EXPECT_EQ(load_case(write(kBase), {}, "", {{"coarse_tolerance", "1e-6"}}).definition.options.newton.coarse_tolerance,
+            1e-6);
+  for (const char* bad : {"1e-3", "-1e-7", "nan"})
+    EXPECT_THROW(load_case(write(kBase), {}, "", {{"coarse_tolerance", bad}}), CaseError) << bad;
   // A case without [solver] gains one; a reload keeps the overrides.
   const Case s = load_case(write(kSpatialBase), {}, "", {{"abs_tol", "1e-9"}});
   EXPECT_EQ(s.definition.options.integrator.abs_tol, 1e-9);

@@ -202,7 +202,9 @@ TEST(StepMatrices, NotOfferedWithObstaclesOrLooserOwnMatrices) {
 TEST(StepMatrices, SameNewtonIterationsAndSolutionForTheElastica) {
   Case c = load_case(testing::case_path("simply_supported.toml"), {{"theta0", 2.8}});
   const ShootingProblem problem(c.definition);
-  NewtonOptions exact = c.definition.options.newton, step = exact;
+  NewtonOptions exact = c.definition.options.newton;
+  exact.coarse_tolerance = 0.0;  // the step matrices alone (the coarse phase: CoarsePhase below)
+  NewtonOptions step = exact;
   exact.step_matrix_tolerance = 0.0;
   ASSERT_GT(step.step_matrix_tolerance, 0.0);
   const Eigen::VectorXd x0 = problem.initial_unknowns(c.start_guess);
@@ -224,6 +226,127 @@ TEST(StepMatrices, SameNewtonIterationsAndSolutionForTheElastica) {
   ASSERT_TRUE(problem.evaluate(x_exact, &F, &J, &failure));
   const double inverse_norm = J.inverse().cwiseAbs().rowwise().sum().maxCoeff();
   EXPECT_LE((x_step - x_exact).lpNorm<Eigen::Infinity>(), inverse_norm * 2.0 * exact.residual_tolerance);
+}
+
+// A toy system F = (x0^2 - 2, x1 - x0) whose coarse evaluations are off by `error` in each
+// component (as an integration to a loose tolerance is), or fail, and which counts its calls.
+class CoarseToy final : public NonlinearSystem {
+ public:
+  explicit CoarseToy(double error, bool coarse_fails = false) : error_(error), fails_(coarse_fails) {}
+  int size() const override { return 2; }
+  bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, std::string*) const override {
+    ++exact;
+    *F = Eigen::Vector2d(x[0] * x[0] - 2.0, x[1] - x[0]);
+    if (J) *J = (Eigen::Matrix2d() << 2.0 * x[0], 0.0, -1.0, 1.0).finished();
+    return true;
+  }
+  bool has_coarse_evaluations(double) const override { return true; }
+  bool evaluate_coarse(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, double,
+                       std::string* failure) const override {
+    ++coarse;
+    if (fails_) {
+      *failure = "coarse integration failed";
+      return false;
+    }
+    const bool ok = evaluate(x, F, J, failure);
+    --exact;
+    *F += Eigen::Vector2d::Constant(error_);
+    return ok;
+  }
+  mutable int exact = 0, coarse = 0;
+
+ private:
+  double error_;
+  bool fails_;
+};
+
+// Far from the root the iterations are coarse; the solve ends on exact residuals at the exact root
+// (the coarse F's root is 1e-7 away: a solve that stopped on coarse residuals would miss
+// sqrt(2) by that much, far beyond the 1e-10 asked).
+TEST(CoarsePhase, FarIterationsCoarseTheEndExact) {
+  NewtonOptions o;
+  o.fallback_search = false;
+  ASSERT_GT(o.coarse_tolerance, 0.0);
+  const CoarseToy system(1e2 * o.coarse_tolerance);
+  Eigen::VectorXd x = Eigen::Vector2d(20.0, 0.0);
+  const NewtonSummary s = newton_solve(system, x, o);
+  ASSERT_TRUE(s.converged()) << s.brief_report();
+  EXPECT_NEAR(x[0], std::sqrt(2.0), 1e-10);
+  EXPECT_NEAR(x[1], std::sqrt(2.0), 1e-10);
+  EXPECT_GE(system.coarse, 4);  // 20 -> sqrt(2) halves x0 at each of the first few steps
+  EXPECT_GT(system.exact, 0);
+  // Every coarse |F| above the phase's end (1e4 tolerances = 1e-3) but the last coarse one.
+  int coarse_norms = 0;
+  for (const double norm : s.history) coarse_norms += norm > 1e4 * o.coarse_tolerance;
+  EXPECT_GE(coarse_norms, 3);
+}
+
+TEST(CoarsePhase, AFailedCoarseEvaluationIsMadeExactly) {
+  NewtonOptions o;
+  o.fallback_search = false;
+  const CoarseToy system(0.0, true);
+  Eigen::VectorXd x = Eigen::Vector2d(20.0, 0.0);
+  const NewtonSummary s = newton_solve(system, x, o);
+  ASSERT_TRUE(s.converged()) << s.brief_report();
+  EXPECT_NEAR(x[0], std::sqrt(2.0), 1e-10);
+  EXPECT_EQ(system.coarse, 1);  // tried once, then the phase is over
+}
+
+TEST(CoarsePhase, ToleranceZeroCallsOnlyEvaluate) {
+  NewtonOptions o;
+  o.fallback_search = false;
+  o.coarse_tolerance = 0.0;
+  const CoarseToy system(0.0);
+  Eigen::VectorXd x = Eigen::Vector2d(20.0, 0.0);
+  ASSERT_TRUE(newton_solve(system, x, o).converged());
+  EXPECT_EQ(system.coarse, 0);
+  o.coarse_tolerance = -1e-7;
+  EXPECT_FALSE(o.validate().empty());
+  o.coarse_tolerance = 1e-3;  // coarser than any |F| the phase would end at
+  EXPECT_FALSE(o.validate().empty());
+}
+
+TEST(CoarsePhase, NotOfferedWithObstaclesOrALooserOwnTolerance) {
+  Case c = load_case(testing::case_path("simply_supported.toml"), {{"theta0", 1.0}});
+  const double tol = 1e-7;
+  EXPECT_TRUE(ShootingProblem(c.definition).has_coarse_evaluations(tol));
+  ProblemDefinition with_wall = c.definition;
+  with_wall.obstacles.push_back(Obstacle::plane(Vec3(0.0, -10.0, 0.0), Vec3::UnitY()));
+  EXPECT_FALSE(ShootingProblem(with_wall).has_coarse_evaluations(tol));
+  ProblemDefinition loose = c.definition;
+  loose.options.integrator.abs_tol = 1e-6;
+  EXPECT_FALSE(ShootingProblem(loose).has_coarse_evaluations(tol));
+}
+
+// The Elastica far from its solution (theta0 = 2.8 from the case's guess, 8 Newton steps): with
+// the coarse phase and without, the same solution to what two points with |F| <= tol can differ
+// by, |dx| <= |J^-1| 2 tol, for fewer right-hand sides (measured: two thirds; a coarse phase that
+// did not engage would make them equal).
+TEST(CoarsePhase, SameElasticaForFewerRightHandSides) {
+  Case c = load_case(testing::case_path("simply_supported.toml"), {{"theta0", 2.8}});
+  const ShootingProblem problem(c.definition);
+  NewtonOptions coarse = c.definition.options.newton, exact = coarse;
+  exact.coarse_tolerance = 0.0;
+  ASSERT_GT(coarse.coarse_tolerance, 0.0);
+  const Eigen::VectorXd x0 = problem.initial_unknowns(c.start_guess);
+  Eigen::VectorXd x_exact = x0, x_coarse = x0;
+  long rhs = problem.rhs_evaluations();
+  ASSERT_TRUE(newton_solve(problem, x_exact, exact).converged());
+  const long rhs_exact = problem.rhs_evaluations() - rhs;
+  rhs = problem.rhs_evaluations();
+  const NewtonSummary s = newton_solve(problem, x_coarse, coarse);
+  const long rhs_coarse = problem.rhs_evaluations() - rhs;
+  ASSERT_TRUE(s.converged()) << s.brief_report();
+  EXPECT_LT(rhs_coarse, 0.8 * rhs_exact);
+  Eigen::VectorXd F;
+  Eigen::MatrixXd J;
+  std::string failure;
+  ASSERT_TRUE(problem.evaluate(x_exact, &F, &J, &failure));
+  const double inverse_norm = J.inverse().cwiseAbs().rowwise().sum().maxCoeff();
+  EXPECT_LE((x_coarse - x_exact).lpNorm<Eigen::Infinity>(), inverse_norm * 2.0 * exact.residual_tolerance);
+  // The converged residual is the exact one.
+  ASSERT_TRUE(problem.evaluate(x_coarse, &F, nullptr, &failure));
+  EXPECT_LE(F.lpNorm<Eigen::Infinity>(), coarse.residual_tolerance);
 }
 
 }  // namespace

@@ -87,7 +87,7 @@ void read_solver(const Reader& reader, const Value& s, const Parameters& paramet
                  ProblemDefinition* d) {
   reader.allow_keys(s, "solver", {"unknowns", "segments", "stepper", "abs_tol", "rel_tol", "sensitivity_tol",
                                   "tolerance", "max_iterations", "jacobian", "fallback_search", "phase_condition",
-                                  "threads"});
+                                  "threads", "coarse_tolerance"});
   ShootingOptions& o = d->options;
   if (const Value* v = Reader::find(s, "unknowns")) d->unknown_parameters = read_unknowns(reader, *v, parameters, dependents);
   if (const Value* v = Reader::find(s, "segments")) o.segments = read_segments(reader, *v, *d);
@@ -107,6 +107,14 @@ void read_solver(const Reader& reader, const Value& s, const Parameters& paramet
   positive("rel_tol", &o.integrator.rel_tol);
   positive("sensitivity_tol", &o.integrator.sensitivity_tol);
   positive("tolerance", &o.newton.residual_tolerance);
+  if (const Value* v = Reader::find(s, "coarse_tolerance")) {
+    const double x = reader.number(*v, "solver.coarse_tolerance");
+    if (!(x == 0.0 || (x > 0.0 && x <= 1e-4)))
+      reader.fail(*v, "solver.coarse_tolerance",
+                  "must be 0 (no coarse iterations) or in (0, 1e-4] (Newton's far iterations integrated to it), got " +
+                      shown(x));
+    o.newton.coarse_tolerance = x;
+  }
   if (const Value* v = Reader::find(s, "max_iterations")) {
     o.newton.max_iterations = reader.integer(*v, "solver.max_iterations", 1, kMaxIterations,
                                              " (each iteration forms a Jacobian; Newton converges in tens)");

@@ -31,6 +31,8 @@ std::string NewtonOptions::validate() const {
   if (!(finite_difference_step > 0)) return "finite_difference_step must be > 0";
   if (max_backtracks < 0) return "max_backtracks must be >= 0";
   if (!(step_matrix_tolerance >= 0)) return "step_matrix_tolerance must be >= 0 (0: exact matrices)";
+  if (!(coarse_tolerance >= 0 && coarse_tolerance <= 1e-4))
+    return "coarse_tolerance must be in [0, 1e-4] (0: no coarse iterations)";
   if (!(max_seconds >= 0 && max_seconds <= 1e9)) return "max_seconds must be in [0, 1e9] (0: no limit)";
   return {};
 }
@@ -101,6 +103,13 @@ namespace {
 // later than on the exact matrices.
 constexpr double kStepMatrixRate = 1e-2;
 
+// The coarse phase (NewtonOptions::coarse_tolerance) lasts while max |F| exceeds this many times
+// its tolerance: the coarse F's error is about the tolerance times the state's scale (1 to 1e2 on
+// the rods here), so above that |F| is known to a percent or better and its steps are Newton's.
+constexpr double kCoarseReach = 1e4;
+// The coarse F's error, at most, in units of its tolerance (the state's scale).
+constexpr double kCoarseError = 1e2;
+
 // Whether the next full Newton step will likely converge, after a full step from |F_previous|
 // to |F|: quadratic convergence (|F_next| ~ |F|^3 / |F_previous|^2) takes |F| below the tolerance.
 bool expect_convergence(double norm, double previous_norm, double tolerance) {
@@ -109,10 +118,11 @@ bool expect_convergence(double norm, double previous_norm, double tolerance) {
   return norm * ratio * ratio <= tolerance;
 }
 
-// One solve's evaluations of F, with J when asked: exact, by finite differences, or a step
-// matrix (NonlinearSystem::has_step_matrices: F as evaluate's, a cheaper J). Step matrices are
-// cleared for the rest of the solve when one is too ill-conditioned or its step fails; without
-// them every evaluation is exactly evaluate's, as it was before they existed.
+// One solve's evaluations of F, with J when asked: coarse (NonlinearSystem::has_coarse_evaluations,
+// F and J both) while the coarse phase lasts, then exact, by finite differences, or a step matrix
+// (NonlinearSystem::has_step_matrices: F as evaluate's, a cheaper J). Step matrices are cleared
+// for the rest of the solve when one is too ill-conditioned or its step fails; without them every
+// evaluation after the coarse phase is exactly evaluate's, as it was before they existed.
 class Evaluations {
  public:
   Evaluations(const NonlinearSystem& system, const NewtonOptions& options, NewtonSummary* summary)
@@ -120,12 +130,22 @@ class Evaluations {
         options_(options),
         summary_(summary),
         step_matrices_(options.step_matrix_tolerance > 0 && !options.finite_difference_jacobian &&
-                       system.has_step_matrices(options.step_matrix_tolerance)) {}
+                       system.has_step_matrices(options.step_matrix_tolerance)),
+        coarse_(options.coarse_tolerance > 0 && !options.finite_difference_jacobian &&
+                system.has_coarse_evaluations(options.coarse_tolerance)) {}
 
   bool operator()(const Eigen::VectorXd& at, Eigen::VectorXd* f, Eigen::MatrixXd* jac) {
     ++summary_->evaluations;
     not_finite_ = false;
     bool ok = false;
+    if (coarse_) {
+      // An evaluation that fails coarse is made again exactly, and ends the coarse phase.
+      ok = system_.evaluate_coarse(at, f, jac, options_.coarse_tolerance, &failure_) && f->allFinite() &&
+           (!jac || jac->allFinite());
+      if (ok) return true;
+      end_coarse_phase();
+      ++summary_->evaluations;
+    }
     if (jac && step_matrices_)
       ok = system_.evaluate_for_step(at, f, jac, options_.step_matrix_tolerance, &failure_);
     else if (jac && options_.finite_difference_jacobian)
@@ -145,6 +165,10 @@ class Evaluations {
 
   bool step_matrices() const { return step_matrices_; }
   void use_exact_matrices() { step_matrices_ = false; }
+  bool coarse() const { return coarse_; }
+  // Whether a coarse |F| of `norm` ends the coarse phase (within kCoarseReach of its tolerance).
+  bool coarse_reached(double norm) const { return coarse_ && norm <= kCoarseReach * options_.coarse_tolerance; }
+  void end_coarse_phase() { coarse_ = false; }
 
   // The summary of a solve ended by the last failed evaluation, at residual `norm`.
   NewtonSummary failed(double norm) const {
@@ -160,6 +184,7 @@ class Evaluations {
   const NewtonOptions& options_;
   NewtonSummary* summary_;
   bool step_matrices_;
+  bool coarse_;
   std::string failure_;
   bool not_finite_ = false;  // the last failed evaluation returned NaN or inf (not an integrator failure)
 };
@@ -190,6 +215,15 @@ LineStep line_search(Evaluations& evaluate, const NewtonOptions& options, const 
   return step;
 }
 
+// Ends the coarse phase at x: F (with J, when given) evaluated there exactly, its max |F| in *norm.
+bool leave_coarse_phase(Evaluations& evaluate, const Eigen::VectorXd& x, Eigen::VectorXd* F, double* norm,
+                        Eigen::MatrixXd* J = nullptr) {
+  evaluate.end_coarse_phase();
+  if (!evaluate(x, F, J)) return false;
+  *norm = max_abs_or_nan(*F);
+  return true;
+}
+
 NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, const NewtonOptions& options,
                            const Deadline& deadline) {
   NewtonSummary summary;
@@ -208,6 +242,14 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
   bool last_step_full = true;
   double previous_norm = NAN;
   for (int it = 0; it < options.max_iterations; ++it) {
+    if (evaluate.coarse_reached(norm)) {
+      // With the matrix the next step needs, unless |F| is within the coarse F's error (a start
+      // that may be converged already: F alone, as without a coarse phase).
+      const bool with_matrix = norm > kCoarseError * options.coarse_tolerance;
+      if (!leave_coarse_phase(evaluate, x, &F, &norm, with_matrix ? &J : nullptr)) return evaluate.failed(norm);
+      have_matrix = with_matrix;
+      summary.residual_norm = norm;
+    }
     if (norm <= options.residual_tolerance) {
       summary.status = SolverStatus::Converged;
       return summary;
@@ -221,6 +263,13 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
     have_matrix = false;
     const JacobianLU lu(J);
     const double rcond = lu.reciprocal_condition();
+    // Too ill-conditioned for the coarse matrices' error (as for the step matrices below): the
+    // rest of the solve on exact evaluations.
+    if (evaluate.coarse() && !(options.coarse_tolerance <= kStepMatrixRate * rcond)) {
+      if (!leave_coarse_phase(evaluate, x, &F, &norm)) return evaluate.failed(norm);
+      --it;
+      continue;
+    }
     // A step matrix's error (~ its tolerance, relative) times the condition number is the rate
     // of the linear convergence it ends in: above kStepMatrixRate (or singular), the exact one.
     if (evaluate.step_matrices() && !(options.step_matrix_tolerance <= kStepMatrixRate * rcond)) {
@@ -234,10 +283,17 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
       return summary;
     }
     const Eigen::VectorXd dx = -lu.solve(F);
-    const bool matrix_with_full_step = evaluate.step_matrices() && last_step_full &&
-                                       !expect_convergence(norm, previous_norm, options.residual_tolerance);
+    // (In the coarse phase the aim is its end, where the exact F and matrix are evaluated anyway.)
+    const double aim = evaluate.coarse() ? kCoarseReach * options.coarse_tolerance : options.residual_tolerance;
+    const bool matrix_with_full_step = (evaluate.step_matrices() || evaluate.coarse()) && last_step_full &&
+                                       !expect_convergence(norm, previous_norm, aim);
     const LineStep step = line_search(evaluate, options, deadline, x, dx, F.squaredNorm(), matrix_with_full_step,
                                       &x_trial, &F_trial, &J_trial);
+    if (!step.accepted && evaluate.coarse() && !deadline.passed()) {  // retried on exact evaluations
+      if (!leave_coarse_phase(evaluate, x, &F, &norm)) return evaluate.failed(norm);
+      --it;
+      continue;
+    }
     if (!step.accepted && evaluate.step_matrices() && !deadline.passed()) {  // retried on the exact matrix
       evaluate.use_exact_matrices();
       --it;

@@ -32,6 +32,19 @@ class NonlinearSystem {
     (void)tolerance;
     return evaluate(x, F, J, failure);
   }
+
+  // Coarse evaluations for Newton's iterations far from the root (NewtonOptions::coarse_tolerance):
+  // F, and J when asked, computed to about `tolerance` relative for less than evaluate. The
+  // default: none, evaluate_coarse is evaluate.
+  virtual bool has_coarse_evaluations(double tolerance) const {
+    (void)tolerance;
+    return false;
+  }
+  virtual bool evaluate_coarse(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, double tolerance,
+                               std::string* failure) const {
+    (void)tolerance;
+    return evaluate(x, F, J, failure);
+  }
 };
 
 enum class SolverStatus {
@@ -64,12 +77,21 @@ struct NewtonOptions {
   // variational equations are then integrated to it, IntegratorOptions::sensitivity_tol). The
   // residual stays exact, so the converged point is decided as before; the convergence stays
   // quadratic down to ~tolerance x condition number and is linear with that rate below it. 1e-8:
-  // as the continuation's march matrices (ContinuationOptions::march_sensitivity_tol). A step
+  // as the continuation's march matrices (RodContinuationOptions::march_sensitivity_tol). A step
   // matrix whose condition number times this tolerance exceeds 1e-2 (the linear rate it would
   // converge at), or on which the step fails (no step length decreases |F|), is replaced by the
   // exact one, and the exact matrices are kept to the end of the solve. 0: the exact matrices
   // throughout, every evaluation as evaluate's.
   double step_matrix_tolerance = 1e-8;
+  // The iterations far from the root on coarse evaluations where the system offers them
+  // (NonlinearSystem::has_coarse_evaluations: shooting problems without obstacles or contacts,
+  // integrated to this tolerance, F and J alike): a step from a residual of 1e-1 needs neither to
+  // twelve digits, and RK78 takes about (1e-12 / tolerance)^(1/8) as many steps. The coarse phase
+  // ends once the coarse max |F| is within kCoarseReach (1e4) times this tolerance, or at the first
+  // coarse step that fails (no step length decreases |F|, an ill-conditioned or unevaluable
+  // point); F is then evaluated exactly where it ended, and every evaluation after that is as
+  // without a coarse phase: the converged point is decided on exact residuals. 0: none.
+  double coarse_tolerance = 1e-7;
   bool fallback_search = true;  // run an NLopt least-squares search when Newton fails
   int fallback_evaluations = 2000;
   // Wall-clock limit of one solve in seconds (0: none), and an instant no solve runs past (a

@@ -272,6 +272,22 @@ bool ShootingProblem::evaluate_for_step(const Eigen::VectorXd& x, Eigen::VectorX
   return evaluate_with(x, F, J, &y_end, loose, failure);
 }
 
+bool ShootingProblem::has_coarse_evaluations(double tolerance) const {
+  const IntegratorOptions& own = definition_.options.integrator;
+  return tolerance > std::max(own.abs_tol, own.rel_tol) && definition_.contacts.empty() &&
+         definition_.obstacles.empty() && !definition_.moving_obstacles;
+}
+
+bool ShootingProblem::evaluate_coarse(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
+                                      double tolerance, std::string* failure) const {
+  Eigen::VectorXd& y_end = workspace_.buffers().y_end;
+  if (!has_coarse_evaluations(tolerance)) return evaluate_with_end(x, F, J, &y_end, failure);
+  IntegratorOptions coarse = definition_.options.integrator;
+  coarse.abs_tol = coarse.rel_tol = tolerance;
+  coarse.sensitivity_tol = 10.0 * tolerance;
+  return evaluate_with(x, F, J, &y_end, coarse, failure);
+}
+
 bool ShootingProblem::parameter_derivative(const Eigen::VectorXd& x, const std::string& name, Eigen::VectorXd* dF,
                                            std::string* failure, const Eigen::VectorXd* y_end) const {
   const double value = definition_.parameters.get(name);

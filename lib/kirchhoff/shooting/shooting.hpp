@@ -128,6 +128,12 @@ class ShootingProblem final : public NonlinearSystem {
   bool has_step_matrices(double tolerance) const override;
   bool evaluate_for_step(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, double tolerance,
                          std::string* failure) const override;
+  // Newton's coarse evaluations (NewtonOptions::coarse_tolerance): the state and the variational
+  // equations integrated to `tolerance` (absolute and relative) for this call only. Offered where
+  // `tolerance` is looser than the problem's own, and not with obstacles or contacts (as above).
+  bool has_coarse_evaluations(double tolerance) const override;
+  bool evaluate_coarse(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, double tolerance,
+                       std::string* failure) const override;
 
   // Unknown vector from a state guess at s = 0 (completed with the start conditions) by
   // integrating across the segments; throws IntegrationError when that integration fails.
