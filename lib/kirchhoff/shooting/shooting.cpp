@@ -257,10 +257,13 @@ bool ShootingProblem::evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eig
   return evaluate_with_end(x, F, J, &workspace_.buffers().y_end, failure);
 }
 
+bool ShootingProblem::without_obstacles() const {
+  return definition_.contacts.empty() && definition_.obstacles.empty() && !definition_.moving_obstacles;
+}
+
 bool ShootingProblem::has_step_matrices(double tolerance) const {
   const IntegratorOptions& own = definition_.options.integrator;
-  return tolerance > std::max(own.sensitivity_tol, own.abs_tol) && definition_.contacts.empty() &&
-         definition_.obstacles.empty() && !definition_.moving_obstacles;
+  return tolerance > std::max(own.sensitivity_tol, own.abs_tol) && without_obstacles();
 }
 
 bool ShootingProblem::evaluate_for_step(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
@@ -274,8 +277,7 @@ bool ShootingProblem::evaluate_for_step(const Eigen::VectorXd& x, Eigen::VectorX
 
 bool ShootingProblem::has_coarse_evaluations(double tolerance) const {
   const IntegratorOptions& own = definition_.options.integrator;
-  return tolerance > std::max(own.abs_tol, own.rel_tol) && definition_.contacts.empty() &&
-         definition_.obstacles.empty() && !definition_.moving_obstacles;
+  return tolerance > std::max(own.abs_tol, own.rel_tol) && without_obstacles();
 }
 
 bool ShootingProblem::evaluate_coarse(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J,
@@ -284,6 +286,8 @@ bool ShootingProblem::evaluate_coarse(const Eigen::VectorXd& x, Eigen::VectorXd*
   if (!has_coarse_evaluations(tolerance)) return evaluate_with_end(x, F, J, &y_end, failure);
   IntegratorOptions coarse = definition_.options.integrator;
   coarse.abs_tol = coarse.rel_tol = tolerance;
+  // The variational equations in their own, looser pass (written out where the equations have
+  // them, cheaper than dual numbers): a far step needs its matrix to a few digits.
   coarse.sensitivity_tol = 10.0 * tolerance;
   return evaluate_with(x, F, J, &y_end, coarse, failure);
 }

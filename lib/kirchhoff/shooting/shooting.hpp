@@ -207,6 +207,9 @@ class ShootingProblem final : public NonlinearSystem {
                          std::string* failure) const;
 
  private:
+  // No obstacle and no contact: where Newton's step and coarse evaluations are offered (an
+  // active-set decision or an event follows every iterate, which they leave as they were).
+  bool without_obstacles() const;
   // `integrator`: the options of the flows without contacts (null: the definition's).
   bool residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F, Eigen::MatrixXd* J,
                 std::string* failure, Eigen::VectorXd* y_end = nullptr,
