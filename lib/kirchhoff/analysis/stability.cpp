@@ -1,6 +1,7 @@
 // The index of an equilibrium by conjugate points (see stability.hpp for the method).
 #include "kirchhoff/analysis/stability.hpp"
 
+#include "kirchhoff/analysis/detail/moment_bound.hpp"
 #include "kirchhoff/analysis/detail/stability_extended_contact.hpp"
 #include "kirchhoff/analysis/detail/stability_free_length.hpp"
 #include "kirchhoff/analysis/detail/stability_symmetric.hpp"
@@ -297,10 +298,15 @@ class StabilityAnalysis {
       field_integrator_.abs_tol = field_integrator_.rel_tol = options_.field_tolerance;
     }
     // The profile sets scales (the fields' rate) and whether a field's gradient acts: integrated
-    // to the fields' tolerance, as they are.
-    std::vector<double> s(17);
-    for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
-    profile_ = problem_.sample(x_, s, &field_integrator_);
+    // to the fields' tolerance, as they are. Where H bounds the moment (moment_bound.hpp) the
+    // start alone serves: a fifth of the Elastica's index was this profile.
+    profile_ = problem_.sample(x_, {0.0}, &field_integrator_);
+    moment_bound_ = detail::moment_bound(*eq_, profile_.front(), !problem_.contacts_at(x_).empty());
+    if (!moment_bound_) {
+      std::vector<double> s(17);
+      for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
+      profile_ = problem_.sample(x_, s, &field_integrator_);
+    }
     full_ = options_.positions_as_configuration || positions_are_configuration();
     const int n = coords_.size(), kr = coords_.kr();
     offset_ = full_ ? 0 : kr;
@@ -316,6 +322,7 @@ class StabilityAnalysis {
       for (int k = 0; k < 3; ++k) stiffness = std::min(stiffness, model.B[k](q.s));
     for (const RodPoint& q : profile_)
       rate = std::max({rate, scales_.length * std::sqrt(q.n.norm() / stiffness), scales_.length * q.m.norm() / stiffness});
+    if (moment_bound_) rate = std::max(rate, scales_.length * *moment_bound_ / stiffness);
     // A field stiffness k (|df/dr|) makes the fields oscillate like a beam on a foundation, with
     // wavenumber (k / B)^(1/4).
     if (model.field)
@@ -379,7 +386,10 @@ class StabilityAnalysis {
   std::shared_ptr<const RodEquations> eq_;
   Coordinates coords_;
   Scales scales_;
-  std::vector<RodPoint> profile_;  // the equilibrium at 17 equally spaced points, for the checks above
+  // The equilibrium at 17 equally spaced points, for the checks above; at s = 0 alone where the
+  // moment's bound stands for it.
+  std::vector<RodPoint> profile_;
+  std::optional<double> moment_bound_;
   long rhs_ = 0;
   IntegratorOptions field_integrator_;  // the state's, or looser (StabilityOptions::field_tolerance)
   CarriedSteps steps_;  // the step sizes the fields' integration proposes next (flowed)
