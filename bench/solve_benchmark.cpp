@@ -414,38 +414,28 @@ int run_summary(int runs_planar, int runs_3d) {
     std::fflush(stdout);
   }
 
-  std::printf("\nStep matrices / exact matrices (NewtonOptions::step_matrix_tolerance; same process, single shooting):\n");
-  for (const CaseSpec& spec : case_specs())
-    for (Guess g : {Guess::Case, Guess::Perturbed}) {
-      const Stats& v = results[Scenario{&spec, 1, Jacobian::Variational, g}.name()];
-      const Stats& e = results[Scenario{&spec, 1, Jacobian::ExactVariational, g}.name()];
-      if (!v.ok || !e.ok) continue;
-      std::printf("  %-28s %-16s time %.2f (%.1f / %.1f us)  rhs %.2f (%.0f / %.0f)  its %.2f / %.2f\n",
-                  spec.label.c_str(), g == Guess::Case ? "case_guess" : "perturbed_guess", v.median_us / e.median_us,
-                  v.median_us, e.median_us, v.rhs / e.rhs, v.rhs, e.rhs, v.iterations, e.iterations);
-    }
-
-  std::printf("\nWith / without Newton's coarse phase (NewtonOptions::coarse_tolerance; same process, single shooting):\n");
-  for (const CaseSpec& spec : case_specs())
-    for (Guess g : {Guess::Case, Guess::Perturbed}) {
-      const Stats& v = results[Scenario{&spec, 1, Jacobian::Variational, g}.name()];
-      const Stats& n = results[Scenario{&spec, 1, Jacobian::VariationalNoCoarse, g}.name()];
-      if (!v.ok || !n.ok) continue;
-      std::printf("  %-28s %-16s time %.2f (%.1f / %.1f us)  rhs %.2f (%.0f / %.0f)  its %.2f / %.2f\n",
-                  spec.label.c_str(), g == Guess::Case ? "case_guess" : "perturbed_guess", v.median_us / n.median_us,
-                  v.median_us, n.median_us, v.rhs / n.rhs, v.rhs, n.rhs, v.iterations, n.iterations);
-    }
-
-  std::printf("\nVariational / finite-difference Jacobian (same process, single shooting):\n");
-  for (const CaseSpec& spec : case_specs())
-    for (Guess g : {Guess::Case, Guess::Perturbed}) {
-      const Stats& v = results[Scenario{&spec, 1, Jacobian::Variational, g}.name()];
-      const Stats& f = results[Scenario{&spec, 1, Jacobian::FiniteDifference, g}.name()];
-      if (!v.ok || !f.ok) continue;
-      std::printf("  %-28s %-16s time %.2f (%.1f / %.1f us)  rhs %.2f (%.0f / %.0f)\n", spec.label.c_str(),
-                  g == Guess::Case ? "case_guess" : "perturbed_guess", v.median_us / f.median_us, v.median_us,
-                  f.median_us, v.rhs / f.rhs, v.rhs, f.rhs);
-    }
+  // The default (variational step matrices, coarse phase) against one variant, single shooting,
+  // each guess: time, right-hand sides and, where asked, Newton iterations, default / variant.
+  auto against_default = [&](const char* title, Jacobian variant, bool iterations) {
+    std::printf("\n%s\n", title);
+    for (const CaseSpec& spec : case_specs())
+      for (Guess g : {Guess::Case, Guess::Perturbed}) {
+        const Stats& v = results[Scenario{&spec, 1, Jacobian::Variational, g}.name()];
+        const Stats& o = results[Scenario{&spec, 1, variant, g}.name()];
+        if (!v.ok || !o.ok) continue;
+        std::printf("  %-28s %-16s time %.2f (%.1f / %.1f us)  rhs %.2f (%.0f / %.0f)", spec.label.c_str(),
+                    g == Guess::Case ? "case_guess" : "perturbed_guess", v.median_us / o.median_us, v.median_us,
+                    o.median_us, v.rhs / o.rhs, v.rhs, o.rhs);
+        if (iterations) std::printf("  its %.2f / %.2f", v.iterations, o.iterations);
+        std::printf("\n");
+      }
+  };
+  against_default("Step matrices / exact matrices (NewtonOptions::step_matrix_tolerance; same process, single shooting):",
+                  Jacobian::ExactVariational, true);
+  against_default("With / without Newton's coarse phase (NewtonOptions::coarse_tolerance; same process, single shooting):",
+                  Jacobian::VariationalNoCoarse, true);
+  against_default("Variational / finite-difference Jacobian (same process, single shooting):", Jacobian::FiniteDifference,
+                  false);
 
   std::printf("\nSingle / multiple (4 segments) shooting, Elastica, variational Jacobian:\n");
   for (const CaseSpec& spec : case_specs()) {

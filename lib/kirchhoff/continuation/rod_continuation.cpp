@@ -40,8 +40,7 @@ RodContinuation::RodContinuation(const ShootingProblem& problem, const RodContin
                    // quantities.
                    [&options](const ContinuationOptions& configured) {
                      return rod_point_recorder(options, configured.derived);
-                   }),
-      rod_options_(options) {}
+                   }) {}
 
 const ShootingProblem& RodContinuation::problem() const {
   return static_cast<const ShootingSystem&>(system()).problem();

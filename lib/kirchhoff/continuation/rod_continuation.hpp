@@ -63,11 +63,6 @@ class RodContinuation : public Continuation {
 
   // The rod's shooting problem followed.
   const ShootingProblem& problem() const;
-  // The rod settings it was built with (options() gives the engine's, as configured).
-  const RodContinuationOptions& rod_options() const { return rod_options_; }
-
- private:
-  RodContinuationOptions rod_options_;
 };
 
 // Branch switching at the double branch point of an isotropic twisted rod (the straight rod's

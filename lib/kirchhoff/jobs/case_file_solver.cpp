@@ -109,10 +109,10 @@ void read_solver(const Reader& reader, const Value& s, const Parameters& paramet
   positive("tolerance", &o.newton.residual_tolerance);
   if (const Value* v = Reader::find(s, "coarse_tolerance")) {
     const double x = reader.number(*v, "solver.coarse_tolerance");
-    if (!(x == 0.0 || (x > 0.0 && x <= 1e-4)))
+    if (!(x >= 0.0 && x <= kMaxCoarseTolerance))
       reader.fail(*v, "solver.coarse_tolerance",
-                  "must be 0 (no coarse iterations) or in (0, 1e-4] (Newton's far iterations integrated to it), got " +
-                      shown(x));
+                  "must be 0 (no coarse iterations) or in (0, " + shown(kMaxCoarseTolerance) +
+                      "] (Newton's far iterations integrated to it), got " + shown(x));
     o.newton.coarse_tolerance = x;
   }
   if (const Value* v = Reader::find(s, "max_iterations")) {

@@ -1,4 +1,3 @@
-#include "kirchhoff/analysis/point_record.hpp"
 #include "kirchhoff/jobs/continue_outputs.hpp"
 
 #include <algorithm>
@@ -7,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "kirchhoff/analysis/point_record.hpp"
 #include "kirchhoff/analysis/solution.hpp"
 
 namespace kirchhoff {

@@ -31,8 +31,11 @@ std::string NewtonOptions::validate() const {
   if (!(finite_difference_step > 0)) return "finite_difference_step must be > 0";
   if (max_backtracks < 0) return "max_backtracks must be >= 0";
   if (!(step_matrix_tolerance >= 0)) return "step_matrix_tolerance must be >= 0 (0: exact matrices)";
-  if (!(coarse_tolerance >= 0 && coarse_tolerance <= 1e-4))
-    return "coarse_tolerance must be in [0, 1e-4] (0: no coarse iterations)";
+  if (!(coarse_tolerance >= 0 && coarse_tolerance <= kMaxCoarseTolerance)) {
+    std::ostringstream os;
+    os << "coarse_tolerance must be in [0, " << kMaxCoarseTolerance << "] (0: no coarse iterations)";
+    return os.str();
+  }
   if (!(max_seconds >= 0 && max_seconds <= 1e9)) return "max_seconds must be in [0, 1e9] (0: no limit)";
   return {};
 }

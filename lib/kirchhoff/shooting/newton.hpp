@@ -62,6 +62,10 @@ enum class SolverStatus {
 };
 const char* to_string(SolverStatus status);
 
+// The loosest NewtonOptions::coarse_tolerance: its phase ends at max |F| <= 1e4 times it, so
+// beyond 1e-4 it would reach a residual of 1.
+constexpr double kMaxCoarseTolerance = 1e-4;
+
 struct NewtonOptions {
   int max_iterations = 50;
   double residual_tolerance = 1e-10;  // on max_i |F_i|; the integrator is run at 1e-12
