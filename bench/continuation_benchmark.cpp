@@ -74,6 +74,7 @@
 #include <unistd.h>
 
 #include "kirchhoff/analysis/analytic.hpp"
+#include "kirchhoff/analysis/detail/derived_quantities.hpp"
 #include "kirchhoff/analysis/point_record.hpp"
 #include "kirchhoff/analysis/solution.hpp"
 #include "kirchhoff/continuation/continuation.hpp"
@@ -219,8 +220,8 @@ RodContinuationOptions euler_branch_options(bool invariants) {
   o.events = {{"theta0", 3.0, true}};
   o.derived = {"theta0"};
   o.compute_invariants = invariants;
-  // theta0 is read at s = 0, but describe() samples the whole rod anyway: two samples is the
-  // least work; with the invariants on, the usual profile of 101 points.
+  // theta0 is read at s = 0: without the invariants each point is described at its start alone
+  // (make_start_solution; samples unused); with them, the usual profile of 101 points.
   o.samples = invariants ? 101 : 2;
   if (g_tight_march) o.march_sensitivity_tol = 0;
   return o;
@@ -764,6 +765,10 @@ void cost_breakdown(const char* label, const ShootingProblem& base, const Contin
   rhs0 = problem.rhs_evaluations();
   const double t_desc = median_us(reps, [&] { sink += make_solution(problem, r, samples, derived).derived.size(); });
   const double t_desc2 = median_us(reps, [&] { sink += make_solution(problem, r, 2, derived).derived.size(); });
+  // What a continuation recording only quantities read at s = 0 describes (point_record.cpp).
+  const bool start_only = derived_read_start_only(derived);
+  const double t_start =
+      start_only ? median_us(reps, [&] { sink += make_start_solution(problem, r, derived).derived.size(); }) : 0.0;
   benchmark::DoNotOptimize(sink);
   std::printf("  %s, %d unknowns + parameter, at %s = %.4g:\n", label, n, parameter.c_str(), p.parameter);
   std::printf("    residual F (one chord iteration)       %8.1f us  %6.0f rhs\n", t_f, rhs_f);
@@ -791,6 +796,7 @@ void cost_breakdown(const char* label, const ShootingProblem& base, const Contin
   for (const auto& d : derived) std::printf(" %s", d.c_str());
   std::printf(", invariants always)\n");
   std::printf("    describe: make_solution(  2 samples)    %8.1f us\n", t_desc2);
+  if (start_only) std::printf("    describe: make_start_solution (s = 0)   %8.1f us\n", t_start);
   {
     // Where the Jacobian's RHS calls go: one pass over the rod with and without the variational
     // equations (RK78: 13 calls per attempted step); unknown model parameters add two plain
@@ -945,7 +951,7 @@ int run_table(int reps) {
   // (1) Euler branch
   euler_branch(false);  // warm-up
   const BranchStats e_fast = time_branch(reps, [] { return euler_branch(false); });
-  print_branch("euler buckled, derived theta0, 2 samples", e_fast, kPlanarGoalIssue);
+  print_branch("euler buckled, derived theta0 at s = 0", e_fast, kPlanarGoalIssue);
   const BranchStats e_inv = time_branch(reps, [] { return euler_branch(true); });
   print_branch("euler buckled, invariants on, 101 samples", e_inv, kPlanarGoalIssue);
   const BranchStats e_tangent = time_branch(reps, [] { return euler_branch(false, 0, Predictor::Tangent); });
@@ -1057,7 +1063,7 @@ int run_table(int reps) {
                 e_fast.points_per_s / e_fixed.points_per_s, e_fast.points_per_s, e_fixed.points_per_s,
                 e_fixed.median_cpu / e_fast.median_cpu, 1e3 * e_fast.median_cpu, 1e3 * e_fixed.median_cpu);
   if (e_fast.ok && e_inv.ok)
-    std::printf("  planar: invariants on (101 samples) cost %.2fx the time per point of derived-only (2 samples)\n",
+    std::printf("  planar: invariants on (101 samples) cost %.2fx the time per point of derived-only (theta0 read at s = 0)\n",
                 e_fast.points_per_s / e_inv.points_per_s);
   if (e_fast.ok && e_tangent.ok)
     std::printf("  planar: tangent / quadratic predictor = %.2f in time for the branch (%.1f / %.1f ms; %d / %d points)\n",

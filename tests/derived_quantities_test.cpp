@@ -8,6 +8,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "kirchhoff/analysis/detail/derived_quantities.hpp"
 #include "kirchhoff/contact/plectoneme.hpp"
 #include "kirchhoff/jobs/case_solve.hpp"
 #include "test_support.hpp"
@@ -110,6 +111,40 @@ TEST(DerivedQuantities, EvaluatorRefusesExactlyTheNamesTheCatalogueLacks) {
   }
   // A plectoneme quantity of a rod without self-contact is not unknown but unavailable.
   EXPECT_THROW(make_solution(*s.problem, s.solution.result, 21, {"T_ext"}), std::invalid_argument);
+}
+
+// The quantities the table marks as reading the start alone come out of a solution described at
+// s = 0 (make_start_solution, no integration) bit for bit as out of the whole profile: the same
+// start state, the same function. A mark on a quantity that reads more would differ (the end,
+// a maximum) or throw here. Every other quantity is refused on such a solution, and
+// derived_read_start_only says which lists a continuation may describe so.
+TEST(DerivedQuantities, StartOnlyQuantitiesAreTheSameFromTheStartAlone) {
+  std::vector<std::string> start_names, other_names;
+  for (const auto& [name, meaning] : derived_catalogue())
+    (derived_read_start_only({name}) ? start_names : other_names).push_back(name);
+  ASSERT_GE(start_names.size(), 5u);  // P, theta0, n_x, ... (the table's marks)
+  for (const auto& [file, overrides] : kCases) {
+    const Case c = load_case(testing::case_path(file), overrides);
+    const CaseSolve s = solved(c);
+    ASSERT_TRUE(s.converged()) << file << ": " << s.failure << " " << s.message;
+    const ShootingProblem& problem = *s.solved.problem;
+    const Solution whole = make_solution(problem, s.solved.result, 21, start_names);
+    const Solution start = make_start_solution(problem, s.solved.result, start_names);
+    ASSERT_EQ(start.profile.size(), 1u);
+    EXPECT_EQ(start.contacts.size(), whole.contacts.size()) << file;
+    for (const auto& name : start_names) {
+      const double a = start.derived.at(name), b = whole.derived.at(name);
+      EXPECT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << file << ": " << name << " " << a << " vs " << b;
+    }
+    for (const auto& name : other_names) {
+      if (is_plectoneme_quantity(name)) continue;
+      EXPECT_THROW(make_start_solution(problem, s.solved.result, {name}), std::logic_error) << file << ": " << name;
+    }
+  }
+  EXPECT_TRUE(derived_read_start_only({}));
+  EXPECT_TRUE(derived_read_start_only({"theta0", "P"}));
+  EXPECT_FALSE(derived_read_start_only({"theta0", "end_to_end"}));
+  EXPECT_FALSE(derived_read_start_only({"not_a_quantity"}));
 }
 
 }  // namespace

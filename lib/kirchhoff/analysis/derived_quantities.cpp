@@ -53,6 +53,9 @@ struct DerivedQuantity {
   std::string name;
   std::string meaning;  // one line; says where the value is NaN
   std::function<double(DerivedInputs&)> value;
+  // Reads nothing but the state at s = 0 (and the model): a solution described at the start alone
+  // (make_start_solution) has it without integrating the rod.
+  bool start_only = false;
 };
 
 // Maximum of f along the rod: the best sample, then Brent's method on the two neighbouring
@@ -120,9 +123,9 @@ using In = DerivedInputs;
 // The rod's ends, loads and shape.
 std::vector<DerivedQuantity> shape_and_load_quantities() {
   return {
-    {"P", "compressive end load -n_x(0)", [](In& in) { return -in.start().n.x(); }},
+    {"P", "compressive end load -n_x(0)", [](In& in) { return -in.start().n.x(); }, true},
     {"theta0", "angle of the tangent d3(0) to the x axis, in the (x, y) plane",
-     [](In& in) { return in.planar() ? in.start().turn_angle : tangent_angle(in.start()); }},
+     [](In& in) { return in.planar() ? in.start().turn_angle : tangent_angle(in.start()); }, true},
     {"theta_end", "angle of the tangent d3(L) to the x axis, in the (x, y) plane",
      [](In& in) { return in.planar() ? in.end().turn_angle : tangent_angle(in.end()); }},
     {"y_max", "largest |y(s)| along the rod",
@@ -130,19 +133,19 @@ std::vector<DerivedQuantity> shape_and_load_quantities() {
     {"kappa_max", "largest bending curvature sqrt(u1^2 + u2^2) along the rod",
      [](In& in) { return refined_maximum(in, curvature); }},
     {"end_to_end", "distance |r(L) - r(0)|", [](In& in) { return (in.end().r - in.start().r).norm(); }},
-    {"M", "twisting moment m3 = m.d3 at s = 0", [](In& in) { return in.start().m.dot(in.start().R.col(2)); }},
+    {"M", "twisting moment m3 = m.d3 at s = 0", [](In& in) { return in.start().m.dot(in.start().R.col(2)); }, true},
     {"tension", "axial force n.d3 at s = L", [](In& in) { return in.end().n.dot(in.end().R.col(2)); }},
     {"tip_x", "x(L)", [](In& in) { return in.end().r.x(); }},
     {"tip_y", "y(L)", [](In& in) { return in.end().r.y(); }},
     {"tip_z", "z(L)", [](In& in) { return in.end().r.z(); }},
-    {"n_x", "n_x(0)", [](In& in) { return in.start().n.x(); }},
-    {"n_y", "n_y(0)", [](In& in) { return in.start().n.y(); }},
-    {"n_z", "n_z(0)", [](In& in) { return in.start().n.z(); }},
-    {"m_start", "|m(0)|, the moment at the start (clamping moment)", [](In& in) { return in.start().m.norm(); }},
+    {"n_x", "n_x(0)", [](In& in) { return in.start().n.x(); }, true},
+    {"n_y", "n_y(0)", [](In& in) { return in.start().n.y(); }, true},
+    {"n_z", "n_z(0)", [](In& in) { return in.start().n.z(); }, true},
+    {"m_start", "|m(0)|, the moment at the start (clamping moment)", [](In& in) { return in.start().m.norm(); }, true},
     {"kappa_mid", "curvature u2 at s = L/2 (signed, planar)",
      [](In& in) { return in.problem.sample(in.x(), {0.5 * in.end().s}).front().u[1]; }},
     {"kappa_end", "curvature u2 at s = L (signed, planar)", [](In& in) { return in.end().u[1]; }},
-    {"kappa_start", "curvature u2 at s = 0 (signed, planar)", [](In& in) { return in.start().u[1]; }},
+    {"kappa_start", "curvature u2 at s = 0 (signed, planar)", [](In& in) { return in.start().u[1]; }, true},
     {"stretch_max", "largest axial strain |v3 - 1| along the rod",
      [](In& in) {
        double worst = 0.0;
@@ -158,7 +161,7 @@ std::vector<DerivedQuantity> energy_quantities() {
     {"H", "mean of the arclength Hamiltonian H = n.v + m.u - V along the rod (eq. 29)",
      [](In& in) { return in.sol.invariants.H.mean; }},
     {"H_spread", "max - min of H along the rod", [](In& in) { return in.sol.invariants.H.spread; }},
-    {"H_start", "H at s = 0", [](In& in) { return hamiltonian(in.model(), in.start()); }},
+    {"H_start", "H at s = 0", [](In& in) { return hamiltonian(in.model(), in.start()); }, true},
     {"H_end", "H at s = L", [](In& in) { return hamiltonian(in.model(), in.end()); }},
     {"h_spread", "max - min of h = H + W_ext (eq. 67), not invariant under a field",
      [](In& in) {
@@ -306,9 +309,20 @@ std::map<std::string, double> derived_values(const std::vector<std::string>& nam
   for (const auto& name : names) {
     const auto q = table.find(name);
     if (q == table.end()) throw std::invalid_argument("unknown derived quantity '" + name + "'");
+    if (sol.profile.size() < 2 && !q->second.start_only)
+      throw std::logic_error("derived quantity '" + name + "' reads the whole rod, not its start alone");
     out[name] = q->second.value(inputs);
   }
   return out;
+}
+
+bool derived_read_start_only(const std::vector<std::string>& names) {
+  const auto& table = quantities_by_name();
+  for (const auto& name : names) {
+    const auto q = table.find(name);
+    if (q == table.end() || !q->second.start_only) return false;
+  }
+  return true;
 }
 
 }  // namespace kirchhoff

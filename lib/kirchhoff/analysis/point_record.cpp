@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <any>
 
+#include "kirchhoff/analysis/detail/derived_quantities.hpp"
 #include "kirchhoff/analysis/solution.hpp"
 #include "kirchhoff/analysis/stability.hpp"
 #include "kirchhoff/continuation/shooting_system.hpp"
@@ -27,8 +28,13 @@ bool H_is_flat(const PointRecord& point) { return kept(point).H_flat; }
 
 PointRecorder rod_point_recorder(const RodRecordOptions& options, const std::vector<std::string>& derived) {
   PointRecorder recorder;
+  // Where nothing recorded reads beyond s = 0, the rod is not integrated again to describe a
+  // point (a sixth of the Euler column's branch recording theta0 alone); a field's domain is
+  // checked along the whole profile (make_solution), so not with a field.
+  const bool start_only = !options.compute_invariants && derived_read_start_only(derived);
   if (options.compute_invariants || !derived.empty())
-    recorder.describe = [samples = options.samples, derived](ParameterisedSystem& system, ContinuationPoint* point) {
+    recorder.describe = [samples = options.samples, derived, start_only](ParameterisedSystem& system,
+                                                                        ContinuationPoint* point) {
       ContinuationPoint& p = *point;
       const ShootingProblem& problem = shooting_problem_at(system, p.parameter);
       ShootingResult r;
@@ -36,7 +42,9 @@ PointRecorder rod_point_recorder(const RodRecordOptions& options, const std::vec
       r.summary.status = SolverStatus::Converged;
       r.parameters = problem.parameters_at(p.x);
       const Parameters at = r.parameters;
-      const Solution s = make_solution(problem, std::move(r), samples, derived);
+      const bool at_start = start_only && !problem.equations(at)->model().field;
+      const Solution s = at_start ? make_start_solution(problem, std::move(r), derived)
+                                  : make_solution(problem, std::move(r), samples, derived);
       if (!s.result.summary.converged()) p.check_failure = s.result.summary.message;
       p.derived = s.derived;
       // Parameters solved for belong on the branch too (e.g. the load of a displacement-controlled run).

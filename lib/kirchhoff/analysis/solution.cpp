@@ -47,6 +47,17 @@ Solution make_solution(const ShootingProblem& problem, ShootingResult result, in
   return sol;
 }
 
+Solution make_start_solution(const ShootingProblem& problem, ShootingResult result,
+                             const std::vector<std::string>& derived_names) {
+  Solution sol;
+  sol.result = std::move(result);
+  sol.profile = problem.sample(sol.result.x, {0.0});
+  sol.contacts = problem.contacts_at(sol.result.x);
+  mark_check_failure(&sol.result, profile_failure(problem.equations(sol.result.parameters)->model(), sol.profile));
+  sol.derived = derived_values(derived_names, problem, sol);
+  return sol;
+}
+
 double explicit_s_derivative_of_energy(const RodModel& model, const RodPoint& p) {
   double dV = 0.0;
   for (int i = 0; i < 3; ++i) {

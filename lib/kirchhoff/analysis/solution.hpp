@@ -23,6 +23,14 @@ struct Solution {
 Solution make_solution(const ShootingProblem& problem, ShootingResult result, int n_samples,
                        const std::vector<std::string>& derived_names);
 
+// The solution described at s = 0 alone, without integrating the rod: a profile of one point, no
+// invariants (their report says they do not apply), the contacts, and derived quantities that
+// read only the start (throws std::logic_error for another). For a continuation that records
+// such quantities at every point and nothing else; a field's domain along the rod (a soft wall's
+// gap, which make_solution checks on its profile) is not checked here.
+Solution make_start_solution(const ShootingProblem& problem, ShootingResult result,
+                             const std::vector<std::string>& derived_names);
+
 // What the outputs (CLI JSON, Python) say of each contact: where, how hard, and H just before it
 // and just after it (after the flat part of an extended contact), which section 6.3 says agree.
 struct ContactReport {
