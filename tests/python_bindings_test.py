@@ -103,6 +103,13 @@ class LoadCaseTest(unittest.TestCase):
         # The CLI's message.
         self.assertIn("--set no_such_key: no parameter 'no_such_key' in [parameters]", str(cm.exception))
 
+    def test_non_finite_parameter_is_refused_in_the_clis_words(self):
+        # tests/cli_test.cpp (NonFiniteOverrideExitsTwo) expects the same text from `--set theta0=nan`.
+        with self.assertRaises(kirchhoff.CaseError) as cm:
+            kirchhoff.load_case(case_path("simply_supported.toml"), set={"theta0": math.nan})
+        self.assertIn("simply_supported.toml: --set theta0: nan is not a finite number with magnitude <= 1e+100",
+                      str(cm.exception))
+
     def test_bad_key_in_file_raises_value_error_naming_it(self):
         text = pathlib.Path(case_path("simply_supported.toml")).read_text()
         text = text.replace("[solver]\n", "[solver]\nbogus_setting = 3\n")

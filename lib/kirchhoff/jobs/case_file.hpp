@@ -108,8 +108,10 @@ std::pair<std::string, std::string> parse_solver_override(const std::string& tex
 // Every --solver text parsed; throws CaseError naming the bad one ("--solver tolerance: ...").
 SolverOverrides parse_solver_overrides(const std::vector<std::string>& texts);
 
-// Parses "NAME=VALUE" (--set); throws std::invalid_argument with the reason: no '=', an empty
-// name or one that is not an identifier, a value that is not a finite number with |value| <= 1e100.
+// Parses "NAME=VALUE" (--set, --event); throws std::invalid_argument with the reason: no '=', an
+// empty name or one that is not an identifier, a value that is not a number. The value's range
+// (finite, |value| <= 1e100) is checked where it is used, as for a value Python passes: load_case
+// refuses a --set value, the continuation's request an event's.
 std::pair<std::string, double> parse_override(const std::string& text);
 
 }  // namespace kirchhoff
