@@ -716,7 +716,8 @@ TEST(ParseOverride, RefusesNonNumericValue) {
   }
   EXPECT_THROW(parse_override("P=1.5x"), std::invalid_argument);
   EXPECT_THROW(parse_override("P="), std::invalid_argument);
-  EXPECT_THROW(parse_override("P=1e999"), std::invalid_argument);
+  // A number out of range is still a number: load_case refuses it (input_limits_test.cpp).
+  EXPECT_TRUE(std::isinf(parse_override("P=1e999").second));
 }
 
 TEST(ParseOverride, RefusesMissingEquals) {

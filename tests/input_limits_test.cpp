@@ -304,15 +304,16 @@ TEST(Files, OversizedFileIsRefusedWithoutParsing) {
 // ---- --set NAME=VALUE ----------------------------------------------------------------------
 
 TEST(Overrides, ValuesMustBeFiniteAndInRangeAndNamesIdentifiers) {
-  for (const char* text : {"P=1e308", "P=-1e101", "P=inf", "P=nan", "P=1e999", "P= 1", "P=0x", "1P=2", "a b=1",
-                           "P=", "=1"}) {
+  // The text's syntax is parse_override's to refuse.
+  for (const char* text : {"P= 1", "P=0x", "1P=2", "a b=1", "P=", "=1", "P=abc"}) {
     SCOPED_TRACE(text);
     EXPECT_THROW(parse_override(text), std::invalid_argument);
   }
-  try {
-    parse_override("P=1e308");
-  } catch (const std::invalid_argument& e) {
-    EXPECT_THAT(std::string(e.what()), HasSubstr("out of range"));
+  // The value's range is load_case's, for the CLI's parsed values as for Python's (one message).
+  for (const char* text : {"P=1e308", "P=-1e101", "P=inf", "P=nan", "P=1e999"}) {
+    SCOPED_TRACE(text);
+    const auto parsed = parse_override(text);
+    expect_refused(read(kPlanar), "", {"--set P", "is not a finite number with magnitude <= 1e+100"}, 0, {parsed});
   }
   EXPECT_EQ(parse_override("P=1e100").second, 1e100);
   EXPECT_EQ(parse_override("P=1e-400").second, 0.0);  // underflow is a number: 0
