@@ -1,6 +1,7 @@
 // The index of an equilibrium by conjugate points (see stability.hpp for the method).
 #include "kirchhoff/analysis/stability.hpp"
 
+#include "kirchhoff/analysis/detail/eigenphases.hpp"
 #include "kirchhoff/analysis/detail/moment_bound.hpp"
 #include "kirchhoff/analysis/detail/stability_extended_contact.hpp"
 #include "kirchhoff/analysis/detail/stability_free_length.hpp"
@@ -11,13 +12,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <complex>
 #include <functional>
 #include <limits>
 #include <sstream>
 
 namespace kirchhoff {
 namespace {
+
+using detail::eigenphases;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -216,35 +218,6 @@ std::string unsupported(const ShootingProblem& problem, const Eigen::VectorXd& x
 }
 
 double wrap(double angle) { return std::remainder(angle, 2 * kPi); }
-
-// Eigenphases of W = (U + iP)(U - iP)^-1: with the frame made orthonormal, W = X X^T for the
-// unitary X = U + iP. One field (the planar rod's rotation frame): W = (u + ip)^2 / (u^2 + p^2),
-// whose phase is 2 atan2(p, u). The matrices are at most 12 x 6 (the full frame of a spatial rod):
-// fixed-capacity storage, no allocation at each of the index's steps. `orthonormal`: [U; P] has
-// orthonormal columns already (orthonormalise), else they are made so by a QR here.
-Eigen::VectorXd eigenphases(const Eigen::MatrixXd& U_in, const Eigen::MatrixXd& P_in, bool orthonormal) {
-  const int m = static_cast<int>(U_in.cols());
-  Eigen::VectorXd phase(m);
-  if (m == 0) return phase;
-  if (m == 1) {
-    phase[0] = wrap(2 * std::atan2(P_in(0, 0), U_in(0, 0)));
-    return phase;
-  }
-  using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 6>;
-  using SmallComplex = Eigen::Matrix<std::complex<double>, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
-  Small Q(2 * m, m);
-  Q << U_in, P_in;
-  if (!orthonormal) {
-    const Eigen::HouseholderQR<Small> qr(Q);
-    Q.setIdentity(2 * m, m);
-    Q.applyOnTheLeft(qr.householderQ());
-  }
-  const SmallComplex X = Q.topRows(m).cast<std::complex<double>>() + std::complex<double>(0, 1) * Q.bottomRows(m);
-  const SmallComplex W = X * X.transpose();
-  Eigen::ComplexEigenSolver<SmallComplex> solver(W, false);
-  for (int j = 0; j < m; ++j) phase[j] = std::arg(solver.eigenvalues()[j]);
-  return phase;
-}
 
 // The frame of Jacobi fields along the rod, in state coordinates, with its canonical blocks.
 struct Frame {
