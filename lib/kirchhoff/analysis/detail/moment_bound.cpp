@@ -4,24 +4,42 @@
 #include <cmath>
 
 namespace kirchhoff::detail {
+namespace {
+
+// Uniform but for the symmetry-unfolding couple, which moment_bound bounds itself.
+bool uniform_apart_from_unfolding(const RodModel& model) {
+  for (int k = 0; k < 3; ++k)
+    if (!model.B[k].is_constant() || !model.u_hat[k].is_constant() || !model.v_hat[k].is_constant()) return false;
+  return true;
+}
+
+}  // namespace
 
 std::optional<double> moment_bound(const RodEquations& equations, const RodPoint& start, bool has_contacts) {
   const RodModel& model = equations.model();
-  if (model.field || model.extensible || !model.is_uniform() || has_contacts) return std::nullopt;
+  if (model.field || model.extensible || !uniform_apart_from_unfolding(model) || has_contacts) return std::nullopt;
   // r' = d3 (no natural strain) and no natural curvature: H is as written.
   for (int k = 0; k < 3; ++k)
     if (model.u_hat[k](0.0) != 0.0 || model.v_hat[k](0.0) != (k == 2 ? 1.0 : 0.0)) return std::nullopt;
+  const double mu = std::abs(model.symmetry_unfolding), L = model.length;
   const Vec3 m = start.R.transpose() * start.m;  // body components
   const double n_d3 = start.n.dot(start.R.col(2)), n_norm = start.n.norm();
   if (equations.is_planar()) {  // it bends about d2 only
+    if (mu != 0.0) return std::nullopt;
     const double B = model.B[1](0.0), H = 0.5 * m[1] * m[1] / B + n_d3;
     return std::sqrt(2.0 * B * std::max(0.0, H + n_norm));
   }
   const double B1 = model.B[0](0.0), B2 = model.B[1](0.0), B3 = model.B[2](0.0);
-  const double H = 0.5 * (m[0] * m[0] / B1 + m[1] * m[1] / B2 + m[2] * m[2] / B3) + n_d3;
+  // The unfolding couple mu g (|g| <= 2) changes H at a rate |u.mu g| <= 2 mu |m| / B_min, with
+  // |m| <= |m(0)| + (|n| + 2 mu) L all along (|m'| <= |n| + 2 mu); and m3 at a rate <= 2 mu.
+  const double B_min = std::min({B1, B2, B3}), crude = start.m.norm() + (n_norm + 2.0 * mu) * L;
+  const double H = 0.5 * (m[0] * m[0] / B1 + m[1] * m[1] / B2 + m[2] * m[2] / B3) + n_d3 + 2.0 * mu * L * crude / B_min;
   const double budget = 2.0 * std::max(0.0, H + n_norm);  // >= m.B^-1 m all along
-  // Isotropic: m3 = m.d3 is conserved as well, and only the bending part varies.
-  if (B1 == B2) return std::sqrt(B1 * std::max(0.0, budget - m[2] * m[2] / B3) + m[2] * m[2]);
+  // Isotropic: m3 = m.d3 is conserved as well (within 2 mu L), and only the bending part varies.
+  if (B1 == B2) {
+    const double m3_low = std::max(0.0, std::abs(m[2]) - 2.0 * mu * L), m3_high = std::abs(m[2]) + 2.0 * mu * L;
+    return std::sqrt(B1 * std::max(0.0, budget - m3_low * m3_low / B3) + m3_high * m3_high);
+  }
   return std::sqrt(std::max({B1, B2, B3}) * budget);
 }
 
