@@ -18,7 +18,8 @@ namespace kirchhoff::detail {
 // v^T C v + i v^T S v. Where two different eigenphases lie symmetrically about a (the
 // combination's eigenvalue double, its eigenvectors mixing theirs) the residual of
 // W v = e^(i theta) v shows it, and another a is tried; after three, the complex eigensolver of W
-// (Schur's). A real symmetric eigenproblem of order m costs a tenth of the complex one.
+// (Schur's). A real symmetric eigenproblem of order m costs about a third of the complex one
+// (3.3 against 10.2 thousand instructions on the twisted rod's 3 x 3 frames).
 Eigen::VectorXd eigenphases(const Eigen::MatrixXd& U, const Eigen::MatrixXd& P, bool orthonormal);
 
 // The same by the complex eigensolver of W alone: the reference the tests compare with.
