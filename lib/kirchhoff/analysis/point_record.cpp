@@ -29,8 +29,8 @@ bool H_is_flat(const PointRecord& point) { return kept(point).H_flat; }
 PointRecorder rod_point_recorder(const RodRecordOptions& options, const std::vector<std::string>& derived) {
   PointRecorder recorder;
   // Where nothing recorded reads beyond s = 0, the rod is not integrated again to describe a
-  // point (a sixth of the Euler column's branch recording theta0 alone); a field's domain is
-  // checked along the whole profile (make_solution), so not with a field.
+  // point (13 % of the instructions of the Euler column's branch recording theta0 alone); a
+  // field's domain is checked along the whole profile (make_solution), so not with a field.
   const bool start_only = !options.compute_invariants && derived_read_start_only(derived);
   if (options.compute_invariants || !derived.empty())
     recorder.describe = [samples = options.samples, derived, start_only](ParameterisedSystem& system,

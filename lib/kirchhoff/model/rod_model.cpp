@@ -92,8 +92,9 @@ void RodModel::validate() const {
     for (int i = 0; i < 3; ++i) require_positive(A[i], length, shear_names[i]);
 }
 
-bool RodModel::is_uniform() const {
-  if (symmetry_unfolding != 0.0) return false;
+bool RodModel::is_uniform() const { return symmetry_unfolding == 0.0 && has_constant_properties(); }
+
+bool RodModel::has_constant_properties() const {
   for (int i = 0; i < 3; ++i) {
     if (!B[i].is_constant() || !u_hat[i].is_constant() || !v_hat[i].is_constant()) return false;
     if (extensible && !A[i].is_constant()) return false;

@@ -130,6 +130,9 @@ struct RodModel {
   void validate() const;
   // True when no property depends on s, so the Lagrangian has no explicit s and H is conserved.
   bool is_uniform() const;
+  // True when no stiffness or natural strain depends on s: is_uniform() but for the
+  // symmetry-unfolding couple, whose effect on H a caller may bound itself.
+  bool has_constant_properties() const;
 };
 
 }  // namespace kirchhoff

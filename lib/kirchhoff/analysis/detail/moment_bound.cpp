@@ -4,20 +4,11 @@
 #include <cmath>
 
 namespace kirchhoff::detail {
-namespace {
-
-// Uniform but for the symmetry-unfolding couple, which moment_bound bounds itself.
-bool uniform_apart_from_unfolding(const RodModel& model) {
-  for (int k = 0; k < 3; ++k)
-    if (!model.B[k].is_constant() || !model.u_hat[k].is_constant() || !model.v_hat[k].is_constant()) return false;
-  return true;
-}
-
-}  // namespace
 
 std::optional<double> moment_bound(const RodEquations& equations, const RodPoint& start, bool has_contacts) {
   const RodModel& model = equations.model();
-  if (model.field || model.extensible || !uniform_apart_from_unfolding(model) || has_contacts) return std::nullopt;
+  // Uniform but for the symmetry-unfolding couple, whose effect on H is bounded below.
+  if (model.field || model.extensible || !model.has_constant_properties() || has_contacts) return std::nullopt;
   // r' = d3 (no natural strain) and no natural curvature: H is as written.
   for (int k = 0; k < 3; ++k)
     if (model.u_hat[k](0.0) != 0.0 || model.v_hat[k](0.0) != (k == 2 ? 1.0 : 0.0)) return std::nullopt;
