@@ -13,6 +13,7 @@
 
 #include "kirchhoff/continuation/detail/broyden_steps.hpp"
 #include "kirchhoff/continuation/detail/continuation_detectors.hpp"
+#include "kirchhoff/continuation/detail/kinked_minimum.hpp"
 #include "kirchhoff/shooting/detail/jacobian_lu.hpp"
 #include "kirchhoff/shooting/newton.hpp"
 
@@ -21,7 +22,7 @@ namespace {
 
 // Step growth and shrink factors: the usual choices for predictor-corrector continuation.
 constexpr double kGrow = 1.5, kShrink = 0.5;
-// Secant/Brent location stops when the step interval is this small relative to the step.
+// Location (Illinois, the kinked minimum) stops when the step interval is this small relative to the step.
 constexpr double kLocateTolerance = 1e-12;
 constexpr int kLocateIterations = 60;
 // Chord iterations continue while each one reduces the residual at least by this factor.
@@ -413,13 +414,24 @@ std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& f
                                                       bool minimise, PointType type, const Eigen::VectorXd* curvature) {
   std::optional<ContinuationPoint> best;
   if (minimise) {
+    // The trial points kept by h, so that the minimum's point is not corrected a second time.
+    std::optional<ContinuationPoint> lowest;
+    double lowest_value = INFINITY;
     auto f = [&](double h) {
       auto p = step_from(from, h, type, curvature);
-      return p ? monitor(*p) : INFINITY;
+      const double value = p ? monitor(*p) : INFINITY;
+      if (value < lowest_value) {
+        lowest_value = value;
+        lowest = std::move(p);
+      }
+      return value;
     };
-    const auto [h, value] = boost::math::tools::brent_find_minima(f, 0.0, h_max, 40);
-    (void)value;
-    best = step_from(from, h, type, curvature);
+    // The minimum sought is a branch point's kink (kinked_minimum.hpp): bracketed by the step's
+    // ends and its middle, where the march's point lies. Brent where the middle is no bracket.
+    const detail::MinimumSample a{0.0, monitor(from)}, b{h_max, f(h_max)}, m{0.5 * h_max, f(0.5 * h_max)};
+    const auto kinked = detail::minimise_kinked(f, a, m, b, kLocateTolerance * h_max, kLocateIterations);
+    if (!kinked.bracketed) boost::math::tools::brent_find_minima(f, 0.0, h_max, 40);
+    best = std::move(lowest);
   } else {
     // Illinois (modified regula falsi) on h: brackets the root and converges superlinearly.
     double a = 0.0, fa = monitor(from), b = h_max;
