@@ -107,12 +107,13 @@ CLI::App* add_continue_command(CLI::App& app, ContinueArguments* args, std::stri
       "one CSV row per point, flushed as it goes; --resume picks up a killed run");
   add_case_options(command, args);
   command->add_option("--param", args->parameter, "Parameter to continue in (from [parameters])")->required();
-  command->add_option("--to", args->to, "Stop when the parameter reaches this value")
+  command->add_option("--to", args->to, "Stop when the parameter reaches this value (on the starting branch: a branch switched onto with "
+                      "--switch-at-bp runs to an --event or --max-points)")
       ->each([args](const std::string&) { args->has_to = true; });
   command->add_option("--step", args->step, "Initial pseudo-arclength step")->capture_default_str();
   command->add_option("--min-step", args->min_step, "Smallest step before giving up")->capture_default_str();
   command->add_option("--max-step", args->max_step, "Largest step")->capture_default_str();
-  command->add_option("--max-points", args->max_points, "Largest number of points")->capture_default_str();
+  command->add_option("--max-points", args->max_points, "Largest number of points of each branch (a switched branch counts its own)")->capture_default_str();
   command->add_option("--switch-at-bp", args->switch_at_bp,
                       "Switch onto the branch bifurcating at the K-th branch point found (double branch points\n"
                       "of isotropic twisted rods switch with the axial phase condition)");

@@ -95,7 +95,8 @@ void bind_case_continuation(py::class_<PyCase>& cls) {
 
 Args:
     param (str): the continued parameter; its value in the case is the starting one.
-    to (float, optional): stop on reaching this value (None: no target, go along `direction`).
+    to (float, optional): stop on reaching this value on the starting branch (None: no target, go
+        along `direction`); a branch switched onto runs to an event or `max_points`.
     step, min_step, max_step (float): initial, smallest and largest pseudo-arclength step.
     max_points (int): points per branch.
     events (dict name -> value): stop when a derived quantity crosses the value.

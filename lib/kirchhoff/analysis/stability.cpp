@@ -22,6 +22,14 @@ namespace {
 using detail::eigenphases;
 
 constexpr double kPi = 3.14159265358979323846;
+// A load-controlled mode is an exact zero mode of the isoperimetric correction where its share of
+// D is this many times the rest (its sign then decides, as the exact count assumes), or where its
+// singular value is below this fraction of the largest (round-off: the decomposition drops it).
+constexpr double kExactZeroShare = 1e3;
+constexpr double kRoundOffZero = 1e-13;
+// The relative error of the conditions' singular values, at least (7e-12 measured on the
+// plectoneme's arch in a solve), and ten times the fields' tolerance (1e-8 along a branch).
+constexpr double kConditionsNoise = 1e-9;
 
 // Scales making the canonical coordinates dimensionless: lengths by L, forces by B / L^2,
 // moments by B / L. The symplectic form only gains the constant factor L / B.
@@ -880,6 +888,55 @@ Eigen::MatrixXd StabilityAnalysis::end_terms(const Frame& f, const Held& end, St
   return null_space(conditions, m, tol);
 }
 
+// The load-controlled problem's modes as the isoperimetric correction sees them. Each mode j
+// (singular triplet u_j, sigma_j, v_j of the end conditions) adds to D the part
+// -g_j (u_j.loads) / sigma_j, g_j its chord change.
+//  - `exact`: the modes below the zero tolerance enter as exact zero modes (r_Z, and D on the
+//    loads that do no work on them) - the limit sigma -> 0 at a fixed g, right where their part
+//    outgrows the rest of D (and where sigma is zero to round-off). Where it does not, such a
+//    mode is near zero without being one - an isotropic rod's turn about its axis as its twist
+//    goes to zero, sigma ~ twist^2 and g ~ twist, so that g^2 / sigma stays finite - and D is
+//    taken with it, as with any other mode: counting it as exact there gave the plectoneme arch at
+//    turns 1e-6 .. 2.5e-4 index 1 between index 0 at turns 0 and past 2.6e-4.
+//  - `resolution(v)`: how far an eigenvalue of D along v is known. Each part carries the relative
+//    error of its sigma_j, `noise` of the largest over sigma_j: on the plectoneme arch a part of
+//    0.04 through sigma = 2e-11 of 0.36 came out 12 % off, and with the fields at a branch's 1e-8
+//    one through sigma = 8e-6 left D = 1e-5 where the rod's turn makes it 0.
+struct NearZeroModes {
+  bool exact = false;
+  std::vector<std::pair<Eigen::MatrixXd, double>> parts;  // (symmetrised part, its relative error)
+  double resolution(const Eigen::VectorXd& v, double tol) const {
+    double r = tol;
+    for (const auto& [part, error] : parts) r += error * std::abs(v.dot(part * v));
+    return r;
+  }
+};
+
+NearZeroModes near_zero_modes(const Eigen::MatrixXd& conditions, const Eigen::MatrixXd& loads,
+                              const Eigen::MatrixXd& frame_values, const Eigen::MatrixXd& particular_values,
+                              double tol, double noise) {
+  NearZeroModes out;
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(conditions, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::VectorXd& sigma = svd.singularValues();
+  if (sigma.size() == 0) return out;
+  Eigen::MatrixXd below = Eigen::MatrixXd::Zero(loads.cols(), loads.cols()), rest = particular_values;
+  for (Eigen::Index j = 0; j < sigma.size(); ++j) {
+    if (sigma[j] <= kRoundOffZero * sigma[0]) {
+      out.exact = true;
+      continue;
+    }
+    const Eigen::MatrixXd part =
+        -(frame_values * svd.matrixV().col(j)) * (svd.matrixU().col(j).transpose() * loads) / sigma[j];
+    (sigma[j] <= tol ? below : rest) += part;
+    out.parts.push_back({0.5 * (part + part.transpose()), noise * sigma[0] / sigma[j]});
+  }
+  out.exact = out.exact || below.norm() > kExactZeroShare * std::max(rest.norm(), tol);
+  if (out.exact)  // the modes below the tolerance are projected out of D
+    for (Eigen::Index j = 0; j < sigma.size(); ++j)
+      if (sigma[j] <= tol && sigma[j] > kRoundOffZero * sigma[0]) out.parts[static_cast<size_t>(j)].second = 0.0;
+  return out;
+}
+
 // The isoperimetric correction (Maddocks; Manning, Rogers & Maddocks 1998): with the end
 // positions held along k directions, index = index_dead + r_Z + n_+(D) - k, where D = dg/dF is how
 // the chord g = r(L) - r(0) along them moves per unit change of the end load (the multiplier),
@@ -907,9 +964,13 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
   // indeterminate though it enters the second variation. The index is then not defined.
   const Eigen::MatrixXd active = column_basis(values, tol);  // in constraint coordinates
   if (active.cols() < all_constraints) {
-    report->reason = "a degenerate constraint: a held chord (or contact) that no perturbation changes to first "
-                     "order, as a straight inextensible rod held at its full length; its multiplier is "
-                     "indeterminate";
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(values);
+    std::ostringstream why;
+    why << "a degenerate constraint: a held chord (or contact) that perturbations change to first order by at most "
+        << svd.singularValues()[svd.singularValues().size() - 1] << " (the zero tolerance is " << tol
+        << "), as a straight inextensible rod held at its full length or clamped ends held where they meet "
+           "(and near them); its multiplier is indeterminate";
+    report->reason = why.str();
     return false;
   }
   const Eigen::MatrixXd frame_values = active.transpose() * values.leftCols(m);
@@ -926,33 +987,54 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
   Eigen::MatrixXd conditions(m, m), loads(m, k);
   conditions << held.transpose() * f.U, free_rotation.transpose() * f.P_physical;
   loads << held.transpose() * particular_U, free_rotation.transpose() * particular_P_physical;
-  report->zero_modes = 0;
-  int correction = 0;
-  if (k > 0) {
-    const Eigen::MatrixXd c = -conditions.completeOrthogonalDecomposition().solve(loads);
-    const Eigen::MatrixXd chord = frame_values * c + particular_values;  // D, k x k
-
-    const Eigen::MatrixXd chord_zero = frame_values * zero_modes;        // k x z
-    const int r_z = static_cast<int>(column_basis(chord_zero, tol).cols());
-    const Eigen::MatrixXd quiet = null_space(chord_zero.transpose(), k, tol);  // loads doing no work on them
-    // D = C H^-1 C^T is symmetric (reciprocity of the multipliers' responses): 1e-14 of its size
-    // on the cases of the tests once every Jacobi field gets each contact's jump.
-    const Eigen::MatrixXd D_quiet = quiet.transpose() * chord * quiet;
-    const Eigen::MatrixXd D = 0.5 * (D_quiet + D_quiet.transpose());
-    int positive = 0;
-    if (D.rows() > 0) {
-      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(D);
-      for (int i = 0; i < eig.eigenvalues().size(); ++i)
-        if (eig.eigenvalues()[i] > tol) ++positive;
-    }
-    correction = r_z + positive - k;
-  }
   Eigen::MatrixXd all(m + k, m + k);
   all.topLeftCorner(m, m) = conditions;
   all.topRightCorner(m, k) = loads;
   all.bottomLeftCorner(k, m) = frame_values;
   all.bottomRightCorner(k, k) = particular_values;
   report->zero_modes = static_cast<int>(null_space(all, m + k, tol).cols());
+  int correction = 0;
+  if (k > 0) {
+    const Eigen::MatrixXd c = -conditions.completeOrthogonalDecomposition().solve(loads);
+    const Eigen::MatrixXd chord = frame_values * c + particular_values;  // D, k x k
+
+    const NearZeroModes near = near_zero_modes(conditions, loads, frame_values, particular_values, tol,
+                                               std::max(kConditionsNoise, 10 * field_integrator_.rel_tol));
+    const Eigen::MatrixXd chord_zero = near.exact ? Eigen::MatrixXd(frame_values * zero_modes)  // k x z
+                                                  : Eigen::MatrixXd(k, 0);
+    const int r_z = static_cast<int>(column_basis(chord_zero, tol).cols());
+    const Eigen::MatrixXd quiet = null_space(chord_zero.transpose(), k, tol);  // loads doing no work on them
+    // D = C H^-1 C^T is symmetric (reciprocity of the multipliers' responses): 1e-14 of its size
+    // on the cases of the tests once every Jacobi field gets each contact's jump.
+    const Eigen::MatrixXd D_quiet = quiet.transpose() * chord * quiet;
+    const Eigen::MatrixXd D = 0.5 * (D_quiet + D_quiet.transpose());
+    // Eigenvalues of D within its resolution are zero: the whole problem's zero modes. Where more
+    // lie there than it has (one past the tolerance but within the resolution) D does not say.
+    int positive = 0, unresolved = 0;
+    double unresolved_value = 0.0, unresolved_resolution = 0.0;
+    if (D.rows() > 0) {
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(D);
+      for (int i = 0; i < eig.eigenvalues().size(); ++i) {
+        const double lambda = eig.eigenvalues()[i];
+        const double resolution = near.resolution(quiet * eig.eigenvectors().col(i), tol);
+        if (lambda > resolution) ++positive;
+        else if (std::abs(lambda) > tol && std::abs(lambda) <= resolution) {
+          ++unresolved;
+          unresolved_value = lambda;
+          unresolved_resolution = resolution;
+        }
+      }
+    }
+    if (unresolved > report->zero_modes) {
+      std::ostringstream why;
+      why << "the isoperimetric correction is not resolved: the chord's response to the multipliers has an "
+          << "eigenvalue " << unresolved_value << " within its resolution " << unresolved_resolution
+          << " (a load-controlled mode near zero), and the whole problem not as many zero modes";
+      report->reason = why.str();
+      return false;
+    }
+    correction = r_z + positive - k;
+  }
   report->constraint_count = k;
   report->constraint_correction = correction;
   return true;
