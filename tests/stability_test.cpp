@@ -17,6 +17,7 @@
 #include "kirchhoff/analysis/discrete_stability.hpp"
 #include "kirchhoff/continuation/continuation.hpp"
 #include "kirchhoff/continuation/rod_continuation.hpp"
+#include "kirchhoff/jobs/result_json.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {
@@ -828,6 +829,32 @@ TEST(Stability, UnsupportedCasesSayWhy) {
   ASSERT_TRUE(sleeve.defined()) << sleeve.reason;
   EXPECT_EQ(sleeve.method, "conjugate_points+reduced_energy");
   EXPECT_EQ(sleeve.sliding_length, "ell");
+}
+
+}  // namespace
+}  // namespace kirchhoff
+
+namespace kirchhoff {
+namespace {
+
+// "agrees" in the JSON: true or false only where both indices exist and the discretised check
+// passed its own tests; null otherwise (false would read as two indices that differ).
+TEST(StabilityJson, CrossCheckAgreesOnlyWhereDecided) {
+  StabilityReport conjugate;
+  conjugate.index = 1;
+  DiscreteStability discrete;
+  discrete.index = 1;
+  discrete.trustworthy = true;
+  EXPECT_EQ(stability_json(conjugate, &discrete)["cross_check"]["agrees"], true);
+  discrete.index = 2;
+  EXPECT_EQ(stability_json(conjugate, &discrete)["cross_check"]["agrees"], false);
+  discrete.index = 1;
+  discrete.trustworthy = false;
+  EXPECT_TRUE(stability_json(conjugate, &discrete)["cross_check"]["agrees"].is_null());
+  discrete.trustworthy = true;
+  conjugate.index.reset();
+  conjugate.reason = "not defined here";
+  EXPECT_TRUE(stability_json(conjugate, &discrete)["cross_check"]["agrees"].is_null());
 }
 
 }  // namespace

@@ -52,6 +52,14 @@ nlohmann::json path_json(const SolvePath& path) {
   return j;
 }
 
+// Whether the discretised energy's index is the conjugate points': null where that is not decided
+// (the check did not pass its own tests, or the index is undefined), so that false always means
+// two indices that differ.
+static nlohmann::json agreement(const StabilityReport& st, const DiscreteStability& discrete) {
+  if (!discrete.trustworthy || !st.index) return nlohmann::json();
+  return *st.index == *discrete.index;
+}
+
 nlohmann::json stability_json(const StabilityReport& st, const DiscreteStability* discrete) {
   nlohmann::json j;
   j["index"] = st.index ? nlohmann::json(*st.index) : nlohmann::json();
@@ -70,7 +78,7 @@ nlohmann::json stability_json(const StabilityReport& st, const DiscreteStability
                         {"zero_modes", discrete->zero_modes},
                         {"trustworthy", discrete->trustworthy},
                         {"check", discrete->check_message},
-                        {"agrees", discrete->trustworthy && st.index && *st.index == *discrete->index}};
+                        {"agrees", agreement(st, *discrete)}};
     // With a sliding length: the discrete d^2 E*/d ell^2, beside the conjugate points' S below.
     if (!discrete->sliding_length.empty() && std::isfinite(discrete->reduced_curvature))
       j["cross_check"]["reduced_energy_curvature"] = discrete->reduced_curvature;
