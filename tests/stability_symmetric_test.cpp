@@ -415,6 +415,36 @@ TEST(StabilitySymmetric, TheSlightlyTwistedArchIsStable) {
   }
 }
 
+// On the ply past the loop's closing (turns 2.2 .. 2.5, the barrier acting), the symmetric half's
+// eigenphases were paired wrongly at the default observation steps where the barrier is stiff (a
+// passage "against the Legendre direction" near s = 0.27, index undefined on 40 of the branch's
+// first 149 points); observed again with denser steps (run_resolved in stability.cpp) every
+// point has an index: 0 with the turn about the axis as its zero mode, the stable ply that the
+// branch holds until its fold at turns = 2.8642 (docs/stability.md).
+TEST(StabilitySymmetric, ThePlyHasAnIndexWhereTheBarrierIsStiff) {
+  const Case c = load_case_text(half_rod_text(true), "half.toml");
+  ShootingProblem problem(c.definition);
+  const ContinuationResult branch = follow_onto_the_ply(problem, c, 2.5);
+  ASSERT_FALSE(branch.points.empty());
+  ASSERT_NEAR(branch.points.back().parameter, 2.5, 1e-9);
+  StabilityOptions options;
+  options.field_tolerance = 1e-8;  // as along a branch
+  int checked = 0;
+  bool past_the_closing = false;  // the loop closes at the fold at turns = 1.1492
+  for (const ContinuationPoint& p : branch.points) {
+    if (p.type == PointType::Fold && p.parameter < 1.2) past_the_closing = true;
+    if (!past_the_closing || p.parameter < 2.2) continue;
+    ShootingProblem here(c.definition);
+    here.set_parameter("turns", p.parameter);
+    const StabilityReport r = analyse_stability(here, p.x, options);
+    ASSERT_TRUE(r.defined()) << "turns = " << p.parameter << ": " << r.reason;
+    EXPECT_EQ(*r.index, 0) << "turns = " << p.parameter;
+    EXPECT_EQ(r.zero_modes, 1) << "turns = " << p.parameter;
+    ++checked;
+  }
+  EXPECT_GE(checked, 5);
+}
+
 // plectoneme.toml's barrier at turns = 0 is exactly off (its Gaussian underflows 1e2 ranges from the
 // arch); reaching 0.1 L instead of R/4 it acts on the arch, which it pushes outwards only.
 TEST(StabilitySymmetric, WhereTheSelfContactActsTheIndexIsDefined) {

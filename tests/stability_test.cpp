@@ -17,6 +17,7 @@
 #include "kirchhoff/analysis/discrete_stability.hpp"
 #include "kirchhoff/continuation/continuation.hpp"
 #include "kirchhoff/continuation/rod_continuation.hpp"
+#include "kirchhoff/jobs/case_solve.hpp"
 #include "kirchhoff/jobs/result_json.hpp"
 #include "test_support.hpp"
 
@@ -653,6 +654,28 @@ TEST(Stability, SoftWallArchRegainsItsStabilityAtTheBranchPointTowardsTheHardWal
   }
   EXPECT_GT(before, 10);
   EXPECT_GT(after, 5);
+}
+
+// The soft wall pushed further (log_b = -4, Delta 0.0307 .. 0.06): where the barrier is stiff the
+// Jacobi fields turn faster than the rate estimate says, and at the default observation steps
+// their eigenphases were paired wrongly (a passage "against the Legendre direction", index
+// undefined, on alternate points of a branch). Observed again with denser steps, the index is
+// defined and equals the discretised energy's (with the barrier; it passes its own checks).
+TEST(Stability, SoftWallPushedFurtherHasTheDiscretisedIndex) {
+  for (const double delta : {0.0307124618, 0.045, 0.06}) {
+    // As `kirchhoff solve` does: by homotopy from the case's own equilibrium (Newton alone does
+    // not reach these from the guess).
+    const Case c = load_case(testing::case_path("soft_wall.toml"),
+                             {{"log_b", -4.0}, {"Delta", delta}, {"P_guess", 40.0}, {"m_guess", 0.9}});
+    const CaseSolve solved = kirchhoff::solve_case(c);
+    ASSERT_TRUE(solved.converged()) << "Delta = " << delta << ": " << solved.message;
+    ASSERT_TRUE(solved.stability && solved.stability_check);
+    const StabilityReport& r = *solved.stability;
+    ASSERT_TRUE(r.defined()) << "Delta = " << delta << ": " << r.reason;
+    const DiscreteStability& d = *solved.stability_check;
+    ASSERT_TRUE(d.defined() && d.trustworthy) << "Delta = " << delta << ": " << d.check_message;
+    EXPECT_EQ(*r.index, *d.index) << "Delta = " << delta;
+  }
 }
 
 // wall.toml with its plane replaced by a disc of radius rho touching the same line y = a at
