@@ -12,7 +12,13 @@ std::vector<std::pair<std::string, double>> named_values(const py::object& obj) 
   for (const py::handle item : items) {
     const auto pair = item.cast<py::tuple>();
     if (pair.size() != 2) throw py::type_error("expected (name, value) pairs");
-    out.emplace_back(pair[0].cast<std::string>(), pair[1].cast<double>());
+    const auto name = pair[0].cast<std::string>();
+    try {
+      out.emplace_back(name, pair[1].cast<double>());
+    } catch (const py::cast_error&) {
+      // The CLI's words for `--set NAME=abc` (a CaseError, so a ValueError).
+      throw CaseError("'" + py::str(pair[1]).cast<std::string>() + "' given for '" + name + "' is not a number");
+    }
   }
   return out;
 }

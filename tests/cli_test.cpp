@@ -640,6 +640,17 @@ TEST_F(CliTest, SolverSettingsFromTheCommandLine) {
   EXPECT_EQ(run("check " + ss + " --solver tolerance").status, 2);
 }
 
+// --to at the starting value would never be crossed (the run marched off to its point budget):
+// exit 2 saying so, and no CSV (python_bindings_test.py expects the same text).
+TEST_F(CliTest, TargetAtTheStartingValueIsRefused) {
+  const fs::path csv = dir_ / "b.csv";
+  const CliRun r = run("continue " + quoted(case_path("euler_column.toml")) + " --param P --to 12 --out " +
+                       quoted(csv.string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("--to 12 is P's starting value: nothing to continue"));
+  EXPECT_FALSE(fs::exists(csv));
+}
+
 // continue in a computed parameter: exit 2 naming the one to continue in.
 TEST_F(CliTest, ContinueInAComputedParameterIsRefused) {
   const std::string path = variant("simply_supported.toml", "EI = 1.0", "r = 0.5\nEI = \"pi*r^2\"");

@@ -120,6 +120,18 @@ class LoadCaseTest(unittest.TestCase):
                 kirchhoff.load_case(str(path))
         self.assertIn("bogus_setting", str(cm.exception))
 
+    def test_value_that_is_no_number_is_refused_by_name(self):
+        with self.assertRaises(kirchhoff.CaseError) as cm:
+            kirchhoff.load_case(case_path("wall.toml"), set={"Delta": "abc"})
+        self.assertIn("'abc' given for 'Delta' is not a number", str(cm.exception))
+
+    def test_target_at_the_starting_value_is_refused(self):
+        # tests/cli_test.cpp (TargetAtTheStartingValueIsRefused) expects the same text.
+        case = kirchhoff.load_case(case_path("euler_column.toml"))
+        with self.assertRaises(kirchhoff.CaseError) as cm:
+            case.continue_("P", to=12)
+        self.assertIn("--to 12 is P's starting value: nothing to continue", str(cm.exception))
+
     def test_missing_file_raises_value_error(self):
         with self.assertRaises(ValueError):
             kirchhoff.load_case(case_path("does_not_exist.toml"))
@@ -474,13 +486,13 @@ class ContinuationTest(unittest.TestCase):
     def test_bad_inputs_raise_value_error(self):
         case = kirchhoff.load_case(case_path("euler_column.toml"))
         with self.assertRaises(ValueError) as cm:
-            case.continue_("not_a_parameter", to=12.0)
+            case.continue_("not_a_parameter", to=13.0)
         self.assertIn("not_a_parameter", str(cm.exception))
         with self.assertRaises(ValueError) as cm:
-            case.continue_("P", to=12.0, events={"not_derived": 1.0})
+            case.continue_("P", to=13.0, events={"not_derived": 1.0})
         self.assertIn("not_derived", str(cm.exception))
         with self.assertRaises(ValueError):
-            case.continue_("P", to=12.0, step=-1.0)
+            case.continue_("P", to=13.0, step=-1.0)
 
     def test_branch_points_can_be_skipped(self):
         case = kirchhoff.load_case(case_path("euler_column.toml"), set={"P": 1.0, "theta_guess": 0.0})

@@ -334,6 +334,14 @@ std::string ContinueRequest::validate(const Case& c) const {
     if (!std::isfinite(e.value) || std::abs(e.value) > case_limits::kMaxMagnitude)
       return "--event/--record: " + e.quantity + "'s value must be finite, within +-1e100";
   }
+  // A target at the starting value is never crossed: the run would march off to its point budget.
+  if (!start && !resume && target == c.definition.parameters.get(parameter)) {
+    std::ostringstream why;
+    why.precision(17);
+    why << c.path << ": --to " << target << " is " << parameter
+        << "'s starting value: nothing to continue (start elsewhere with --set " << parameter << "=...)";
+    return why.str();
+  }
   return options_for(c, *this).validate();
 }
 
