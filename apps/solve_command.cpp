@@ -37,6 +37,9 @@ void print_human(const Case& c, const Solution& sol, const StabilityReport& stab
   std::cout << "  " << describe(stability) << "\n";
   if (discrete.defined() && discrete.trustworthy && stability.index && *stability.index != *discrete.index)
     std::cout << "  warning: the discretised energy's check finds index " << *discrete.index << "\n";
+  if (discrete.defined() && discrete.trustworthy && !stability.index)
+    std::cout << "  the discretised energy's check (" << discrete.elements << " elements, passed its own tests) finds index "
+              << *discrete.index << "\n";
 }
 
 // How the equilibrium was reached, when a homotopy took it there.

@@ -640,6 +640,16 @@ TEST_F(CliTest, SolverSettingsFromTheCommandLine) {
   EXPECT_EQ(run("check " + ss + " --solver tolerance").status, 2);
 }
 
+// Where the conjugate points leave the index undefined (here a chord held nearly degenerate:
+// the clamped ends 1e-5 apart, docs/stability.md) and the discretised energy's check passed its
+// own tests, the text output gives the check's index (the symmetric loop is stable for D > 0).
+TEST_F(CliTest, UndefinedIndexShowsTheDiscretisedCheck) {
+  const CliRun r = run("solve " + quoted(case_path("clamped_clamped.toml")) + " --set D=1e-5");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("index undefined: a degenerate constraint"));
+  EXPECT_THAT(r.out, HasSubstr("the discretised energy's check (400 elements, passed its own tests) finds index 0"));
+}
+
 // --to at the starting value would never be crossed (the run marched off to its point budget):
 // exit 2 saying so, and no CSV (python_bindings_test.py expects the same text).
 TEST_F(CliTest, TargetAtTheStartingValueIsRefused) {
