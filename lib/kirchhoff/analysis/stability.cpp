@@ -925,8 +925,9 @@ NearZeroModes near_zero_modes(const Eigen::MatrixXd& conditions, const Eigen::Ma
   if (sigma.size() == 0) return out;
   Eigen::MatrixXd below = Eigen::MatrixXd::Zero(loads.cols(), loads.cols()), rest = particular_values;
   for (Eigen::Index j = 0; j < sigma.size(); ++j) {
-    if (sigma[j] <= kRoundOffZero * sigma[0]) {
+    if (sigma[j] <= kRoundOffZero * sigma[0]) {  // dropped by the decomposition: no part of D
       out.exact = true;
+      out.parts.push_back({Eigen::MatrixXd::Zero(loads.cols(), loads.cols()), 0.0});
       continue;
     }
     const Eigen::MatrixXd part =
@@ -935,9 +936,9 @@ NearZeroModes near_zero_modes(const Eigen::MatrixXd& conditions, const Eigen::Ma
     out.parts.push_back({0.5 * (part + part.transpose()), noise * sigma[0] / sigma[j]});
   }
   out.exact = out.exact || below.norm() > kExactZeroShare * std::max(rest.norm(), tol);
-  if (out.exact)  // the modes below the tolerance are projected out of D
+  if (out.exact)  // the modes below the tolerance are projected out of D (parts[j] is mode j's)
     for (Eigen::Index j = 0; j < sigma.size(); ++j)
-      if (sigma[j] <= tol && sigma[j] > kRoundOffZero * sigma[0]) out.parts[static_cast<size_t>(j)].second = 0.0;
+      if (sigma[j] <= tol) out.parts[static_cast<size_t>(j)].second = 0.0;
   return out;
 }
 
