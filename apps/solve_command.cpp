@@ -35,9 +35,10 @@ void print_human(const Case& c, const Solution& sol, const StabilityReport& stab
       std::cout << " at s = " << contact.s << ", force " << contact.force << "\n";
   }
   std::cout << "  " << describe(stability) << "\n";
-  if (discrete.defined() && discrete.trustworthy && stability.index && *stability.index != *discrete.index)
+  const bool checked = discrete.defined() && discrete.trustworthy;
+  if (checked && stability.index && *stability.index != *discrete.index)
     std::cout << "  warning: the discretised energy's check finds index " << *discrete.index << "\n";
-  if (discrete.defined() && discrete.trustworthy && !stability.index)
+  if (checked && !stability.index)
     std::cout << "  the discretised energy's check (" << discrete.elements << " elements, passed its own tests) finds index "
               << *discrete.index << "\n";
 }

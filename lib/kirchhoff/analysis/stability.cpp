@@ -1230,13 +1230,17 @@ constexpr int kRefinements = 2;
 constexpr double kKeepRefining = 4.0;
 
 // `run(options, &reversed)`: one analysis with those options, saying whether it saw a reversal.
+// The report's right-hand sides are those of every run made.
 template <class Run>
 StabilityReport run_resolved(const StabilityOptions& options, const Run& run) {
   StabilityOptions o = options;
+  long rhs_before = 0;
   for (int refinement = 0;; ++refinement) {
     bool reversed = false;
     StabilityReport report = run(o, &reversed);
+    report.rhs_evaluations += rhs_before;
     if (!reversed || refinement == kRefinements) return report;
+    rhs_before = report.rhs_evaluations;
     o.max_phase_step /= kKeepRefining;
     o.min_steps = static_cast<int>(o.min_steps * kKeepRefining);
   }

@@ -1,7 +1,7 @@
 #include "kirchhoff/continuation/detail/kinked_minimum.hpp"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <vector>
 

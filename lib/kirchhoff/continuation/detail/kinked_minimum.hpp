@@ -4,12 +4,14 @@
 //
 // Brent's parabolic steps model a smooth minimum; at a kink they are rejected and it falls back to
 // golden sections, about 58 evaluations for 40 bits, each one a corrector solve. Here each step
-// fits a V, f = f0 + c |h - h*|, through the bracket's three points (two unknown slopes' worth of
-// data fix c, h* and f0 once the side of h* is known: the side whose fit lands inside its own
-// interval). On an exact V one fit lands on h*; with curvature the error falls quadratically.
-// A fit that does not shrink the bracket to 0.6 of its width within two steps is replaced by a
-// golden section of the larger part, so convergence is never slower than golden sections, and a
-// smooth minimum is still found (more slowly than by Brent).
+// intersects a falling line (left of the kink) with a rising one (right of it), each through the
+// nearest samples on its side, for both sides the kink may lie on, and keeps the one that lands in
+// its own interval (the lower where both do). On an exact V one fit lands on h*; with curvature
+// the lines come from ever nearer samples. A fit that lands on the lowest sample is replaced by a
+// probe mirrored across it, so that both sides get near samples. A step that does not bring the
+// bracket to 0.6 of its width within two steps is a golden section of the larger part instead,
+// so convergence is never slower than golden sections, and a smooth minimum is still found (more
+// slowly than by Brent).
 #pragma once
 
 #include <functional>
