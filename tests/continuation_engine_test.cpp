@@ -139,10 +139,13 @@ TEST(ContinuationEngine, FindsThePitchforkAndSwitchesOntoTheParabola) {
 }
 
 // A march resumed from its state at one of its points takes the same steps as the uninterrupted
-// one, bit for bit (MarchState), for any system.
-TEST(ContinuationEngine, ResumedMarchRepeatsTheUninterruptedOne) {
+// one, bit for bit (MarchState), for any system, with or without branch-point detection: the
+// point before the saved one serves the quadratic predictor either way (without it the resumed
+// run's first step is predicted from the tangent alone and lands on other bits).
+void expect_resumed_march_repeats_the_uninterrupted_one(bool detect_branch_points) {
   ContinuationOptions o = options_for("lambda");
   o.max_points = 40;
+  o.detect_branch_points = detect_branch_points;
   std::vector<MarchState> states;
   o.on_resumable = [&](const MarchState& s) { states.push_back(s); };
   Continuation whole(std::make_unique<Circle>(0.0), o);
@@ -166,6 +169,14 @@ TEST(ContinuationEngine, ResumedMarchRepeatsTheUninterruptedOne) {
     EXPECT_EQ(a.parameter, b.parameter) << "point " << a.index;
     EXPECT_EQ(a.x[0], b.x[0]) << "point " << a.index;
   }
+}
+
+TEST(ContinuationEngine, ResumedMarchRepeatsTheUninterruptedOne) {
+  expect_resumed_march_repeats_the_uninterrupted_one(true);
+}
+
+TEST(ContinuationEngine, ResumedMarchWithoutBranchPointsRepeatsTheUninterruptedOne) {
+  expect_resumed_march_repeats_the_uninterrupted_one(false);
 }
 
 // The quadratic predictor (the default) against the tangent alone, on the circle at a fixed

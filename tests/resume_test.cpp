@@ -64,9 +64,13 @@ class ResumeTest : public kirchhoff::testing::ScratchFolderTest {
     ASSERT_EQ(lines_of(csv).size(), static_cast<size_t>(row + 2)) << "the header and rows 0.." << row;
   }
   // Kills the run after `row`, resumes it and compares its CSV with `expected`, line by line.
-  void expect_resume_repeats(const std::vector<std::string>& args, const fs::path& csv,
+  // Both save their state after every point (--checkpoint 0), so the resume starts from row
+  // `row` - 1's state, the march's own, not from the last timed checkpoint (with the default of
+  // a second, a run of a few seconds would resume from its start and test little).
+  void expect_resume_repeats(std::vector<std::string> args, const fs::path& csv,
                              const std::vector<std::string>& expected, int row) {
     SCOPED_TRACE("killed after row " + std::to_string(row));
+    args.insert(args.end(), {"--checkpoint", "0"});
     run_killed_after(args, csv, row);
     ASSERT_EQ(run_to_end(with_resume(args), dir_ / "resume.log"), 0);
     const auto resumed = lines_of(csv);
@@ -130,6 +134,25 @@ TEST_F(ResumeTest, WallResumedOnItsContactLegsRepeatsTheRun) {
   // (Each kill costs a whole run: the point-contact leg's kills are in the test below.)
   for (int row : {flattens, (flattens + hanging) / 2, (fold + last) / 2})
     expect_resume_repeats(wall_args(csv), csv, expected, row);
+}
+
+// The cavity's flat contact (from row 283, Delta = 0.030749) is a long leg whose corrector lands
+// on the branch to its tolerance only along a weakly determined direction: a resumed run whose
+// first step was predicted from the tangent alone, not from the last two points as the
+// uninterrupted run's was, landed 3e-8 away, and the two runs ended on different branches at
+// Delta = 0.1 (P = 273.97 against 169.81). Killed on that leg, the resumed run writes the same rows.
+TEST_F(ResumeTest, CavityResumedOnItsFlatLegRepeatsTheRun) {
+  auto args_for = [](const fs::path& csv) {
+    return std::vector<std::string>{KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/cavity.toml",
+                                    "--param", "Delta", "--to", "0.1", "--max-points", "600", "--out", csv.string()};
+  };
+  const fs::path full = dir_ / "full.csv", csv = dir_ / "killed.csv";
+  ASSERT_EQ(run_to_end(args_for(full), dir_ / "full.log"), 0);
+  const auto expected = lines_of(full);
+  ASSERT_EQ(expected.size(), 601u);
+  const int flattens = first_line_with(expected, "contact_flattens");
+  ASSERT_TRUE(200 < flattens && flattens < 400) << flattens;
+  for (int row : {flattens + 20, flattens + 200}) expect_resume_repeats(args_for(csv), csv, expected, row);
 }
 
 // The legs of a contact run share --max-points: a resumed leg gets the share it had (killed on

@@ -519,7 +519,10 @@ ContinuationResult Continuation::resume(const MarchState& saved, const PointSink
     return failed;
   }
   state.current = std::move(*current);
-  // The point before is only looked at for minima of the smallest singular value.
+  // The point before serves the quadratic predictor (its tangent and arclength, as saved) and,
+  // with its test functions evaluated again, minima of the smallest singular value. Dropped, the
+  // resumed run's first step was predicted linearly where the uninterrupted one's was quadratic,
+  // and on an ill-conditioned leg (the cavity's flat contact) the two runs parted for good.
   if (saved.before && options_.detect_branch_points) {
     auto before = restore(*saved.before, false);
     if (!before) {
@@ -527,8 +530,8 @@ ContinuationResult Continuation::resume(const MarchState& saved, const PointSink
       return failed;
     }
     state.before = std::move(*before);
-  } else {
-    state.before.reset();
+  } else if (state.before) {
+    state.before->jacobian.reset();
   }
   // The saved point is already reported; the rest go to the sink as they are found, so that a
   // resumed run killed again keeps what it had computed.
