@@ -102,6 +102,10 @@ void print_table(const Case& c, const EquilibriaSearch& search) {
   for (size_t i = 0; i < search.equilibria.size(); ++i) {
     const StabilityReport& s = search.equilibria[i].stability;
     if (!s.index) std::cout << "  #" << i + 1 << ": index undefined: " << s.reason << "\n";
+    const NewtonSummary& summary = search.equilibria[i].solution.result.summary;
+    if (!summary.message.empty())
+      std::cout << "  #" << i + 1 << ": converged with " << summary.message
+                << "; its residual is as low as this shooting's conditioning allows (more [solver] segments lower it)\n";
   }
   if (!search.rejected.empty())
     std::cout << "  " << search.rejected.size() << " converged points rejected (not admissible or failed checks; "
@@ -123,6 +127,8 @@ nlohmann::json search_json(const Case& c, const EquilibriaSearch& search) {
     j["rank"] = i + 1;
     j["energy"] = std::isfinite(e.energy) ? nlohmann::json(e.energy) : nlohmann::json();
     j["found_by"] = e.found_by;
+    // "step at round-off": the residual is above the tolerance, at the shooting's round-off.
+    if (!e.solution.result.summary.message.empty()) j["message"] = e.solution.result.summary.message;
     // No zero mode: an isolated equilibrium; null where the stability analysis is not defined.
     j["isolated"] = e.stability.defined() ? nlohmann::json(e.stability.zero_modes == 0) : nlohmann::json();
     // The continuous family it is a point of (docs/equilibria.md), null when isolated.

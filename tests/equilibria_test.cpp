@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -14,6 +15,7 @@
 #include <iostream>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "kirchhoff/analysis/analytic.hpp"
@@ -116,7 +118,8 @@ double elastica_theta0(double P, double EI, double L, int n) {
 // The Euler column's rods whose ends meet (x(L) = 0), at the dead load P: each is a closed
 // mode-k Elastica (k half-waves) under the force |n| = k^2 lambda_1, lambda_1 the load at which the
 // mode-1 Elastica's ends meet (theta0 = theta_c, x(L) = 0), turned so that n_x = -P: the lateral
-// reaction is +-sqrt(|n|^2 - P^2), and each sign comes with its mirror image, four rods per k.
+// reaction is +-sqrt(|n|^2 - P^2), and each sign comes with its mirror image, four rods per k
+// with k^2 lambda_1 > P (k >= 2 at P = 50, without end).
 // Energy: bending only (x(L) = 0), -|n| L cos(theta_c) (H = -|n| cos(theta_c) along the rod and
 // the chord along n is zero).
 // They are isolated equilibria, not points of a family: turning such a rod by phi about the pin
@@ -131,13 +134,13 @@ void expect_isolated_rods_whose_ends_meet(const std::vector<const Equilibrium*>&
     (analytic::PinnedElastica{1.0, 1.0, mid}.end_to_end() > 0 ? lo : hi) = mid;
   }
   const double theta_c = 0.5 * (lo + hi), lambda_1 = analytic::PinnedElastica{1.0, 1.0, theta_c}.load();
-  ASSERT_EQ(meeting.size(), 8u);
-  int count[4] = {0, 0, 0, 0}, positive_reaction[4] = {0, 0, 0, 0};
+  ASSERT_GE(meeting.size(), 8u);
+  std::map<int, int> count, positive_reaction;
   for (const Equilibrium* e : meeting) {
     const Vec3 n = e->solution.profile.front().n;
     const int k = static_cast<int>(std::lround(std::sqrt(n.norm() / lambda_1)));
     SCOPED_TRACE("closed mode " + std::to_string(k) + ", n_y = " + std::to_string(n.y()));
-    ASSERT_TRUE(k == 2 || k == 3);  // mode 1 closes at lambda_1 = 21.5 < P: no such rod at P = 50
+    ASSERT_GE(k, 2);  // mode 1 closes at lambda_1 = 21.5 < P: no such rod at P = 50
     ++count[k];
     positive_reaction[k] += n.y() > 0;
     EXPECT_LT(e->solution.derived.at("end_to_end"), 1e-9);
@@ -149,10 +152,17 @@ void expect_isolated_rods_whose_ends_meet(const std::vector<const Equilibrium*>&
     EXPECT_EQ(*e->stability.index, k);
     EXPECT_EQ(e->stability.zero_modes, 0);
   }
-  for (int k : {2, 3}) {
-    EXPECT_EQ(count[k], 4);
-    EXPECT_EQ(positive_reaction[k], 2);
+  // The search stops at --max (16), so a group may be listed in part; a whole one has two rods
+  // of each reaction's sign.
+  int whole_groups = 0;
+  for (const auto& [k, found] : count) {
+    EXPECT_LE(found, 4) << "closed mode " << k;
+    if (found == 4) {
+      ++whole_groups;
+      EXPECT_EQ(positive_reaction[k], 2) << "closed mode " << k;
+    }
   }
+  EXPECT_GE(whole_groups, 1);
   // The independent count on one rod of each energy (the list is sorted by energy).
   for (const Equilibrium* e : {meeting.front(), meeting.back()}) {
     const DiscreteStability d = discrete_stability(*e->problem, e->solution.result.x);
@@ -171,19 +181,27 @@ void expect_isolated_rods_whose_ends_meet(const std::vector<const Equilibrium*>&
 TEST(Equilibria, EulerColumnAtP50) {
   const double P = 50.0, EI = 1.0, L = 1.0;
   const EquilibriaSearch s = search("euler_column.toml", {{"P", P}});
-  // Besides the five classical equilibria the dead-load column has rods whose ends meet
+  // Besides the six classical equilibria the dead-load column has rods whose ends meet
   // (x(L) = 0: the roller's lateral reaction then does no moment about the pin, so n_y != 0 is
-  // allowed). The five are the ones with the ends apart; the others are checked below.
+  // allowed). The six are the ones with the ends apart; the others are checked below.
   std::vector<const Equilibrium*> apart, meeting;
   for (const auto& e : s.equilibria)
     (e.solution.derived.at("end_to_end") > 1e-9 ? apart : meeting).push_back(&e);
-  ASSERT_EQ(apart.size(), 5u);
+  ASSERT_EQ(apart.size(), 6u);
   expect_isolated_rods_whose_ends_meet(meeting, P);
-  EXPECT_EQ(s.families, 0);  // all thirteen isolated
-  // By energy: mode 1 (both mirror images), mode 2 (both), the straight column.
+  EXPECT_EQ(s.families, 0);  // all isolated
+  // By energy: the straight rod turned against the load (in tension: the global minimum, -P L,
+  // and stable, its second variation EI eta'^2 + P eta^2 positive), mode 1 (both mirror images),
+  // mode 2 (both), the straight column.
+  const Equilibrium& tension = *apart[0];
+  EXPECT_NEAR(std::cos(tension.solution.profile.front().turn_angle), -1.0, 1e-9);
+  EXPECT_NEAR(tension.energy, -P * L, 1e-9 * P * L);
+  ASSERT_TRUE(tension.stability.index);
+  EXPECT_EQ(*tension.stability.index, 0);
+  EXPECT_EQ(tension.stability.zero_modes, 0);
   const int expected_modes[5] = {1, 1, 2, 2, 0};
   for (int k = 0; k < 5; ++k) {
-    const Equilibrium& e = *apart[k];
+    const Equilibrium& e = *apart[k + 1];
     const double theta0 = e.solution.profile.front().turn_angle;
     const double x_L = e.solution.profile.back().r.x();
     const int n = expected_modes[k];
@@ -208,6 +226,38 @@ TEST(Equilibria, EulerColumnAtP50) {
     // (theta0 = 2.906 > 2.2813, docs/stability.md: the ends meeting is a loss of stability).
     ASSERT_TRUE(e.stability.index) << k;
     EXPECT_EQ(*e.stability.index, 1) << k;
+  }
+}
+
+// Well above the third Euler load the shooting is ill-conditioned (the residual's sensitivity to
+// theta0 grows like exp(sqrt(P) L)): at P = 100 the first mode's residual read 3e-10 when
+// integrated without sensitivities and the search rejected it, and no seed reached the straight
+// rod in tension. Now the list starts with that rod (-P L, stable) and holds each mode k = 1, 2,
+// 3 ((k pi)^2 < P) as the closed form gives it, with the discretised energy's index.
+TEST(Equilibria, EulerColumnAtP100ListsTheRodInTensionAndEveryMode) {
+  const double P = 100.0, EI = 1.0, L = 1.0;
+  const EquilibriaSearch s = search("euler_column.toml", {{"P", P}});
+  ASSERT_FALSE(s.equilibria.empty());
+  const Equilibrium& tension = s.equilibria.front();
+  EXPECT_NEAR(std::cos(tension.solution.profile.front().turn_angle), -1.0, 1e-9);
+  EXPECT_NEAR(tension.energy, -P * L, 1e-9 * P * L);
+  ASSERT_TRUE(tension.stability.index);
+  EXPECT_EQ(*tension.stability.index, 0);
+  for (int n = 1; n <= 3; ++n) {
+    SCOPED_TRACE("mode " + std::to_string(n));
+    const double closed = elastica_theta0(P, EI, L, n);
+    const auto mode = std::find_if(s.equilibria.begin(), s.equilibria.end(), [&](const Equilibrium& e) {
+      const double theta0 = e.solution.profile.front().turn_angle;
+      // theta0 up to its sign and whole turns; the solve's 1e-8 (the closed form's ~1e-12).
+      return std::abs(std::cos(theta0) - std::cos(closed)) < 1e-8 &&
+             std::abs(std::abs(std::sin(theta0)) - std::sin(closed)) < 1e-8;
+    });
+    ASSERT_NE(mode, s.equilibria.end());
+    const DiscreteStability d = discrete_stability(*mode->problem, mode->solution.result.x);
+    ASSERT_TRUE(d.defined()) << d.reason;
+    ASSERT_TRUE(d.trustworthy) << d.check_message;
+    ASSERT_TRUE(mode->stability.index) << mode->stability.reason;
+    EXPECT_EQ(mode->stability.index, d.index);
   }
 }
 
@@ -497,19 +547,26 @@ TEST(EquilibriaCli, PointsOfAContinuousFamilyAreListedAsOneFamily) {
   EXPECT_NE(table.find("): 0 isolated, 4 with zero modes on 3 continuous families (see below)"), std::string::npos)
       << table;
   EXPECT_NE(table.find("1 +1 zero"), std::string::npos) << table;
-  EXPECT_NE(table.find("family 2: #2, #3 (1 zero mode): 2 points of one continuous family"), std::string::npos)
-      << table;
+  // (Which two of the four points share a family depends on the order the seeds reach them.)
+  EXPECT_NE(table.find("(1 zero mode): 2 points of one continuous family"), std::string::npos) << table;
   ASSERT_EQ(run(args + " --json", json), 0);
   std::ifstream in_json(json);
   const nlohmann::json j = nlohmann::json::parse(in_json);
   EXPECT_EQ(j["families"], 3);
   ASSERT_EQ(j["equilibria"].size(), 4u);
-  const int families[4] = {1, 2, 2, 3};
+  std::map<int, int> members;
   for (int k = 0; k < 4; ++k) {
     EXPECT_EQ(j["equilibria"][k]["isolated"], false) << k;
-    EXPECT_EQ(j["equilibria"][k]["family"], families[k]) << k;
+    ASSERT_TRUE(j["equilibria"][k]["family"].is_number()) << k;
+    ++members[j["equilibria"][k]["family"].get<int>()];
     EXPECT_EQ(j["equilibria"][k]["stability"]["zero_modes"], 1) << k;
   }
+  // Three families numbered 1 to 3, one of them with two of the points.
+  ASSERT_EQ(members.size(), 3u);
+  for (int f = 1; f <= 3; ++f) EXPECT_EQ(members.count(f), 1u) << f;
+  int largest = 0;
+  for (const auto& [f, count] : members) largest = std::max(largest, count);
+  EXPECT_EQ(largest, 2);
 }
 
 }  // namespace

@@ -92,15 +92,19 @@ NewtonSummary deflated_newton(const NonlinearSystem& system, Eigen::VectorXd& x,
       return stop(summary, SolverStatus::NotFinite, "the residual or its Jacobian is not finite");
     summary.iterations = it;
     summary.history.push_back(summary.residual_norm);
-    if (summary.residual_norm <= options.residual_tolerance) {
+    const auto at_root = [&](const char* how) {
       if (deflation.nearest_root_distance(x) <= options.known_root_distance)
         return stop(summary, SolverStatus::MaxIterations, "returned to a known root despite the deflation");
-      return stop(summary, SolverStatus::Converged, "converged");
-    }
+      return stop(summary, SolverStatus::Converged, how);
+    };
+    if (summary.residual_norm <= options.residual_tolerance) return at_root("converged");
     if (it == options.max_iterations) break;
     const Eigen::PartialPivLU<Eigen::MatrixXd> lu(J);
     if (!(lu.rcond() > 1e-15)) return stop(summary, SolverStatus::SingularJacobian, "singular Jacobian");
     const Eigen::VectorXd d = lu.solve(-F);
+    if (step_at_round_off(d.lpNorm<Eigen::Infinity>(), x.lpNorm<Eigen::Infinity>(), summary.residual_norm,
+                          options.step_tolerance, options.residual_tolerance))
+      return at_root("step at round-off");
     // The deflated step delta = d / (1 - v.d) (Sherman-Morrison on J_G, see the header).
     const double denominator = 1.0 - deflation.log_gradient(x).dot(d);
     if (!(std::abs(denominator) > options.min_denominator))

@@ -65,11 +65,16 @@ struct DeflatedNewtonOptions {
   // A converged point this close (scaled distance) to a known root is that root reached anyway
   // (possible when the deflation is too weak at the start): reported as not converged.
   double known_root_distance = 1e-6;
+  // Converged also where the plain Newton step is at round-off (step_at_round_off, as
+  // NewtonOptions::step_tolerance): a root of an ill-conditioned problem that no iterate can
+  // bring within residual_tolerance.
+  double step_tolerance = 1e-14;
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
 };
 
 // Deflated Newton from x (on return the last iterate). The summary's status is Converged only when
-// max |F| <= residual_tolerance at a point that is not a known root; otherwise why it stopped.
+// max |F| <= residual_tolerance (or the Newton step is at round-off, message "step at round-off")
+// at a point that is not a known root; otherwise why it stopped.
 NewtonSummary deflated_newton(const NonlinearSystem& system, Eigen::VectorXd& x, const DeflationOperator& deflation,
                               const DeflatedNewtonOptions& options = {});
 

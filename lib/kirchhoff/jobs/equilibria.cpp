@@ -295,13 +295,17 @@ class Search {
     definition_.options.newton.step_matrix_tolerance = 0.0;
     deflated_ = options.deflation;
     deflated_.residual_tolerance = definition.options.newton.residual_tolerance;
+    deflated_.step_tolerance = definition.options.newton.step_tolerance;
     deflated_.deadline = std::min(deadline_, definition.options.newton.deadline);
     force_scale_ = force_scale();
   }
 
   EquilibriaSearch run() {
     push_start(guess_, definition_.contacts, "guess");
-    if (options_.mirrors) push_mirrors(guess_, "guess");
+    if (options_.mirrors) {
+      push_mirrors(guess_, "guess");
+      push_half_turn(guess_, "guess", -INFINITY);
+    }
     if (options_.discrete_seeds) push_discrete_seeds();
     while (!seeds_.empty() && !should_stop()) {
       const auto next = std::min_element(seeds_.begin(), seeds_.end(),
@@ -386,6 +390,29 @@ class Search {
     push_start(start, contacts, "reversal of " + of, priority);
     push_start(reflected(start, start.r, reflections(RodKind::Planar).front()), {}, "mirrored reversal of " + of,
                priority);
+  }
+
+  // The planar rod's start turned by a half-turn about e_z, its forces and moment kept: the loads
+  // are dead, so this reverses the rod's direction against them. The straight column under
+  // compression, turned, is the straight rod in tension (the global minimum under a dead end
+  // load, which no other seed reached); a buckled mode turned starts near the modes that leave
+  // the support the other way. Turning the rod against its loads can lower the energy far below
+  // its parent's, so the seed is taken in the order of the lower of the two: its parent's and
+  // that of the rod integrated from it (without obstacles; with them the parent's).
+  void push_half_turn(const RodPoint& start, const std::string& of, double priority) {
+    if (definition_.kind != RodKind::Planar) return;
+    RodPoint turned = start;
+    turned.R = Vec3(-1.0, -1.0, 1.0).asDiagonal() * start.R;
+    if (definition_.obstacles.empty()) {
+      try {
+        const ShootingProblem& problem = *family({}).problem;
+        const double energy = total_potential_energy(problem, problem.initial_unknowns(turned));
+        if (std::isfinite(energy)) priority = std::min(priority, energy);
+      } catch (const std::exception&) {
+        // (An integration that fails from the seed: the parent's order.)
+      }
+    }
+    push_start(turned, {}, "half-turn of " + of, priority);
   }
 
   void push_discrete_seeds() {
@@ -508,14 +535,42 @@ class Search {
     return "";
   }
 
-  // The residual recomputed without the Jacobian can differ from the one Newton saw by the
-  // integrator's error control (an integration with sensitivities takes other steps): a root at
-  // the tolerance may read up to a few times above it. A few plain Newton steps settle it, kept
-  // only when they stay within the distinctness scale of the root (so they cannot move to another).
-  void polish(const ShootingProblem& problem, const DeflationOperator& deflation, Eigen::VectorXd& x) const {
+  // max |F| at x as Newton judges it, and the Newton step there. Integrated with the
+  // sensitivities, whose error control takes smaller steps than the state's alone: without them
+  // the residual carries more of the integrator's error, which grows with the shooting's
+  // sensitivity (on the Euler column at P = 100 its first mode read 3e-10 without them and 1e-12
+  // with them, and every root near the tolerance 1e-10 was rejected).
+  struct RootCheck {
+    bool evaluated = false;
+    double residual = NAN;
+    double step = NAN;  // max |J^-1 F|
+  };
+  static RootCheck check_root(const ShootingProblem& problem, const Eigen::VectorXd& x, std::string* failure) {
     Eigen::VectorXd F;
+    Eigen::MatrixXd J;
+    RootCheck c;
+    c.evaluated = problem.evaluate(x, &F, &J, failure);
+    if (!c.evaluated) return c;
+    c.residual = max_abs_or_nan(F);
+    if (std::isfinite(c.residual) && J.allFinite())
+      c.step = Eigen::PartialPivLU<Eigen::MatrixXd>(J).solve(F).lpNorm<Eigen::Infinity>();
+    return c;
+  }
+  // A root as Newton's tests have it: within the tolerance, or with its step at round-off.
+  bool is_root(const RootCheck& c, const Eigen::VectorXd& x) const {
+    return c.residual <= deflated_.residual_tolerance ||
+           step_at_round_off(c.step, x.lpNorm<Eigen::Infinity>(), c.residual, deflated_.step_tolerance,
+                             deflated_.residual_tolerance);
+  }
+
+  // A root deflated Newton reached at the tolerance may read a few times above it when evaluated
+  // again (the integrator's steps differ from its last iterate's). A few plain Newton steps
+  // settle it, kept only when they stay within the distinctness scale of the root (so they
+  // cannot move to another).
+  void polish(const ShootingProblem& problem, const DeflationOperator& deflation, Eigen::VectorXd& x) const {
     std::string failure;
-    if (!problem.evaluate(x, &F, nullptr, &failure) || max_abs_or_nan(F) <= deflated_.residual_tolerance) return;
+    const RootCheck c = check_root(problem, x, &failure);
+    if (!std::isfinite(c.residual) || is_root(c, x)) return;
     NewtonOptions newton = definition_.options.newton;
     newton.max_iterations = 4;
     newton.fallback_search = false;
@@ -532,12 +587,12 @@ class Search {
     result.x = x;
     result.parameters = f.problem->parameters_at(x);
     std::string failure;
-    Eigen::VectorXd F;
-    if (!f.problem->evaluate(x, &F, nullptr, &failure)) return reject(label, "cannot be re-evaluated: " + failure, NAN);
+    const RootCheck root = check_root(*f.problem, x, &failure);
+    if (!root.evaluated) return reject(label, "cannot be re-evaluated: " + failure, NAN);
     result.summary.status = SolverStatus::Converged;
-    result.summary.residual_norm = max_abs_or_nan(F);
-    if (!(result.summary.residual_norm <= deflated_.residual_tolerance))
-      return reject(label, "residual above the tolerance", result.summary.residual_norm);
+    result.summary.residual_norm = root.residual;
+    if (!is_root(root, x)) return reject(label, "residual above the tolerance", root.residual);
+    if (!(root.residual <= deflated_.residual_tolerance)) result.summary.message = "step at round-off";
     if (const std::string why = inadmissibility(*f.problem, x); !why.empty()) {
       reject(label, why, result.summary.residual_norm);
       // The active-set loop from the same rod may find the admissible equilibrium nearby.
@@ -593,6 +648,7 @@ class Search {
     if (options_.mirrors) {
       push_mirrors(f.problem->sample(x, {0.0}).front(), name, priority);
       push_reversals(*f.problem, x, name, priority);
+      push_half_turn(f.problem->sample(x, {0.0}).front(), name, priority);
     }
     push_contact_variants(*f.problem, x, name, priority);
     const std::string key = family_key(f.problem->definition().contacts);

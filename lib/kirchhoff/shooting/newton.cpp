@@ -48,6 +48,11 @@ std::string NewtonSummary::brief_report() const {
   return os.str();
 }
 
+bool step_at_round_off(double step, double x_norm, double residual, double step_tolerance,
+                       double residual_tolerance) {
+  return step <= step_tolerance * (1.0 + x_norm) && residual <= 1e3 * residual_tolerance;
+}
+
 double max_abs_or_nan(const Eigen::VectorXd& v) {
   if (!v.allFinite()) return NAN;
   return v.size() == 0 ? 0.0 : v.lpNorm<Eigen::Infinity>();
@@ -321,9 +326,8 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
     norm = max_abs_or_nan(F);
     summary.residual_norm = norm;
     summary.history.push_back(norm);
-    const bool stalled = step.alpha * dx.lpNorm<Eigen::Infinity>() <=
-                         options.step_tolerance * (1.0 + x.lpNorm<Eigen::Infinity>());
-    if (stalled && norm <= 1e3 * options.residual_tolerance) {
+    if (step_at_round_off(step.alpha * dx.lpNorm<Eigen::Infinity>(), x.lpNorm<Eigen::Infinity>(), norm,
+                          options.step_tolerance, options.residual_tolerance)) {
       summary.status = SolverStatus::Converged;
       summary.message = "step at round-off";
       return summary;

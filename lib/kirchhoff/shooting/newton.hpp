@@ -136,6 +136,14 @@ std::chrono::steady_clock::time_point deadline_after(double seconds);
 // maximum whose comparisons ignore a NaN, so a NaN residual could pass a `<= tolerance` test.)
 double max_abs_or_nan(const Eigen::VectorXd& v);
 
+// Newton's second test of convergence (NewtonOptions::step_tolerance): a Newton step `step`
+// (max-norm) from x (max-norm `x_norm`) within step_tolerance of x's size, while max |F| is
+// within 1e3 x residual_tolerance. An ill-conditioned shooting problem (a rod in tension under a
+// large dead load, where the residual's sensitivity to the start grows like exp(sqrt(P) L))
+// cannot lower its residual further: the iterate has stopped moving at round-off.
+bool step_at_round_off(double step, double x_norm, double residual, double step_tolerance,
+                       double residual_tolerance);
+
 // Central-difference Jacobian; returns false when an evaluation fails.
 bool finite_difference_jacobian(const NonlinearSystem& system, const Eigen::VectorXd& x, double step,
                                 Eigen::MatrixXd* J);
