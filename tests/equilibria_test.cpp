@@ -391,6 +391,30 @@ TEST(Equilibria, WallBeyondFlatteningHasAFlatContactBesideAsymmetricOnes) {
   for (const auto& r : s.rejected) EXPECT_NE(r.reason.find("penetrates"), std::string::npos) << r.reason;
 }
 
+// From the case's own guess (the straight rod) at phi = 10, well below the bifurcation at 11.68
+// from which the subcritical buckled rods' branch comes back in phi: only a far kick along the straight rod's low modes reaches the
+// buckled rod (its reactions ~4 F0 away), tried once the near seeds are exhausted. Its M and
+// end-to-end distance as the continuation of the README's buckled rod from phi = 11.58 down to 10
+// gives them (`continue cases/twisted_clamped.toml --set phi=11.58 --set m_lateral=-1.7 --set
+// n_lateral=3.4 --phase-condition axial --param phi --to 10`: 6.14925661284, 0.71279840773),
+// to the two solves' 1e-8.
+TEST(Equilibria, TwistedRodWellBelowItsBifurcationHasTheBuckledRodFoundFromTheStraightGuess) {
+  const EquilibriaSearch s = search("twisted_clamped.toml", {{"phi", 10.0}});
+  ASSERT_EQ(s.equilibria.size(), 2u) << s.stopped_because;
+  EXPECT_EQ(s.stopped_because, "seeds exhausted");
+  const Equilibrium& straight = s.equilibria[0];
+  EXPECT_NEAR(straight.solution.derived.at("end_to_end"), 1.0, 1e-9);
+  ASSERT_TRUE(straight.stability.index);
+  EXPECT_EQ(*straight.stability.index, 0);
+  const Equilibrium& buckled = s.equilibria[1];
+  EXPECT_NEAR(buckled.solution.derived.at("M"), 6.14925661284, 1e-8);
+  EXPECT_NEAR(buckled.solution.derived.at("end_to_end"), 0.71279840773, 1e-8);
+  ASSERT_TRUE(buckled.stability.index);
+  EXPECT_EQ(*buckled.stability.index, 1);
+  EXPECT_EQ(buckled.stability.zero_modes, 1);
+  EXPECT_NE(buckled.found_by.find("far kick"), std::string::npos) << buckled.found_by;
+}
+
 TEST(Equilibria, TwistedRodListsEachCircleOfBuckledRodsOnce) {
   // Below the Greenhill twist (M L / B = 8.9077 < 8.9868) the straight rod is stable and the
   // subcritical buckled rod (index 1) coexists; the isotropic rod's buckled equilibria come in

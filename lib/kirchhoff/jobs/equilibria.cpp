@@ -214,6 +214,7 @@ struct Seed {
   // the first ones), so the search explores around low-energy equilibria first and --max keeps
   // the lowest ones it can reach.
   double priority = -INFINITY;
+  bool far = false;  // a far kick (EquilibriaOptions::far_mode_amplitudes): after every other seed
   bool from_start = true;
   RodPoint start;
   std::vector<PointContact> contacts;  // the starting active set (from_start)
@@ -309,7 +310,9 @@ class Search {
     if (options_.discrete_seeds) push_discrete_seeds();
     while (!seeds_.empty() && !should_stop()) {
       const auto next = std::min_element(seeds_.begin(), seeds_.end(),
-                                         [](const Seed& a, const Seed& b) { return a.priority < b.priority; });
+                                         [](const Seed& a, const Seed& b) {
+                                           return a.far != b.far ? b.far : a.priority < b.priority;
+                                         });
       Seed seed = std::move(*next);
       seeds_.erase(next);
       seed.from_start ? run_start_seed(seed) : run_deflated(seed);
@@ -363,10 +366,12 @@ class Search {
     seeds_.push_back(std::move(s));
   }
 
-  void push_unknowns(const std::string& family, Eigen::VectorXd x0, const std::string& label, double priority) {
+  void push_unknowns(const std::string& family, Eigen::VectorXd x0, const std::string& label, double priority,
+                     bool far = false) {
     Seed s;
     s.label = label;
     s.priority = priority;
+    s.far = far;
     s.from_start = false;
     s.family = family;
     s.x0 = std::move(x0);
@@ -653,11 +658,14 @@ class Search {
     push_contact_variants(*f.problem, x, name, priority);
     const std::string key = family_key(f.problem->definition().contacts);
     const auto modes = low_mode_directions(*f.problem, x, f.deflation.scale(), options_.low_modes);
-    for (const double amplitude : options_.mode_amplitudes)
-      for (size_t k = 0; k < modes.size(); ++k)
-        for (const double sign : {1.0, -1.0})
-          push_unknowns(key, x + sign * amplitude * modes[k],
-                        "low mode " + std::to_string(k + 1) + (sign > 0 ? "+" : "-") + " of " + name, priority);
+    for (const bool far : {false, true})
+      for (const double amplitude : far ? options_.far_mode_amplitudes : options_.mode_amplitudes)
+        for (size_t k = 0; k < modes.size(); ++k)
+          for (const double sign : {1.0, -1.0})
+            push_unknowns(key, x + sign * amplitude * modes[k],
+                          std::string(far ? "far kick along low mode " : "low mode ") + std::to_string(k + 1) +
+                              (sign > 0 ? "+" : "-") + " of " + name,
+                          priority, far);
   }
 
   ProblemDefinition definition_;
@@ -686,6 +694,8 @@ EquilibriaSearch find_equilibria(const ProblemDefinition& definition, const RodP
                                  const EquilibriaOptions& options) {
   if (options.max_equilibria < 1 || options.restarts_per_seed < 1 || options.low_modes < 0 ||
       std::any_of(options.mode_amplitudes.begin(), options.mode_amplitudes.end(), [](double a) { return !(a > 0); }) ||
+      std::any_of(options.far_mode_amplitudes.begin(), options.far_mode_amplitudes.end(),
+                  [](double a) { return !(a > 0); }) ||
       !(options.distinct_tolerance > 0) || !(options.family_energy_tolerance > 0) || options.compare_samples < 2 ||
       !(options.max_seconds >= 0))
     throw std::invalid_argument("equilibria: invalid options (counts >= 1, amplitudes and tolerances > 0)");

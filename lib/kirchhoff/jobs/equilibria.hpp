@@ -58,6 +58,13 @@ struct EquilibriaOptions {
   // 0.05 stays near it, for equilibria close by (a contact that moved slightly off mid-span),
   // where a large kick sends Newton past them.
   std::vector<double> mode_amplitudes{0.5, 0.05};
+  // Kicks along the same low modes far beyond the root's neighbourhood, tried only once every
+  // other starting point is exhausted (so that a search --max stops keeps what the near seeds
+  // find first): branches of finite amplitude that no near seed reaches, such as the
+  // subcritical buckled rod of `twisted_clamped.toml` at phi = 10, reactions ~4 F0 away from
+  // the straight rod's (found from a kick of 8, not of 4: deflated Newton's steps are at most 2
+  // scaled units, and a longer kick keeps it on the mode's side).
+  std::vector<double> far_mode_amplitudes{8.0};
   bool mirrors = true;
   bool discrete_seeds = true;  // Ipopt's seeds where discrete_seed.hpp applies
   // Profiles closer than this (scale-free, see above) are one equilibrium. Converged profiles
