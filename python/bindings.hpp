@@ -81,6 +81,7 @@ struct PyBranch {
   bool switched = false;
   bool ok = false;  // what the CLI turns into exit status 0 (ContinueRunResult::ok)
   std::vector<std::string> contact_changes;  // as the CLI's "contact:" lines
+  std::vector<std::string> notes;            // the run's notes, as the CLI prints them
   py::dict points;
   size_t size = 0;
 };

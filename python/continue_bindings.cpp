@@ -11,6 +11,8 @@ namespace {
 class CollectingSink : public ContinueSink {
  public:
   std::vector<BranchPoint> points;
+  std::vector<std::string> notes;  // the run's notes, as the CLI prints them
+  void note(const std::string& line) override { notes.push_back(line); }
   void point(const RunPoint& p) override {
     points.push_back({*p.point, p.branch, p.row});
     points.back().point.jacobian.reset();
@@ -74,6 +76,7 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
   out.switched = result.switched;
   out.ok = result.ok;
   out.contact_changes = result.contact_changes;
+  out.notes = collect.notes;
   out.size = collect.points.size();
   out.points = branch_points_dict(collect.points, result.derived);
   return out;

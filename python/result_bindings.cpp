@@ -88,6 +88,9 @@ Attributes:
         what ("Delta = 0.0250667: a contact appears with obstacle 0 at s = 0.5"), as the CLI's
         "contact:" lines; the point's `event` holds the event's name (obstacle_reached,
         contact_lifts_off, contact_flattens, ...) as the CLI's CSV does.
+    notes (list of str): the run's notes, as the CLI prints them: how the branch started (where
+        Newton from the guess failed and it started from solve's equilibrium, reached by
+        homotopy), the self-contact guard, a seed, a branch switch.
     ok (bool): what the CLI reports with exit status 0 (kirchhoff::ended_normally): not
         start_failed, step_too_small, inadmissible or time_limit, and the requested branch switch
         happened.
@@ -106,6 +109,7 @@ Attributes:
       .def_readonly("switched", &PyBranch::switched)
       .def_readonly("ok", &PyBranch::ok)
       .def_readonly("contact_changes", &PyBranch::contact_changes)
+      .def_readonly("notes", &PyBranch::notes)
       .def_readonly("points", &PyBranch::points)
       .def("__len__", [](const PyBranch& b) { return b.size; })
       .def("__repr__", [](const PyBranch& b) {

@@ -108,6 +108,34 @@ TEST_F(ContinueCli, KilledContactRunResumesToTheSameRows) {
   EXPECT_NE(after.back().find(",endpoint,"), std::string::npos);
 }
 
+// Where Newton cannot start the branch from the case's guess at the --set values (the wall at
+// Delta = 0.04: the active-set loop from the arch's guess does not settle, and the run used to
+// stop with start_failed), the branch starts from the equilibrium `solve` reports there, reached
+// by homotopy from the file's values, and says so: its first row is that equilibrium (P as
+// `solve --json` gives it, to the two runs' identical arithmetic: both solve the same way).
+TEST_F(ContinueCli, StartsFromSolvesEquilibriumWhereNewtonFromTheGuessFails) {
+  const std::string wall = std::string(KIRCHHOFF_CASES_DIR) + "/wall.toml";
+  const fs::path csv = dir_ / "wall.csv", json = dir_ / "solve.json";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", wall, "--set", "Delta=0.04", "--param", "Delta", "--to", "0.045",
+                        "--out", csv.string()},
+                       dir_ / "continue.log"),
+            0);
+  bool noted = false;
+  for (const auto& line : lines_of(dir_ / "continue.log"))
+    noted = noted || line.find("the branch starts from the equilibrium solve reaches, by homotopy from the file's "
+                               "values (Delta = 0.026 -> 0.04)") != std::string::npos;
+  EXPECT_TRUE(noted);
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "solve", wall, "--set", "Delta=0.04", "--json"}, json, true), 0);
+  std::ifstream in(json);
+  const nlohmann::json solved = nlohmann::json::parse(in);
+  const auto rows = lines_of(csv);
+  ASSERT_GT(rows.size(), 2u);
+  const int P_column = 4;  // index, branch, Delta, arclength, P, ...
+  ASSERT_EQ(csv_field(rows[1], 2), 0.04);
+  EXPECT_NEAR(csv_field(rows[1], P_column), solved["derived"]["P"].get<double>(), 1e-12 * 251.69);
+  EXPECT_NE(rows.back().find(",endpoint,"), std::string::npos);
+}
+
 // The stability index along the run: the straight column is stable below pi^2 and the branch
 // point there has a zero mode; the buckled branch is stable until its ends meet (theta0 =
 // 2.2813, where the continuation finds a second branch point, the rod free to turn about the

@@ -953,6 +953,17 @@ class EquilibriaTest(unittest.TestCase):
         with self.assertWarnsRegex(RuntimeWarning, "no equilibrium found"):
             self.assertEqual(case.equilibria(max=2, max_seconds=60), [])
 
+    def test_continue_starts_from_solve_s_equilibrium_where_the_guess_fails(self):
+        # The wall at Delta = 0.04: the active-set loop from the arch's guess does not settle, so
+        # the branch starts from the equilibrium solve reaches by homotopy (the CLI's note, in
+        # Branch.notes), P = 251.69 on the flat contact, as solve() gives it.
+        case = kirchhoff.load_case(case_path("wall.toml"), set={"Delta": 0.04})
+        b = case.continue_("Delta", to=0.045, stability=False)
+        self.assertTrue(b.ok, b.message)
+        self.assertTrue(any("by homotopy from the file's values (Delta = 0.026 -> 0.04)" in n for n in b.notes),
+                        b.notes)
+        self.assertAlmostEqual(b.points["P"][0], case.solve().derived["P"], delta=1e-12 * 251.69)
+
     def test_continue_deflate_follows_every_branch_from_the_start(self):
         # The Euler column's five equilibria at P = 50, each followed to P = 60 (as the CLI's
         # --deflate; tests/continue_cli_test.cpp checks the ends against the closed form).

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "kirchhoff/analysis/discrete_seed.hpp"
@@ -10,6 +12,7 @@
 #include "kirchhoff/contact/self_passage.hpp"
 #include "kirchhoff/equations/integrator.hpp"
 #include "kirchhoff/continuation/rod_continuation.hpp"
+#include "kirchhoff/jobs/case_solve.hpp"
 #include "kirchhoff/jobs/deflated_continuation.hpp"
 
 namespace kirchhoff {
@@ -62,6 +65,43 @@ ProblemDefinition definition_for(const Case& c, const std::string& phase) {
 }
 
 // A run in progress: its state, its sinks, and the points it reports.
+// Where the first point cannot be corrected from the case's guess at the --set values (the wall at
+// Delta = 0.04: the active-set loop from the arch's guess does not settle), the equilibrium
+// `solve` reports there, reached by homotopy from the file's values (case_solve.hpp), is where
+// the branch starts instead: its unknowns and active set. Nothing where no homotopy applies (a
+// start from another run or a seed, a resume, a phase condition, no --set of a parameter that is
+// not solved for) or where it stops short too; either way `note` says what happened.
+struct HomotopyStart {
+  Eigen::VectorXd x;
+  std::vector<PointContact> contacts;
+};
+std::optional<HomotopyStart> start_by_homotopy(const Case& c, const ContinueRequest& request,
+                                               const std::string& direct_failure,
+                                               const std::function<void(const std::string&)>& note) {
+  if (request.start || request.resume || request.seed.ipopt || request.deflate) return std::nullopt;
+  if (!request.phase_condition.empty() && request.phase_condition != "none") return std::nullopt;
+  const std::vector<ParameterChange> changes = homotopy_changes(c);
+  if (changes.empty()) return std::nullopt;
+  CaseSolveOptions options;
+  options.solution = options.stability = options.stability_check = false;
+  const CaseSolve solved = solve_case(c, options);
+  const std::string failed = "start: the first point could not be corrected from the case's guess (" + direct_failure + ")";
+  if (!solved.converged() || !solved.solved.problem) {
+    std::string why = solved.message.empty() ? solved.summary().brief_report() : solved.message;
+    if (const size_t hint = why.find(kDirectSolveHint); hint != std::string::npos) why.erase(hint);
+    note(failed + ", nor did solve's homotopy from the file's values reach them: " + why);
+    return std::nullopt;
+  }
+  std::ostringstream line;
+  line.precision(10);
+  line << failed << "; the branch starts from the equilibrium solve reaches, by homotopy from the file's values (";
+  for (size_t i = 0; i < changes.size(); ++i)
+    line << (i ? ", " : "") << changes[i].name << " = " << changes[i].from << " -> " << changes[i].to;
+  line << ")";
+  note(line.str());
+  return HomotopyStart{solved.solved.result.x, solved.solved.problem->definition().contacts};
+}
+
 class Run {
  public:
   Run(const Case& c, const ContinueRequest& r, RodContinuationOptions options, const std::vector<ContinueSink*>& sinks)
@@ -193,6 +233,12 @@ ContinuationResult or_start_failed(F&& march) {
   return result;
 }
 
+// A new run (not a resume nor a start from a given point) whose first point could not be corrected
+// from the case's guess.
+bool from_the_guess_failed(const ContinuationResult& result, const Eigen::VectorXd& start_point, bool resuming) {
+  return !resuming && start_point.size() == 0 && result.reason == StopReason::StartFailed && result.points.empty();
+}
+
 ContinueRunResult Run::plain(const Eigen::VectorXd& start_point, bool resuming) {
   // The state after every point the march can resume from (right after its row).
   options_.on_resumable = [this](const MarchState& m) {
@@ -228,6 +274,9 @@ ContinueRunResult Run::plain(const Eigen::VectorXd& start_point, bool resuming) 
                     : run.run(start_point.size() > 0 ? start_point : problem->initial_unknowns(c_.start_guess),
                               sink_for(*problem, 0, state.phase_condition));
   });
+  if (from_the_guess_failed(result, start_point, resuming))
+    if (const auto h = start_by_homotopy(c_, r_, result.message, [this](const std::string& l) { note(l); }))
+      result = or_start_failed([&] { return run.run(h->x, sink_for(*problem, 0, state.phase_condition)); });
   bool switched = branch == 1;  // (a run resumed on the switched branch)
   if (branch == 0 && r_.switch_at_bp > 0 && result.reason != StopReason::TimeLimit) {
     if (result.reason != StopReason::BranchPointStop) {
@@ -283,6 +332,15 @@ ContinueRunResult Run::with_contacts(const Eigen::VectorXd& start_point, bool re
             : continue_with_contacts(c_.definition, c_.start_guess, first, sink, {}, on_active_set, save_leg);
     return r.result;
   });
+  if (from_the_guess_failed(r.result, start_point, resuming))
+    if (const auto h = start_by_homotopy(c_, r_, r.result.message, [this](const std::string& l) { note(l); })) {
+      ProblemDefinition at_start = c_.definition;
+      at_start.contacts = h->contacts;
+      r.result = or_start_failed([&] {
+        r = continue_with_contacts_from(at_start, h->x, first, sink, {}, on_active_set, save_leg);
+        return r.result;
+      });
+    }
   bool switched = branch == 1;  // (a run resumed on the switched branch)
   std::vector<std::string> changes;  // the starting branch's, when the run switched
   if (branch == 0 && r_.switch_at_bp > 0 && r.result.reason != StopReason::TimeLimit) {

@@ -9,10 +9,6 @@
 namespace kirchhoff {
 namespace {
 
-constexpr const char* kDirectHint =
-    "; a direct solve (--direct, or direct=True in Python) starts Newton from the guess at the requested values "
-    "instead, and reaches whichever equilibrium attracts it";
-
 bool solved_for(const ProblemDefinition& d, const std::string& name) {
   return std::find(d.unknown_parameters.begin(), d.unknown_parameters.end(), name) != d.unknown_parameters.end();
 }
@@ -48,14 +44,14 @@ CaseSolve by_homotopy(const Case& c, std::vector<ParameterChange> changes, Homot
     out.failure = to_string(at_start.result.summary.status);
     out.solved.result.summary = at_start.result.summary;
     out.message = "not converged: the case's own solve at its file's values, where the homotopy to the requested "
-                  "values starts: " + at_start.result.summary.brief_report() + kDirectHint;
+                  "values starts: " + at_start.result.summary.brief_report() + kDirectSolveHint;
     return out;
   }
   HomotopyResult h =
       follow_homotopy(at_start.problem->definition(), at_start.result.x, changes, options);
   if (h.stop != "reached" && h.stop != "not_converged") {
     out.failure = h.stop;
-    out.message = h.message + kDirectHint;
+    out.message = h.message + kDirectSolveHint;
     // No iterate at the requested values was evaluated: no residual there to report.
     out.solved.result.summary.residual_norm = INFINITY;
     out.path.homotopy = std::move(h);

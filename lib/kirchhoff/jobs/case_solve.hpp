@@ -46,6 +46,12 @@ struct CaseSolveOptions {
   bool stability_check = true;  // discrete_stability: the index's independent check, where it applies
 };
 
+// What a homotopy that stopped short adds to its message: the direct solve, which `continue` (whose
+// start is direct already) leaves out.
+inline constexpr const char* kDirectSolveHint =
+    "; a direct solve (--direct, or direct=True in Python) starts Newton from the guess at the requested values "
+    "instead, and reaches whichever equilibrium attracts it";
+
 // How the equilibrium was reached.
 struct SolvePath {
   std::string method;                    // "direct", "homotopy" or "ipopt_seed"
