@@ -129,6 +129,25 @@ TEST(Homotopy, FollowsContactSetChanges) {
   EXPECT_TRUE(s.solved.problem->definition().contacts.empty());
 }
 
+// On the wall's flat contact (clamps parallel to the wall) the Jacobian is singular and Newton
+// stalls at the integrator's noise: at Delta = 0.032 the homotopy's polish ended at 1.05e-12
+// against the tolerance 1e-12, and solve reported line_search_failed where a direct solve on the
+// same active set accepts such a stall (within 10 x the tolerance) as converged at round-off. The
+// polish accepts it the same way and says so; P equals the continuation's at Delta = 0.032
+// (`continue cases/wall.toml --param Delta --to 0.032 --set Delta=0.005 --set m_guess=0.9
+// --max-step 2`: 167.46928372372) to its 1e-10 relative conditioning (dP/dDelta ~ 3e4).
+TEST(Homotopy, PolishOnAFlatContactAcceptsTheStallAtRoundOff) {
+  const CaseSolve s = solve_at("wall.toml", {{"Delta", 0.032}});
+  ASSERT_TRUE(s.failure.empty()) << s.message;
+  ASSERT_TRUE(s.solved.result.summary.converged()) << s.solved.result.summary.brief_report();
+  ASSERT_TRUE(s.solution);
+  EXPECT_NEAR(s.solution->derived.at("P"), 167.46928372372, 1e-10 * 167.47);
+  bool noted = false;
+  for (const auto& line : s.path.homotopy.contact_changes)
+    noted = noted || line.find("converged at round-off") != std::string::npos;
+  EXPECT_TRUE(noted);
+}
+
 // A clamp turned by a parameter through half a turn: its frame's quaternion passes w = 0 there,
 // where a turn angle gauged into (-pi, pi] jumps by 2 pi, and Newton cannot carry the start clamp
 // across (the plectoneme case stalled at turns = 0.999 on its way to 1). A straight rod, its start

@@ -240,6 +240,13 @@ void report_flat_pairs_as_extended(std::unique_ptr<ShootingProblem>* problem, Pr
 
 }  // namespace
 
+ShootingResult solve_on_active_set(const ShootingProblem& problem, const Eigen::VectorXd& x, std::string* note) {
+  ShootingResult r = solve(problem, x);
+  if (!r.summary.converged() && converged_at_round_off(problem, &r) && note)
+    *note = round_off_note(r.summary, problem.definition());
+  return r;
+}
+
 ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& guess, const ContactOptions& options) {
   ContactSolveResult out;
   std::sort(d.contacts.begin(), d.contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
@@ -260,10 +267,10 @@ ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& gues
   const std::vector<PointContact> stated = d.contacts;
   Eigen::VectorXd x = problem->initial_unknowns(guess);
   for (int round = 0; round < options.max_rounds; ++round) {
-    out.result = solve(*problem, x);
+    std::string round_off;
+    out.result = solve_on_active_set(*problem, x, &round_off);
     out.definition = d;
-    if (!out.result.summary.converged() && converged_at_round_off(*problem, &out.result))
-      out.log.push_back(round_off_note(out.result.summary, d));
+    if (!round_off.empty()) out.log.push_back(round_off);
     if (!out.result.summary.converged()) {
       out.message = "solve with " + std::to_string(d.contacts.size()) + " contact(s) did not converge";
       if (const std::string why = stalled_flat_contact_reason(d, out.result.summary); !why.empty()) out.message += ": " + why;

@@ -84,6 +84,11 @@ struct DefinitionSolve {
   std::vector<std::string> contact_log;
 };
 DefinitionSolve solve_definition(const ProblemDefinition& definition, const RodPoint& guess);
+// Newton on one active set (solve, verification.hpp), as the active-set loop runs it: a solve that
+// stalls on the singular Jacobian of a flat contact on a plane (an end clamped parallel to it)
+// within 10 x the tolerance is converged at round-off, "step at round-off", and *note (if given)
+// says why; where it is not, *note is left as it was.
+ShootingResult solve_on_active_set(const ShootingProblem& problem, const Eigen::VectorXd& x, std::string* note);
 // An active-set loop's result as such a solve (a loop that did not settle: max_iterations).
 DefinitionSolve as_definition_solve(ContactSolveResult contact);
 

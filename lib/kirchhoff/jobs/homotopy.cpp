@@ -113,7 +113,11 @@ void polish(const ProblemDefinition& start, const std::vector<ParameterChange>& 
   for (const auto& c : changes) d.parameters.set(c.name, c.to);
   d.contacts = contacts;
   const ShootingProblem problem(d);
-  h->result = solve(problem, x);
+  // As the active-set loop solves (a flat contact's stall at round-off is converged), so that a
+  // solve by homotopy accepts what a direct one does.
+  std::string round_off;
+  h->result = solve_on_active_set(problem, x, &round_off);
+  if (!round_off.empty()) h->contact_changes.push_back("at the requested values: " + round_off);
   h->definition = std::move(d);
   h->reached = h->result.summary.converged();
   if (!h->reached) {
