@@ -139,7 +139,9 @@ CLI::App* add_continue_command(CLI::App& app, ContinueArguments* args, std::stri
   command->add_option("--out", args->out_path, "Branch CSV (a .state.json file is kept beside it)")
       ->capture_default_str();
   command->add_option("--profiles", args->profiles_dir, "Write each point's profile CSV into this folder");
-  command->add_option("--samples", args->samples, "Profile samples per point (invariants, derived quantities)")
+  command->add_option("--samples", args->samples,
+                      "Profile samples per point (invariants, derived quantities); not the case's [output] "
+                      "samples, which solve uses")
       ->capture_default_str();
   command->add_flag("--resume", args->resume, "Resume the run whose CSV is --out from its last written point");
   command->add_flag("--deflate", args->deflate,

@@ -307,6 +307,33 @@ void expect_admissible(const Equilibrium& e) {
   }
 }
 
+// The symmetric point contact at s = 0.5 and its reversal (the rod run from its other end) are
+// one equilibrium; solved twice, their contacts came out at 0.5 + 5e-13 and 0.5 - 3e-14, so a
+// profile sample at 0.5 read the internal force on opposite sides of the contact's jump (|dn| =
+// its force, 43.3) and the same rod was listed twice. Independently of that comparison: no two
+// listed rods with the same energy, contact positions and derived values.
+TEST(Equilibria, WallListsItsSymmetricContactOnce) {
+  const EquilibriaSearch s = search("wall.toml", {{"Delta", 0.028}});
+  int symmetric = 0;
+  for (size_t i = 0; i < s.equilibria.size(); ++i) {
+    const Equilibrium& a = s.equilibria[i];
+    expect_admissible(a);
+    if (a.solution.contacts.size() == 1 && std::abs(a.solution.contacts[0].s - 0.5) < 1e-8) ++symmetric;
+    for (size_t j = 0; j < i; ++j) {
+      const Equilibrium& b = s.equilibria[j];
+      bool same = std::abs(a.energy - b.energy) <= 1e-9 * (1.0 + std::abs(a.energy)) &&
+                  a.solution.contacts.size() == b.solution.contacts.size();
+      for (size_t k = 0; same && k < a.solution.contacts.size(); ++k)
+        same = std::abs(a.solution.contacts[k].s - b.solution.contacts[k].s) < 1e-8;
+      for (const auto& [name, value] : a.solution.derived)
+        same = same && std::abs(value - b.solution.derived.at(name)) <= 1e-8 * (1.0 + std::abs(value));
+      EXPECT_FALSE(same) << "#" << j + 1 << " and #" << i + 1 << " are one rod (" << b.found_by << ", "
+                         << a.found_by << ")";
+    }
+  }
+  EXPECT_EQ(symmetric, 1);
+}
+
 TEST(Equilibria, WallNearFlatteningHasSymmetricAndAsymmetricContacts) {
   const EquilibriaSearch s = search("wall.toml", {{"Delta", 0.0307}});
   int symmetric = 0, asymmetric = 0, far = 0, free_down = 0;
