@@ -105,7 +105,8 @@ void print_table(const Case& c, const EquilibriaSearch& search) {
     const NewtonSummary& summary = search.equilibria[i].solution.result.summary;
     if (!summary.message.empty())
       std::cout << "  #" << i + 1 << ": converged with " << summary.message
-                << "; its residual is as low as this shooting's conditioning allows (more [solver] segments lower it)\n";
+                << "; its residual is as low as this shooting's conditioning allows (more [solver] segments "
+                   "lower it)\n";
   }
   if (!search.rejected.empty())
     std::cout << "  " << search.rejected.size() << " converged points rejected (not admissible or failed checks; "

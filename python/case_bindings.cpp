@@ -177,8 +177,8 @@ PySolution equilibrium_solution(const Case& c, const Equilibrium& e) {
   out.status = to_string(sol.result.summary.status);
   out.converged = sol.result.summary.converged();
   out.residual = sol.result.summary.residual_norm;
-  out.message = e.solution.result.summary.message.empty() ? e.found_by
-                                                         : e.found_by + "; converged with " + e.solution.result.summary.message;
+  const std::string& how = e.solution.result.summary.message;  // "step at round-off", or empty
+  out.message = how.empty() ? e.found_by : e.found_by + "; converged with " + how;
   out.energy = e.energy;
   out.found_by = e.found_by;
   if (e.family > 0) out.family = py::int_(e.family);

@@ -85,7 +85,8 @@ std::optional<HomotopyStart> start_by_homotopy(const Case& c, const ContinueRequ
   CaseSolveOptions options;
   options.solution = options.stability = options.stability_check = false;
   const CaseSolve solved = solve_case(c, options);
-  const std::string failed = "start: the first point could not be corrected from the case's guess (" + direct_failure + ")";
+  const std::string failed =
+      "start: the first point could not be corrected from the case's guess (" + direct_failure + ")";
   if (!solved.converged() || !solved.solved.problem) {
     std::string why = solved.message.empty() ? solved.summary().brief_report() : solved.message;
     if (const size_t hint = why.find(kDirectSolveHint); hint != std::string::npos) why.erase(hint);
