@@ -45,7 +45,9 @@ command_of() {
 now() { date +%s.%N; }
 status=0
 for name in "$@"; do
-  args=$(command_of "$name") || exit 2
+  # The state after every point (--checkpoint 0): a kill then resumes from the point before it,
+  # not from the last timed checkpoint, which in a run of a few seconds is its start.
+  args="$(command_of "$name") --checkpoint 0" || exit 2
   # shellcheck disable=SC2086
   start=$(now); "$BIN" continue $args --out "$WORK/full.csv" 2>/dev/null; end=$(now)
   duration=$(awk -v a="$start" -v b="$end" 'BEGIN { print b - a }')
