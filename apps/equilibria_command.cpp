@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "kirchhoff/jobs/case_equilibria.hpp"
 #include "kirchhoff/jobs/case_file.hpp"
 #include "kirchhoff/jobs/equilibria.hpp"
 #include "kirchhoff/jobs/result_json.hpp"
@@ -170,7 +171,7 @@ int run_equilibria(const EquilibriaArguments& args) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitBadInput;
   }
-  const EquilibriaSearch search = find_equilibria(c.definition, c.start_guess, c.derived, c.samples, options);
+  const EquilibriaSearch search = find_case_equilibria(c, c.samples, options);
   if (!args.profiles_dir.empty()) {
     try {
       write_profiles(args.profiles_dir, search);

@@ -36,6 +36,7 @@
 #include "kirchhoff/continuation/continuation.hpp"
 #include "kirchhoff/equations/invariants.hpp"
 #include "kirchhoff/jobs/case_continue.hpp"
+#include "kirchhoff/jobs/case_equilibria.hpp"
 #include "kirchhoff/jobs/case_file.hpp"
 #include "kirchhoff/jobs/case_solve.hpp"
 #include "kirchhoff/jobs/continue_outputs.hpp"

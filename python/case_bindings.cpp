@@ -204,7 +204,7 @@ py::list py_equilibria(const PyCase& pc, int max, double max_seconds, const py::
   EquilibriaSearch search;
   {
     py::gil_scoped_release release;
-    search = find_equilibria(c.definition, c.start_guess, c.derived, samples, options);
+    search = find_case_equilibria(c, samples, options);
   }
   py::list out;
   for (const auto& e : search.equilibria) out.append(equilibrium_solution(c, e));

@@ -20,7 +20,9 @@
 
 #include "kirchhoff/analysis/analytic.hpp"
 #include "kirchhoff/analysis/discrete_stability.hpp"
+#include "kirchhoff/jobs/case_equilibria.hpp"
 #include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/jobs/case_solve.hpp"
 #include "kirchhoff/jobs/detail/equilibrium_families.hpp"
 #include "test_support.hpp"
 
@@ -332,6 +334,30 @@ TEST(Equilibria, WallListsItsSymmetricContactOnce) {
     }
   }
   EXPECT_EQ(symmetric, 1);
+}
+
+// The equilibria of a case at --set values include the one `solve` reports there (reached by
+// homotopy from the file's values): at Delta = 0.04 the wall's flat contact, which no seed of the
+// search reached from the arch's guess before --max stopped it (the active-set loop from a point
+// contact widened by 0.05 L does not settle on [0.3909, 0.6091]). Its P is solve's, 251.69 (the
+// same Newton on the same path: to round-off).
+TEST(Equilibria, CaseEquilibriaIncludeSolvesEquilibrium) {
+  const Case c = load_case(case_path("wall.toml"), {{"Delta", 0.04}});
+  const EquilibriaSearch s = find_case_equilibria(c, c.samples);
+  expect_all_sound(s, c.definition.options.newton.residual_tolerance * 10);  // (its flat contact: at round-off)
+  CaseSolveOptions without_stability;
+  without_stability.stability = without_stability.stability_check = false;
+  const CaseSolve solved = solve_case(c, without_stability);
+  ASSERT_TRUE(solved.converged()) << solved.message;
+  const double P = solved.solution->derived.at("P");
+  const auto flat = std::find_if(s.equilibria.begin(), s.equilibria.end(), [](const Equilibrium& e) {
+    return e.solution.contacts.size() == 1 && e.solution.contacts[0].extended;
+  });
+  ASSERT_NE(flat, s.equilibria.end());
+  EXPECT_NEAR(flat->solution.derived.at("P"), P, 1e-10 * P);
+  EXPECT_NEAR(flat->solution.contacts[0].s, 0.3909, 1e-4);
+  EXPECT_NE(flat->found_by.find("solve"), std::string::npos) << flat->found_by;
+  for (const auto& e : s.equilibria) expect_admissible(e);
 }
 
 TEST(Equilibria, WallNearFlatteningHasSymmetricAndAsymmetricContacts) {

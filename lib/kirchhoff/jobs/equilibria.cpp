@@ -322,6 +322,7 @@ class Search {
   }
 
   EquilibriaSearch run() {
+    for (const auto& known : options_.known_roots) consider_known(known);
     push_start(guess_, definition_.contacts, "guess");
     if (options_.mirrors) {
       push_mirrors(guess_, "guess");
@@ -602,6 +603,21 @@ class Search {
     Eigen::VectorXd polished = x;
     const NewtonSummary s = newton_solve(problem, polished, newton);
     if (s.converged() && deflation.distance(polished, x) < options_.distinct_tolerance) x = polished;
+  }
+
+  // An equilibrium known beforehand, on its active set (a start that does not fit the problem is
+  // logged and left out).
+  void consider_known(const EquilibriaOptions::KnownRoot& known) {
+    try {
+      Family& f = family(known.contacts);
+      if (known.x.size() != f.problem->size()) {
+        out_.log.push_back(known.found_by + ": its unknowns do not fit the problem; not used");
+        return;
+      }
+      consider(f, known.x, known.found_by);
+    } catch (const std::exception& e) {
+      out_.log.push_back(known.found_by + ": " + e.what());
+    }
   }
 
   // A converged root: deflated from now on; reported if it is a new admissible equilibrium.

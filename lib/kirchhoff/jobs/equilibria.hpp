@@ -67,6 +67,14 @@ struct EquilibriaOptions {
   std::vector<double> far_mode_amplitudes{8.0};
   bool mirrors = true;
   bool discrete_seeds = true;  // Ipopt's seeds where discrete_seed.hpp applies
+  // Equilibria known beforehand (the one `solve` reports, reached by homotopy: case_equilibria.hpp),
+  // considered before any seed, so that the list holds them and explores around them.
+  struct KnownRoot {
+    std::vector<PointContact> contacts;  // its active set
+    Eigen::VectorXd x;                   // its unknowns on that set
+    std::string found_by;
+  };
+  std::vector<KnownRoot> known_roots;
   // Profiles closer than this (scale-free, see above) are one equilibrium. Converged profiles
   // are accurate to ~1e-9 (integrator at 1e-12, residuals at 1e-10 amplified by the Jacobian's
   // conditioning); distinct equilibria differ at O(1) unless they sit within 1e-6 of a
