@@ -64,7 +64,6 @@ ProblemDefinition definition_for(const Case& c, const std::string& phase) {
   return d;
 }
 
-// A run in progress: its state, its sinks, and the points it reports.
 // Where the first point cannot be corrected from the case's guess at the --set values (the wall at
 // Delta = 0.04: the active-set loop from the arch's guess does not settle), the equilibrium
 // `solve` reports there, reached by homotopy from the file's values (case_solve.hpp), is where
@@ -103,6 +102,7 @@ std::optional<HomotopyStart> start_by_homotopy(const Case& c, const ContinueRequ
   return HomotopyStart{solved.solved.result.x, solved.solved.problem->definition().contacts};
 }
 
+// A run in progress: its state, its sinks, and the points it reports.
 class Run {
  public:
   Run(const Case& c, const ContinueRequest& r, RodContinuationOptions options, const std::vector<ContinueSink*>& sinks)

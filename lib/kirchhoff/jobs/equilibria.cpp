@@ -687,9 +687,10 @@ class Search {
     const double priority = std::isnan(e.energy) ? INFINITY : e.energy;
     out_.equilibria.push_back(std::move(e));
     if (options_.mirrors) {
-      push_mirrors(f.problem->sample(x, {0.0}).front(), name, priority);
+      const RodPoint start = f.problem->sample(x, {0.0}).front();
+      push_mirrors(start, name, priority);
       push_reversals(*f.problem, x, name, priority);
-      push_half_turn(f.problem->sample(x, {0.0}).front(), name, priority);
+      push_half_turn(start, name, priority);
     }
     push_contact_variants(*f.problem, x, name, priority);
     const std::string key = family_key(f.problem->definition().contacts);
