@@ -45,6 +45,36 @@ TEST(Summary, ReportsIterationsHistoryAndStatusWords) {
   EXPECT_STREQ(to_string(SolverStatus::MaxIterations), "max_iterations");
 }
 
+// F(x) = 1e12 (x - 1) + 5e-9: at x = 1 the Newton step (-5e-21) does not move x in double
+// precision, so no step length lowers |F| = 5e-9 - the situation of a shooting problem in
+// tension, where F's sensitivity grows like exp(sqrt(P) L). A step at round-off with |F| within
+// 1e3 x the tolerance is convergence (step_at_round_off), not a failed line search.
+class SteepWithAFloor : public NonlinearSystem {
+ public:
+  int size() const override { return 1; }
+  bool evaluate(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, std::string*) const override {
+    *F = Eigen::VectorXd::Constant(1, 1e12 * (x[0] - 1.0) + 5e-9);
+    if (J) *J = Eigen::MatrixXd::Constant(1, 1, 1e12);
+    return true;
+  }
+};
+
+TEST(Summary, AStepAtRoundOffWhereNoStepLowersTheResidualIsConvergence) {
+  NewtonOptions o;
+  o.fallback_search = false;
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(1, 1.0);
+  const NewtonSummary s = newton_solve(SteepWithAFloor(), x, o);
+  EXPECT_EQ(s.status, SolverStatus::Converged) << s.brief_report();
+  EXPECT_EQ(s.message, "step at round-off");
+  EXPECT_DOUBLE_EQ(s.residual_norm, 5e-9);
+  // A floor above 1e3 x the tolerance stays a failure with its best residual.
+  o.residual_tolerance = 1e-12;
+  x[0] = 1.0;
+  const NewtonSummary above = newton_solve(SteepWithAFloor(), x, o);
+  EXPECT_EQ(above.status, SolverStatus::LineSearchFailed);
+  EXPECT_DOUBLE_EQ(above.residual_norm, 5e-9);
+}
+
 TEST(Summary, MaxIterationsIsReportedWithTheBestResidual) {
   Case c = load_case(testing::case_path("simply_supported.toml"), {{"theta0", 2.0}, {"P", 12.0}});
   const ShootingProblem problem(c.definition);

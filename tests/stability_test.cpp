@@ -138,6 +138,23 @@ TEST(Stability, StraightColumnCountsTheEulerLoadsBelowTheLoad) {
   }
 }
 
+// The same column turned a half-turn against its load, in tension P: stable, with no zero mode,
+// at every P. Its shooting is ill-conditioned (the fields grow like exp(sqrt(P) L), 3e7 at P =
+// 300): Newton stops at round-off (residual 1e-8 at P = 300, 1e3 x its tolerance) rather than
+// failing its line search, and the chord's response to the end's lateral reaction - a string's
+// compliance, about 1/P - is not mistaken for zero where the particular field lies within 1e-7
+// of the frame's span (P >= 250 reported one zero mode).
+TEST(Stability, ColumnInTensionIsStableWithoutZeroModes) {
+  for (double P : {50.0, 200.0, 300.0}) {
+    SCOPED_TRACE("P = " + std::to_string(P));
+    const auto solved = solve_case("euler_column.toml", {{"P", P}, {"theta_guess", M_PI}});
+    const StabilityReport r = index_of(solved);
+    ASSERT_TRUE(r.defined()) << r.reason;
+    EXPECT_EQ(*r.index, 0);
+    EXPECT_EQ(r.zero_modes, 0);
+  }
+}
+
 // Buckled Elasticas of the same column: the first mode is stable, the second has index 1, the
 // third index 2. Past
 // the point where the ends meet (the roller passes the pin) the first mode loses its stability:

@@ -942,6 +942,31 @@ NearZeroModes near_zero_modes(const Eigen::MatrixXd& conditions, const Eigen::Ma
   return out;
 }
 
+// The whole problem's zero modes: frame fields c and load changes l with conditions c + loads l = 0
+// and frame_values c + particular_values l = 0. The load columns are first reduced by the frame
+// fields that answer them (c = -conditions^+ loads), a column operation that keeps the null space:
+// they then carry the chord's response to the loads (D). The particular fields themselves grow
+// with the frame's (as exp(sqrt(P) L) on a rod in tension) and lie within 1e-7 of the frame's span
+// at s = L where D is 3e-3, the compliance of a string. Only the conditions' singular directions
+// within 1e2 of the largest answer: a near-singular one (a conjugate point near L, as at a branch
+// point) would amplify the matrix's error past the zero tolerance (the soft wall's branch point:
+// smallest singular value 8e-8 unreduced, 2e-6 reduced through one of 2.4e-4).
+int whole_problem_zero_modes(const Eigen::MatrixXd& conditions, const Eigen::MatrixXd& loads,
+                             const Eigen::MatrixXd& frame_values, const Eigen::MatrixXd& particular_values,
+                             double tol) {
+  const Eigen::Index m = conditions.cols(), k = loads.cols();
+  Eigen::MatrixXd answer = Eigen::MatrixXd::Zero(m, k);  // -conditions^+ loads, truncated
+  if (m > 0 && k > 0) {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(conditions, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    for (Eigen::Index j = 0; j < svd.singularValues().size(); ++j)
+      if (svd.singularValues()[j] > std::max(tol, 1e-2 * svd.singularValues()[0]))
+        answer -= svd.matrixV().col(j) * (svd.matrixU().col(j).transpose() * loads) / svd.singularValues()[j];
+  }
+  Eigen::MatrixXd all(m + k, m + k);
+  all << conditions, loads + conditions * answer, frame_values, particular_values + frame_values * answer;
+  return static_cast<int>(null_space(all, static_cast<int>(m + k), tol).cols());
+}
+
 // The isoperimetric correction (Maddocks; Manning, Rogers & Maddocks 1998): with the end
 // positions held along k directions, index = index_dead + r_Z + n_+(D) - k, where D = dg/dF is how
 // the chord g = r(L) - r(0) along them moves per unit change of the end load (the multiplier),
@@ -992,12 +1017,7 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
   Eigen::MatrixXd conditions(m, m), loads(m, k);
   conditions << held.transpose() * f.U, free_rotation.transpose() * f.P_physical;
   loads << held.transpose() * particular_U, free_rotation.transpose() * particular_P_physical;
-  Eigen::MatrixXd all(m + k, m + k);
-  all.topLeftCorner(m, m) = conditions;
-  all.topRightCorner(m, k) = loads;
-  all.bottomLeftCorner(k, m) = frame_values;
-  all.bottomRightCorner(k, k) = particular_values;
-  report->zero_modes = static_cast<int>(null_space(all, m + k, tol).cols());
+  report->zero_modes = whole_problem_zero_modes(conditions, loads, frame_values, particular_values, tol);
   int correction = 0;
   if (k > 0) {
     const Eigen::MatrixXd c = -conditions.completeOrthogonalDecomposition().solve(loads);

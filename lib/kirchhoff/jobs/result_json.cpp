@@ -109,6 +109,8 @@ nlohmann::json solution_json(const Case& c, const ShootingProblem& problem, cons
   j["status"] = to_string(sol.result.summary.status);
   j["iterations"] = sol.result.summary.iterations;
   j["residual"] = sol.result.summary.residual_norm;
+  // How Newton converged where it says ("step at round-off": its residual is the conditioning's floor).
+  if (!sol.result.summary.message.empty()) j["message"] = sol.result.summary.message;
   j["parameters"] = parameters_json(sol.result.parameters);
   j["derived"] = nlohmann::json::object();
   for (const auto& [name, value] : sol.derived) j["derived"][name] = value;

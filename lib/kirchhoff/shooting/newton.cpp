@@ -308,6 +308,14 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
       continue;
     }
     ++summary.iterations;
+    // At the exact solution of an ill-conditioned shooting problem no step lowers the residual's
+    // noise: where Newton's own step is at round-off, that is convergence, not a failed search.
+    if (!step.accepted && step_at_round_off(dx.lpNorm<Eigen::Infinity>(), x.lpNorm<Eigen::Infinity>(), norm,
+                                            options.step_tolerance, options.residual_tolerance)) {
+      summary.status = SolverStatus::Converged;
+      summary.message = "step at round-off";
+      return summary;
+    }
     if (!step.accepted) {
       const bool timed_out = deadline.passed();  // once: status and message must agree
       summary.status = timed_out ? SolverStatus::TimeLimit : SolverStatus::LineSearchFailed;
