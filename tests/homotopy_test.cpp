@@ -148,6 +148,23 @@ TEST(Homotopy, PolishOnAFlatContactAcceptsTheStallAtRoundOff) {
   EXPECT_TRUE(noted);
 }
 
+// The heavy cantilever at w = 300 by homotopy from w = 3: the path ends converged, and Newton's
+// polish there starts with a coarse residual 7e-3 off (the coarse phase's integration of so heavy
+// a rod), leaves the coarse phase on its ill-conditioned matrix and finds the start converged
+// (7e-12). It reported the coarse residual, "converged, residual 0.00707": the residual reported
+// is now the one judged, equal to F recomputed at the solution.
+TEST(Homotopy, ReportsTheResidualItJudgedNotTheCoarseOne) {
+  const CaseSolve s = solve_at("heavy_cantilever.toml", {{"w", 300.0}});
+  ASSERT_TRUE(s.failure.empty()) << s.message;
+  const NewtonSummary& summary = s.solved.result.summary;
+  ASSERT_TRUE(summary.converged()) << summary.brief_report();
+  Eigen::VectorXd F;
+  std::string failure;
+  ASSERT_TRUE(s.solved.problem->evaluate(s.solved.result.x, &F, nullptr, &failure)) << failure;
+  EXPECT_LE(summary.residual_norm, s.solved.problem->definition().options.newton.residual_tolerance);
+  EXPECT_DOUBLE_EQ(summary.residual_norm, F.lpNorm<Eigen::Infinity>());
+}
+
 // A clamp turned by a parameter through half a turn: its frame's quaternion passes w = 0 there,
 // where a turn angle gauged into (-pi, pi] jumps by 2 pi, and Newton cannot carry the start clamp
 // across (the plectoneme case stalled at turns = 0.999 on its way to 1). A straight rod, its start

@@ -256,8 +256,10 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
       const bool with_matrix = norm > kCoarseError * options.coarse_tolerance;
       if (!leave_coarse_phase(evaluate, x, &F, &norm, with_matrix ? &J : nullptr)) return evaluate.failed(norm);
       have_matrix = with_matrix;
-      summary.residual_norm = norm;
     }
+    // The residual reported is the one judged: every path back to this test (the coarse phase
+    // left on an ill-conditioned matrix, the exact matrix taken over) has just evaluated it anew.
+    summary.residual_norm = norm;
     if (norm <= options.residual_tolerance) {
       summary.status = SolverStatus::Converged;
       return summary;
