@@ -101,6 +101,28 @@ TEST(ContinuationEngine, FollowsACircleThroughBothFolds) {
   EXPECT_TRUE(r.points.front().derived.empty());
 }
 
+// A step that passes the target and a stopping event just beyond it finds both; the run ends at
+// the target, which it reached: ReachedTarget, not the event's stop (a contact leg's homotopy, whose
+// lift-off event lay past its target, reported "stopped (event)" at fraction 1).
+TEST(ContinuationEngine, TargetReachedBeforeAStoppingEventInTheSameStepIsReached) {
+  ContinuationOptions o = options_for("lambda");
+  o.initial_step = 0.5;
+  o.max_step = 0.5;
+  o.target = 0.3;
+  o.detect_folds = false;
+  // On the circle from (x, lambda) = (1, 0): lambda = 0.3 at x = 0.954, lambda = 0.35 at x = 0.937.
+  o.events.push_back({"x", 0.937, true, ""});
+  o.recorder = PointRecorder{[](ParameterisedSystem&, ContinuationPoint* p) { p->derived["x"] = p->x[0]; }, {}};
+  Continuation run(std::make_unique<Circle>(0.0), o);
+  const ContinuationResult r = run.run(Eigen::VectorXd::Constant(1, 1.0));
+  ASSERT_EQ(r.reason, StopReason::ReachedTarget) << r.message;
+  EXPECT_EQ(r.points.back().type, PointType::Endpoint);
+  EXPECT_NEAR(r.points.back().parameter, 0.3, 1e-12);
+  // The step that reached the target (from lambda = 0.25: the tangent's turn limits the first
+  // step) had the event inside it too; it is beyond the end and not on the branch.
+  for (const auto& p : r.points) EXPECT_NE(p.type, PointType::Event) << "at lambda = " << p.parameter;
+}
+
 TEST(ContinuationEngine, FindsThePitchforkAndSwitchesOntoTheParabola) {
   ContinuationOptions o = options_for("lambda");
   o.target = 1.0;

@@ -165,6 +165,19 @@ TEST(Homotopy, ReportsTheResidualItJudgedNotTheCoarseOne) {
   EXPECT_DOUBLE_EQ(summary.residual_norm, F.lpNorm<Eigen::Infinity>());
 }
 
+// The ribbon pressed on its pole, turned from phi = 2 to 4.1: the contact's lift-off (phi =
+// 4.165) lies beyond the target inside the path's last step. The path reached its target; it
+// ended "stopped (event) at fraction 1" (exit 1) before. The contact holds with force 0.0605, which
+// falls to zero at the lift-off (`continue ... --param phi`).
+TEST(Homotopy, ReachesATargetWithAContactEventJustBeyondIt) {
+  const CaseSolve s = solve_at("twisted_ribbon_pole.toml", {{"phi", 4.1}});
+  ASSERT_TRUE(s.failure.empty()) << s.message;
+  ASSERT_TRUE(s.solved.result.summary.converged()) << s.solved.result.summary.brief_report();
+  EXPECT_EQ(s.path.homotopy.stop, "reached");
+  ASSERT_TRUE(s.solution);
+  EXPECT_GT(s.solution->derived.at("contact_force"), 0.0);
+}
+
 // A clamp turned by a parameter through half a turn: its frame's quaternion passes w = 0 there,
 // where a turn angle gauged into (-pi, pi] jumps by 2 pi, and Newton cannot carry the start clamp
 // across (the plectoneme case stalled at turns = 0.999 on its way to 1). A straight rod, its start

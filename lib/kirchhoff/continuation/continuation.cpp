@@ -785,7 +785,9 @@ struct Continuation::Marcher {
       accept(d.point);
       const ContinuationPoint& p = result.points.back();
       if (auto s = d.detector->act(p, &counters)) return s;
-      if (step_stop && p.type == PointType::Endpoint) return detail::Stop{*step_stop, ""};
+      // An end point stops with its own reason: a contact leg's stopping event found beyond the
+      // target in the same step does not make the target an event.
+      if (step_stop && p.type == PointType::Endpoint) return detail::Stop{d.stop.value_or(*step_stop), ""};
       if (step_stop == StopReason::EventStop && p.type == PointType::Event)
         return detail::Stop{StopReason::EventStop, "event " + p.event};
     }
