@@ -80,6 +80,32 @@ TEST(StabilityExtendedContact, WrapAtAnotherLoadIsStable) {
   expect_wrap_stable(s);
 }
 
+// Pushed further onto the disc (rise 0.19 to 0.21) the lowest eigenvalue, 130 to 265, changes by
+// 1.1 to 2.3 % from 400 to 800 elements: first-order convergence, the sign decided by a factor of
+// 20 or more. The self-check allows a contact 5 % (kDiscreteStabilityContactAgreement); at the 1 %
+// of a rod without contact the index was null ("not resolved") at all three.
+TEST(StabilityExtendedContact, WrapPushedFurtherIsStable) {
+  for (const double rise : {0.19, 0.2, 0.21}) {
+    SCOPED_TRACE("rise = " + std::to_string(rise));
+    const CaseSolve s = solved("wrapped_indenter.toml", {{"rise", rise}});
+    const StabilityReport report = analyse_stability(*s.solved.problem, s.solved.result.x);
+    ASSERT_TRUE(report.defined()) << report.reason;
+    EXPECT_EQ(*report.index, 0);
+    EXPECT_EQ(report.zero_modes, 0);
+  }
+}
+
+// The cavity as its rod starts to lie flat (Delta = 0.031): the flat part is so short that at 400
+// elements no node lies between its edges, so its lift-off has nothing to compare with at N/2.
+// The index is null and the reason says that ("nan at N/2" before).
+TEST(StabilityExtendedContact, FlatPartTooShortAtHalfTheElementsSaysSo) {
+  const CaseSolve s = solved("cavity.toml", {{"Delta", 0.031}});
+  const StabilityReport report = analyse_stability(*s.solved.problem, s.solved.result.x);
+  ASSERT_FALSE(report.defined());
+  EXPECT_NE(report.reason.find("no node between its edges at N/2 elements"), std::string::npos) << report.reason;
+  EXPECT_EQ(report.reason.find("nan"), std::string::npos) << report.reason;
+}
+
 // wall.toml past flattening (Delta = 0.04): the rod lies flat on the wall over [s1, s2] with the
 // forces at the edges and none inside (weakly active). Two closed forms:
 //  - the lift-off: the flat part is a strut clamped by the wall at its edges under the compression
