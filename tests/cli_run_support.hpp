@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -27,6 +28,24 @@ inline std::vector<std::string> lines_of(const fs::path& p) {
   std::vector<std::string> out;
   for (std::string line; std::getline(in, line);)
     if (!line.empty()) out.push_back(line);
+  return out;
+}
+
+// The comma-separated fields of a CSV line, as text (the project's CSVs quote nothing).
+inline std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> out;
+  size_t from = 0;
+  for (size_t comma; (comma = line.find(',', from)) != std::string::npos; from = comma + 1)
+    out.push_back(line.substr(from, comma - from));
+  out.push_back(line.substr(from));
+  return out;
+}
+
+// Each column's position, by the names of a CSV header line.
+inline std::map<std::string, int> csv_header(const std::string& line) {
+  std::map<std::string, int> out;
+  const std::vector<std::string> names = csv_fields(line);
+  for (size_t k = 0; k < names.size(); ++k) out[names[k]] = static_cast<int>(k);
   return out;
 }
 

@@ -620,4 +620,39 @@ TEST_F(ContinueCli, DeflateFollowsEveryBranchFromTheStart) {
   EXPECT_EQ(run_to_end(resumed, dir_ / "r.log"), 2);
 }
 
+// plectoneme.toml's branch as docs/stability.md follows it, to the fold where the end loop closes
+// (60 points, turns 0 -> 1.770 -> 1.149): index 0 up to the fold where the loop starts to form,
+// 1 between the folds (their symmetric direction), 0 past the second, with the turn about the
+// clamps' axis as a zero mode at every regular point. Where the loop is about to close (turns
+// 1.1576) the barrier's spike is narrow: at the default observations of the Jacobi fields one row
+// had index 2 (a whole turn of an eigenphase inside one step); confirmed by denser observations in
+// a field, it has 1.
+TEST_F(ContinueCli, PlectonemeIndexAlongTheLoopFormingFolds) {
+  const fs::path csv = dir_ / "plectoneme.csv";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/plectoneme.toml", "--param",
+                        "turns", "--to", "4", "--max-step", "60", "--max-points", "60", "--out", csv.string()},
+                       dir_ / "run.log"),
+            0);
+  const auto lines = lines_of(csv);
+  ASSERT_EQ(lines.size(), 61u);
+  const auto header = kirchhoff::testing::csv_header(lines.front());
+  const int turns = header.at("turns"), type = header.at("type"), index = header.at("stability_index"),
+            zero = header.at("zero_modes");
+  int folds = 0, between = 0;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const auto fields = kirchhoff::testing::csv_fields(lines[i]);
+    if (fields[type] == "fold") {
+      ++folds;
+      continue;
+    }
+    SCOPED_TRACE("turns = " + fields[turns]);
+    ASSERT_FALSE(fields[index].empty());
+    EXPECT_EQ(std::stoi(fields[index]), folds == 1 ? 1 : 0);
+    EXPECT_EQ(std::stoi(fields[zero]), 1);
+    between += folds == 1;
+  }
+  EXPECT_EQ(folds, 2);
+  EXPECT_GE(between, 10);
+}
+
 }  // namespace

@@ -75,6 +75,23 @@ TEST(Summary, AStepAtRoundOffWhereNoStepLowersTheResidualIsConvergence) {
   EXPECT_DOUBLE_EQ(above.residual_norm, 5e-9);
 }
 
+// The Euler column turned against its load, in tension at P = 1000: with one shooting segment the
+// fields grow by exp(sqrt(P) L) = 5e13 and the Jacobian is singular to the solver; the failure
+// says that more segments help, and with 8 the same solve converges (2 iterations).
+TEST(Summary, ASingularSingleShootingSaysMoreSegmentsHelp) {
+  Case c = load_case(testing::case_path("euler_column.toml"), {{"P", 1000.0}, {"theta_guess", M_PI}});
+  const ShootingProblem single(c.definition);
+  const ShootingResult failed = solve(single, single.initial_unknowns(c.start_guess));
+  ASSERT_FALSE(failed.summary.converged());
+  EXPECT_NE(failed.summary.message.find("more segments condition it better"), std::string::npos)
+      << failed.summary.message;
+  c.definition.options.segments = 8;
+  const ShootingProblem multiple(c.definition);
+  const ShootingResult solved = solve(multiple, multiple.initial_unknowns(c.start_guess));
+  ASSERT_TRUE(solved.summary.converged()) << solved.summary.brief_report();
+  EXPECT_EQ(solved.summary.message.find("segments"), std::string::npos);
+}
+
 TEST(Summary, MaxIterationsIsReportedWithTheBestResidual) {
   Case c = load_case(testing::case_path("simply_supported.toml"), {{"theta0", 2.0}, {"P", 12.0}});
   const ShootingProblem problem(c.definition);

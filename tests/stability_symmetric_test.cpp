@@ -429,20 +429,33 @@ TEST(StabilitySymmetric, ThePlyHasAnIndexWhereTheBarrierIsStiff) {
   ASSERT_NEAR(branch.points.back().parameter, 2.5, 1e-9);
   StabilityOptions options;
   options.field_tolerance = 1e-8;  // as along a branch
-  int checked = 0;
+  int checked = 0, between = 0;
   bool past_the_closing = false;  // the loop closes at the fold at turns = 1.1492
-  for (const ContinuationPoint& p : branch.points) {
-    if (p.type == PointType::Fold && p.parameter < 1.2) past_the_closing = true;
-    if (!past_the_closing || p.parameter < 2.2) continue;
+  bool past_the_first = false;    // the end loop starts to form at the fold at turns = 1.7704
+  const auto expect_index = [&](const ContinuationPoint& p, int expected) {
     ShootingProblem here(c.definition);
     here.set_parameter("turns", p.parameter);
     const StabilityReport r = analyse_stability(here, p.x, options);
     ASSERT_TRUE(r.defined()) << "turns = " << p.parameter << ": " << r.reason;
-    EXPECT_EQ(*r.index, 0) << "turns = " << p.parameter;
+    EXPECT_EQ(*r.index, expected) << "turns = " << p.parameter;
     EXPECT_EQ(r.zero_modes, 1) << "turns = " << p.parameter;
+  };
+  for (const ContinuationPoint& p : branch.points) {
+    if (p.type == PointType::Fold && p.parameter > 1.7) past_the_first = true;
+    if (p.type == PointType::Fold && p.parameter < 1.2) past_the_closing = true;
+    // Between the two folds, index 1 (the folds' symmetric direction) with the turn's zero mode
+    // (ContinueCli.PlectonemeIndexAlongTheLoopFormingFolds checks the point near the closing
+    // where the default observations alone counted 2).
+    if (past_the_first && !past_the_closing && p.type == PointType::Regular) {
+      expect_index(p, 1);
+      ++between;
+    }
+    if (!past_the_closing || p.parameter < 2.2) continue;
+    expect_index(p, 0);
     ++checked;
   }
   EXPECT_GE(checked, 5);
+  EXPECT_GE(between, 5);
 }
 
 // plectoneme.toml's barrier at turns = 0 is exactly off (its Gaussian underflows 1e2 ranges from the

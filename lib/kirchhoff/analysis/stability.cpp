@@ -1249,26 +1249,61 @@ StabilityReport sliding_undefined(const std::string& reason, const StabilityRepo
 constexpr int kRefinements = 2;
 constexpr double kKeepRefining = 4.0;
 
+bool same_count(const StabilityReport& a, const StabilityReport& b) {
+  return a.index == b.index && a.zero_modes == b.zero_modes;
+}
+
 // `run(options, &reversed)`: one analysis with those options, saying whether it saw a reversal.
-// The report's right-hand sides are those of every run made.
+// The report's right-hand sides are those of every run made. With `confirm` (a rod in an external
+// field) a count stands once observations kKeepRefining times denser repeat it: the steps are
+// sized by the fields' wave number on a coarse profile (field_rate), which a stiff barrier's spike
+// (a self-contact crossing, ~sqrt(R gap) wide) can fall between, and across it a phase can turn a
+// whole turn within one step without moving a step's worth from end to end: on plectoneme.toml's
+// branch (turns 1.1576, between two folds at index 1) the default observations counted 2, four and
+// sixteen times denser ones 1. Denser observations can also see a phase that hovers at pi pass it
+// and come back (the soft wall at log_b = -4, Delta = 0.045, s = 0.505): such a run counts nothing.
+// A single count that no denser one contradicts stands; counts that differ and are never repeated
+// leave the index undefined.
 template <class Run>
-StabilityReport run_resolved(const StabilityOptions& options, const Run& run) {
+StabilityReport run_resolved(const StabilityOptions& options, bool confirm, const Run& run) {
   StabilityOptions o = options;
   long rhs_before = 0;
-  for (int refinement = 0;; ++refinement) {
+  std::vector<StabilityReport> counted;  // the runs without a reversal, in the order made
+  StabilityReport last;
+  for (int refinement = 0; refinement <= kRefinements; ++refinement) {
     bool reversed = false;
-    StabilityReport report = run(o, &reversed);
-    report.rhs_evaluations += rhs_before;
-    if (!reversed || refinement == kRefinements) return report;
-    rhs_before = report.rhs_evaluations;
+    last = run(o, &reversed);
+    last.rhs_evaluations += rhs_before;
+    rhs_before = last.rhs_evaluations;
+    if (!reversed) {
+      if (!confirm || (!counted.empty() && same_count(counted.back(), last))) return last;
+      counted.push_back(last);
+    }
     o.max_phase_step /= kKeepRefining;
     o.min_steps = static_cast<int>(o.min_steps * kKeepRefining);
   }
+  if (counted.empty()) return last;  // a reversal at every density: the index is undefined
+  StabilityReport out = counted.back();
+  out.rhs_evaluations = rhs_before;
+  if (counted.size() == 1) return out;
+  std::ostringstream why;
+  why << "the count is not settled by denser observations of the Jacobi fields (index";
+  for (size_t k = 0; k < counted.size(); ++k)
+    why << (k ? ", then " : " ") << (counted[k].index ? std::to_string(*counted[k].index) : std::string("undefined"));
+  why << "): a stiff field turns them faster than they are observed";
+  out.reason = why.str();
+  out.index.reset();
+  return out;
+}
+
+// Whether the rod is in an external field (gravity, a soft wall, self-contact's barrier).
+bool in_field(const ShootingProblem& problem, const Eigen::VectorXd& x) {
+  return problem.definition().model(problem.parameters_at(x)).field != nullptr;
 }
 
 StabilityReport run_plain(const ShootingProblem& problem, const Eigen::VectorXd& x, const StabilityOptions& options,
                           const EndCondition& end) {
-  return run_resolved(options, [&](const StabilityOptions& o, bool* reversed) {
+  return run_resolved(options, in_field(problem, x), [&](const StabilityOptions& o, bool* reversed) {
     StabilityAnalysis analysis(problem, x, o, end, nullptr);
     StabilityReport report = analysis.run();
     *reversed = analysis.reversed();
@@ -1301,7 +1336,7 @@ StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::V
     const StabilityReport symmetric = run_plain(problem, x, options, end);
     const EndCondition anti_end = antisymmetric_half_turn_end(end.half_turn_axis());
     std::string sliding;
-    const StabilityReport antisymmetric = run_resolved(options, [&](const StabilityOptions& o, bool* reversed) {
+    const StabilityReport antisymmetric = run_resolved(options, in_field(problem, x), [&](const StabilityOptions& o, bool* reversed) {
       StabilityAnalysis anti(problem, x, o, anti_end, antisymmetric_equations(*equations));
       anti.track_barrier(equations);
       StabilityReport report = anti.run();

@@ -721,6 +721,21 @@ bool singular_at_solution(const ShootingProblem& problem, const Eigen::VectorXd&
   return problem.evaluate(x, &F, &J, &failure) && !(JacobianLU(J).reciprocal_condition() > threshold);
 }
 
+// A single segment whose Jacobian is singular to the solver, or whose residual no step lowers,
+// is most often a shooting problem too ill-conditioned for one segment: the fields grow like
+// exp(sqrt(P) L) along a rod in tension (the Euler column in tension at P = 1000: singular at one
+// segment, converged in 2 iterations at 8). The failure says what would help.
+void note_single_shooting(const ShootingProblem& problem, NewtonSummary* summary) {
+  const SolverStatus status = summary->status;
+  if (problem.segments() != 1 || (status != SolverStatus::SingularJacobian && status != SolverStatus::LineSearchFailed))
+    return;
+  const std::string hint =
+      "with a single shooting segment; where the rod is long or under a large tension its shooting is "
+      "ill-conditioned, and more segments condition it better ([solver] segments in the case file, e.g. "
+      "--solver segments=8 on the command line)";
+  summary->message = summary->message.empty() ? hint : summary->message + "; " + hint;
+}
+
 }  // namespace
 
 ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) {
@@ -728,6 +743,7 @@ ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) 
   result.x = x0;
   result.summary = solve_with_fallback(problem, result.x, problem.definition().options.newton);
   result.parameters = problem.parameters_at(result.x);
+  note_single_shooting(problem, &result.summary);
   if (result.summary.converged()) mark_check_failure(&result, unknowns_failure(problem, result));
   if (result.summary.converged()) mark_check_failure(&result, zero_iteration_failure(problem, result));
   if (!result.summary.converged() || !result.parameters.contains(kUnfoldingParameter)) return result;
