@@ -4,6 +4,7 @@
 # (lib/CMakeLists.txt, listed in BUILD/kirchhoff_public_headers.txt as LAYER/NAME.hpp) are installed: any other
 # header in the prefix fails the test, and a translation unit including every public header is
 # compiled against the prefix, so a public header that includes an internal one fails the build.
+# The consumer solves, continues and sweeps (main.cpp); the sweep writes into a scratch folder.
 set -euo pipefail
 build="$1" source="$2" scratch="$3"
 rm -rf "$scratch"
@@ -28,4 +29,5 @@ echo "compiling the $count public headers from the installed tree"
 cmake -S "$source/tests/find_package" -B "$scratch/consumer" -DCMAKE_PREFIX_PATH="$scratch/prefix" \
       -DKIRCHHOFF_ALL_HEADERS="$all" > /dev/null
 cmake --build "$scratch/consumer" > /dev/null
-"$scratch/consumer/consumer" "$source/cases/simply_supported.toml"
+mkdir -p "$scratch/sweep"
+"$scratch/consumer/consumer" "$source/cases/simply_supported.toml" "$scratch/sweep"
