@@ -23,6 +23,8 @@
 namespace {
 
 using kirchhoff::testing::csv_field;
+using kirchhoff::testing::csv_fields;
+using kirchhoff::testing::csv_header;
 using kirchhoff::testing::lines_of;
 using kirchhoff::testing::run_and_kill;
 using kirchhoff::testing::run_to_end;
@@ -574,19 +576,13 @@ TEST_F(ContinueCli, DeflateFollowsEveryBranchFromTheStart) {
   ASSERT_EQ(run_to_end(args, dir_ / "d.log"), 0);
   const auto lines = lines_of(csv);
   ASSERT_GT(lines.size(), 10u);
-  std::vector<std::string> header;
-  std::stringstream h(lines[0]);
-  for (std::string cell; std::getline(h, cell, ',');) header.push_back(cell);
-  const auto column = [&](const std::string& name) {
-    return static_cast<size_t>(std::find(header.begin(), header.end(), name) - header.begin());
-  };
-  const size_t branch_col = column("branch"), P_col = column("P"), theta_col = column("theta0"), type_col = column("type");
+  const auto header = csv_header(lines[0]);
+  const size_t branch_col = header.at("branch"), P_col = header.at("P"), theta_col = header.at("theta0"),
+               type_col = header.at("type");
   std::vector<double> theta_at_60;
   std::vector<int> branches;
   for (size_t i = 1; i < lines.size(); ++i) {
-    std::vector<std::string> f;
-    std::stringstream row(lines[i]);
-    for (std::string cell; std::getline(row, cell, ',');) f.push_back(cell);
+    const std::vector<std::string> f = csv_fields(lines[i]);
     const int branch = std::stoi(f[branch_col]);
     if (std::find(branches.begin(), branches.end(), branch) == branches.end()) {
       branches.push_back(branch);
@@ -635,12 +631,12 @@ TEST_F(ContinueCli, PlectonemeIndexAlongTheLoopFormingFolds) {
             0);
   const auto lines = lines_of(csv);
   ASSERT_EQ(lines.size(), 61u);
-  const auto header = kirchhoff::testing::csv_header(lines.front());
+  const auto header = csv_header(lines.front());
   const int turns = header.at("turns"), type = header.at("type"), index = header.at("stability_index"),
             zero = header.at("zero_modes");
   int folds = 0, between = 0;
   for (size_t i = 1; i < lines.size(); ++i) {
-    const auto fields = kirchhoff::testing::csv_fields(lines[i]);
+    const auto fields = csv_fields(lines[i]);
     if (fields[type] == "fold") {
       ++folds;
       continue;

@@ -916,11 +916,11 @@ struct NearZeroModes {
   }
 };
 
-NearZeroModes near_zero_modes(const Eigen::MatrixXd& conditions, const Eigen::MatrixXd& loads,
+// `svd`: the end conditions' (full U and V).
+NearZeroModes near_zero_modes(const Eigen::JacobiSVD<Eigen::MatrixXd>& svd, const Eigen::MatrixXd& loads,
                               const Eigen::MatrixXd& frame_values, const Eigen::MatrixXd& particular_values,
                               double tol, double noise) {
   NearZeroModes out;
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(conditions, Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Eigen::VectorXd& sigma = svd.singularValues();
   if (sigma.size() == 0) return out;
   Eigen::MatrixXd below = Eigen::MatrixXd::Zero(loads.cols(), loads.cols()), rest = particular_values;
@@ -951,13 +951,13 @@ NearZeroModes near_zero_modes(const Eigen::MatrixXd& conditions, const Eigen::Ma
 // within 1e2 of the largest answer: a near-singular one (a conjugate point near L, as at a branch
 // point) would amplify the matrix's error past the zero tolerance (the soft wall's branch point:
 // smallest singular value 8e-8 unreduced, 2e-6 reduced through one of 2.4e-4).
-int whole_problem_zero_modes(const Eigen::MatrixXd& conditions, const Eigen::MatrixXd& loads,
-                             const Eigen::MatrixXd& frame_values, const Eigen::MatrixXd& particular_values,
-                             double tol) {
+// `svd`: the conditions' (full U and V).
+int whole_problem_zero_modes(const Eigen::MatrixXd& conditions, const Eigen::JacobiSVD<Eigen::MatrixXd>& svd,
+                             const Eigen::MatrixXd& loads, const Eigen::MatrixXd& frame_values,
+                             const Eigen::MatrixXd& particular_values, double tol) {
   const Eigen::Index m = conditions.cols(), k = loads.cols();
   Eigen::MatrixXd answer = Eigen::MatrixXd::Zero(m, k);  // -conditions^+ loads, truncated
   if (m > 0 && k > 0) {
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(conditions, Eigen::ComputeFullU | Eigen::ComputeFullV);
     for (Eigen::Index j = 0; j < svd.singularValues().size(); ++j)
       if (svd.singularValues()[j] > std::max(tol, 1e-2 * svd.singularValues()[0]))
         answer -= svd.matrixV().col(j) * (svd.matrixU().col(j).transpose() * loads) / svd.singularValues()[j];
@@ -1017,13 +1017,14 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
   Eigen::MatrixXd conditions(m, m), loads(m, k);
   conditions << held.transpose() * f.U, free_rotation.transpose() * f.P_physical;
   loads << held.transpose() * particular_U, free_rotation.transpose() * particular_P_physical;
-  report->zero_modes = whole_problem_zero_modes(conditions, loads, frame_values, particular_values, tol);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(conditions, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  report->zero_modes = whole_problem_zero_modes(conditions, svd, loads, frame_values, particular_values, tol);
   int correction = 0;
   if (k > 0) {
     const Eigen::MatrixXd c = -conditions.completeOrthogonalDecomposition().solve(loads);
     const Eigen::MatrixXd chord = frame_values * c + particular_values;  // D, k x k
 
-    const NearZeroModes near = near_zero_modes(conditions, loads, frame_values, particular_values, tol,
+    const NearZeroModes near = near_zero_modes(svd, loads, frame_values, particular_values, tol,
                                                std::max(kConditionsNoise, 10 * field_integrator_.rel_tol));
     const Eigen::MatrixXd chord_zero = near.exact ? Eigen::MatrixXd(frame_values * zero_modes)  // k x z
                                                   : Eigen::MatrixXd(k, 0);
@@ -1301,9 +1302,10 @@ bool in_field(const ShootingProblem& problem, const Eigen::VectorXd& x) {
   return problem.definition().model(problem.parameters_at(x)).field != nullptr;
 }
 
+// `confirm`: run_resolved's, for a rod in a field (in_field).
 StabilityReport run_plain(const ShootingProblem& problem, const Eigen::VectorXd& x, const StabilityOptions& options,
-                          const EndCondition& end) {
-  return run_resolved(options, in_field(problem, x), [&](const StabilityOptions& o, bool* reversed) {
+                          const EndCondition& end, bool confirm) {
+  return run_resolved(options, confirm, [&](const StabilityOptions& o, bool* reversed) {
     StabilityAnalysis analysis(problem, x, o, end, nullptr);
     StabilityReport report = analysis.run();
     *reversed = analysis.reversed();
@@ -1327,23 +1329,25 @@ StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::V
       return report;
     }
     const EndCondition& end = problem.definition().end;
+    const bool confirm = in_field(problem, x);
     if (!end.is_half_turn_symmetry() || !unsupported(problem, x).empty())
-      return run_plain(problem, x, options, end);
+      return run_plain(problem, x, options, end, confirm);
     // Half of a half-turn symmetric rod: the end as stated holds the symmetric perturbations; the
     // antisymmetric ones have the complementary conditions and, with self-contact, the pair
     // energy's other second variation.
     const auto equations = problem.equations(problem.parameters_at(x));
-    const StabilityReport symmetric = run_plain(problem, x, options, end);
+    const StabilityReport symmetric = run_plain(problem, x, options, end, confirm);
     const EndCondition anti_end = antisymmetric_half_turn_end(end.half_turn_axis());
     std::string sliding;
-    const StabilityReport antisymmetric = run_resolved(options, in_field(problem, x), [&](const StabilityOptions& o, bool* reversed) {
+    const auto run_antisymmetric = [&](const StabilityOptions& o, bool* reversed) {
       StabilityAnalysis anti(problem, x, o, anti_end, antisymmetric_equations(*equations));
       anti.track_barrier(equations);
       StabilityReport report = anti.run();
       *reversed = anti.reversed();
       sliding = anti.sliding_reason();
       return report;
-    });
+    };
+    const StabilityReport antisymmetric = run_resolved(options, confirm, run_antisymmetric);
     if (!sliding.empty()) return sliding_undefined(sliding, symmetric, antisymmetric.rhs_evaluations);
     return whole_rod(symmetric, antisymmetric);
   } catch (const IntegrationError& e) {
