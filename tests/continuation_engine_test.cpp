@@ -117,6 +117,7 @@ TEST(ContinuationEngine, TargetReachedBeforeAStoppingEventInTheSameStepIsReached
   const ContinuationResult r = run.run(Eigen::VectorXd::Constant(1, 1.0));
   ASSERT_EQ(r.reason, StopReason::ReachedTarget) << r.message;
   EXPECT_EQ(r.points.back().type, PointType::Endpoint);
+  // The end is corrected again at the target itself (ParameterValue::refine): lambda = 0.3 to round-off.
   EXPECT_NEAR(r.points.back().parameter, 0.3, 1e-12);
   // The step that reached the target (from lambda = 0.25: the tangent's turn limits the first
   // step) had the event inside it too; it is beyond the end and not on the branch.
