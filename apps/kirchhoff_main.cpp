@@ -402,6 +402,7 @@ int main(int argc, char** argv) {
   PlectonemesArguments plect;
   auto* plectonemes_cmd = add_plectonemes_command(app, &plect);
   SweepArguments sweep;
+  sweep.command_line = argv;
   auto* sweep_cmd = add_sweep_command(app, &sweep);
 
   try {
