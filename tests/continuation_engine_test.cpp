@@ -11,6 +11,7 @@
 
 #include "kirchhoff/continuation/continuation.hpp"
 #include "kirchhoff/continuation/detail/broyden_steps.hpp"
+#include "kirchhoff/continuation/detail/singular_point_index.hpp"
 
 namespace kirchhoff {
 namespace {
@@ -234,6 +235,35 @@ TEST(ContinuationEngine, QuadraticPredictorNeedsFewerCorrectorIterations) {
 // on B0 alone contracts by the spectral radius of I - B0^-1 A, 0.5 (its 2-norm 0.51), per step:
 // 0.5^8 = 3.9e-3 of the first residual after 2n steps, above the 1e-3 checked, so the test would
 // fail on plain chord steps.
+PointRecord counted(std::optional<int> index, int zero_modes) {
+  PointRecord r;
+  r.stability_index = index;
+  r.zero_modes = zero_modes;
+  return r;
+}
+
+// A fold or branch point between regular points of indices a and b has index min(a, b): a count
+// that agrees is kept; one that differs is replaced where the point's zero modes beyond its
+// neighbours' explain the change (|a - b| of them: a simple and a double crossing, with a
+// symmetry's zero mode on both sides), and made undefined where they do not; an undefined count,
+// here or at a neighbour, is left as it is.
+TEST(SingularPointIndex, IsTheNeighboursLowerIndexWhereTheZeroModesExplainTheChange) {
+  auto settled = [](PointRecord p, const PointRecord& a, const PointRecord& b) {
+    detail::settle_singular_point_index(&p, a, b);
+    return p.stability_index;
+  };
+  EXPECT_EQ(settled(counted(0, 1), counted(0, 0), counted(1, 0)), 0);
+  EXPECT_EQ(settled(counted(2, 1), counted(0, 0), counted(1, 0)), 0);  // the soft wall's branch point
+  EXPECT_EQ(settled(counted(2, 1), counted(1, 0), counted(0, 0)), 0);  // the same, walked the other way
+  EXPECT_EQ(settled(counted(1, 2), counted(0, 0), counted(2, 0)), 0);  // a double branch point
+  EXPECT_EQ(settled(counted(3, 2), counted(1, 1), counted(2, 1)), 1);  // beside a symmetry's zero mode
+  EXPECT_EQ(settled(counted(1, 1), counted(1, 1), counted(2, 1)), 1);  // agrees
+  EXPECT_EQ(settled(counted(2, 0), counted(0, 0), counted(1, 0)), std::nullopt);  // no zero mode to explain it
+  EXPECT_EQ(settled(counted(1, 2), counted(0, 1), counted(2, 1)), std::nullopt);  // one crossing mode for two
+  EXPECT_EQ(settled(counted(std::nullopt, 1), counted(0, 0), counted(1, 0)), std::nullopt);
+  EXPECT_EQ(settled(counted(2, 1), counted(std::nullopt, 0), counted(1, 0)), 2);
+}
+
 TEST(BroydenSteps, SolveALinearSystemInAtMostTwiceItsSizeSteps) {
   constexpr int n = 4;
   Eigen::Matrix4d A;

@@ -269,6 +269,35 @@ TEST(SoftWall, TheEndPointIsExactlyOnTheTarget) {
   }
 }
 
+// The soft wall at log_b = -4 shortened through its branch point (Delta = 0.029511, where the
+// asymmetric equilibria branch off): index 0 before it, 1 after it, and at the branch point itself
+// 0 with one zero mode. The direct count there gave 2: besides the zero eigenvalue of the branch
+// point, a conjugate point of the clamped problem lies within 4e-8 of the end and was counted
+// negative. The neighbours settle it (continuation/detail/singular_point_index.hpp).
+TEST(SoftWall, BranchPointInTheShorteningHasItsNeighboursLowerIndex) {
+  RodContinuationOptions o;
+  o.parameter = "Delta";
+  o.target = 0.0297;
+  o.samples = 41;
+  o.compute_stability = true;
+  const BranchRun run = continue_case("soft_wall.toml", {{"log_b", -4.0}, {"Delta", 0.02}, {"m_guess", 1.0}}, o);
+  ASSERT_EQ(run.result.reason, StopReason::ReachedTarget) << run.result.message;
+  int branch_points = 0;
+  for (const auto& p : run.result.points) {
+    ASSERT_TRUE(p.stability_index.has_value()) << "Delta = " << p.parameter;
+    if (p.type != PointType::BranchPoint) {
+      EXPECT_EQ(*p.stability_index, p.parameter < 0.029511 ? 0 : 1) << "Delta = " << p.parameter;
+      EXPECT_EQ(p.zero_modes, 0) << "Delta = " << p.parameter;
+      continue;
+    }
+    ++branch_points;
+    EXPECT_NEAR(p.parameter, 0.0295110, 1e-6);
+    EXPECT_EQ(*p.stability_index, 0);
+    EXPECT_EQ(p.zero_modes, 1);
+  }
+  EXPECT_EQ(branch_points, 1);
+}
+
 // A step_check that refuses steps longer than 2 in P: the run shortens its steps and goes on
 // (every accepted step within the limit, the same target reached); one that refuses every step
 // stops the run as inadmissible with its reason.

@@ -1,5 +1,7 @@
 #include "kirchhoff/continuation/continuation.hpp"
 
+#include "kirchhoff/continuation/detail/singular_point_index.hpp"
+
 #include <algorithm>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
@@ -642,6 +644,7 @@ struct Continuation::Marcher {
   // on to `current`, for the next corrector's chord. A long branch keeping every one would hold
   // n^2 doubles per point.
   std::shared_ptr<const Eigen::MatrixXd> newest_matrix;
+  bool candidate_recorded = false;  // the step's candidate was recorded by take_special
 
   bool has_room() const { return points_before + static_cast<int>(result.points.size()) < o.max_points; }
 
@@ -675,13 +678,21 @@ struct Continuation::Marcher {
     report_state();
   }
 
-  // Puts p on the branch: recorded, then reported.
-  void accept(ContinuationPoint p) {
+  // Puts p on the branch: recorded (unless it was), then reported. A fold or branch point takes
+  // its index from its neighbours where its own count disagrees (singular_point_index.hpp): the
+  // regular points on either side of it along the branch, `after` being the step's candidate,
+  // recorded before it.
+  void accept(ContinuationPoint p, bool recorded = false, const ContinuationPoint* after = nullptr) {
     p.index = result.points.back().index + 1;
     p.step = ds;
     newest_matrix = std::move(p.jacobian);
     p.jacobian = p.type == PointType::BranchPoint ? newest_matrix : nullptr;
-    c.record(&p);
+    if (!recorded) c.record(&p);
+    if (after && (p.type == PointType::Fold || p.type == PointType::BranchPoint)) {
+      // An even branch point may lie just behind `current` (between `before` and it).
+      const bool behind = before && p.arclength < current.arclength;
+      detail::settle_singular_point_index(&p, behind ? *before : current, behind ? current : *after);
+    }
     result.points.push_back(std::move(p));
     if (sink) sink(result.points.back());
   }
@@ -770,7 +781,16 @@ struct Continuation::Marcher {
   // The special points of a step on the branch, in order along it, each acted on by its detector.
   // A step in which a stopping detector found its point ends the run at its first end point, or
   // with a stopping event at its first event point (the reason of the last such detection).
-  std::optional<detail::Stop> take_special(std::vector<detail::Detection> found) {
+  std::optional<detail::Stop> take_special(std::vector<detail::Detection> found, ContinuationPoint* candidate) {
+    const bool singular = std::any_of(found.begin(), found.end(), [](const detail::Detection& d) {
+      return d.point.type == PointType::Fold || d.point.type == PointType::BranchPoint;
+    });
+    // The candidate is recorded first where the step holds a singular point, whose index its
+    // neighbours settle.
+    if (singular) {
+      c.record(candidate);
+      candidate_recorded = true;
+    }
     std::optional<StopReason> step_stop;
     for (const auto& d : found)
       if (d.stop) step_stop = d.stop;
@@ -782,7 +802,7 @@ struct Continuation::Marcher {
       return d.point.type == PointType::BranchPoint;
     });
     for (auto& d : found) {
-      accept(d.point);
+      accept(d.point, false, singular ? candidate : nullptr);
       const ContinuationPoint& p = result.points.back();
       if (auto s = d.detector->act(p, &counters)) return s;
       // An end point stops with its own reason: a contact leg's stopping event found beyond the
@@ -802,7 +822,8 @@ struct Continuation::Marcher {
     previous_h = ds;
     if (iterations <= o.grow_iterations) ds = std::min(ds * kGrow, o.max_step);
     if (iterations >= o.shrink_iterations) ds = std::max(ds * kShrink, o.min_step);
-    accept(std::move(candidate));
+    accept(std::move(candidate), candidate_recorded);
+    candidate_recorded = false;
     current = result.points.back();
     current.jacobian = std::move(newest_matrix);
     report_state();
@@ -825,7 +846,7 @@ ContinuationResult Continuation::march(MarchState state, const PointSink& sink, 
       m.ds *= kShrink;
       continue;
     }
-    if (auto s = m.take_special(std::move(found))) return m.stop(s->first, s->second);
+    if (auto s = m.take_special(std::move(found), &*candidate)) return m.stop(s->first, s->second);
     m.advance(std::move(*candidate));
   }
   return m.stop(StopReason::MaxPoints);

@@ -1,0 +1,25 @@
+// The stability index at a fold or branch point, from the points on either side of it.
+//
+// At a singular point of a branch an eigenvalue of the second variation is zero, so a direct
+// count there sits on a knife's edge: an eigenvalue that is zero in exact arithmetic, or a second
+// one that is small there for another reason (the soft wall's branch point, where a conjugate
+// point of the clamped problem also lies within 1e-7 of the end), may come out either side. The
+// regular points around it do not have that trouble, and continuity along the branch settles the
+// count: every eigenvalue negative at the singular point is negative at both neighbours, and every
+// one negative at both that does not cross zero between them is negative there. With no crossing
+// inside the step other than the located one (what the detectors assume when they locate it), the
+// index at the singular point is the smaller of its neighbours' indices, and the zero eigenvalues
+// there are those that cross, |a - b| of them, besides the symmetries' zero modes.
+#pragma once
+
+#include "kirchhoff/continuation/continuation.hpp"
+
+namespace kirchhoff::detail {
+
+// Sets `singular`'s index to min(a, b), a and b the indices of the regular points before and after
+// it, where its own count differs and its extra zero modes (beyond the fewer of its neighbours')
+// account for the change from a to b; a count that the zero modes do not explain becomes undefined
+// (an empty index). Leaves the point alone where it agrees or an index is undefined.
+void settle_singular_point_index(PointRecord* singular, const PointRecord& before, const PointRecord& after);
+
+}  // namespace kirchhoff::detail
