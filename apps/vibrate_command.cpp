@@ -47,6 +47,7 @@ nlohmann::json vibration_json(const Case& c, const ShootingResult& equilibrium, 
           {"parameters", parameters_json(equilibrium.parameters)},
           {"rho_s", options.rho_s},
           {"straight_equilibrium", analysis.straight_equilibrium},
+          {"H_vib_not_conserved", analysis.H_vib_not_conserved},
           {"axial_indeterminate", analysis.axial_indeterminate},
           {"omega_scale", analysis.omega_scale},
           {"frequencies", analysis.frequencies()},
@@ -80,7 +81,7 @@ void print_table(const Case& c, const VibrationAnalysis& analysis) {
     std::cout << "  " << std::setw(2) << k + 1 << std::setprecision(12) << "  " << std::setw(18) << m.omega << "  "
               << std::setw(18) << m.omega * m.omega << "  " << std::setw(18) << m.H_vib_stats.mean << "  "
               << std::setprecision(3) << m.H_vib_stats.relative_spread()
-              << (m.H_vib_stats.applies ? "" : "  (not invariant: theta_e varies)") << "\n";
+              << (m.H_vib_stats.applies ? "" : "  (not invariant: " + analysis.H_vib_not_conserved + ")") << "\n";
   }
   for (size_t k = 0; k < analysis.unstable_modes.size(); ++k) {
     const VibrationMode& m = analysis.unstable_modes[k];

@@ -164,6 +164,7 @@ py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
   out["omega2"] = analysis.omega2();
   out["frequencies"] = column<double>(analysis.modes.size(), [&](size_t k) { return analysis.modes[k].omega; });
   out["straight_equilibrium"] = analysis.straight_equilibrium;
+  out["H_vib_not_conserved"] = analysis.H_vib_not_conserved;
   out["parameters"] = parameters_dict(at);  // as the CLI's JSON "parameters"
   out["modes"] = mode_list;
   return out;
@@ -255,7 +256,9 @@ Returns:
     "ybar", "thetabar", "nbarx", "nbary", "mbar", "H_vib_along_s" (and "omega2", "growth_rate").
     "unstable_modes": the same for omega^2 < 0 (imaginary frequencies: the equilibrium is unstable
     under dead loads; their number, "negative_omega2_count", is its index), most negative first;
-    "unstable_searched" (bool) and "omega2" (every mode's omega^2, increasing). "parameters": the
+    "unstable_searched" (bool) and "omega2" (every mode's omega^2, increasing).
+    "H_vib_not_conserved": why H_vib varies along the modes ("" where it is conserved: a straight
+    equilibrium of a uniform rod in no field). "parameters": the
     equilibrium's (those solved for included), as solve() gives them.
 
 Raises:

@@ -353,6 +353,19 @@ TEST_F(CaseFileTest, PlanarPositionOutOfThePlane) {
   expect_refused(text, "start.position", {"planar"});
 }
 
+// An unknown that no expression of the problem reads (here: the load is a number, so P balances
+// nothing) could take any value: Newton's Jacobian has a zero column, and a solve stopped wherever
+// it started. Refused where the unknowns are named; a parameter used only through another
+// (computed) parameter is used.
+TEST_F(CaseFileTest, UnknownUsedByNoExpressionIsRefused) {
+  const std::string text = replaced(kBase, "force = [\"-P\", 0]\n\n[solver]", "force = [-12.0, 0]\n\n[solver]");
+  expect_refused(text, "solver.unknowns", {"'P' is used by no expression"}, line_of(text, "unknowns"));
+  const std::string through_computed =
+      replaced(replaced(kBase, "P = 12.0", "P = 12.0\nload = \"2*P\""), "force = [\"-P\", 0]\n\n[solver]",
+               "force = [\"-load/2\", 0]\n\n[solver]");
+  EXPECT_NO_THROW(load_case_text(through_computed, "computed.toml"));
+}
+
 TEST_F(CaseFileTest, UnknownsNameMissingParameter) {
   const std::string text = replaced(kBase, "unknowns = [\"P\"]", "unknowns = [\"Q\"]");
   expect_refused(text, "solver.unknowns", {"'Q' is not in [parameters]"}, line_of(text, "unknowns"));

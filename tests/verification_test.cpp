@@ -1,6 +1,7 @@
 // No result is called converged unless it is one: NaN and inf never pass Newton's test, a
 // converged solve is checked again (verification.hpp), solves end within their wall-clock limit,
 // and both steppers give the same equilibrium on every shipped case.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -8,6 +9,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "kirchhoff/jobs/case_solve.hpp"
 #include "kirchhoff/shooting/newton.hpp"
 #include "kirchhoff/shooting/verification.hpp"
 #include "test_support.hpp"
@@ -127,6 +129,43 @@ TEST(ProfileFailure, NamesNaNAndTheSoftWall) {
 
 // A solve of the soft wall at a range b = 1e-20 once "converged" with the rod beyond the wall:
 // now it is never reported converged with a negative gap.
+// An extensible cantilever (A3 = 10) under a compressive dead load P: straight, stretch v3 =
+// 1 - P/A3. Below A3 it converges; at P = 12 the equations are solved with v3 = -0.2 (the tip at
+// x = -0.2), a rod turned inside out, which is a check failure naming the stretch, not "converged".
+TEST(ProfileFailure, AnExtensibleRodCompressedPastZeroLengthIsNoSolution) {
+  const std::string text = R"(model = "planar"
+[parameters]
+P = 5.0
+[rod]
+length = 1.0
+B = 1.0
+extensible = true
+A1 = 100.0
+A3 = 10.0
+[start]
+type = "clamped"
+position = [0, 0]
+[end]
+type = "loaded"
+force = ["-P", 0]
+[guess]
+force = ["-P", 0]
+)";
+  for (const double P : {5.0, 12.0}) {
+    const Case c = load_case_text(text, "squeezed.toml", {{"P", P}});
+    CaseSolveOptions direct;
+    direct.direct = true;
+    const CaseSolve solved = solve_case(c, direct);
+    if (P < 10.0) {
+      EXPECT_TRUE(solved.converged()) << solved.message;
+      continue;
+    }
+    EXPECT_EQ(solved.summary().status, SolverStatus::CheckFailed);
+    EXPECT_THAT(solved.summary().message, ::testing::HasSubstr("compressed to zero or negative length"));
+    EXPECT_THAT(solved.summary().message, ::testing::HasSubstr("v3 = -0.2"));
+  }
+}
+
 TEST(SoftWall, NoConvergedSolutionBeyondTheWall) {
   for (double log_b : {-20.0, -25.0}) {
     const Case c = load_case(testing::case_path("soft_wall.toml"), {{"log_b", log_b}});

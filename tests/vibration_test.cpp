@@ -212,6 +212,51 @@ TEST(Vibration, BuckledElasticaHasFiniteFrequenciesAndHvibIsNotInvariant) {
     // theta_e' != 0: the Lagrangian depends on s through theta_e(s) and H_vib varies.
     EXPECT_GT(mode.H_vib_stats.relative_spread(), 1e-3) << "omega = " << mode.omega;
   }
+  EXPECT_EQ(analysis.H_vib_not_conserved, "the equilibrium is curved (theta_e varies)");
+}
+
+// Straight equilibria on which H_vib still varies, for another reason than a curved rod (the
+// table and JSON said "theta_e varies" on them): the tapered column (EI(s)), and a column standing
+// under its own weight (its axial force varies along it). The uniform column has it conserved.
+TEST(Vibration, SaysWhyHvibVariesOnAStraightEquilibrium) {
+  const std::string heavy_column = R"(model = "planar"
+[parameters]
+w = 5.0
+[rod]
+length = 1.0
+B = 1.0
+gravity = { weight = "w", up = [1, 0, 0] }
+[start]
+type = "clamped"
+position = [0, 0]
+[end]
+type = "free"
+[guess]
+force = ["w", 0]
+)";
+  auto heavy = [&heavy_column] {
+    testing::Solved out;
+    out.c = load_case_text(heavy_column, "heavy_column.toml");
+    out.problem = std::make_unique<ShootingProblem>(out.c.definition);
+    ShootingResult r = solve(*out.problem, out.problem->initial_unknowns(out.c.start_guess));
+    EXPECT_TRUE(r.summary.converged()) << r.summary.brief_report();
+    out.solution = make_solution(*out.problem, std::move(r), 101, {});
+    return out;
+  };
+  std::vector<std::pair<testing::Solved, std::string>> cases;
+  cases.emplace_back(testing::solve_case("tapered_column.toml", {{"P", 1.0}}), "the rod's properties vary along it");
+  cases.emplace_back(heavy(), "an external field acts (the axial force varies)");
+  cases.emplace_back(straight_euler_column(5.0), "");
+  for (const auto& [solved, reason] : cases) {
+    VibrationOptions options;
+    options.modes = 1;
+    const VibrationProblem vib(*solved.problem, solved.solution.result.x, options);
+    ASSERT_TRUE(vib.straight_equilibrium()) << reason;
+    const VibrationAnalysis analysis = vib.analyse();
+    EXPECT_EQ(analysis.H_vib_not_conserved, reason);
+    ASSERT_EQ(analysis.modes.size(), 1u);
+    EXPECT_EQ(analysis.modes[0].H_vib_stats.applies, reason.empty()) << reason;
+  }
 }
 
 TEST(Vibration, BuckledElasticaFirstFrequencyVanishesAtTheBifurcation) {

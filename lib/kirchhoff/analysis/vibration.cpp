@@ -538,6 +538,10 @@ VibrationAnalysis VibrationProblem::analyse() const {
   out.straight_equilibrium = straight_;
   out.axial_indeterminate = axial_indeterminate_;
   out.omega_scale = omega_scale_;
+  const RodModel& model = equations_->model();
+  if (!straight_) out.H_vib_not_conserved = "the equilibrium is curved (theta_e varies)";
+  else if (!model.is_uniform()) out.H_vib_not_conserved = "the rod's properties vary along it";
+  else if (model.field) out.H_vib_not_conserved = "an external field acts (the axial force varies)";
   for (double omega : frequencies()) out.modes.push_back(mode(omega));
   out.sigma_max = sigma_max_;
   out.unstable_searched = options_.unstable_modes;

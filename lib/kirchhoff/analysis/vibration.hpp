@@ -131,6 +131,10 @@ struct VibrationAnalysis {
   bool straight_equilibrium = false;
   bool axial_indeterminate = false;  // the degenerate straight case above (transverse problem solved)
   double omega_scale = 0.0;          // omega_0
+  // Why H_vib (eq. 95b) is not conserved along the modes, "" where it is (a straight equilibrium of
+  // a uniform rod in no field): the curved equilibrium, the stiffness or density varying along the
+  // rod, or the external field (whose axial force varies).
+  std::string H_vib_not_conserved;
   std::vector<double> frequencies() const;
   int negative_omega2_count() const { return static_cast<int>(unstable_modes.size()); }
   // omega^2 of every mode found, unstable ones first, increasing.

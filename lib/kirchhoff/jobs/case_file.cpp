@@ -702,6 +702,21 @@ std::set<std::string> problem_parameters(const Reader& reader, const ProblemDefi
   return used;
 }
 
+// Every parameter [solver] unknowns names must be used by the problem: one that no expression of
+// the rod, its ends or obstacles reads could take any value (the shooting Jacobian's column is
+// zero), and Newton would stop wherever it starts.
+void check_unknowns_used(const Reader& reader, const Value& root, const Case& c) {
+  const Value* solver = Reader::find(root, "solver");
+  const Value* unknowns = solver ? Reader::find(*solver, "unknowns") : nullptr;
+  if (!unknowns) return;
+  for (const auto& name : reader.strings(*unknowns, "solver.unknowns"))
+    if (!c.problem_parameters.count(name))
+      reader.fail(*unknowns, "solver.unknowns",
+                  "'" + name + "' is used by no expression of the rod, its ends or obstacles: solved for, it could "
+                  "take any value. Use it where the condition it balances acts (e.g. an end's force = [\"-" + name +
+                  "\", 0]), or leave it out of the unknowns");
+}
+
 }  // namespace
 
 Case load_case_text(const std::string& text, const std::string& path, const ParameterOverrides& overrides,
@@ -741,6 +756,7 @@ Case load_case_text(const std::string& text, const std::string& path, const Para
   read_output(reader, root, &c);
   check_problem(reader, root, d);
   c.problem_parameters = problem_parameters(reader, d);
+  check_unknowns_used(reader, root, c);
   return c;
 }
 

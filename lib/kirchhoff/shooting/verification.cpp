@@ -103,6 +103,15 @@ std::string zero_iteration_failure(const ShootingProblem& problem, const Shootin
 std::string profile_failure(const RodModel& model, const std::vector<RodPoint>& profile) {
   for (const RodPoint& p : profile)
     if (!finite(p)) return "the solution's profile holds NaN or inf" + at(p.s);
+  if (model.extensible)
+    for (const RodPoint& p : profile)
+      if (!(p.v[2] > 0.0)) {
+        std::ostringstream os;
+        os << "the rod is compressed to zero or negative length" << at(p.s) << " (stretch v3 = " << p.v[2]
+           << "): an extensible rod's sections must keep their orientation along it (v3 > 0), so this solves the "
+              "equations, not the rod";
+        return os.str();
+      }
   if (!model.field) return {};
   for (const RodPoint& p : profile) {
     const double gap = model.field->gap(p.s, p.r);

@@ -31,9 +31,11 @@ std::string zero_iteration_failure(const ShootingProblem& problem, const Shootin
 // what a residual that is small only by scale gives (orders of magnitude beyond the unknowns).
 inline constexpr double kGuessCorrectionTolerance = 1e-4;
 
-// Every sampled state is finite, and the rod stays strictly inside the domain of its external
-// field's potential (a soft wall's W_ext = b / (a - y) is infinite at the wall and has no
-// physical meaning beyond it: a solution there is a solution of the equations, not of the rod).
+// Every sampled state is finite, an extensible rod's stretch v3 = v.d3 stays positive (at v3 <= 0
+// a section has been pushed onto or past its neighbour: Reissner's strains, like Antman's, require
+// v3 > 0), and the rod stays strictly inside the domain of its external field's potential (a soft
+// wall's W_ext = b / (a - y) is infinite at the wall and has no physical meaning beyond it: a
+// solution there is a solution of the equations, not of the rod).
 std::string profile_failure(const RodModel& model, const std::vector<RodPoint>& profile);
 
 // Applies a check to a result Newton called converged: a failure turns it into CheckFailed with
