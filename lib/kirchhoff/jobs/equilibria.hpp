@@ -143,9 +143,13 @@ EquilibriaSearch find_equilibria(const ProblemDefinition& definition, const RodP
 // part of this energy, so comparing such equilibria by it would mislead).
 double total_potential_energy(const ShootingProblem& problem, const Eigen::VectorXd& x);
 
-// The scale-free distance between two solutions (see above) over `samples` points.
+// The scale-free distance between two solutions (see above) over `samples` points. Without
+// `compare_contacts`, the lists of contacts are not compared, only the rod: for one equilibrium
+// written with different contact sets (a flat part whose forceless edge may sit anywhere the rod
+// lies on the obstacle).
 double profile_distance(const ShootingProblem& a, const Eigen::VectorXd& xa, const ShootingProblem& b,
-                        const Eigen::VectorXd& xb, double force_scale, int samples = 101);
+                        const Eigen::VectorXd& xb, double force_scale, int samples = 101,
+                        bool compare_contacts = true);
 
 // The same modulo a rotation about the e3 axis through a's r(0) (the angle fitted by least squares):
 // the largest difference of (r - r(0)) / L, d3, n / F0 and m / (F0 L) along the rod. The director
