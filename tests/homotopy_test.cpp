@@ -90,6 +90,24 @@ TEST(Homotopy, StopsAtAFoldAndSaysWhere) {
   EXPECT_TRUE(below.failure.empty()) << below.message;
 }
 
+// The Euler column's first mode followed from the file's P = 12 to 500 on one shooting segment:
+// past P ~ 450 the fields grow like exp(sqrt(P) L) ~ 1e9 and the corrector's best residual sits
+// at 1.5e-10, above the tolerance 1e-10, down to the minimum step. The failure says that more
+// segments help, and with 8 the same request reaches the Elastica: theta0 = 3.14148108804982883,
+// the root of 4 K(sin(theta0/2))^2 = 500 (EI = L = 1; bisection in mpmath at 50 digits). Within
+// 1e-9: near pi theta0 is ill-conditioned by about 10 against the residual's 1e-10 (with 8, 16
+// and 32 segments it comes out 4.7e-10, 2.7e-10 and 1.9e-10 below; P = 4 K^2 from it is 1e-6 off,
+// as dP/dtheta0 ~ 1e6 there).
+TEST(Homotopy, AStepTooSmallOnOneSegmentSaysMoreSegmentsHelp) {
+  const CaseSolve one = solve_at("euler_column.toml", {{"P", 500.0}});
+  EXPECT_EQ(one.failure, "step_too_small");
+  EXPECT_NE(one.message.find("more segments condition it better"), std::string::npos) << one.message;
+  const Case c = load_case(testing::case_path("euler_column.toml"), {{"P", 500.0}}, "", {{"segments", "8"}});
+  const CaseSolve eight = solve_case(c);
+  ASSERT_TRUE(eight.converged()) << eight.message;
+  EXPECT_NEAR(eight.solution->derived.at("theta0"), 3.14148108804982883, 1e-9);
+}
+
 // theta_guess shapes only the [guess]: setting it picks the start (the straight column), and the
 // load's change is then followed along the straight column, through the Euler load pi^2.
 TEST(Homotopy, ParametersOfTheGuessAloneStayGuesses) {

@@ -178,7 +178,11 @@ HomotopyResult follow_homotopy(const ProblemDefinition& start, const Eigen::Vect
   }
   h.fraction = run.points.back().parameter;
   if (run.reason != StopReason::ReachedTarget) {
-    h.message = stop_message(h, changes, run.message);
+    // A corrector that failed down to the minimum step on one segment has most often met the
+    // residual's floor of an ill-conditioned shooting (the Euler column's first mode at P = 454:
+    // best residual 1.5e-10 against the tolerance 1e-10; with 8 segments P = 500 converges).
+    const bool ill_conditioned = run.reason == StopReason::StepTooSmall && problem.segments() == 1;
+    h.message = stop_message(h, changes, ill_conditioned ? run.message + "; " + single_segment_hint() : run.message);
     return h;
   }
   polish(start, changes, contacts, run.points.back().x, &h);

@@ -729,14 +729,17 @@ void note_single_shooting(const ShootingProblem& problem, NewtonSummary* summary
   const SolverStatus status = summary->status;
   if (problem.segments() != 1 || (status != SolverStatus::SingularJacobian && status != SolverStatus::LineSearchFailed))
     return;
-  const std::string hint =
-      "with a single shooting segment; where the rod is long or under a large tension its shooting is "
-      "ill-conditioned, and more segments condition it better ([solver] segments in the case file, e.g. "
-      "--solver segments=8 on the command line)";
+  const std::string hint = single_segment_hint();
   summary->message = summary->message.empty() ? hint : summary->message + "; " + hint;
 }
 
 }  // namespace
+
+std::string single_segment_hint() {
+  return "with a single shooting segment; where the rod is long or under a large tension its shooting is "
+         "ill-conditioned, and more segments condition it better ([solver] segments in the case file, e.g. "
+         "--solver segments=8 on the command line)";
+}
 
 ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) {
   ShootingResult result;

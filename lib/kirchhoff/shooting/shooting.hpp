@@ -322,7 +322,11 @@ struct ShootingResult {
   Parameters parameters;
 };
 
-// Newton (with the NLopt fallback when enabled) from the unknowns x0.
+// Newton (with the NLopt fallback when enabled) from the unknowns x0. A single segment that is
+// singular to the solver, or whose line search fails, adds single_segment_hint() to the message.
 ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0);
+
+// What a failure on one shooting segment adds: more segments condition an ill-conditioned shooting.
+std::string single_segment_hint();
 
 }  // namespace kirchhoff
