@@ -246,7 +246,7 @@ PointRecord counted(std::optional<int> index, int zero_modes) {
 // that agrees is kept; one that differs is replaced where the point's zero modes beyond its
 // neighbours' explain the change (|a - b| of them: a simple and a double crossing, with a
 // symmetry's zero mode on both sides), and made undefined where they do not; an undefined count,
-// here or at a neighbour, is left as it is.
+// here or at a neighbour, is left as it is, and so is the count between equal neighbours.
 TEST(SingularPointIndex, IsTheNeighboursLowerIndexWhereTheZeroModesExplainTheChange) {
   auto settled = [](PointRecord p, const PointRecord& a, const PointRecord& b) {
     detail::settle_singular_point_index(&p, a, b);
@@ -258,6 +258,7 @@ TEST(SingularPointIndex, IsTheNeighboursLowerIndexWhereTheZeroModesExplainTheCha
   EXPECT_EQ(settled(counted(1, 2), counted(0, 0), counted(2, 0)), 0);  // a double branch point
   EXPECT_EQ(settled(counted(3, 2), counted(1, 1), counted(2, 1)), 1);  // beside a symmetry's zero mode
   EXPECT_EQ(settled(counted(1, 1), counted(1, 1), counted(2, 1)), 1);  // agrees
+  EXPECT_EQ(settled(counted(0, 1), counted(1, 0), counted(1, 0)), 0);  // no change: an eigenvalue touching zero from below
   EXPECT_EQ(settled(counted(2, 0), counted(0, 0), counted(1, 0)), std::nullopt);  // no zero mode to explain it
   EXPECT_EQ(settled(counted(1, 2), counted(0, 1), counted(2, 1)), std::nullopt);  // one crossing mode for two
   EXPECT_EQ(settled(counted(std::nullopt, 1), counted(0, 0), counted(1, 0)), std::nullopt);

@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "kirchhoff/contact/detail/ipopt_application.hpp"
+
 namespace kirchhoff {
 namespace {
 
@@ -291,7 +293,7 @@ DiscreteElasticaResult solve_discrete_elastica(const DiscreteClampedElastica& ro
     throw std::invalid_argument("discrete Elastica: initial_multiplier must be >= 0");
   DiscreteElasticaResult out;
   Ipopt::SmartPtr<Ipopt::TNLP> nlp = new ClampedElasticaNLP(rod, segments, options, &out);
-  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = detail::make_ipopt_application();
   app->Options()->SetIntegerValue("print_level", 0);
   app->Options()->SetStringValue("sb", "yes");
   app->Options()->SetNumericValue("tol", 1e-12);

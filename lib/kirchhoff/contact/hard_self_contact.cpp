@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "kirchhoff/contact/detail/ipopt_application.hpp"
 #include "kirchhoff/contact/plectoneme.hpp"
 #include "kirchhoff/contact/self_contact.hpp"
 
@@ -452,7 +453,7 @@ HalfRod half_rod(const ShootingProblem& problem, const Eigen::VectorXd& x, const
 HardSelfContactPlectoneme solve_hard_self_contact(const ShootingProblem& problem, const Eigen::VectorXd& x,
                                                   const HardSelfContactOptions& options) {
   HalfRod rod = half_rod(problem, x, options);
-  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = detail::make_ipopt_application();
   app->Options()->SetIntegerValue("print_level", 0);
   app->Options()->SetStringValue("sb", "yes");
   app->Options()->SetNumericValue("tol", options.tolerance);

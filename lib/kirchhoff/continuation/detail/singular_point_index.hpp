@@ -9,7 +9,9 @@
 // one negative at both that does not cross zero between them is negative there. With no crossing
 // inside the step other than the located one (what the detectors assume when they locate it), the
 // index at the singular point is the smaller of its neighbours' indices, and the zero eigenvalues
-// there are those that cross, |a - b| of them, besides the symmetries' zero modes.
+// there are those that cross, |a - b| of them, besides the symmetries' zero modes. Where a = b
+// nothing crossed, and an eigenvalue that only touches zero there may do so from below (index
+// a - 1 with a zero mode) or above (a): the point's own count stands.
 #pragma once
 
 #include "kirchhoff/continuation/continuation.hpp"
@@ -19,7 +21,8 @@ namespace kirchhoff::detail {
 // Sets `singular`'s index to min(a, b), a and b the indices of the regular points before and after
 // it, where its own count differs and its extra zero modes (beyond the fewer of its neighbours')
 // account for the change from a to b; a count that the zero modes do not explain becomes undefined
-// (an empty index). Leaves the point alone where it agrees or an index is undefined.
+// (an empty index). Leaves the point alone where it agrees, where a = b, or where an index is
+// undefined.
 void settle_singular_point_index(PointRecord* singular, const PointRecord& before, const PointRecord& after);
 
 }  // namespace kirchhoff::detail
