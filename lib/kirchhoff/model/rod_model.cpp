@@ -48,6 +48,11 @@ Mat3 FieldSum::force_gradient(double s, const Vec3& r) const {
   return total;
 }
 
+bool FieldSum::stiffens_perturbations() const {
+  for (const auto& f : fields_)
+    if (f->stiffens_perturbations()) return true;
+  return false;
+}
 bool FieldSum::has_tangent_stiffness() const {
   for (const auto& f : fields_)
     if (f->has_tangent_stiffness()) return true;

@@ -59,6 +59,11 @@ class ExternalField {
   virtual bool has_tangent_stiffness() const { return false; }
   virtual void add_tangent_stiffness(double /*s*/, const Vec3& /*r*/, const Vec3& /*d3*/, const Vec3& /*d3_prime*/,
                                      Eigen::Matrix<double, 6, 6>* /*S*/) const {}
+  // Whether the field adds to the second variation directly (a force gradient or a tangent
+  // stiffness somewhere): false for a field linear in r, which acts on perturbations only through
+  // the equilibrium's internal force. The stability index confirms its count by denser
+  // observations only in a field that does (analysis/stability.hpp).
+  virtual bool stiffens_perturbations() const { return true; }
 };
 
 // Weight per unit length w acting along -up: W_ext = w r.up (section 3.1, rho S g r.e_z).
@@ -68,6 +73,7 @@ class UniformGravity final : public ExternalField {
   double potential(double, const Vec3& r) const override { return weight_ * r.dot(up_); }
   Vec3 force(double, const Vec3&) const override { return -weight_ * up_; }
   Mat3 force_gradient(double, const Vec3&) const override { return Mat3::Zero(); }
+  bool stiffens_perturbations() const override { return false; }
 
  private:
   double weight_;
@@ -101,6 +107,7 @@ class FieldSum final : public ExternalField {
   bool has_tangent_stiffness() const override;
   void add_tangent_stiffness(double s, const Vec3& r, const Vec3& d3, const Vec3& d3_prime,
                              Eigen::Matrix<double, 6, 6>* S) const override;
+  bool stiffens_perturbations() const override;
   const std::vector<std::shared_ptr<const ExternalField>>& fields() const { return fields_; }
 
  private:
