@@ -127,8 +127,6 @@ TEST(ProfileFailure, NamesNaNAndTheSoftWall) {
   EXPECT_NE(profile_failure(model, profile).find("soft wall"), std::string::npos) << profile_failure(model, profile);
 }
 
-// A solve of the soft wall at a range b = 1e-20 once "converged" with the rod beyond the wall:
-// now it is never reported converged with a negative gap.
 // An extensible cantilever (A3 = 10) under a compressive dead load P: straight, stretch v3 =
 // 1 - P/A3. Below A3 it converges; at P = 12 the equations are solved with v3 = -0.2 (the tip at
 // x = -0.2), a rod turned inside out, which is a check failure naming the stretch, not "converged".
@@ -166,6 +164,8 @@ force = ["-P", 0]
   }
 }
 
+// A solve of the soft wall at a range b = 1e-20 once "converged" with the rod beyond the wall:
+// now it is never reported converged with a negative gap.
 TEST(SoftWall, NoConvergedSolutionBeyondTheWall) {
   for (double log_b : {-20.0, -25.0}) {
     const Case c = load_case(testing::case_path("soft_wall.toml"), {{"log_b", log_b}});

@@ -529,8 +529,15 @@ VibrationMode VibrationProblem::mode_at(double omega2) const {
   out.H_vib_stats.mean = h_sum / static_cast<double>(samples.size());
   out.H_vib_stats.spread = h_max - h_min;
   out.H_vib_stats.scale = scale;
-  out.H_vib_stats.applies = straight_ && model.is_uniform() && !model.field;
+  out.H_vib_stats.applies = H_vib_not_conserved().empty();
   return out;
+}
+
+std::string VibrationProblem::H_vib_not_conserved() const {
+  if (!straight_) return "the equilibrium is curved (theta_e varies)";
+  if (!model().is_uniform()) return "the rod's properties vary along it";
+  if (model().field) return "an external field acts (the axial force varies)";
+  return "";
 }
 
 VibrationAnalysis VibrationProblem::analyse() const {
@@ -538,10 +545,7 @@ VibrationAnalysis VibrationProblem::analyse() const {
   out.straight_equilibrium = straight_;
   out.axial_indeterminate = axial_indeterminate_;
   out.omega_scale = omega_scale_;
-  const RodModel& model = equations_->model();
-  if (!straight_) out.H_vib_not_conserved = "the equilibrium is curved (theta_e varies)";
-  else if (!model.is_uniform()) out.H_vib_not_conserved = "the rod's properties vary along it";
-  else if (model.field) out.H_vib_not_conserved = "an external field acts (the axial force varies)";
+  out.H_vib_not_conserved = H_vib_not_conserved();
   for (double omega : frequencies()) out.modes.push_back(mode(omega));
   out.sigma_max = sigma_max_;
   out.unstable_searched = options_.unstable_modes;

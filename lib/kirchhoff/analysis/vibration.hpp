@@ -174,6 +174,9 @@ class VibrationProblem {
   bool axial_indeterminate() const { return axial_indeterminate_; }
   double omega_scale() const { return omega_scale_; }
   const RodModel& model() const { return equations_->model(); }
+  // Why H_vib (eq. 95b) varies along the modes (VibrationAnalysis::H_vib_not_conserved); "" where
+  // it is an invariant: a straight equilibrium of a uniform rod in no field.
+  std::string H_vib_not_conserved() const;
 
  private:
   struct Matching;
