@@ -317,6 +317,61 @@ TEST(Stability, EveryShippedCaseHasAnIndexOrAReason) {
   }
 }
 
+// Observing the eigenphases on the integration's interpolant (StabilityOptions::
+// interpolated_observations) must count exactly as observing every one on an exact integration:
+// on every shipped case and on equilibria whose phases turn fast or pass several conjugate points,
+// at the state's tolerance (solve) and at a branch's (1e-8). Conjugate points are located on
+// exact frames either way, each to ~1e-7 L: 1e-5 apart at most. And it must save integration
+// somewhere, or this test would compare a path with itself: on the straight twisted rod, whose
+// phases turn slowly along most of it, it takes fewer right-hand sides.
+TEST(Stability, InterpolatedObservationsCountAsExactOnes) {
+  struct Equilibrium {
+    std::string name;
+    DefinitionSolve solved;
+  };
+  std::vector<Equilibrium> equilibria;
+  auto add = [&](const std::string& name, const ParameterOverrides& set) {
+    const Case c = load_case(testing::case_path(name), set);
+    try {
+      DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
+      if (solved.result.summary.converged()) equilibria.push_back({name, std::move(solved)});
+    } catch (const std::exception&) {
+      // a case solved elsewhere by continuation
+    }
+  };
+  for (const auto& entry : std::filesystem::directory_iterator(KIRCHHOFF_CASES_DIR))
+    if (entry.path().extension() == ".toml") add(entry.path().filename().string(), {});
+  add("euler_column.toml", {{"P", 200.0}, {"theta_guess", 0.0}});
+  add("euler_column.toml", {{"P", 100.0}, {"theta_guess", 1.5}});
+  add("twisted_clamped.toml", {{"phi", 12.0}});
+  add("twisted_clamped.toml", {{"phi", 30.0}, {"tension", -20.0}});
+  add("clamped_clamped.toml", {{"s_mode", 1.0}});
+  ASSERT_GT(equilibria.size(), 20u);
+  long saved_on_the_twisted_rod = 0;
+  for (const double tolerance : {0.0, 1e-8}) {
+    for (const Equilibrium& e : equilibria) {
+      SCOPED_TRACE(e.name + " at field tolerance " + std::to_string(tolerance));
+      StabilityOptions interpolated, exact;
+      interpolated.field_tolerance = exact.field_tolerance = tolerance;
+      exact.interpolated_observations = false;
+      const Eigen::VectorXd& x = e.solved.result.x;
+      const StabilityReport a = analyse_stability(*e.solved.problem, x, interpolated);
+      const StabilityReport b = analyse_stability(*e.solved.problem, x, exact);
+      ASSERT_EQ(a.defined(), b.defined()) << a.reason << " / " << b.reason;
+      EXPECT_EQ(a.reason, b.reason);
+      if (!a.defined()) continue;
+      EXPECT_EQ(*a.index, *b.index);
+      EXPECT_EQ(a.zero_modes, b.zero_modes);
+      ASSERT_EQ(a.conjugate_points.size(), b.conjugate_points.size());
+      for (size_t j = 0; j < a.conjugate_points.size(); ++j)
+        EXPECT_NEAR(a.conjugate_points[j], b.conjugate_points[j], 1e-5);
+      if (e.name == "twisted_clamped.toml" && *a.index == 2 && tolerance > 0)
+        saved_on_the_twisted_rod = b.rhs_evaluations - a.rhs_evaluations;
+    }
+  }
+  EXPECT_GT(saved_on_the_twisted_rod, 0);
+}
+
 TEST(Stability, GravityAndExtensibleRodsAreStableWhereExpected) {
   // A cantilever hanging under its weight: a stable equilibrium of a dead load.
   const StabilityReport heavy = index_of(solve_case("heavy_cantilever.toml"));

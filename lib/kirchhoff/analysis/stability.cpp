@@ -22,6 +22,10 @@ namespace {
 using detail::eigenphases;
 
 constexpr double kPi = 3.14159265358979323846;
+// An integration step observed on its interpolant (interpolated_step) is at most this many of
+// the rate's observation steps long, and its eigenphases stay this far from conjugate points.
+constexpr double kInterpolatedSteps = 4.0;
+constexpr double kPassageMargin = 0.1;  // rad
 // A load-controlled mode is an exact zero mode of the isoperimetric correction where its share of
 // D is this many times the rest (its sign then decides, as the exact count assumes), or where its
 // singular value is below this fraction of the largest (round-off: the decomposition drops it).
@@ -244,6 +248,10 @@ struct Frame {
   // full frame the positions the start holds (at s = 0), then the contacts' nu.dr(s_c) / L,
   // recorded as each contact is passed.
   Eigen::MatrixXd recorded_rows_frame, recorded_rows_particular;
+  // d/ds of y and dY where slope_at == s (StabilityAnalysis::slopes), else stale.
+  Eigen::VectorXd y_slope;
+  Eigen::MatrixXd dY_slope;
+  double slope_at = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Follows lifted eigenphases, and where they pass odd multiples of pi (a stack per eigenphase:
@@ -341,6 +349,12 @@ class StabilityAnalysis {
   void orthonormalise(Frame* f) const;
   void flowed(const Frame& f, double s1, CarriedSteps* steps, bool frame_only, Frame* next);
   void march(Frame* f, double end, double longest, PhaseTrack* track);
+  void march_observed(Frame* f, double end, double longest, PhaseTrack* track);
+  bool interpolated_step(Frame* f, double s1, double longest, PhaseTrack* track);
+  bool near_passage(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
+  void slopes(Frame* f);
+  bool interpolant_is_close(const Frame& a, const Frame& b) const;
+  double observation_step(double longest) const;
   void advance(Frame* f, double s1, PhaseTrack* track, int depth);
   void record(const Frame& f, const Eigen::VectorXd& after, double s1, PhaseTrack* track);
   double locate_passage(const Frame& f, const Eigen::VectorXd& before, int j, long multiple, double s1, double ta,
@@ -378,13 +392,18 @@ class StabilityAnalysis {
   IntegratorOptions field_integrator_;  // the state's, or looser (StabilityOptions::field_tolerance)
   bool reversed_ = false;
   CarriedSteps steps_;  // the step sizes the fields' integration proposes next (flowed)
+  // The last observation step taken and the largest move of an eigenphase over it (advance);
+  // none yet (zero step) at the start and past a contact.
+  struct Observation {
+    double step = 0.0, move = 0.0;
+  } last_observation_;
   // Workspaces kept across the index's steps (no allocation at each): the map (map_at), the
   // canonical coordinates of the fields (canonical_blocks), the frame a step arrives at (advance)
   // and the trial frames of locate_passage.
   mutable CanonicalMap map_;
   mutable bool map_known_ = false, map_has_G_ = true;
   mutable Eigen::MatrixXd z_, z_particular_;
-  Frame arriving_, trial_;
+  Frame arriving_, trial_, interpolated_;
   Eigen::MatrixXd directions_;  // the fields handed to the integration (flowed)
   // The full frame: positions are configuration variables beside the rotation (see
   // positions_are_configuration); its U block holds (dr / L, dpsi), offset_ = 0. Otherwise the
@@ -545,7 +564,7 @@ void StabilityAnalysis::orthonormalise(Frame* f) const {
   const int m = static_cast<int>(f->U.cols());
   if (m == 0) return;
   auto apply = [&](auto&& divide) {
-    for (Eigen::MatrixXd* X : {&f->dY, &f->U, &f->P, &f->P_physical, &f->R, &f->recorded_rows_frame})
+    for (Eigen::MatrixXd* X : {&f->dY, &f->dY_slope, &f->U, &f->P, &f->P_physical, &f->R, &f->recorded_rows_frame})
       if (X->size() > 0) divide(*X);
   };
   if (m == 1) {
@@ -672,6 +691,7 @@ void StabilityAnalysis::flowed(const Frame& f, double s1, CarriedSteps* steps, b
   rhs_ += flow.rhs_evaluations;
   next->y.swap(flow.y);
   next->s = s1;
+  next->slope_at = std::numeric_limits<double>::quiet_NaN();
   next->dY = flow.directions.leftCols(m);
   next->particular.setZero(f.particular.rows(), frame_only ? 0 : f.particular.cols());
   for (int i = 0; i < count; ++i) next->particular.col(started[i]) = flow.directions.col(m + i);
@@ -680,19 +700,159 @@ void StabilityAnalysis::flowed(const Frame& f, double s1, CarriedSteps* steps, b
   next->recorded_rows_particular = f.recorded_rows_particular;
 }
 
-// Marches the frame to `end` (a shooting node, a contact or L) as one adaptive integration
-// observed at the end of each of its own steps: each observation step is the step the
-// integrator proposes (steps_), so none is cut short to land on a grid and its right-hand sides
-// are those of the integration alone. At most `longest`, so that no eigenphase turns by pi
-// between two observations unseen (see run); the last steps are evened out to land on `end`.
+// Marches the frame to `end` (a shooting node, a contact or L) in the integration's own steps,
+// up to kInterpolatedSteps observation steps long, each observed in between on its interpolant
+// (interpolated_step); a step in which an eigenphase comes near a conjugate point, or whose
+// interpolant cannot be followed, is marched again in observation steps of their own
+// (march_observed), which locate the passage on exact frames. Where the sliding partners of a
+// self-contact are tracked (track_barrier), every observation is of an exact state.
 void StabilityAnalysis::march(Frame* f, double end, double longest, PhaseTrack* track) {
+  if (barrier_eq_ || !options_.interpolated_observations) return march_observed(f, end, longest, track);
   const double sliver = 1e-12 * scales_.length;
+  if (!(steps_.directions > 0)) steps_.directions = longest;
   while (end - f->s > sliver) {
-    double h = longest;
+    const double h = std::min(kInterpolatedSteps * longest, steps_.directions), left = end - f->s;
+    const double s1 = left <= h ? end : f->s + left / std::ceil(left / h);
+    // Where the integration's step is not much longer than an observation step, the step is
+    // observed at its end alone (the interpolant's slopes would cost more than they save).
+    if (s1 - f->s < 1.5 * observation_step(longest)) advance(f, s1, track, 0);
+    else if (!interpolated_step(f, s1, longest, track)) march_observed(f, s1, longest, track);
+  }
+}
+
+// Marches the frame to `end` as one adaptive integration observed at the end of each of its own
+// steps: each observation step is the step the integrator proposes (steps_), so none is cut
+// short to land on a grid and its right-hand sides are those of the integration alone. At most
+// `longest` (twice it where the phases move slowly, observation_step), so that no eigenphase turns
+// by pi between two observations unseen (see run); the last steps are evened out to land on `end`.
+void StabilityAnalysis::march_observed(Frame* f, double end, double longest, PhaseTrack* track) {
+  const double sliver = 1e-12 * scales_.length;
+  // The integration's first trial step is the observation step itself (not a fraction of it,
+  // which the integrator would have to grow through several short steps).
+  if (!(steps_.directions > 0)) steps_.directions = longest;
+  while (end - f->s > sliver) {
+    double h = observation_step(longest);
     if (steps_.directions > 0) h = std::min(h, steps_.directions);
     const double left = end - f->s;
     advance(f, left <= h ? end : f->s + left / std::ceil(left / h), track, 0);
   }
+}
+
+// Whether an eigenphase moving from `from` to `to` (lifted) passes an odd multiple of pi or
+// comes within kPassageMargin of one: there march_observed takes over.
+bool StabilityAnalysis::near_passage(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const {
+  for (int j = 0; j < from.size(); ++j) {
+    const double lo = std::min(from[j], to[j]) - kPassageMargin, hi = std::max(from[j], to[j]) + kPassageMargin;
+    if (odd_multiples_between(lo, hi) > 0) return true;
+  }
+  return false;
+}
+
+// The frame's slopes (Frame::y_slope, dY_slope) where not known yet: the right-hand side, and its
+// derivatives along the fields by forward differences (to ~1e-7 of the fields, far below what
+// observing their eigenphases on an interpolant needs). One right-hand side each. (The frame's
+// orthonormalisation then keeps them, as it does the fields.)
+void StabilityAnalysis::slopes(Frame* f) {
+  if (f->slope_at == f->s) return;
+  f->y_slope = eq_->derivative(f->y, f->s);
+  f->dY_slope.resize(f->dY.rows(), f->dY.cols());
+  const double size = std::max(1.0, f->y.norm());
+  for (Eigen::Index j = 0; j < f->dY.cols(); ++j) {
+    const double norm = f->dY.col(j).norm();
+    const double e = norm > 0 ? 1e-7 * size / norm : 0.0;
+    if (e > 0) f->dY_slope.col(j) = (eq_->derivative(f->y + e * f->dY.col(j), f->s) - f->y_slope) / e;
+    else f->dY_slope.col(j).setZero();
+  }
+  f->slope_at = f->s;
+  rhs_ += 1 + f->dY.cols();
+}
+
+// One integration step of the fields from f to s1, their eigenphases observed in between on the
+// cubic Hermite interpolant of the state and the fields (the slopes at both ends), in sub-steps
+// on which no phase moves more than max_phase_step. Integration steps up to kInterpolatedSteps
+// observation steps long turn the fields by ~1 rad at the rate's estimate: the interpolant is
+// good to ~(1 rad)^4 / 384, 3e-3, and the phases to about as much, well inside kPassageMargin.
+// That is checked, not assumed (interpolant_is_close). The step is taken (f moves to s1, the
+// phases recorded) where no phase comes within that margin of an odd multiple of pi, so that no
+// conjugate point can hide in the interpolant's error; false (f and the track unchanged)
+// otherwise, and where the sub-steps would be shorter than 1 / 64 of the step.
+bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double longest, PhaseTrack* track) {
+  if (near_passage(track->lifted, track->lifted)) return false;
+  const CarriedSteps before = steps_;
+  Frame& next = arriving_;
+  flowed(*f, s1, &steps_, false, &next);
+  slopes(f);
+  slopes(&next);
+  const double h = s1 - f->s;
+  if (!interpolant_is_close(*f, next)) {
+    steps_ = before;
+    return false;
+  }
+  Eigen::VectorXd lifted = track->lifted, lowest = track->lowest;
+  double t = 0.0, dt = std::min(1.0, observation_step(longest) / h), move = 0.0;
+  while (t < 1.0) {
+    const double t1 = std::min(1.0, t + dt);
+    if (t1 < 1.0) {
+      const double a = 2 * t1 * t1 * t1 - 3 * t1 * t1 + 1, b = t1 * t1 * t1 - 2 * t1 * t1 + t1;
+      const double c = 1 - a, d = t1 * t1 * t1 - t1 * t1;
+      interpolated_.s = f->s + t1 * h;
+      interpolated_.y = a * f->y + b * h * f->y_slope + c * next.y + d * h * next.y_slope;
+      interpolated_.dY = a * f->dY + b * h * f->dY_slope + c * next.dY + d * h * next.dY_slope;
+    } else {
+      interpolated_ = next;
+    }
+    canonical_blocks(&interpolated_);
+    orthonormalise(&interpolated_);
+    const Eigen::VectorXd phases = lift(lifted, eigenphases(interpolated_.U, interpolated_.P, true));
+    const double largest = phases.size() == 0 ? 0.0 : (phases - lifted).cwiseAbs().maxCoeff();
+    if (largest > options_.max_phase_step && dt > 1.0 / 64) {
+      dt *= 0.5;
+      continue;
+    }
+    if (largest > options_.max_phase_step || near_passage(lifted, phases)) {
+      steps_ = before;
+      return false;
+    }
+    lifted = phases;
+    lowest = lowest.cwiseMin(phases);
+    move = largest;
+    if (t1 == 1.0) std::swap(*f, interpolated_);
+    t = t1;
+    dt = std::min(2.0 * dt, largest > 0 ? dt * 0.7 * options_.max_phase_step / largest : 2.0 * dt);
+  }
+  track->lifted = lifted;
+  track->lowest = lowest;
+  last_observation_ = {dt * h, move};
+  return true;
+}
+
+// Whether the cubic Hermite interpolant of each field between frames a and b (its slopes known)
+// is good to a few 1e-3 of it: its cubic term D = h (Y'(a) + Y'(b)) - 2 (Y(b) - Y(a)), which for
+// a field turning by x rad over the step is x^3 / 6 of it, at most 0.5 (x < 1.45), where the
+// interpolant's own error, x^4 / 384, is below 0.012.
+bool StabilityAnalysis::interpolant_is_close(const Frame& a, const Frame& b) const {
+  const double h = b.s - a.s;
+  for (Eigen::Index j = 0; j < a.dY.cols(); ++j) {
+    const double cubic = (h * (a.dY_slope.col(j) + b.dY_slope.col(j)) - 2.0 * (b.dY.col(j) - a.dY.col(j))).norm();
+    if (!(cubic <= 0.5 * std::max(a.dY.col(j).norm(), b.dY.col(j).norm()))) return false;
+  }
+  return true;
+}
+
+// The next observation step: `longest` (the fields' rate's, carry_across) where nothing is
+// known yet, else the last one scaled so that the eigenphases would move about 0.7
+// max_phase_step over it (growing at most twofold), between a quarter of `longest` and twice it.
+// Where the phases turn slower than the rate allows (most of a twisted rod), fewer observations
+// serve. None passes a turn unseen: a move of 2 pi - max_phase_step would look like one of
+// max_phase_step, beyond which advance() halves the step, so a phase would have to turn over 20
+// times faster than over the last step, where the rate's steps (L / (4 rate), at most twice
+// them here) keep the estimated move near 0.5 rad.
+double StabilityAnalysis::observation_step(double longest) const {
+  const Observation& last = last_observation_;
+  if (!(last.step > 0)) return longest;
+  const double target = 0.7 * options_.max_phase_step;
+  const double grown = last.move > 0 ? last.step * std::min(2.0, target / last.move) : 2.0 * last.step;
+  return std::clamp(grown, 0.25 * longest, 2.0 * longest);
 }
 
 // One observation step, halved while an eigenphase moves more than max_phase_step over it as
@@ -716,6 +876,7 @@ void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int dept
     return;
   }
   record(*f, phases, s1, track);
+  last_observation_ = {s1 - f->s, largest};
   std::swap(*f, next);  // (next keeps f's storage for the following step)
   if (barrier_eq_ && sliding_reason_.empty())
     sliding_reason_ = kirchhoff::sliding_reason(*barrier_eq_, eq_->point(f->y, f->s), options_.zero_tolerance);
@@ -1118,6 +1279,7 @@ std::string StabilityAnalysis::carry_across(Frame* f, const std::vector<PointCon
     for (size_t c = 0; c < contacts.size(); ++c) {
       if (std::abs(contacts[c].s - breaks[i + 1]) > 1e-12 * scales_.length) continue;
       if (std::string why = pass_contact(f, contacts[c], static_cast<int>(c), track, &shear); !why.empty()) return why;
+      last_observation_ = {};  // the contact's shear moves the phases anew
     }
   }
   return "";

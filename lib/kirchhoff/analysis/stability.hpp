@@ -92,6 +92,11 @@ struct StabilityOptions {
   double passage_tolerance = 1e-7;
   int max_locating_steps = 20;
   int max_halvings = 16;
+  // Observe the eigenphases between the integration's steps on its interpolant where those steps
+  // are longer than the observations need (most of a rod whose phases turn slowly), going back to
+  // exact observations near a conjugate point: fewer integration steps, the same count. false:
+  // every observation on an exact integration (tests compare the two).
+  bool interpolated_observations = true;
   // Singular values (of the orthonormal frame's blocks, dimensionless) and eigenvalues of the
   // boundary form below this are zero: a conjugate point exactly at L, a zero mode. The frame is
   // integrated to ~1e-10, so 1e-6 leaves four orders of margin; modes within 1e-6 of neutral
