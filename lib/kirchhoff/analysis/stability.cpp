@@ -25,7 +25,7 @@ constexpr double kPi = 3.14159265358979323846;
 // An integration step observed on its interpolant (interpolated_step) is at most this many of
 // the rate's observation steps long, and its eigenphases stay this far from conjugate points.
 constexpr double kInterpolatedSteps = 4.0;
-constexpr double kPassageMargin = 0.1;  // rad
+constexpr double kPassageMargin = 0.03;  // rad
 // A load-controlled mode is an exact zero mode of the isoperimetric correction where its share of
 // D is this many times the rest (its sign then decides, as the exact count assumes), or where its
 // singular value is below this fraction of the largest (round-off: the decomposition drops it).
@@ -276,7 +276,8 @@ class StabilityAnalysis {
   // antisymmetric half of a half-turn symmetric rod (stability_symmetric.hpp).
   StabilityAnalysis(const ShootingProblem& problem, const Eigen::VectorXd& x, const StabilityOptions& options,
                     const EndCondition& end, std::shared_ptr<const RodEquations> equations)
-      : problem_(problem), x_(x), options_(options), end_(end), p_(problem.parameters_at(x)),
+      : problem_(problem), x_(x), options_(options),
+        max_phase_step_(options.max_phase_step / options.observation_density), end_(end), p_(problem.parameters_at(x)),
         eq_(equations ? std::move(equations) : problem.equations(p_)) {
     coords_.position_dirs = eq_->admissible_directions(Slot::Position);
     coords_.rotation_dirs = eq_->admissible_directions(Slot::Orientation);
@@ -348,7 +349,7 @@ class StabilityAnalysis {
   void canonical_blocks(Frame* f) const;
   void orthonormalise(Frame* f) const;
   void flowed(const Frame& f, double s1, CarriedSteps* steps, bool frame_only, Frame* next);
-  void march(Frame* f, double end, double longest, PhaseTrack* track);
+  void march(Frame* f, double end, double longest, double observed, PhaseTrack* track);
   void march_observed(Frame* f, double end, double longest, PhaseTrack* track);
   bool interpolated_step(Frame* f, double s1, double longest, PhaseTrack* track);
   bool near_passage(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
@@ -379,6 +380,7 @@ class StabilityAnalysis {
   const ShootingProblem& problem_;
   const Eigen::VectorXd& x_;
   StabilityOptions options_;
+  double max_phase_step_;  // the options', over their observation_density
   const EndCondition& end_;
   Parameters p_;
   std::shared_ptr<const RodEquations> eq_;
@@ -701,22 +703,23 @@ void StabilityAnalysis::flowed(const Frame& f, double s1, CarriedSteps* steps, b
 }
 
 // Marches the frame to `end` (a shooting node, a contact or L) in the integration's own steps,
-// up to kInterpolatedSteps observation steps long, each observed in between on its interpolant
+// up to kInterpolatedSteps times `longest` (the rate's step, carry_across), each observed in
+// between on its interpolant at most `observed` apart
 // (interpolated_step); a step in which an eigenphase comes near a conjugate point, or whose
 // interpolant cannot be followed, is marched again in observation steps of their own
 // (march_observed), which locate the passage on exact frames. Where the sliding partners of a
 // self-contact are tracked (track_barrier), every observation is of an exact state.
-void StabilityAnalysis::march(Frame* f, double end, double longest, PhaseTrack* track) {
-  if (barrier_eq_ || !options_.interpolated_observations) return march_observed(f, end, longest, track);
+void StabilityAnalysis::march(Frame* f, double end, double longest, double observed, PhaseTrack* track) {
+  if (barrier_eq_ || !options_.interpolated_observations) return march_observed(f, end, observed, track);
   const double sliver = 1e-12 * scales_.length;
-  if (!(steps_.directions > 0)) steps_.directions = longest;
+  if (!(steps_.directions > 0)) steps_.directions = observed;
   while (end - f->s > sliver) {
     const double h = std::min(kInterpolatedSteps * longest, steps_.directions), left = end - f->s;
     const double s1 = left <= h ? end : f->s + left / std::ceil(left / h);
     // Where the integration's step is not much longer than an observation step, the step is
     // observed at its end alone (the interpolant's slopes would cost more than they save).
-    if (s1 - f->s < 1.5 * observation_step(longest)) advance(f, s1, track, 0);
-    else if (!interpolated_step(f, s1, longest, track)) march_observed(f, s1, longest, track);
+    if (s1 - f->s < 1.5 * observation_step(observed)) advance(f, s1, track, 0);
+    else if (!interpolated_step(f, s1, observed, track)) march_observed(f, s1, observed, track);
   }
 }
 
@@ -771,11 +774,11 @@ void StabilityAnalysis::slopes(Frame* f) {
 // cubic Hermite interpolant of the state and the fields (the slopes at both ends), in sub-steps
 // on which no phase moves more than max_phase_step. Integration steps up to kInterpolatedSteps
 // observation steps long turn the fields by ~1 rad at the rate's estimate: the interpolant is
-// good to ~(1 rad)^4 / 384, 3e-3, and the phases to about as much, well inside kPassageMargin.
+// good to ~(1 rad)^4 / 384, 3e-3, and the phases to about twice that, inside kPassageMargin.
 // That is checked, not assumed (interpolant_is_close). The step is taken (f moves to s1, the
 // phases recorded) where no phase comes within that margin of an odd multiple of pi, so that no
 // conjugate point can hide in the interpolant's error; false (f and the track unchanged)
-// otherwise, and where the sub-steps would be shorter than 1 / 64 of the step.
+// otherwise, and where the sub-steps would be shorter than 1 / 256 of the step.
 bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double longest, PhaseTrack* track) {
   if (near_passage(track->lifted, track->lifted)) return false;
   const CarriedSteps before = steps_;
@@ -789,7 +792,8 @@ bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double longest, P
     return false;
   }
   Eigen::VectorXd lifted = track->lifted, lowest = track->lowest;
-  double t = 0.0, dt = std::min(1.0, observation_step(longest) / h), move = 0.0;
+  const Observation before_step = last_observation_;
+  double t = 0.0, dt = std::min(1.0, observation_step(longest) / h);
   while (t < 1.0) {
     const double t1 = std::min(1.0, t + dt);
     if (t1 < 1.0) {
@@ -805,36 +809,37 @@ bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double longest, P
     orthonormalise(&interpolated_);
     const Eigen::VectorXd phases = lift(lifted, eigenphases(interpolated_.U, interpolated_.P, true));
     const double largest = phases.size() == 0 ? 0.0 : (phases - lifted).cwiseAbs().maxCoeff();
-    if (largest > options_.max_phase_step && dt > 1.0 / 64) {
+    if (largest > max_phase_step_ && dt > 1.0 / 256) {
       dt *= 0.5;
       continue;
     }
-    if (largest > options_.max_phase_step || near_passage(lifted, phases)) {
+    if (largest > max_phase_step_ || near_passage(lifted, phases)) {
       steps_ = before;
+      last_observation_ = before_step;
       return false;
     }
     lifted = phases;
     lowest = lowest.cwiseMin(phases);
-    move = largest;
+    last_observation_ = {(t1 - t) * h, largest};
     if (t1 == 1.0) std::swap(*f, interpolated_);
     t = t1;
-    dt = std::min(2.0 * dt, largest > 0 ? dt * 0.7 * options_.max_phase_step / largest : 2.0 * dt);
+    dt = std::min(2.0 * dt, largest > 0 ? dt * 0.7 * max_phase_step_ / largest : 2.0 * dt);
   }
   track->lifted = lifted;
   track->lowest = lowest;
-  last_observation_ = {dt * h, move};
   return true;
 }
 
 // Whether the cubic Hermite interpolant of each field between frames a and b (its slopes known)
 // is good to a few 1e-3 of it: its cubic term D = h (Y'(a) + Y'(b)) - 2 (Y(b) - Y(a)), which for
-// a field turning by x rad over the step is x^3 / 6 of it, at most 0.5 (x < 1.45), where the
-// interpolant's own error, x^4 / 384, is below 0.012.
+// a field turning by x rad over the step is x^3 / 6 of it, at most 0.25 (x < 1.15), where the
+// interpolant's own error, x^4 / 384, is below 4.5e-3, and the eigenphases' (W is quadratic in
+// the fields) below 0.009, a third of kPassageMargin.
 bool StabilityAnalysis::interpolant_is_close(const Frame& a, const Frame& b) const {
   const double h = b.s - a.s;
   for (Eigen::Index j = 0; j < a.dY.cols(); ++j) {
     const double cubic = (h * (a.dY_slope.col(j) + b.dY_slope.col(j)) - 2.0 * (b.dY.col(j) - a.dY.col(j))).norm();
-    if (!(cubic <= 0.5 * std::max(a.dY.col(j).norm(), b.dY.col(j).norm()))) return false;
+    if (!(cubic <= 0.25 * std::max(a.dY.col(j).norm(), b.dY.col(j).norm()))) return false;
   }
   return true;
 }
@@ -850,7 +855,7 @@ bool StabilityAnalysis::interpolant_is_close(const Frame& a, const Frame& b) con
 double StabilityAnalysis::observation_step(double longest) const {
   const Observation& last = last_observation_;
   if (!(last.step > 0)) return longest;
-  const double target = 0.7 * options_.max_phase_step;
+  const double target = 0.7 * max_phase_step_;
   const double grown = last.move > 0 ? last.step * std::min(2.0, target / last.move) : 2.0 * last.step;
   return std::clamp(grown, 0.25 * longest, 2.0 * longest);
 }
@@ -868,7 +873,7 @@ void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int dept
   // pair them wrongly though each lies near some new phase.
   const double largest =
       phases.size() == 0 ? 0.0 : (lift(track->lifted, phases) - track->lifted).cwiseAbs().maxCoeff();
-  if (largest > options_.max_phase_step && depth < options_.max_halvings) {
+  if (largest > max_phase_step_ && depth < options_.max_halvings) {
     const double mid = 0.5 * (f->s + s1);
     steps_ = before;  // the halves continue from f, not from the step taken past them
     advance(f, mid, track, depth + 1);
@@ -1266,16 +1271,19 @@ std::string StabilityAnalysis::carry_across(Frame* f, const std::vector<PointCon
   // per step at most (march takes the integrator's own steps below that).
   const int wanted = std::max(options_.min_steps, static_cast<int>(std::ceil(4.0 * scales_.rate)));
   const int steps = std::max(2, (wanted + pieces - 1) / pieces);
+  const int observed_wanted = std::max(static_cast<int>(options_.min_steps * options_.observation_density),
+                                       static_cast<int>(std::ceil(4.0 * scales_.rate)));
+  const int observed_steps = std::max(2, (observed_wanted + pieces - 1) / pieces);
   double shear = 0.0;  // of the contact just passed
   for (int i = 0; i < pieces; ++i) {
-    const double longest = (breaks[i + 1] - breaks[i]) / steps;
+    const double longest = (breaks[i + 1] - breaks[i]) / steps, observed = (breaks[i + 1] - breaks[i]) / observed_steps;
     // Past a contact whose shear S is large (the contact near flattening, f / g'' large) the
     // fields turn on the length L / S: steps grow geometrically from a fraction of it, so no
     // eigenphase turns a whole turn within one (which a step could not tell from no turn).
-    for (double h = 0.25 * scales_.length / (1.0 + shear); shear > 0 && h < longest; h *= 2)
+    for (double h = 0.25 * scales_.length / (1.0 + shear); shear > 0 && h < observed; h *= 2)
       advance(f, breaks[i] + h, track, 0);
     shear = 0.0;
-    march(f, breaks[i + 1], longest, track);
+    march(f, breaks[i + 1], longest, observed, track);
     for (size_t c = 0; c < contacts.size(); ++c) {
       if (std::abs(contacts[c].s - breaks[i + 1]) > 1e-12 * scales_.length) continue;
       if (std::string why = pass_contact(f, contacts[c], static_cast<int>(c), track, &shear); !why.empty()) return why;
@@ -1442,8 +1450,7 @@ StabilityReport run_resolved(const StabilityOptions& options, bool confirm, cons
       if (!confirm || (!counted.empty() && same_count(counted.back(), last))) return last;
       counted.push_back(last);
     }
-    o.max_phase_step /= kKeepRefining;
-    o.min_steps = static_cast<int>(o.min_steps * kKeepRefining);
+    o.observation_density *= kKeepRefining;
   }
   if (counted.empty()) return last;  // a reversal at every density: the index is undefined
   StabilityReport out = counted.back();

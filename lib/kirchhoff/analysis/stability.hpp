@@ -97,6 +97,10 @@ struct StabilityOptions {
   // exact observations near a conjugate point: fewer integration steps, the same count. false:
   // every observation on an exact integration (tests compare the two).
   bool interpolated_observations = true;
+  // Observations this many times denser than min_steps and max_phase_step say, on integration
+  // steps as long as at 1 where they are observed on the interpolant: how a count in a field
+  // that stiffens the perturbations is confirmed (analyse_stability runs it again so).
+  double observation_density = 1.0;
   // Singular values (of the orthonormal frame's blocks, dimensionless) and eigenvalues of the
   // boundary form below this are zero: a conjugate point exactly at L, a zero mode. The frame is
   // integrated to ~1e-10, so 1e-6 leaves four orders of margin; modes within 1e-6 of neutral
