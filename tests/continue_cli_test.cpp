@@ -186,7 +186,7 @@ TEST_F(ContinueCli, BranchCsvHasTheDocumentedColumnsAndPointTypes) {
   ASSERT_EQ(run_to_end(args, dir_ / "b.log"), 0);
   const auto lines = lines_of(csv);
   EXPECT_EQ(lines[0],
-            "index,branch,P,arclength,theta0,y_max,end_to_end,H_spread,m3_spread,n_dot_m_spread,H_flat,type,"
+            "index,branch,P,arclength,theta0,y_max,end_to_end,H_relative_spread,m3_relative_spread,n_dot_m_relative_spread,H_flat,type,"
             "multiplicity,event,newton_iterations,stability_index,zero_modes");
   std::string all;
   for (const auto& l : lines) all += l + "\n";
@@ -202,6 +202,58 @@ TEST_F(ContinueCli, BranchCsvHasTheDocumentedColumnsAndPointTypes) {
 
 // --no-branch-points: the straight column is followed past its Euler loads with no branch point
 // row; asking to switch at one without looking for them is refused.
+// tapered.toml lists its unknown P and the derived quantity H_spread (max - min of H, which varies
+// with EI(s)) among its outputs: each is one column, and H_spread is the absolute spread, apart
+// from the relative spreads of the invariants (H_relative_spread = H_spread / H's scale).
+TEST_F(ContinueCli, EveryColumnIsNamedOnceAndHSpreadIsAbsolute) {
+  const fs::path csv = dir_ / "tapered.csv";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/tapered.toml", "--param",
+                        "theta0", "--to", "1.2", "--no-stability", "--out", csv.string()},
+                       dir_ / "t.log"),
+            0);
+  const auto header = csv_fields(lines_of(csv)[0]);
+  for (const std::string& name : header)
+    EXPECT_EQ(std::count(header.begin(), header.end(), name), 1) << name << " in " << lines_of(csv)[0];
+  const auto rows = lines_of(csv);
+  ASSERT_GT(rows.size(), 2u);
+  const auto column = csv_header(rows[0]);
+  const double absolute = csv_field(rows.back(), column.at("H_spread"));
+  const double relative = csv_field(rows.back(), column.at("H_relative_spread"));
+  EXPECT_GT(absolute, 0.1);  // EI doubles along the rod: H changes by O(1), not by round-off
+  EXPECT_LT(relative, absolute);
+}
+
+// --resume appends to the CSV of the run it continues: a header of other outputs (here one more
+// derived column) is refused, rows are not appended under it; the header an earlier version wrote
+// (the relative spreads named H_spread, m3_spread, n_dot_m_spread) is renamed and the run goes on.
+TEST_F(ContinueCli, ResumeRefusesACsvOfOtherColumnsAndRenamesTheEarlierSpreads) {
+  const fs::path full = dir_ / "full.csv", partial = dir_ / "partial.csv";
+  ASSERT_EQ(run_to_end(continue_args(full), dir_ / "full.log"), 0);
+  const auto expected = lines_of(full);
+  ASSERT_TRUE(run_and_kill(continue_args(partial), dir_ / "killed.log",
+                           [&] { return lines_of(partial).size() >= expected.size() / 3; }));
+  auto rewrite_header = [&](const std::string& header) {
+    auto lines = lines_of(partial);
+    lines[0] = header;
+    std::ofstream out(partial, std::ios::trunc);
+    for (const auto& l : lines) out << l << "\n";
+  };
+  const std::string earlier = std::string(expected[0]).replace(expected[0].find("H_relative_spread"),
+                                                               std::string("H_relative_spread,m3_relative_spread,"
+                                                                           "n_dot_m_relative_spread").size(),
+                                                               "H_spread,m3_spread,n_dot_m_spread");
+  auto resume = continue_args(partial);
+  resume.push_back("--resume");
+  rewrite_header(expected[0] + ",kappa_max");
+  EXPECT_EQ(run_to_end(resume, dir_ / "refused.log"), 2);
+  std::ifstream log(dir_ / "refused.log");
+  const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("its header is not this run's"), std::string::npos) << text;
+  rewrite_header(earlier);
+  ASSERT_EQ(run_to_end(resume, dir_ / "resume.log"), 0);
+  EXPECT_EQ(lines_of(partial), expected);
+}
+
 TEST_F(ContinueCli, BranchPointsCanBeSkippedButNotSwitchedAt) {
   const std::vector<std::string> straight = {KIRCHHOFF_CLI, "continue",
                                              std::string(KIRCHHOFF_CASES_DIR) + "/euler_column.toml", "--param",

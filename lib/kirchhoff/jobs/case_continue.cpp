@@ -460,8 +460,13 @@ ContinueRunResult continue_case(Case c, const ContinueRequest& request, const st
   state.has_set_parameters = true;
   state.set_parameters = request.set_parameters;
 
-  std::vector<std::string> columns = c.definition.unknown_parameters;  // solved-for parameters first
-  columns.insert(columns.end(), options.derived.begin(), options.derived.end());
+  // Solved-for parameters first, then the derived quantities, each once (a case may list an
+  // unknown or the continued parameter among its derived quantities too).
+  std::vector<std::string> columns;
+  for (const std::vector<std::string>* names : {&c.definition.unknown_parameters, &options.derived})
+    for (const std::string& name : *names)
+      if (name != request.parameter && std::find(columns.begin(), columns.end(), name) == columns.end())
+        columns.push_back(name);
   try {
     for (auto* s : sinks) s->begin(request.parameter, columns, resumed_after);
   } catch (const CaseError&) {

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <iomanip>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 
@@ -22,21 +24,58 @@ bool same_contacts(const std::vector<PointContact>& a, const std::vector<PointCo
   });
 }
 
+// The invariants' relative spreads. Earlier versions named them H_spread, m3_spread and
+// n_dot_m_spread, which the derived quantity H_spread (absolute, max - min) names too.
+constexpr const char* kSpreadColumns = "H_relative_spread,m3_relative_spread,n_dot_m_relative_spread";
+constexpr const char* kEarlierSpreadColumns = "H_spread,m3_spread,n_dot_m_spread";
+
+std::string csv_header(const std::string& parameter, const std::vector<std::string>& columns, const char* spreads) {
+  std::string header = "index,branch," + parameter + ",arclength";
+  for (const auto& d : columns) header += "," + d;
+  return header + "," + spreads + ",H_flat,type,multiplicity,event,newton_iterations,stability_index,zero_modes";
+}
+
+std::string first_line(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  return line;
+}
+
+// A resumed run appends to the CSV of the run it continues: its header must be this run's, or
+// the same as an earlier version wrote it (then renamed). Anything else was written with other
+// outputs, and rows appended to it would not line up with its columns.
+void check_resumed_header(const fs::path& path, const std::string& header, const std::string& earlier) {
+  const std::string found = first_line(path);
+  if (found == header || found == earlier) return;
+  throw std::runtime_error(path.string() + ": its header is not this run's (it has \"" + found + "\", this run writes \"" +
+                           header + "\"): written with other outputs; run again without --resume");
+}
+
+void replace_first_line(const fs::path& path, const std::string& line) {
+  std::ifstream in(path);
+  std::string old, rest((std::istreambuf_iterator<char>(std::getline(in, old))), std::istreambuf_iterator<char>());
+  in.close();
+  std::ofstream(path, std::ios::trunc) << line << "\n" << rest;
+}
+
 }  // namespace
 
 void BranchCsvSink::begin(const std::string& parameter, const std::vector<std::string>& columns,
                           int resumed_after_row) {
   columns_ = columns;
   const bool append = resumed_after_row >= 0;
-  if (append) truncate_csv(path_, resumed_after_row);
+  const std::string header = csv_header(parameter, columns_, kSpreadColumns);
+  if (append) {
+    check_resumed_header(path_, header, csv_header(parameter, columns_, kEarlierSpreadColumns));
+    truncate_csv(path_, resumed_after_row);
+    if (first_line(path_) != header) replace_first_line(path_, header);
+  }
   out_.open(path_, append ? std::ios::app : std::ios::trunc);
   if (!out_) throw std::runtime_error("cannot write " + path_.string());
   out_ << std::setprecision(15);
   if (!append) {
-    out_ << "index,branch," << parameter << ",arclength";
-    for (const auto& d : columns_) out_ << ',' << d;
-    out_ << ",H_spread,m3_spread,n_dot_m_spread,H_flat,type,multiplicity,event,newton_iterations,stability_index,"
-            "zero_modes\n";
+    out_ << header << "\n";
     out_.flush();
   }
 }
