@@ -800,6 +800,8 @@ bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double longest, P
       const double a = 2 * t1 * t1 * t1 - 3 * t1 * t1 + 1, b = t1 * t1 * t1 - 2 * t1 * t1 + t1;
       const double c = 1 - a, d = t1 * t1 * t1 - t1 * t1;
       interpolated_.s = f->s + t1 * h;
+      // (Its particular fields are not observed; a first one, default-made, gets their shape.)
+      if (interpolated_.particular.rows() != f->y.size()) interpolated_.particular.resize(f->y.size(), 0);
       interpolated_.y = a * f->y + b * h * f->y_slope + c * next.y + d * h * next.y_slope;
       interpolated_.dY = a * f->dY + b * h * f->dY_slope + c * next.dY + d * h * next.dY_slope;
     } else {
