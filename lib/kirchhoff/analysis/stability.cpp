@@ -770,6 +770,17 @@ void StabilityAnalysis::slopes(Frame* f) {
   rhs_ += 1 + f->dY.cols();
 }
 
+// The state and the fields at a fraction t of the way from frame a to frame b, on their cubic
+// Hermite interpolant (the slopes at both ends known). The particular fields are not observed.
+void hermite(const Frame& a, const Frame& b, double t, Frame* out) {
+  const double h = b.s - a.s, t2 = t * t, t3 = t2 * t;
+  const double at_a = 2 * t3 - 3 * t2 + 1, slope_a = (t3 - 2 * t2 + t) * h, slope_b = (t3 - t2) * h;
+  out->s = a.s + t * h;
+  out->y = at_a * a.y + slope_a * a.y_slope + (1 - at_a) * b.y + slope_b * b.y_slope;
+  out->dY = at_a * a.dY + slope_a * a.dY_slope + (1 - at_a) * b.dY + slope_b * b.dY_slope;
+  if (out->particular.rows() != a.y.size()) out->particular.resize(a.y.size(), 0);  // (a default-made frame)
+}
+
 // One integration step of the fields from f to s1, their eigenphases observed in between on the
 // cubic Hermite interpolant of the state and the fields (the slopes at both ends), in sub-steps
 // on which no phase moves more than max_phase_step. Integration steps up to kInterpolatedSteps
@@ -786,27 +797,18 @@ bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double longest, P
   flowed(*f, s1, &steps_, false, &next);
   slopes(f);
   slopes(&next);
-  const double h = s1 - f->s;
   if (!interpolant_is_close(*f, next)) {
     steps_ = before;
     return false;
   }
   Eigen::VectorXd lifted = track->lifted, lowest = track->lowest;
   const Observation before_step = last_observation_;
+  const double h = s1 - f->s;
   double t = 0.0, dt = std::min(1.0, observation_step(longest) / h);
   while (t < 1.0) {
     const double t1 = std::min(1.0, t + dt);
-    if (t1 < 1.0) {
-      const double a = 2 * t1 * t1 * t1 - 3 * t1 * t1 + 1, b = t1 * t1 * t1 - 2 * t1 * t1 + t1;
-      const double c = 1 - a, d = t1 * t1 * t1 - t1 * t1;
-      interpolated_.s = f->s + t1 * h;
-      // (Its particular fields are not observed; a first one, default-made, gets their shape.)
-      if (interpolated_.particular.rows() != f->y.size()) interpolated_.particular.resize(f->y.size(), 0);
-      interpolated_.y = a * f->y + b * h * f->y_slope + c * next.y + d * h * next.y_slope;
-      interpolated_.dY = a * f->dY + b * h * f->dY_slope + c * next.dY + d * h * next.dY_slope;
-    } else {
-      interpolated_ = next;
-    }
+    if (t1 < 1.0) hermite(*f, next, t1, &interpolated_);
+    else interpolated_ = next;
     canonical_blocks(&interpolated_);
     orthonormalise(&interpolated_);
     const Eigen::VectorXd phases = lift(lifted, eigenphases(interpolated_.U, interpolated_.P, true));
