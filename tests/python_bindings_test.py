@@ -222,6 +222,28 @@ class SolveTest(unittest.TestCase):
         self.assertIsNone(couple.stability["index"])
         self.assertIn("not conservative", couple.stability["reason"])
 
+    def test_the_discretised_energy_decides_where_the_conjugate_points_do_not(self):
+        # A pinned column on a stiff Winkler foundation (k = 1e6: a soft wall balanced by a uniform
+        # weight towards it): the conjugate points call its held end degenerate, the discretised
+        # energy passes its own tests and finds it stable, (10 pi)^2 + k / (10 pi)^2 - P = 800.2 to
+        # its O(h^2) error at 400 elements (measured 1.55; cli_test has the same case).
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "foundation.toml")
+            with open(path, "w") as f:
+                f.write('model = "planar"\n[parameters]\nP = 1200.0\nk = 1e6\nb = "k/2"\n'
+                        '[rod]\nlength = 1.0\nB = 1.0\nbarrier = { b = "b", a = 1.0, normal = [0, 1, 0] }\n'
+                        'gravity = { weight = "b", up = [0, -1, 0] }\n'
+                        '[start]\ntype = "pinned"\nposition = [0, 0]\n'
+                        '[end]\ntype = "sliding"\naxis = [1, 0, 0]\nposition = [0, 0]\nforce = ["-P", 0]\n'
+                        '[guess]\nforce = ["-P", 0]\n')
+            st = kirchhoff.load_case(path).solve(direct=True).stability
+        self.assertEqual(st["index"], 0)
+        self.assertTrue(st["stable"])
+        self.assertEqual(st["method"], "discretised_energy")
+        self.assertIn("degenerate constraint", st["method_reason"])
+        self.assertIsNone(st["cross_check"]["agrees"])
+        self.assertLess(abs(st["lowest_eigenvalues"][0] - ((10 * np.pi) ** 2 + 1e6 / (10 * np.pi) ** 2 - 1200.0)), 5.0)
+
     def test_profile_arrays(self):
         profile = self.solution.profile
         self.assertEqual(set(profile), PROFILE_KEYS | {"kappa"})  # a planar rod: its curvature named too

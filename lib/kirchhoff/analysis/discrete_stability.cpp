@@ -1155,4 +1155,14 @@ std::string describe(const DiscreteStability& result) {
   return out.str();
 }
 
+StabilityReport with_discretised_index(StabilityReport report, const DiscreteStability& discrete) {
+  if (report.defined() || report.unstable || !discrete.defined() || !discrete.trustworthy) return report;
+  report.index = discrete.index;
+  report.zero_modes = discrete.zero_modes;
+  report.method = "discretised_energy";
+  report.method_reason = "the conjugate points do not decide it: " + report.reason;
+  report.reason.clear();
+  return report;
+}
+
 }  // namespace kirchhoff

@@ -88,6 +88,7 @@
 #include <string>
 #include <vector>
 
+#include "kirchhoff/analysis/stability.hpp"
 #include "kirchhoff/shooting/shooting.hpp"
 
 namespace kirchhoff {
@@ -173,5 +174,13 @@ DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen
 
 // "index k (N elements, trustworthy)" and the like, for messages.
 std::string describe(const DiscreteStability& result);
+
+// Where the conjugate points leave the index undefined (`report` has a reason, and is not known
+// unstable) and the discretised energy decides it, having passed its own checks: `report` with
+// that index and its zero modes, method "discretised_energy" and the conjugate points' reason as
+// method_reason (a stiff foundation can make a held chord look degenerate to the conjugate points'
+// absolute zero tolerance while the discretised Hessian is plainly positive). Otherwise `report`
+// as it is.
+StabilityReport with_discretised_index(StabilityReport report, const DiscreteStability& discrete);
 
 }  // namespace kirchhoff

@@ -1540,6 +1540,7 @@ std::string describe(const StabilityReport& report) {
   std::ostringstream out;
   out << (*report.index == 0 ? "stable" : "unstable (index " + std::to_string(*report.index) + ")");
   if (report.zero_modes > 0) out << ", " << report.zero_modes << " zero mode" << (report.zero_modes > 1 ? "s" : "");
+  if (report.method == "discretised_energy") out << " (by the discretised energy: " << report.method_reason << ")";
   return out.str();
 }
 

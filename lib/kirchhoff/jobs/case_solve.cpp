@@ -117,6 +117,8 @@ void analyse(const Case& c, const CaseSolveOptions& options, CaseSolve* out) {
   const Eigen::VectorXd& x = out->solved.result.x;
   if (options.stability) out->stability = analyse_stability(problem, x);
   if (options.stability_check) out->stability_check = discrete_stability(problem, x);
+  if (out->stability && out->stability_check)
+    out->stability = with_discretised_index(std::move(*out->stability), *out->stability_check);
 }
 
 }  // namespace

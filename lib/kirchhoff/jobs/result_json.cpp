@@ -53,10 +53,10 @@ nlohmann::json path_json(const SolvePath& path) {
 }
 
 // Whether the discretised energy's index is the conjugate points': null where that is not decided
-// (the check did not pass its own tests, or the index is undefined), so that false always means
-// two indices that differ.
+// (the check did not pass its own tests, or the index is undefined, or it is the check's own),
+// so that false always means two indices that differ.
 static nlohmann::json agreement(const StabilityReport& st, const DiscreteStability& discrete) {
-  if (!discrete.trustworthy || !st.index) return nlohmann::json();
+  if (!discrete.trustworthy || !st.index || st.method == "discretised_energy") return nlohmann::json();
   return *st.index == *discrete.index;
 }
 
