@@ -372,6 +372,64 @@ TEST(Stability, InterpolatedObservationsCountAsExactOnes) {
   EXPECT_GT(saved_on_the_twisted_rod, 0);
 }
 
+// A pinned column on a stiff Winkler foundation k = 1e6 (a soft wall b / (a - y) balanced by a
+// uniform weight b / a^2 towards it; k = 2 b / a^3): its sine modes diagonalise the second
+// variation, mode j critical at P_j = (j pi)^2 + k / (j pi)^2, so the index at P is the number of
+// P_j below it (closed form). The held end's lateral position answers a unit end load by ~1e-8
+// there, below the zero tolerance: the isoperimetric correction's eigenvalues must not be taken
+// as zero for that. At P = 2500 (7 modes, j = 8..14, below) the count is exact; at P = 2215, 1e-4
+// above P_8 = 2214.76, the correction is not resolved, and the index must be 5 or undefined, never
+// the 4 with a zero mode it was (a negative eigenvalue of -0.2 per int theta'^2 called zero).
+TEST(Stability, ColumnOnAStiffFoundationIsCountedOrUndefinedNeverWrong) {
+  const std::string text = R"(model = "planar"
+[parameters]
+P = 1.0
+k = 1e6
+b = "k/2"
+[rod]
+length = 1.0
+B = 1.0
+barrier = { b = "b", a = 1.0, normal = [0, 1, 0] }
+gravity = { weight = "b", up = [0, -1, 0] }
+[start]
+type = "pinned"
+position = [0, 0]
+[end]
+type = "sliding"
+axis = [1, 0, 0]
+position = [0, 0]
+force = ["-P", 0]
+[guess]
+force = ["-P", 0]
+)";
+  auto closed_form = [](double P) {
+    int below = 0;
+    for (int j = 1; j < 100; ++j) {
+      const double x = j * M_PI * j * M_PI;
+      if (x + 1e6 / x < P) ++below;
+    }
+    return below;
+  };
+  for (const double P : {2500.0, 2215.0}) {
+    SCOPED_TRACE(P);
+    const Case c = load_case_text(text, "foundation.toml", {{"P", P}});
+    const ShootingProblem problem(c.definition);
+    const ShootingResult solved = solve(problem, problem.initial_unknowns(c.start_guess));
+    ASSERT_TRUE(solved.summary.converged());
+    const StabilityReport r = analyse_stability(problem, solved.x);
+    if (P == 2500.0) {
+      ASSERT_TRUE(r.defined()) << r.reason;
+      EXPECT_EQ(*r.index, closed_form(P));
+      EXPECT_EQ(closed_form(P), 7);
+    } else if (r.defined()) {
+      EXPECT_EQ(*r.index, closed_form(P));
+      EXPECT_EQ(closed_form(P), 5);
+    } else {
+      EXPECT_NE(r.reason.find("not resolved"), std::string::npos) << r.reason;
+    }
+  }
+}
+
 TEST(Stability, GravityAndExtensibleRodsAreStableWhereExpected) {
   // A cantilever hanging under its weight: a stable equilibrium of a dead load.
   const StabilityReport heavy = index_of(solve_case("heavy_cantilever.toml"));

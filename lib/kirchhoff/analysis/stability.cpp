@@ -1134,6 +1134,8 @@ int whole_problem_zero_modes(const Eigen::MatrixXd& conditions, const Eigen::Jac
   }
   Eigen::MatrixXd all(m + k, m + k);
   all << conditions, loads + conditions * answer, frame_values, particular_values + frame_values * answer;
+  for (Eigen::Index i = m; i < m + k; ++i)
+    if (all.row(i).norm() > 0) all.row(i) /= all.row(i).norm();
   return static_cast<int>(null_space(all, static_cast<int>(m + k), tol).cols());
 }
 
@@ -1214,7 +1216,7 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
         const double lambda = eig.eigenvalues()[i];
         const double resolution = near.resolution(quiet * eig.eigenvectors().col(i), tol);
         if (lambda > resolution) ++positive;
-        else if (std::abs(lambda) > tol && std::abs(lambda) <= resolution) {
+        else if (std::abs(lambda) <= resolution) {
           ++unresolved;
           unresolved_value = lambda;
           unresolved_resolution = resolution;
