@@ -254,6 +254,59 @@ TEST_F(ContinueCli, ResumeRefusesACsvOfOtherColumnsAndRenamesTheEarlierSpreads) 
   EXPECT_EQ(lines_of(partial), expected);
 }
 
+// A pinned column on a stiff Winkler foundation k = 1e6 (a soft wall balanced by a uniform weight
+// towards it), in 8 shooting segments: its bordered matrix spans many orders of magnitude at every
+// point, so several singular values are below branch_point_tolerance of the largest everywhere.
+// Each critical load P_j = (j pi)^2 + k / (j pi)^2 is a simple branch point, multiplicity 1 (it
+// said 8 or 9: the count of small singular values, not the count beyond the regular points').
+// Located to the secant's accuracy: 1e-6 relative.
+TEST_F(ContinueCli, BranchPointsOfABadlyScaledProblemHaveTheirOwnMultiplicity) {
+  const fs::path path = dir_ / "foundation.toml", csv = dir_ / "f.csv";
+  std::ofstream(path) << R"(model = "planar"
+[parameters]
+P = 1000.0
+k = 1e6
+b = "k/2"
+[rod]
+length = 1.0
+B = 1.0
+barrier = { b = "b", a = 1.0, normal = [0, 1, 0] }
+gravity = { weight = "b", up = [0, -1, 0] }
+[start]
+type = "pinned"
+position = [0, 0]
+[end]
+type = "sliding"
+axis = [1, 0, 0]
+position = [0, 0]
+force = ["-P", 0]
+[guess]
+force = ["-P", 0]
+)";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", path.string(), "--param", "P", "--to", "4000", "--max-step", "20",
+                        "--solver", "segments=8", "--no-stability", "--out", csv.string()},
+                       dir_ / "f.log"),
+            0);
+  const auto rows = lines_of(csv);
+  const auto column = csv_header(rows[0]);
+  std::vector<double> found;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    const auto fields = csv_fields(rows[i]);
+    if (fields[column.at("type")] != "branch_point") continue;
+    EXPECT_EQ(fields[column.at("multiplicity")], "1") << rows[i];
+    found.push_back(std::stod(fields[column.at("P")]));
+  }
+  int critical = 0;
+  for (int j = 1; j < 40; ++j) {
+    const double x = j * M_PI * j * M_PI, P = x + 1e6 / x;
+    if (P <= 1000 || P >= 4000) continue;
+    ++critical;
+    EXPECT_TRUE(std::any_of(found.begin(), found.end(), [&](double f) { return std::abs(f - P) < 1e-6 * P; }))
+        << "P_" << j << " = " << P;
+  }
+  EXPECT_EQ(critical, 14);
+}
+
 TEST_F(ContinueCli, BranchPointsCanBeSkippedButNotSwitchedAt) {
   const std::vector<std::string> straight = {KIRCHHOFF_CLI, "continue",
                                              std::string(KIRCHHOFF_CASES_DIR) + "/euler_column.toml", "--param",

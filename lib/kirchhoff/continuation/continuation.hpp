@@ -13,8 +13,8 @@
 //   - simple branch points: det [F_x F_lambda; t^T] changes sign;
 //   - branch points of any multiplicity (e.g. the double one of the isotropic twisted rod, where
 //     the determinant keeps its sign): a local minimum of the smallest singular value of the
-//     bordered matrix that, located, falls below branch_point_tolerance; the count of such small
-//     singular values is the multiplicity;
+//     bordered matrix that, located, falls below branch_point_tolerance; the number of such small
+//     singular values beyond those of the regular point beside it is the multiplicity;
 //   - events: a derived quantity crosses a given value.
 #pragma once
 
@@ -191,7 +191,7 @@ struct ContinuationPoint : PointRecord {
   Eigen::VectorXd x;        // shooting unknowns
   Eigen::VectorXd tangent;  // (dx, dlambda), unit
   PointType type = PointType::Regular;
-  int multiplicity = 0;     // branch points: number of small singular values
+  int multiplicity = 0;     // branch points: small singular values beyond a regular neighbour's
   int newton_iterations = 0;
   bool jacobian_reused = false;  // its matrix is the previous point's (reuse_jacobian_iterations)
   std::string event;        // events: the quantity that crossed

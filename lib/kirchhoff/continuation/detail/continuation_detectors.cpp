@@ -12,6 +12,15 @@ constexpr double kTargetTolerance = 1e-9;
 // A sign change between a and b (a = 0 exactly is where the last point was located: none).
 bool crossed(double a, double b) { return std::isfinite(a) && std::isfinite(b) && (a < 0) != (b < 0) && a != 0.0; }
 
+// A branch point's multiplicity: how many more singular values of the bordered matrix are small
+// (below branch_point_tolerance of the largest) at the located point than at the regular point
+// beside it. Not their count alone: on a badly scaled problem (a stiff foundation in multiple
+// shooting, whose matrix spans many orders of magnitude by nature) several are that small at every
+// point, and each simple branch point counted 8 or 9.
+int multiplicity(const ContinuationPoint& located, const ContinuationPoint& regular) {
+  return std::max(1, located.small_count - regular.small_count);
+}
+
 // A detector whose test value changes sign inside the step: located by the secant method on h.
 class SignChange : public Detector {
  public:
@@ -27,7 +36,7 @@ class SignChange : public Detector {
     if (!p) return must_locate() && step.can_shrink ? Verdict::RetryShorter : Verdict::Nothing;
     if (!close_enough(*p) && step.can_shrink) return Verdict::RetryShorter;
     refine(step, &*p);
-    finish(&*p);
+    finish(step, &*p);
     found->push_back({std::move(*p), stop(), this});
     return Verdict::Found;
   }
@@ -43,7 +52,7 @@ class SignChange : public Detector {
   virtual bool must_locate() const { return false; }
   // The located point made exact where the test function allows it (the parameter's value).
   virtual void refine(const StepView&, ContinuationPoint*) const {}
-  virtual void finish(ContinuationPoint*) const {}
+  virtual void finish(const StepView&, ContinuationPoint*) const {}
 };
 
 // The parameter reaching a value: the target, or a bound.
@@ -111,7 +120,9 @@ class SimpleBranchPoint : public SignChange {
  protected:
   double value(const ContinuationPoint& p) const override { return p.determinant; }
   PointType type() const override { return PointType::BranchPoint; }
-  void finish(ContinuationPoint* p) const override { p->multiplicity = std::max(1, p->small_count); }
+  void finish(const StepView& step, ContinuationPoint* p) const override {
+    p->multiplicity = multiplicity(*p, step.current);
+  }
 
  private:
   int stop_at_;
@@ -135,7 +146,8 @@ class EvenBranchPoint : public Detector {
                          [](const ContinuationPoint& q) { return q.smallest_singular; }, true,
                          PointType::BranchPoint);
     if (!p || !(p->smallest_singular < tolerance_)) return Verdict::Nothing;
-    p->multiplicity = std::max(1, p->small_count);
+    // Of the step's two ends beside the minimum, the one with fewer small singular values.
+    p->multiplicity = multiplicity(*p, step.before->small_count <= step.candidate.small_count ? *step.before : step.candidate);
     // It may lie just behind `current` (already recorded): points are in detection order.
     found->push_back({std::move(*p), std::nullopt, this});
     return Verdict::Found;
@@ -164,7 +176,7 @@ class Event : public SignChange {
   std::optional<StopReason> stop() const override {
     return event_.stop ? std::optional<StopReason>(StopReason::EventStop) : std::nullopt;
   }
-  void finish(ContinuationPoint* p) const override {
+  void finish(const StepView&, ContinuationPoint* p) const override {
     p->event = event_.label.empty() ? event_.quantity + "=" + std::to_string(event_.value) : event_.label;
     p->event_index = index_;
   }
