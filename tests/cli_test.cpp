@@ -19,6 +19,7 @@
 #include <tuple>
 #include <vector>
 
+#include "foundation_column_case.hpp"
 #include "kirchhoff/analysis/analytic.hpp"
 
 namespace {
@@ -371,29 +372,7 @@ TEST_F(CliTest, SolveReportsTheStabilityIndex) {
 // discretised energy, having passed its own tests, decides the index and is reported as the method.
 TEST_F(CliTest, TheDiscretisedEnergyDecidesWhereTheConjugatePointsDoNot) {
   const std::string path = (dir_ / "foundation.toml").string();
-  std::ofstream(path) << R"(model = "planar"
-[parameters]
-P = 1200.0
-k = 1e6
-a = 1.0
-b = "k*a^3/2"
-w = "b/a^2"
-[rod]
-length = 1.0
-B = 1.0
-barrier = { b = "b", a = "a", normal = [0, 1, 0] }
-gravity = { weight = "w", up = [0, -1, 0] }
-[start]
-type = "pinned"
-position = [0, 0]
-[end]
-type = "sliding"
-axis = [1, 0, 0]
-position = [0, 0]
-force = ["-P", 0]
-[guess]
-force = ["-P", 0]
-)";
+  std::ofstream(path) << kirchhoff::testing::foundation_column_case(1200.0, 1e6);
   const CliRun r = run("solve " + quoted(path) + " --direct --json");
   ASSERT_EQ(r.status, 0) << r.out << r.err;
   const json st = parse(r)["stability"];
@@ -402,7 +381,7 @@ force = ["-P", 0]
   EXPECT_EQ(st["method"], "discretised_energy");
   EXPECT_NE(st["method_reason"].get<std::string>().find("degenerate constraint"), std::string::npos);
   EXPECT_TRUE(st["cross_check"]["agrees"].is_null());  // its own index: no agreement to claim
-  const double j = 10 * M_PI, lowest = j * j + 1e6 / (j * j) - 1200.0;  // 800.17
+  const double lowest = kirchhoff::testing::foundation_column_critical_load(10, 1e6) - 1200.0;  // 800.17
   // The discretisation's O(h^2) error at 400 elements on the mode of wavenumber 10 pi, about
   // (10 pi / 400)^2 / 12 = 5e-4 of its terms of ~1000 each (measured 1.55): 5 leaves a factor 3.
   EXPECT_NEAR(st["lowest_eigenvalues"][0].get<double>(), lowest, 5.0);

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_run_support.hpp"
+#include "foundation_column_case.hpp"
 #include "kirchhoff/analysis/analytic.hpp"
 
 namespace {
@@ -262,27 +263,7 @@ TEST_F(ContinueCli, ResumeRefusesACsvOfOtherColumnsAndRenamesTheEarlierSpreads) 
 // Located to the secant's accuracy: 1e-6 relative.
 TEST_F(ContinueCli, BranchPointsOfABadlyScaledProblemHaveTheirOwnMultiplicity) {
   const fs::path path = dir_ / "foundation.toml", csv = dir_ / "f.csv";
-  std::ofstream(path) << R"(model = "planar"
-[parameters]
-P = 1000.0
-k = 1e6
-b = "k/2"
-[rod]
-length = 1.0
-B = 1.0
-barrier = { b = "b", a = 1.0, normal = [0, 1, 0] }
-gravity = { weight = "b", up = [0, -1, 0] }
-[start]
-type = "pinned"
-position = [0, 0]
-[end]
-type = "sliding"
-axis = [1, 0, 0]
-position = [0, 0]
-force = ["-P", 0]
-[guess]
-force = ["-P", 0]
-)";
+  std::ofstream(path) << kirchhoff::testing::foundation_column_case(1000.0, 1e6);
   ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", path.string(), "--param", "P", "--to", "4000", "--max-step", "20",
                         "--solver", "segments=8", "--no-stability", "--out", csv.string()},
                        dir_ / "f.log"),
@@ -298,7 +279,7 @@ force = ["-P", 0]
   }
   int critical = 0;
   for (int j = 1; j < 40; ++j) {
-    const double x = j * M_PI * j * M_PI, P = x + 1e6 / x;
+    const double P = kirchhoff::testing::foundation_column_critical_load(j, 1e6);
     if (P <= 1000 || P >= 4000) continue;
     ++critical;
     EXPECT_TRUE(std::any_of(found.begin(), found.end(), [&](double f) { return std::abs(f - P) < 1e-6 * P; }))

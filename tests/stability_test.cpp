@@ -19,6 +19,7 @@
 #include "kirchhoff/continuation/rod_continuation.hpp"
 #include "kirchhoff/jobs/case_solve.hpp"
 #include "kirchhoff/jobs/result_json.hpp"
+#include "foundation_column_case.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {
@@ -381,38 +382,14 @@ TEST(Stability, InterpolatedObservationsCountAsExactOnes) {
 // above P_8 = 2214.76, the correction is not resolved, and the index must be 5 or undefined, never
 // the 4 with a zero mode it was (a negative eigenvalue of -0.2 per int theta'^2 called zero).
 TEST(Stability, ColumnOnAStiffFoundationIsCountedOrUndefinedNeverWrong) {
-  const std::string text = R"(model = "planar"
-[parameters]
-P = 1.0
-k = 1e6
-b = "k/2"
-[rod]
-length = 1.0
-B = 1.0
-barrier = { b = "b", a = 1.0, normal = [0, 1, 0] }
-gravity = { weight = "b", up = [0, -1, 0] }
-[start]
-type = "pinned"
-position = [0, 0]
-[end]
-type = "sliding"
-axis = [1, 0, 0]
-position = [0, 0]
-force = ["-P", 0]
-[guess]
-force = ["-P", 0]
-)";
   auto closed_form = [](double P) {
     int below = 0;
-    for (int j = 1; j < 100; ++j) {
-      const double x = j * M_PI * j * M_PI;
-      if (x + 1e6 / x < P) ++below;
-    }
+    for (int j = 1; j < 100; ++j) below += testing::foundation_column_critical_load(j, 1e6) < P ? 1 : 0;
     return below;
   };
   for (const double P : {2500.0, 2215.0}) {
     SCOPED_TRACE(P);
-    const Case c = load_case_text(text, "foundation.toml", {{"P", P}});
+    const Case c = load_case_text(testing::foundation_column_case(P, 1e6), "foundation.toml");
     const ShootingProblem problem(c.definition);
     const ShootingResult solved = solve(problem, problem.initial_unknowns(c.start_guess));
     ASSERT_TRUE(solved.summary.converged());
