@@ -4,7 +4,6 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
-#include <iterator>
 #include <sstream>
 #include <stdexcept>
 
@@ -35,28 +34,16 @@ std::string csv_header(const std::string& parameter, const std::vector<std::stri
   return header + "," + spreads + ",H_flat,type,multiplicity,event,newton_iterations,stability_index,zero_modes";
 }
 
-std::string first_line(const fs::path& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  return line;
-}
-
 // A resumed run appends to the CSV of the run it continues: its header must be this run's, or
-// the same as an earlier version wrote it (then renamed). Anything else was written with other
-// outputs, and rows appended to it would not line up with its columns.
+// the same as an earlier version wrote it (truncate_csv then renames it). Anything else was
+// written with other outputs, and rows appended to it would not line up with its columns.
 void check_resumed_header(const fs::path& path, const std::string& header, const std::string& earlier) {
-  const std::string found = first_line(path);
+  std::ifstream in(path);
+  std::string found;
+  std::getline(in, found);
   if (found == header || found == earlier) return;
   throw std::runtime_error(path.string() + ": its header is not this run's (it has \"" + found + "\", this run writes \"" +
                            header + "\"): written with other outputs; run again without --resume");
-}
-
-void replace_first_line(const fs::path& path, const std::string& line) {
-  std::ifstream in(path);
-  std::string old, rest((std::istreambuf_iterator<char>(std::getline(in, old))), std::istreambuf_iterator<char>());
-  in.close();
-  std::ofstream(path, std::ios::trunc) << line << "\n" << rest;
 }
 
 }  // namespace
@@ -68,8 +55,7 @@ void BranchCsvSink::begin(const std::string& parameter, const std::vector<std::s
   const std::string header = csv_header(parameter, columns_, kSpreadColumns);
   if (append) {
     check_resumed_header(path_, header, csv_header(parameter, columns_, kEarlierSpreadColumns));
-    truncate_csv(path_, resumed_after_row);
-    if (first_line(path_) != header) replace_first_line(path_, header);
+    truncate_csv(path_, resumed_after_row, header);
   }
   out_.open(path_, append ? std::ios::app : std::ios::trunc);
   if (!out_) throw std::runtime_error("cannot write " + path_.string());

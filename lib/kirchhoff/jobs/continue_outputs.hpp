@@ -17,8 +17,8 @@ namespace kirchhoff {
 // The branch CSV: one row per point, `index,branch,<parameter>,arclength,<columns...>,
 // H_relative_spread,m3_relative_spread,n_dot_m_relative_spread,H_flat,type,multiplicity,event,
 // newton_iterations,stability_index,zero_modes`. A resumed run keeps the header (refusing a CSV
-// whose header is another run's) and the rows up to the one its state was saved at, and appends. Each row is flushed as it is written (a state saved after it never points past
-// the file).
+// whose header is another run's) and the rows up to the one its state was saved at, and appends.
+// Each row is flushed as it is written (a state saved after it never points past the file).
 class BranchCsvSink : public ContinueSink {
  public:
   explicit BranchCsvSink(std::filesystem::path path) : path_(std::move(path)) {}

@@ -301,10 +301,11 @@ void set_contact_march_state(RunState* s, const ContactMarchState& m) {
 // was last saved are dropped and computed again, so no point is duplicated on resume). Rows are
 // in order of their index: reading stops after row last_index, so a line a kill cut short after
 // it is dropped whatever its first characters read as.
-void truncate_csv(const std::filesystem::path& path, int last_index) {
+void truncate_csv(const std::filesystem::path& path, int last_index, const std::string& header) {
   std::ifstream in(path);
-  std::string header, line, kept;
-  std::getline(in, header);
+  std::string kept_header, line, kept;
+  std::getline(in, kept_header);
+  if (!header.empty()) kept_header = header;
   while (std::getline(in, line)) {
     if (line.empty()) continue;
     const int index = std::stoi(line.substr(0, line.find(',')));
@@ -314,7 +315,7 @@ void truncate_csv(const std::filesystem::path& path, int last_index) {
   }
   in.close();
   std::ofstream out(path, std::ios::trunc);
-  out << header << "\n" << kept;
+  out << kept_header << "\n" << kept;
 }
 
 }  // namespace kirchhoff

@@ -96,6 +96,7 @@ RunStart plan_start_from(const std::filesystem::path& state_path, const std::str
 
 // Keeps the header and the rows of a branch CSV up to and including the one whose index (first
 // column) is `last_index`; the rows after it, and a row cut short by a kill, are dropped.
-void truncate_csv(const std::filesystem::path& path, int last_index);
+// `header`, where not empty, replaces the file's (a renamed column).
+void truncate_csv(const std::filesystem::path& path, int last_index, const std::string& header = "");
 
 }  // namespace kirchhoff
