@@ -26,6 +26,9 @@ constexpr double kPi = 3.14159265358979323846;
 // the rate's observation steps long, and its eigenphases stay this far from conjugate points.
 constexpr double kInterpolatedSteps = 4.0;
 constexpr double kPassageMargin = 0.03;  // rad
+// Observation steps aim at eigenphase moves of this fraction of max_phase_step (observation_step
+// and the interpolant's sub-steps): beyond max_phase_step a step is halved.
+constexpr double kAimedPhaseMove = 0.7;
 // A load-controlled mode is an exact zero mode of the isoperimetric correction where its share of
 // D is this many times the rest (its sign then decides, as the exact count assumes), or where its
 // singular value is below this fraction of the largest (round-off: the decomposition drops it).
@@ -231,6 +234,12 @@ std::string unsupported(const ShootingProblem& problem, const Eigen::VectorXd& x
 
 double wrap(double angle) { return std::remainder(angle, 2 * kPi); }
 
+// The end of a step of at most h from s towards `end`, the last steps evened out to land on it.
+double step_end(double s, double end, double h) {
+  const double left = end - s;
+  return left <= h ? end : s + left / std::ceil(left / h);
+}
+
 // The frame of Jacobi fields along the rod, in state coordinates, with its canonical blocks.
 struct Frame {
   Eigen::VectorXd y;   // the equilibrium state here
@@ -351,7 +360,7 @@ class StabilityAnalysis {
   void flowed(const Frame& f, double s1, CarriedSteps* steps, bool frame_only, Frame* next);
   void march(Frame* f, double end, double longest, double observed, PhaseTrack* track);
   void march_observed(Frame* f, double end, double longest, PhaseTrack* track);
-  bool interpolated_step(Frame* f, double s1, double longest, PhaseTrack* track);
+  bool interpolated_step(Frame* f, double s1, double observed, PhaseTrack* track);
   bool near_passage(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
   void slopes(Frame* f);
   bool interpolant_is_close(const Frame& a, const Frame& b) const;
@@ -714,8 +723,7 @@ void StabilityAnalysis::march(Frame* f, double end, double longest, double obser
   const double sliver = 1e-12 * scales_.length;
   if (!(steps_.directions > 0)) steps_.directions = observed;
   while (end - f->s > sliver) {
-    const double h = std::min(kInterpolatedSteps * longest, steps_.directions), left = end - f->s;
-    const double s1 = left <= h ? end : f->s + left / std::ceil(left / h);
+    const double s1 = step_end(f->s, end, std::min(kInterpolatedSteps * longest, steps_.directions));
     // Where the integration's step is not much longer than an observation step, the step is
     // observed at its end alone (the interpolant's slopes would cost more than they save).
     if (s1 - f->s < 1.5 * observation_step(observed)) advance(f, s1, track, 0);
@@ -736,8 +744,7 @@ void StabilityAnalysis::march_observed(Frame* f, double end, double longest, Pha
   while (end - f->s > sliver) {
     double h = observation_step(longest);
     if (steps_.directions > 0) h = std::min(h, steps_.directions);
-    const double left = end - f->s;
-    advance(f, left <= h ? end : f->s + left / std::ceil(left / h), track, 0);
+    advance(f, step_end(f->s, end, h), track, 0);
   }
 }
 
@@ -790,7 +797,7 @@ void hermite(const Frame& a, const Frame& b, double t, Frame* out) {
 // phases recorded) where no phase comes within that margin of an odd multiple of pi, so that no
 // conjugate point can hide in the interpolant's error; false (f and the track unchanged)
 // otherwise, and where the sub-steps would be shorter than 1 / 256 of the step.
-bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double longest, PhaseTrack* track) {
+bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double observed, PhaseTrack* track) {
   if (near_passage(track->lifted, track->lifted)) return false;
   const CarriedSteps before = steps_;
   Frame& next = arriving_;
@@ -804,7 +811,7 @@ bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double longest, P
   Eigen::VectorXd lifted = track->lifted, lowest = track->lowest;
   const Observation before_step = last_observation_;
   const double h = s1 - f->s;
-  double t = 0.0, dt = std::min(1.0, observation_step(longest) / h);
+  double t = 0.0, dt = std::min(1.0, observation_step(observed) / h);
   while (t < 1.0) {
     const double t1 = std::min(1.0, t + dt);
     if (t1 < 1.0) hermite(*f, next, t1, &interpolated_);
@@ -827,7 +834,7 @@ bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double longest, P
     last_observation_ = {(t1 - t) * h, largest};
     if (t1 == 1.0) std::swap(*f, interpolated_);
     t = t1;
-    dt = std::min(2.0 * dt, largest > 0 ? dt * 0.7 * max_phase_step_ / largest : 2.0 * dt);
+    dt = std::min(2.0 * dt, largest > 0 ? dt * kAimedPhaseMove * max_phase_step_ / largest : 2.0 * dt);
   }
   track->lifted = lifted;
   track->lowest = lowest;
@@ -849,7 +856,7 @@ bool StabilityAnalysis::interpolant_is_close(const Frame& a, const Frame& b) con
 }
 
 // The next observation step: `longest` (the fields' rate's, carry_across) where nothing is
-// known yet, else the last one scaled so that the eigenphases would move about 0.7
+// known yet, else the last one scaled so that the eigenphases would move about kAimedPhaseMove
 // max_phase_step over it (growing at most twofold), between a quarter of `longest` and twice it.
 // Where the phases turn slower than the rate allows (most of a twisted rod), fewer observations
 // serve. None passes a turn unseen: a move of 2 pi - max_phase_step would look like one of
@@ -859,7 +866,7 @@ bool StabilityAnalysis::interpolant_is_close(const Frame& a, const Frame& b) con
 double StabilityAnalysis::observation_step(double longest) const {
   const Observation& last = last_observation_;
   if (!(last.step > 0)) return longest;
-  const double target = 0.7 * max_phase_step_;
+  const double target = kAimedPhaseMove * max_phase_step_;
   const double grown = last.move > 0 ? last.step * std::min(2.0, target / last.move) : 2.0 * last.step;
   return std::clamp(grown, 0.25 * longest, 2.0 * longest);
 }

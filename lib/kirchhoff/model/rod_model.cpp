@@ -53,6 +53,7 @@ bool FieldSum::stiffens_perturbations() const {
     if (f->stiffens_perturbations()) return true;
   return false;
 }
+
 bool FieldSum::has_tangent_stiffness() const {
   for (const auto& f : fields_)
     if (f->has_tangent_stiffness()) return true;
