@@ -9,6 +9,13 @@ namespace {
 // The located end point of a run with a target is accepted this close to it (relative).
 constexpr double kTargetTolerance = 1e-9;
 
+// An even branch point's located minimum of the smallest singular value lies at least this far
+// below the farther of the two steps' outer ends (which is at least one step from it, where a true
+// branch point's singular value grows linearly away from zero). Below branch_point_tolerance alone is
+// not enough: on a badly scaled problem (a column on a stiff foundation) the smallest singular value
+// is ~1e-13 at every point, and its shallow ripples were reported as branch points.
+constexpr double kBranchPointDrop = 1e-3;
+
 // A sign change between a and b (a = 0 exactly is where the last point was located: none).
 bool crossed(double a, double b) { return std::isfinite(a) && std::isfinite(b) && (a < 0) != (b < 0) && a != 0.0; }
 
@@ -129,7 +136,8 @@ class SimpleBranchPoint : public SignChange {
 };
 
 // Branch points that keep the determinant's sign (even multiplicity): a local minimum of the
-// smallest singular value over the last two steps that is, once located, tiny. Skipped where the
+// smallest singular value over the last two steps that is, once located, tiny and far below the
+// steps' ends (kBranchPointDrop). Skipped where the
 // determinant found one in this step, and right after a branch point was reported (the minimum
 // is that point again).
 class EvenBranchPoint : public Detector {
@@ -145,7 +153,9 @@ class EvenBranchPoint : public Detector {
     auto p = step.locate(*step.before, step.previous_h + step.h,
                          [](const ContinuationPoint& q) { return q.smallest_singular; }, true,
                          PointType::BranchPoint);
-    if (!p || !(p->smallest_singular < tolerance_)) return Verdict::Nothing;
+    const double farther_end = std::max(step.before->smallest_singular, step.candidate.smallest_singular);
+    if (!p || !(p->smallest_singular < tolerance_) || !(p->smallest_singular < kBranchPointDrop * farther_end))
+      return Verdict::Nothing;
     // Of the step's two ends beside the minimum, the one with fewer small singular values.
     p->multiplicity = multiplicity(*p, step.before->small_count <= step.candidate.small_count ? *step.before : step.candidate);
     // It may lie just behind `current` (already recorded): points are in detection order.
