@@ -24,6 +24,7 @@
 #include "kirchhoff/jobs/case_file.hpp"
 #include "kirchhoff/jobs/case_solve.hpp"
 #include "kirchhoff/jobs/detail/equilibrium_families.hpp"
+#include "foundation_column_case.hpp"
 #include "test_support.hpp"
 
 namespace kirchhoff {
@@ -284,6 +285,26 @@ TEST(Equilibria, ClampedClampedModesAgreeWithTheirSolvesFromTheCaseGuess) {
     EXPECT_NEAR(s.equilibria[k].energy, E, 1e-8 * E) << s_mode;
     EXPECT_NEAR(s.equilibria[k + 1].energy, E, 1e-8 * E) << s_mode;
   }
+}
+
+// A column on a stiff Winkler foundation (k = 1e6) below its first critical load (2000.17): the
+// straight rod is the lowest-energy equilibrium, and stable. The conjugate points leave its index
+// undefined (the held end's response to its load is below their zero tolerance); the listing
+// gives the discretised energy's, as solve does, where it was null.
+TEST(Equilibria, TheDiscretisedEnergyDecidesWhereTheConjugatePointsDoNot) {
+  const Case c = load_case_text(testing::foundation_column_case(1100.0, 1e6), "foundation.toml");
+  EquilibriaOptions options;
+  options.max_equilibria = 1;
+  const EquilibriaSearch s = find_equilibria(c.definition, c.start_guess, c.derived, c.samples, options);
+  ASSERT_EQ(s.equilibria.size(), 1u);
+  const StabilityReport& straight = s.equilibria[0].stability;
+  ASSERT_TRUE(straight.index) << straight.reason;
+  EXPECT_EQ(*straight.index, 0);
+  EXPECT_EQ(straight.method, "discretised_energy");
+  EXPECT_NE(straight.method_reason.find("degenerate constraint"), std::string::npos) << straight.method_reason;
+  // The straight rod's energy: the foundation's weight b at height 0 against the wall at a = 1 gives
+  // b / a per length (b = k / 2), and the load's potential P x(L) = P L.
+  EXPECT_NEAR(s.equilibria[0].energy, 5e5 + 1100.0, 1e-9 * 5e5);
 }
 
 TEST(Equilibria, EnergyOfAHeavyCantileverIsElasticPlusFieldPotential) {

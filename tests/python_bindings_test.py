@@ -236,7 +236,13 @@ class SolveTest(unittest.TestCase):
                         '[start]\ntype = "pinned"\nposition = [0, 0]\n'
                         '[end]\ntype = "sliding"\naxis = [1, 0, 0]\nposition = [0, 0]\nforce = ["-P", 0]\n'
                         '[guess]\nforce = ["-P", 0]\n')
-            st = kirchhoff.load_case(path).solve(direct=True).stability
+            case = kirchhoff.load_case(path)
+            st = case.solve(direct=True).stability
+            # A branch's points likewise (their stability_index was NaN): stable up to P_10.
+            branch = case.continue_("P", to=1900.0, max_step=20.0)
+        self.assertEqual(branch.reason, "reached_target")
+        self.assertGreater(len(branch.points["stability_index"]), 20)
+        self.assertTrue(all(i == 0 for i in branch.points["stability_index"]))
         self.assertEqual(st["index"], 0)
         self.assertTrue(st["stable"])
         self.assertEqual(st["method"], "discretised_energy")

@@ -1165,4 +1165,13 @@ StabilityReport with_discretised_index(StabilityReport report, const DiscreteSta
   return report;
 }
 
+StabilityReport with_discretised_index_where_undefined(StabilityReport report, const ShootingProblem& problem,
+                                                       const Eigen::VectorXd& x, bool lying) {
+  if (report.defined() || report.unstable) return report;
+  const std::vector<PointContact> contacts = problem.contacts_at(x);
+  if (!lying && std::any_of(contacts.begin(), contacts.end(), [](const PointContact& c) { return c.extended; }))
+    return report;
+  return with_discretised_index(std::move(report), discrete_stability(problem, x));
+}
+
 }  // namespace kirchhoff

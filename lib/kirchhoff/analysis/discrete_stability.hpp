@@ -183,4 +183,11 @@ std::string describe(const DiscreteStability& result);
 // as it is.
 StabilityReport with_discretised_index(StabilityReport report, const DiscreteStability& discrete);
 
+// with_discretised_index for runs that do not report the discretised check beside the index
+// (branches, lists of equilibria): the check is made only where `report`'s index is undefined (and
+// not known unstable), and with `lying` false not where the rod lies on an obstacle (there it takes
+// 800 elements, ~0.4 s, too slow for every point of a branch; the index stays undefined).
+StabilityReport with_discretised_index_where_undefined(StabilityReport report, const ShootingProblem& problem,
+                                                       const Eigen::VectorXd& x, bool lying);
+
 }  // namespace kirchhoff

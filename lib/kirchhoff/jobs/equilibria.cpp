@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "kirchhoff/analysis/discrete_seed.hpp"
+#include "kirchhoff/analysis/discrete_stability.hpp"
 #include "kirchhoff/contact/closest_approach.hpp"
 #include "kirchhoff/contact/contact.hpp"
 #include "kirchhoff/equations/invariants.hpp"
@@ -655,7 +656,7 @@ class Search {
       return reject(label, sol.result.summary.message, sol.result.summary.residual_norm);
     // (Computed before the comparison only where it decides it: spatial rods.)
     std::optional<StabilityReport> stability;
-    if (definition_.kind == RodKind::Spatial) stability = analyse_stability(*f.problem, x);
+    if (definition_.kind == RodKind::Spatial) stability = stability_of(*f.problem, x);
     // A spatial equilibrium with a zero mode lies on a continuous family: for the isotropic rod
     // with both ends on the e3 axis, rotating it about the axis (the cross-sections turned back)
     // gives the same equilibrium again, which Newton lands on anywhere along the circle. Those
@@ -675,7 +676,13 @@ class Search {
         return;
       }
     }
-    accept(f, std::move(sol), stability ? std::move(*stability) : analyse_stability(*f.problem, x), label);
+    accept(f, std::move(sol), stability ? std::move(*stability) : stability_of(*f.problem, x), label);
+  }
+
+  // The conjugate points' index, or where they leave it undefined the discretised energy's, as
+  // solve reports it.
+  static StabilityReport stability_of(const ShootingProblem& problem, const Eigen::VectorXd& x) {
+    return with_discretised_index_where_undefined(analyse_stability(problem, x), problem, x, true);
   }
 
   // An extended contact whose edge carries no force: the rod beyond the edge lies on the obstacle
