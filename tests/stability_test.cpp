@@ -951,6 +951,31 @@ TEST(Stability, ContactsWithCurvedObstaclesInTheShippedCasesAreStable) {
   }
 }
 
+// The indenter pushed up to rise = 0.3663, where the bordered conditions of the whole problem have
+// a singular value of 9e-8 (below the zero tolerance) through weak couplings alone: the
+// isoperimetric correction's D resolves every eigenvalue as nonzero (-71.7, 5.1e-4, 3.6e-2 at a
+// resolution of 1e-6), and the discretised energy's lowest eigenvalue is +218 (an independent
+// discretisation with the contact sliding gives 217.7). Stable, with no zero mode; it said one,
+// and along the branch in rise (to 0.366) a quarter of the points flickered between 0 and 1.
+TEST(Stability, NoZeroModeWhereTheIsoperimetricCorrectionResolvesEveryEigenvalue) {
+  for (const double rise : {0.3663, 0.36}) {
+    SCOPED_TRACE(rise);
+    // As `kirchhoff solve` does: by homotopy in rise from the case's own equilibrium.
+    const CaseSolve solved = kirchhoff::solve_case(load_case(testing::case_path("indenter.toml"), {{"rise", rise}}));
+    ASSERT_TRUE(solved.converged()) << solved.message;
+    ASSERT_TRUE(solved.stability && solved.stability_check);
+    const StabilityReport& r = *solved.stability;
+    ASSERT_TRUE(r.defined()) << r.reason;
+    EXPECT_EQ(r.method, "conjugate_points");
+    EXPECT_EQ(*r.index, 0);
+    EXPECT_EQ(r.zero_modes, 0);
+    const DiscreteStability& d = *solved.stability_check;
+    ASSERT_TRUE(d.trustworthy) << d.check_message;
+    EXPECT_EQ(d.zero_modes, 0);
+    EXPECT_GT(d.lowest_eigenvalues.front(), 100.0);
+  }
+}
+
 TEST(Stability, UnsupportedCasesSayWhy) {
   // The Reissner rod's end carries a dead couple and is free to turn in 3D: not conservative.
   const StabilityReport couple = index_of(solve_case("reissner.toml"));
