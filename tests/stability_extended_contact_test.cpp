@@ -14,6 +14,7 @@
 #include "kirchhoff/analysis/analytic.hpp"
 #include "kirchhoff/analysis/stability.hpp"
 #include "kirchhoff/jobs/case_solve.hpp"
+#include "kirchhoff/jobs/equilibria.hpp"
 #include "kirchhoff/jobs/result_json.hpp"
 #include "test_support.hpp"
 
@@ -174,6 +175,47 @@ TEST(StabilityExtendedContact, TheWallsFlatContactsAreNeverCounted) {
               std::string::npos)
         << report.reason;
   }
+}
+
+// wall.toml with its clamps inclined towards the wall by 0.3 rad, pushed to Delta = 0.05: among its
+// equilibria is a rod lying flat on the wall over [s1, s2] that the shooting splits into a flat
+// contact over [s1, s] with no force at s and a point contact at s2 (the edge s is one of a
+// continuum). It is one lying part of length l = s2 - s1 under the compression P = -H, past its
+// Euler load when (2 pi / l)^2 < P: unstable by lifting off, its lift-off eigenvalue near
+// (2 pi / l)^2 - P (above it by the shorter discrete strut, as above). It was reported undefined
+// ("zero force at an edge").
+TEST(StabilityExtendedContact, AFlatPartSplitByTheShootingIsOnePart) {
+  std::string text = testing::case_text("wall.toml");
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+           {"m_guess = 2.0", "alpha = 0.3\nm_guess = 2.0"},
+           {"position = [0, 0]\n", "position = [0, 0]\norientation = { axis = [0, 0, 1], angle = \"alpha\" }\n"},
+           {"position = [\"L - Delta\", 0]\n",
+            "position = [\"L - Delta\", 0]\norientation = { axis = [0, 0, 1], angle = \"-alpha\" }\n"}}) {
+    const size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  }
+  const Case c = load_case_text(text, "wall_inclined.toml", {{"Delta", 0.05}});
+  EquilibriaOptions options;
+  options.max_equilibria = 10;
+  const EquilibriaSearch search = find_equilibria(c.definition, c.start_guess, c.derived, c.samples, options);
+  int split = 0;
+  for (const Equilibrium& e : search.equilibria) {
+    const std::vector<PointContact> contacts = e.problem->contacts_at(e.solution.result.x);
+    if (contacts.size() != 2 || !contacts[0].extended || contacts[1].extended) continue;
+    ++split;
+    const double l = contacts[1].s - contacts[0].s;
+    const double P = -e.problem->sample(e.solution.result.x, {0.5 * (contacts[0].s_end + contacts[1].s)}).front().n.x();
+    const double closed = std::pow(2 * kPi / l, 2) - P;
+    ASSERT_LT(closed, 0.0);
+    const StabilityReport& r = e.stability;
+    EXPECT_FALSE(r.defined());
+    EXPECT_TRUE(r.unstable) << r.reason;
+    const DiscreteStability d = discrete_stability(*e.problem, e.solution.result.x);
+    EXPECT_GE(d.lift_off_eigenvalue - closed, 0.0);
+    EXPECT_LE(d.lift_off_eigenvalue - closed, 4.0 / 800 * 2 * std::pow(2 * kPi, 2) / std::pow(l, 3));
+  }
+  EXPECT_GE(split, 1);
 }
 
 // cavity.toml's flat contact past the onset of its buckling (analytic::flat_contact_buckling:

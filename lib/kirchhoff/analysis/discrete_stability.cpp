@@ -100,6 +100,50 @@ std::string multiplier_loads(const ShootingProblem& problem, const Parameters& p
   return "";
 }
 
+// Whether the rod lies on plane `o` all along [s1, s2]: its gap zero (to 1e-9 L) at 65 points.
+bool lies_on(const ShootingProblem& problem, const Eigen::VectorXd& x, const Obstacle& o, double s1, double s2,
+             double length) {
+  std::vector<double> s(65);
+  for (size_t j = 0; j < s.size(); ++j) s[j] = s1 + (s2 - s1) * static_cast<double>(j) / (s.size() - 1);
+  for (const RodPoint& q : problem.sample(x, s))
+    if (!(std::abs(o.gap(q.r)) <= 1e-9 * length)) return false;
+  return true;
+}
+
+// The contacts as the rod lies, in the order of s: an extended contact on a plane whose edge
+// carries no force, with the rod lying on the plane on past that edge up to the next contact with
+// it, is one lying part with that contact's edge for its own. The shooting splits such a part
+// anywhere along it (the edge is one of a continuum, jobs/equilibria.cpp): on wall.toml with
+// clamps inclined by 0.3 at Delta = 0.05, a flat contact over [0.2787, 0.5050] with no force at
+// 0.5050 and a point contact at 0.7213, the rod flat in between - one part 0.4426 long under
+// P = 279.2 > (2 pi / l)^2 = 201.5, past its Euler load, which the split hid ("zero force at an
+// edge").
+std::vector<PointContact> lying_contacts(const ShootingProblem& problem, const Eigen::VectorXd& x,
+                                         const RodModel& model) {
+  std::vector<PointContact> contacts = problem.contacts_at(x);
+  std::sort(contacts.begin(), contacts.end(), [](const PointContact& a, const PointContact& b) { return a.s < b.s; });
+  const std::vector<Obstacle> obstacles = problem.obstacles(problem.parameters_at(x));
+  const double zero = 1e-10 * model.B[1](0.5 * model.length) / (model.length * model.length);
+  const auto end_of = [](const PointContact& c) { return c.extended ? c.s_end : c.s; };
+  for (size_t i = 0; i + 1 < contacts.size();) {
+    PointContact &a = contacts[i], &b = contacts[i + 1];
+    const bool loose_edge = (a.extended && !(a.force_end > zero)) || (b.extended && !(b.force > zero));
+    const Obstacle& o = obstacles[a.obstacle];
+    if (a.obstacle != b.obstacle || !o.is_flat() || !loose_edge ||
+        !lies_on(problem, x, o, end_of(a), b.s, model.length)) {
+      ++i;
+      continue;
+    }
+    PointContact joined = a;
+    joined.extended = true;
+    joined.s_end = end_of(b);
+    joined.force_end = b.extended ? b.force_end : b.force;
+    contacts[i] = joined;
+    contacts.erase(contacts.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+  }
+  return contacts;
+}
+
 // Point contacts with a positive force on planes and discs are modelled; why another is not.
 // Thresholds as the conjugate-point count's (stability.cpp): a force below 1e-10 B/L^2 is zero
 // (weakly active: the index depends on higher-order terms), and g'' below 1e-9 / L means the rod
@@ -107,7 +151,7 @@ std::string multiplier_loads(const ShootingProblem& problem, const Parameters& p
 std::string contacts_not_covered(const ShootingProblem& problem, const Eigen::VectorXd& x, const RodModel& model) {
   const std::vector<Obstacle> obstacles = problem.obstacles(problem.parameters_at(x));
   const double B = model.B[1](0.5 * model.length), L = model.length;
-  for (const PointContact& c : problem.contacts_at(x)) {
+  for (const PointContact& c : lying_contacts(problem, x, model)) {
     if (obstacles[c.obstacle].shape() == Obstacle::Shape::LevelSet)
       return "a contact with a level-set obstacle: not modelled by the discrete check (planes and discs are)";
     // The rod lying on a plane or a disc: its nodes there held (discrete_stability_lying.hpp).
@@ -938,9 +982,9 @@ bool independent_constraints(const DiscreteRod& rod, const std::vector<RodPoint>
 
 // The active point contacts as constraints, the extended ones as intervals lying on their obstacle
 // (contacts_not_covered has refused the others).
-void read_contacts(const ShootingProblem& problem, const Eigen::VectorXd& x, Reading* out) {
+void read_contacts(const ShootingProblem& problem, const Eigen::VectorXd& x, const RodModel& model, Reading* out) {
   const std::vector<Obstacle> obstacles = problem.obstacles(problem.parameters_at(x));
-  for (const PointContact& c : problem.contacts_at(x)) {
+  for (const PointContact& c : lying_contacts(problem, x, model)) {
     if (c.extended) {
       // A flat contact without a field carries no force inside (n' = 0, m = 0 there): weakly active
       // (contacts_not_covered refuses one under a field); a wrap presses with N / radius > 0.
@@ -1111,7 +1155,7 @@ DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen
                  "straight along a fixed line, and its energy is not known";
     return out;
   }
-  read_contacts(problem, x, &reading);
+  read_contacts(problem, x, model, &reading);
   if (std::string why = unresolved_lying_part(reading, nodes, elements / 2); !why.empty()) {
     out.reason = why;
     return out;
