@@ -22,7 +22,7 @@ namespace {
 // The index, and the zero modes beside it ("1 +1 zero"): an equilibrium with zero modes is not
 // isolated (or sits at a bifurcation), which a count of equilibria must not hide.
 std::string index_text(const StabilityReport& s) {
-  if (!s.index) return "-";
+  if (!s.index) return s.unstable ? "unstable" : "-";
   const std::string index = s.stable() && s.zero_modes == 0 ? "0 (stable)" : std::to_string(*s.index);
   return s.zero_modes > 0 ? index + " +" + std::to_string(s.zero_modes) + " zero" : index;
 }
@@ -102,7 +102,7 @@ void print_table(const Case& c, const EquilibriaSearch& search) {
   print_family_notes(search);
   for (size_t i = 0; i < search.equilibria.size(); ++i) {
     const StabilityReport& s = search.equilibria[i].stability;
-    if (!s.index) std::cout << "  #" << i + 1 << ": index undefined: " << s.reason << "\n";
+    if (!s.index) std::cout << "  #" << i + 1 << ": " << describe(s) << "\n";
     const NewtonSummary& summary = search.equilibria[i].solution.result.summary;
     if (!summary.message.empty())
       std::cout << "  #" << i + 1 << ": converged with " << summary.message

@@ -1580,7 +1580,13 @@ StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::V
 }
 
 std::string describe(const StabilityReport& report) {
-  if (!report.index) return (report.unstable ? "unstable, no index: " : "index undefined: ") + report.reason;
+  if (!report.index && report.unstable) {
+    // (The reason may say "unstable: ..." itself, as the lift-off's does.)
+    const std::string said = "unstable: ";
+    const bool says = report.reason.compare(0, said.size(), said) == 0;
+    return "unstable, no index: " + report.reason.substr(says ? said.size() : 0);
+  }
+  if (!report.index) return "index undefined: " + report.reason;
   std::ostringstream out;
   out << (*report.index == 0 ? "stable" : "unstable (index " + std::to_string(*report.index) + ")");
   if (report.zero_modes > 0) out << ", " << report.zero_modes << " zero mode" << (report.zero_modes > 1 ? "s" : "");
