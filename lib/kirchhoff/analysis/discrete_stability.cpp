@@ -1213,7 +1213,9 @@ DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen
   out.lift_off_eigenvalue = fine.lift_off;
   out.coarse_lift_off_eigenvalue = coarse.lift_off;
   const std::string solution_failure = solution_check(fine, coarse, out.zero_tolerance);
-  out.check_message = solution_failure.empty() ? spectrum_check(fine, coarse, coarsest ? &*coarsest : nullptr, out.zero_tolerance) : solution_failure;
+  out.check_message = solution_failure.empty()
+                          ? spectrum_check(fine, coarse, coarsest ? &*coarsest : nullptr, out.zero_tolerance)
+                          : solution_failure;
   out.trustworthy = out.check_message.empty();
   if (out.trustworthy) out.check_message = "passed";
   // A part lying on the obstacle with zero force that lifts off with lower energy: unstable, and

@@ -1083,10 +1083,6 @@ Eigen::MatrixXd StabilityAnalysis::end_terms(const Frame& f, const Held& end, St
 //    error of its sigma_j, `noise` of the largest over sigma_j: on the plectoneme arch a part of
 //    0.04 through sigma = 2e-11 of 0.36 came out 12 % off, and with the fields at a branch's 1e-8
 //    one through sigma = 8e-6 left D = 1e-5 where the rod's turn makes it 0.
-// An eigenvalue of D farther from zero than this many times its resolution is decisively not zero:
-// it overrules the whole problem's null-space test (constraint_correction).
-constexpr double kDecisiveResolutions = 10.0;
-
 struct NearZeroModes {
   bool exact = false;
   std::vector<std::pair<Eigen::MatrixXd, double>> parts;  // (symmetrised part, its relative error)
@@ -1122,6 +1118,10 @@ NearZeroModes near_zero_modes(const Eigen::JacobiSVD<Eigen::MatrixXd>& svd, cons
       if (sigma[j] <= tol) out.parts[static_cast<size_t>(j)].second = 0.0;
   return out;
 }
+
+// An eigenvalue of D farther from zero than this many times its resolution is decisively not zero:
+// it overrules the whole problem's null-space test (constraint_correction).
+constexpr double kDecisiveResolutions = 10.0;
 
 // Whether every singular value of the load-controlled conditions below the zero tolerance is zero
 // to the fields' accuracy (below kExactLoadControlledZero of the largest). Between that and the

@@ -137,9 +137,8 @@ class SimpleBranchPoint : public SignChange {
 
 // Branch points that keep the determinant's sign (even multiplicity): a local minimum of the
 // smallest singular value over the last two steps that is, once located, tiny and far below the
-// steps' ends (kBranchPointDrop). Skipped where the
-// determinant found one in this step, and right after a branch point was reported (the minimum
-// is that point again).
+// steps' ends (kBranchPointDrop). Skipped where the determinant found one in this step, and right
+// after a branch point was reported (the minimum is that point again).
 class EvenBranchPoint : public Detector {
  public:
   EvenBranchPoint(int stop_at, double tolerance) : stop_at_(stop_at), tolerance_(tolerance) {}
