@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "kirchhoff/analysis/discrete_stability.hpp"
 #include "kirchhoff/analysis/solution.hpp"
 #include "kirchhoff/analysis/stability.hpp"
 #include "kirchhoff/contact/contact.hpp"
@@ -79,7 +80,8 @@ std::string read_file(const fs::path& path) {
 }
 
 // A solve job: solve_case as `kirchhoff solve` does (the solution, its checks and its stability
-// index; the index's independent check is not reported here), then its energy.
+// index; the index's independent check is not reported here, but where the conjugate points leave
+// the index undefined it is made, and decides it as in `solve`), then its energy.
 void run_solve(const SweepJob& job, const Case& c, const fs::path& folder, json* result) {
   CaseSolveOptions options;
   options.direct = job.direct;
@@ -98,7 +100,8 @@ void run_solve(const SweepJob& job, const Case& c, const fs::path& folder, json*
   }
   const ShootingProblem& problem = *solved.solved.problem;
   const Solution& sol = *solved.solution;
-  const StabilityReport& stability = *solved.stability;
+  const StabilityReport stability =
+      with_discretised_index_where_undefined(*solved.stability, problem, sol.result.x, true);
   const std::string state = contact_state(problem.obstacles(sol.result.parameters), sol.contacts);
   (*result)["status"] = "ok";
   (*result)["reason"] = "";
@@ -106,6 +109,7 @@ void run_solve(const SweepJob& job, const Case& c, const fs::path& folder, json*
   (*result)["stable_states"] = stability.stable() ? state : "";
   (*result)["stability_index"] = stability_index(stability);
   (*result)["stability_reason"] = stability.reason;
+  (*result)["stability_method"] = stability.method;
   (*result)["equilibria"] = 1;
   (*result)["energy"] = number(total_potential_energy(problem, sol.result.x));
   (*result)["derived"] = derived_json(sol);
