@@ -320,6 +320,25 @@ TEST_F(ContinueCli, EveryPointOfAStiffFoundationsStraightBranchHasItsIndex) {
   }
 }
 
+// The axial phase condition is degenerate on the straight twisted rod: continued from it, the
+// march went along the unfolding couple mu at a fixed twist (mu = 11.5 at row 59), every row a
+// "stable" regular point, exit 0. A point with mu != 0 is not an equilibrium: each step is
+// refused, and the run stops saying why.
+TEST_F(ContinueCli, TheAxialPhaseConditionFromTheStraightRodGivesNoRowsOffEquilibrium) {
+  const fs::path csv = dir_ / "axial.csv", log = dir_ / "axial.log";
+  EXPECT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/twisted_clamped.toml", "--param",
+                        "phi", "--to", "14", "--phase-condition", "axial", "--max-points", "60", "--out", csv.string()},
+                       log),
+            1);
+  const auto lines = lines_of(log);
+  ASSERT_FALSE(lines.empty());
+  EXPECT_NE(lines.back().find("not an equilibrium"), std::string::npos) << lines.back();
+  const auto rows = lines_of(csv);
+  const auto column = csv_header(rows[0]);
+  for (size_t i = 1; i < rows.size(); ++i)
+    EXPECT_LE(std::abs(std::stod(csv_fields(rows[i])[column.at("unfolding")])), 1e-7) << rows[i];
+}
+
 TEST_F(ContinueCli, BranchPointsCanBeSkippedButNotSwitchedAt) {
   const std::vector<std::string> straight = {KIRCHHOFF_CLI, "continue",
                                              std::string(KIRCHHOFF_CASES_DIR) + "/euler_column.toml", "--param",

@@ -33,26 +33,35 @@ PointRecorder rod_point_recorder(const RodRecordOptions& options, const std::vec
   // point (13 % of the instructions of the Euler column's branch recording theta0 alone); a
   // field's domain is checked along the whole profile (make_solution), so not with a field.
   const bool start_only = !options.compute_invariants && derived_read_start_only(derived);
-  if (options.compute_invariants || !derived.empty())
-    recorder.describe = [samples = options.samples, derived, start_only](ParameterisedSystem& system,
-                                                                        ContinuationPoint* point) {
-      ContinuationPoint& p = *point;
-      const ShootingProblem& problem = shooting_problem_at(system, p.parameter);
-      ShootingResult r;
-      r.x = p.x;
-      r.summary.status = SolverStatus::Converged;
-      r.parameters = problem.parameters_at(p.x);
-      const Parameters at = r.parameters;
-      const bool at_start = start_only && !problem.equations(at)->model().field;
-      const Solution s = at_start ? make_start_solution(problem, std::move(r), derived)
-                                  : make_solution(problem, std::move(r), samples, derived);
-      if (!s.result.summary.converged()) p.check_failure = s.result.summary.message;
-      p.derived = s.derived;
-      // Parameters solved for belong on the branch too (e.g. the load of a displacement-controlled run).
-      for (const auto& name : problem.definition().unknown_parameters) p.derived[name] = at.get(name);
-      const InvariantStats& H = s.invariants.H;
-      p.extra = RodPointInvariants{s.invariants, !H.applies || H.spread <= kFlatH * std::max(1.0, H.scale)};
-    };
+  const bool described = options.compute_invariants || !derived.empty();
+  // Every corrected point is checked to be an equilibrium: with the axial phase condition, a
+  // point of the unfolded system with mu != 0 is not one (from the straight twisted rod the march
+  // went along mu at a fixed twist, every row "stable"); the step is refused, as a corrector that
+  // failed (ContinuationPoint::check_failure).
+  recorder.describe = [samples = options.samples, derived, start_only, described](ParameterisedSystem& system,
+                                                                               ContinuationPoint* point) {
+    ContinuationPoint& p = *point;
+    const ShootingProblem& problem = shooting_problem_at(system, p.parameter);
+    if (std::string why = unfolding_failure(problem.parameters_at(p.x)); !why.empty()) {
+      p.check_failure = why;
+      return;
+    }
+    if (!described) return;
+    ShootingResult r;
+    r.x = p.x;
+    r.summary.status = SolverStatus::Converged;
+    r.parameters = problem.parameters_at(p.x);
+    const Parameters at = r.parameters;
+    const bool at_start = start_only && !problem.equations(at)->model().field;
+    const Solution s = at_start ? make_start_solution(problem, std::move(r), derived)
+                                : make_solution(problem, std::move(r), samples, derived);
+    if (!s.result.summary.converged()) p.check_failure = s.result.summary.message;
+    p.derived = s.derived;
+    // Parameters solved for belong on the branch too (e.g. the load of a displacement-controlled run).
+    for (const auto& name : problem.definition().unknown_parameters) p.derived[name] = at.get(name);
+    const InvariantStats& H = s.invariants.H;
+    p.extra = RodPointInvariants{s.invariants, !H.applies || H.spread <= kFlatH * std::max(1.0, H.scale)};
+  };
   if (options.compute_stability)
     recorder.record = [field_tolerance = options.stability_field_tolerance](ParameterisedSystem& system,
                                                                               ContinuationPoint* point) {

@@ -1,6 +1,7 @@
 #include "kirchhoff/shooting/shooting.hpp"
 
 #include <algorithm>
+#include <sstream>
 #include <cmath>
 #include <exception>
 #include <functional>
@@ -741,6 +742,15 @@ std::string single_segment_hint() {
          "--solver segments=8 on the command line)";
 }
 
+std::string unfolding_failure(const Parameters& parameters) {
+  if (!parameters.contains(kUnfoldingParameter)) return "";
+  const double mu = parameters.get(kUnfoldingParameter);
+  if (!(std::abs(mu) > kUnfoldingTolerance)) return "";
+  std::ostringstream why;
+  why << "unfolding = " << mu << ": not an equilibrium (on the straight rod the axial phase condition is degenerate)";
+  return why.str();
+}
+
 ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) {
   ShootingResult result;
   result.x = x0;
@@ -750,10 +760,9 @@ ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) 
   if (result.summary.converged()) mark_check_failure(&result, unknowns_failure(problem, result));
   if (result.summary.converged()) mark_check_failure(&result, zero_iteration_failure(problem, result));
   if (!result.summary.converged() || !result.parameters.contains(kUnfoldingParameter)) return result;
-  if (std::abs(result.parameters.get(kUnfoldingParameter)) > kUnfoldingTolerance) {
+  if (std::string why = unfolding_failure(result.parameters); !why.empty()) {
     result.summary.status = SolverStatus::UnfoldingNotZero;
-    result.summary.message = "unfolding = " + std::to_string(result.parameters.get(kUnfoldingParameter)) +
-                             ": not an equilibrium (on the straight rod the axial phase condition is degenerate)";
+    result.summary.message = why;
     return result;
   }
   // A guess that is already a straight solution converges in zero iterations; the phase

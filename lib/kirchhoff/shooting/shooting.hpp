@@ -315,6 +315,10 @@ inline bool is_unfolding_parameter(const std::string& name) { return name == kUn
 // tolerance times the conditioning, far below this.
 constexpr double kUnfoldingTolerance = 1e-7;
 
+// Why the parameters of a converged point are not an equilibrium (its unfolding above
+// kUnfoldingTolerance), or "" (no unfolding parameter, or it is zero).
+std::string unfolding_failure(const Parameters& parameters);
+
 // A solved problem: the unknowns, how the solve went, and the parameters at the solution.
 struct ShootingResult {
   Eigen::VectorXd x;
