@@ -113,7 +113,7 @@ Args:
         a multiple-shooting case of hundreds of unknowns, such as plectoneme.toml); folds are
         found either way.
     stability (bool): the stability index of every point (column stability_index: NaN where
-        it is not defined; zero_modes beside it), as the CLI's CSV.
+        it is not defined; zero_modes beside it, NaN there too), as the CLI's CSV.
     deflate (bool): follow every branch through the equilibria found at the start by deflation
         (as equilibria() lists them, at most deflate_max): branch k starts at the k-th by energy.
     max_seconds (float): wall-clock limit of the whole run (0: none); past it the run stops

@@ -189,7 +189,9 @@ py::dict branch_points_dict(const std::vector<BranchPoint>& pts, const std::vect
   f("stability_index", [](const ContinuationPoint& p) {
     return p.stability_index ? static_cast<double>(*p.stability_index) : std::numeric_limits<double>::quiet_NaN();
   });
-  i("zero_modes", [](const BranchPoint& b) { return b.point.zero_modes; });
+  f("zero_modes", [](const ContinuationPoint& p) {
+    return p.stability_index ? static_cast<double>(p.zero_modes) : std::numeric_limits<double>::quiet_NaN();
+  });
   return d;
 }
 

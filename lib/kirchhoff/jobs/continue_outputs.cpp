@@ -78,9 +78,10 @@ void BranchCsvSink::point(const RunPoint& rp) {
   out_ << ',' << inv.H.relative_spread() + 0.0 << ',' << inv.m3.relative_spread() + 0.0 << ','
        << inv.n_dot_m.relative_spread() + 0.0 << ',' << (H_is_flat(p) ? 1 : 0) << ',' << to_string(p.type) << ','
        << p.multiplicity << ',' << p.event << ',' << p.newton_iterations << ',';
-  // Empty where the index is not defined (or not computed): never a guessed number.
-  if (p.stability_index) out_ << *p.stability_index;
-  out_ << ',' << p.zero_modes << '\n';
+  // Both empty where the index is not defined (or not computed): never a guessed number.
+  if (p.stability_index) out_ << *p.stability_index << ',' << p.zero_modes;
+  else out_ << ',';
+  out_ << '\n';
   out_.flush();
 }
 
