@@ -289,6 +289,9 @@ TEST_F(ContinueCli, BranchPointsOfABadlyScaledProblemAreTheCriticalLoadsEachSimp
       const auto fields = csv_fields(rows[i]);
       if (fields[column.at("type")] != "branch_point") continue;
       EXPECT_EQ(fields[column.at("multiplicity")], "1") << rows[i];
+      // --no-stability: no index, and no zero-mode count that would read as one (it said 0).
+      EXPECT_EQ(fields[column.at("stability_index")], "") << rows[i];
+      EXPECT_EQ(fields[column.at("zero_modes")], "") << rows[i];
       found.push_back(std::stod(fields[column.at("P")]));
       EXPECT_TRUE(near_one_of(found.back(), critical)) << "not a critical load: " << rows[i];
     }
