@@ -928,7 +928,11 @@ std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contac
   const double g2 = nu.dot(curving) + d3.dot(K * d3), scale = 1.0 / scales_.length;
   if (!(contact.force > 1e-10 * scales_.bending / (scales_.length * scales_.length)))
     return "a contact with zero force (weakly active): the index depends on higher-order terms, not defined here";
-  if (!(g2 > 1e-9 * scale))
+  // Judged on the equilibrium at the state's tolerance too (contact_bending), not only on the
+  // frame's state, integrated with the fields at theirs (a branch's 1e-8): at the wall's
+  // contact_flattens, located where g'' = 1e-13, the frame gave 1.8e-8 and the row an index.
+  const double g2_state = problem_.contact_bending(x_, contact) / obstacle.gradient(here.r).norm();
+  if (!(g2 > 1e-9 * scale) || !(g2_state > 1e-9 * scale))
     return "a contact where the rod does not curve away from the obstacle (g'' = 0: it is about to flatten or wrap "
            "onto it)";
   if (!full_ && K.norm() > 0) throw std::logic_error("stability: a curved obstacle needs the full frame");
