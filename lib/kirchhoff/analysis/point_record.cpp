@@ -42,7 +42,8 @@ PointRecorder rod_point_recorder(const RodRecordOptions& options, const std::vec
                                                                                ContinuationPoint* point) {
     ContinuationPoint& p = *point;
     const ShootingProblem& problem = shooting_problem_at(system, p.parameter);
-    if (std::string why = unfolding_failure(problem.parameters_at(p.x)); !why.empty()) {
+    const Parameters at = problem.parameters_at(p.x);
+    if (std::string why = unfolding_failure(at); !why.empty()) {
       p.check_failure = why;
       return;
     }
@@ -50,8 +51,7 @@ PointRecorder rod_point_recorder(const RodRecordOptions& options, const std::vec
     ShootingResult r;
     r.x = p.x;
     r.summary.status = SolverStatus::Converged;
-    r.parameters = problem.parameters_at(p.x);
-    const Parameters at = r.parameters;
+    r.parameters = at;
     const bool at_start = start_only && !problem.equations(at)->model().field;
     const Solution s = at_start ? make_start_solution(problem, std::move(r), derived)
                                 : make_solution(problem, std::move(r), samples, derived);
