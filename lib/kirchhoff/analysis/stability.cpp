@@ -362,13 +362,23 @@ class StabilityAnalysis {
   void march_observed(Frame* f, double end, double longest, PhaseTrack* track);
   bool interpolated_step(Frame* f, double s1, double observed, PhaseTrack* track);
   bool near_passage(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
+  // A passage of an eigenphase past an odd multiple of pi seen between two observations on an
+  // interpolant (interpolated_step), to be located on exact frames once the step is taken.
+  struct SeenPassage {
+    int j;
+    long multiple;
+    double a, b, ta, tb;        // the observations' arclengths and tan of half their offsets
+    Eigen::VectorXd reference;  // the phases at a, against which trial phases are lifted
+  };
+  bool clear_or_clean_passage(const Eigen::VectorXd& from, const Eigen::VectorXd& to, double a, double b,
+                              std::vector<SeenPassage>* seen) const;
   void slopes(Frame* f);
   bool interpolant_is_close(const Frame& a, const Frame& b) const;
   double observation_step(double longest) const;
   void advance(Frame* f, double s1, PhaseTrack* track, int depth);
   void record(const Frame& f, const Eigen::VectorXd& after, double s1, PhaseTrack* track);
-  double locate_passage(const Frame& f, const Eigen::VectorXd& before, int j, long multiple, double s1, double ta,
-                        double tb);
+  double locate_passage(const Frame& f, const Eigen::VectorXd& reference, int j, long multiple, double a, double b,
+                        double ta, double tb);
   bool count_interior(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start,
                       StabilityReport* report) const;
   Eigen::MatrixXd end_terms(const Frame& f, const Held& end, StabilityReport* report) const;
@@ -409,12 +419,12 @@ class StabilityAnalysis {
     double step = 0.0, move = 0.0;
   } last_observation_;
   // Workspaces kept across the index's steps (no allocation at each): the map (map_at), the
-  // canonical coordinates of the fields (canonical_blocks), the frame a step arrives at (advance)
-  // and the trial frames of locate_passage.
+  // frame a step arrives at (advance), the trial frames of locate_passage and the frames observed
+  // on an interpolant (interpolated_step).
   mutable CanonicalMap map_;
   mutable bool map_known_ = false, map_has_G_ = true;
-  mutable Eigen::MatrixXd z_, z_particular_;
   Frame arriving_, trial_, interpolated_;
+  std::vector<SeenPassage> seen_;  // interpolated_step's passages
   Eigen::MatrixXd directions_;  // the fields handed to the integration (flowed)
   // The full frame: positions are configuration variables beside the rotation (see
   // positions_are_configuration); its U block holds (dr / L, dpsi), offset_ = 0. Otherwise the
@@ -550,23 +560,29 @@ const CanonicalMap& StabilityAnalysis::map_at(const Eigen::VectorXd& y, double s
   return map_;
 }
 
+// Rows [first, first + count) of T dY. T is sparse (each canonical coordinate reads a few state
+// components) and small: its nonzeros alone, row by row, cost a fraction of a dense product.
+void sparse_rows_product(const Eigen::MatrixXd& T, const Eigen::MatrixXd& dY, int first, int count,
+                         Eigen::MatrixXd* out) {
+  out->setZero(count, dY.cols());
+  for (int r = 0; r < count; ++r)
+    for (Eigen::Index k = 0; k < T.cols(); ++k)
+      if (const double t = T(first + r, k); t != 0.0) out->row(r) += t * dY.row(k);
+}
+
 void StabilityAnalysis::canonical_blocks(Frame* f) const {
   const int n = coords_.size(), kr = coords_.kr();
   const CanonicalMap& map = map_at(f->y, f->s);
-  auto blocks = [&](const Eigen::MatrixXd& dY, Eigen::MatrixXd* z, Eigen::MatrixXd* U, Eigen::MatrixXd* P,
-                    Eigen::MatrixXd* P_phys, Eigen::MatrixXd* R) {
-    // Products of a few rows and columns: coefficient-wise (lazyProduct), not through the
-    // blocked kernel that Eigen picks for dynamic sizes, whose set-up costs more than they do.
-    z->noalias() = map.T.lazyProduct(dY);
-    *U = z->middleRows(offset_, mU_);
-    *P_phys = z->middleRows(n + offset_, mU_);
+  auto blocks = [&](const Eigen::MatrixXd& dY, Eigen::MatrixXd* U, Eigen::MatrixXd* P, Eigen::MatrixXd* P_phys,
+                    Eigen::MatrixXd* R) {
+    sparse_rows_product(map.T, dY, offset_, mU_, U);
+    sparse_rows_product(map.T, dY, n + offset_, mU_, P_phys);
     *P = *P_phys;
     if (map_has_G_) P->noalias() += map.G.bottomRightCorner(mU_, mU_).lazyProduct(*U);
-    *R = z->topRows(kr);
+    sparse_rows_product(map.T, dY, 0, kr, R);
   };
-  blocks(f->dY, &z_, &f->U, &f->P, &f->P_physical, &f->R);
-  blocks(f->particular, &z_particular_, &f->particular_U, &f->particular_P, &f->particular_P_physical,
-         &f->particular_R);
+  blocks(f->dY, &f->U, &f->P, &f->P_physical, &f->R);
+  blocks(f->particular, &f->particular_U, &f->particular_P, &f->particular_P_physical, &f->particular_R);
 }
 
 // Keeps the frame's columns orthonormal in (U, P) (the span, a Lagrangian plane, is unchanged):
@@ -632,7 +648,7 @@ void StabilityAnalysis::record(const Frame& f, const Eigen::VectorXd& phases, do
       const long multiple = 2 * (lifted[j] < before[j] ? first + passed - 1 - k : first + k) + 1;
       if (lifted[j] < before[j]) {
         const double ta = std::tan(0.5 * (before[j] - multiple * kPi)), tb = std::tan(0.5 * (lifted[j] - multiple * kPi));
-        stack.emplace_back(multiple, locate_passage(f, before, j, multiple, s1, ta, tb));
+        stack.emplace_back(multiple, locate_passage(f, before, j, multiple, f.s, s1, ta, tb));
       }
       else if (!stack.empty() && stack.back().first == multiple) stack.pop_back();
     }
@@ -645,24 +661,25 @@ void StabilityAnalysis::record(const Frame& f, const Eigen::VectorXd& phases, do
   track->lifted = lifted;
 }
 
-// Where eigenphase j (lifted `before` at f.s) passes multiple * pi within (f.s, s1): near a passage
-// the phase goes as k pi - 2 atan(c (s - s*)), so t(s) = tan of half its offset is close to linear
-// in s, from ta > 0 at f.s to tb < 0 at s1. Regula falsi on t (the Illinois variant, so that an
-// end kept twice does not stall it), each t from the frame carried from f to the trial point, until
-// the estimate moves less than passage_tolerance: the position is then exact to the fields'
+// Where eigenphase j passes multiple * pi within (a, b), f.s <= a < b: near a passage the phase
+// goes as k pi - 2 atan(c (s - s*)), so t(s) = tan of half its offset is close to linear in s, from
+// ta > 0 at a to tb < 0 at b. Regula falsi on t (the Illinois variant, so that an end kept twice
+// does not stall it), each t from the frame carried from f to the trial point and its phases
+// lifted against `reference` (those at a: no phase moves by max_phase_step between a and b),
+// until the estimate moves less than passage_tolerance: the position is then exact to the fields'
 // integration, not to a step's interpolation. The trial frames are not kept (the march goes on
-// from s1).
-double StabilityAnalysis::locate_passage(const Frame& f, const Eigen::VectorXd& before, int j, long multiple,
-                                         double s1, double ta, double tb) {
+// from the step's end).
+double StabilityAnalysis::locate_passage(const Frame& f, const Eigen::VectorXd& reference, int j, long multiple,
+                                         double a, double b, double ta, double tb) {
   const double tolerance = options_.passage_tolerance * scales_.length;
-  double a = f.s, b = s1, estimate = a + ta / (ta - tb) * (b - a);
+  double estimate = a + ta / (ta - tb) * (b - a);
   int kept = 0;  // the end the last step kept: +1 a, -1 b
   for (int i = 0; i < options_.max_locating_steps && b - a > tolerance; ++i) {
     CarriedSteps steps{estimate - f.s, estimate - f.s};  // one integration step to the trial point
     flowed(f, estimate, &steps, true, &trial_);
     canonical_blocks(&trial_);
     orthonormalise(&trial_);
-    const double t = std::tan(0.5 * (lift(before, eigenphases(trial_.U, trial_.P, true))[j] - multiple * kPi));
+    const double t = std::tan(0.5 * (lift(reference, eigenphases(trial_.U, trial_.P, true))[j] - multiple * kPi));
     if (t > 0) {
       a = estimate, ta = t;
       if (kept == -1) tb *= 0.5;  // b kept twice
@@ -758,6 +775,28 @@ bool StabilityAnalysis::near_passage(const Eigen::VectorXd& from, const Eigen::V
   return false;
 }
 
+// Whether each eigenphase moving from `from` at a to `to` at b (lifted, one observation step on an
+// interpolant) stays kPassageMargin clear of the odd multiples of pi, or passes one of them
+// downwards (the Legendre direction) with both observations kPassageMargin clear of it; those
+// passages are appended to `seen`. The interpolant's phases are good to a third of the margin
+// (interpolant_is_close), so the exact ones bracket the same multiple: counting it and locating it
+// on exact frames (locate_passage) needs no march in observation steps. A phase that ends near a
+// multiple or moves upwards past one is neither: march_observed follows it on exact frames.
+bool StabilityAnalysis::clear_or_clean_passage(const Eigen::VectorXd& from, const Eigen::VectorXd& to, double a,
+                                               double b, std::vector<SeenPassage>* seen) const {
+  for (int j = 0; j < from.size(); ++j) {
+    const double lo = std::min(from[j], to[j]), hi = std::max(from[j], to[j]);
+    const int near = odd_multiples_between(lo - kPassageMargin, hi + kPassageMargin);
+    if (near == 0) continue;
+    if (!(to[j] < from[j]) || near != 1 || odd_multiples_between(lo + kPassageMargin, hi - kPassageMargin) != 1)
+      return false;
+    const long multiple = 2 * (static_cast<long>(std::floor((lo / kPi - 1) / 2)) + 1) + 1;
+    seen->push_back({j, multiple, a, b, std::tan(0.5 * (from[j] - multiple * kPi)),
+                     std::tan(0.5 * (to[j] - multiple * kPi)), from});
+  }
+  return true;
+}
+
 // The frame's slopes (Frame::y_slope, dY_slope) where not known yet: the right-hand side, and its
 // derivatives along the fields by forward differences (to ~1e-7 of the fields, far below what
 // observing their eigenphases on an interpolant needs). One right-hand side each. (The frame's
@@ -794,8 +833,9 @@ void hermite(const Frame& a, const Frame& b, double t, Frame* out) {
 // observation steps long turn the fields by ~1 rad at the rate's estimate: the interpolant is
 // good to ~(1 rad)^4 / 384, 3e-3, and the phases to about twice that, inside kPassageMargin.
 // That is checked, not assumed (interpolant_is_close). The step is taken (f moves to s1, the
-// phases recorded) where no phase comes within that margin of an odd multiple of pi, so that no
-// conjugate point can hide in the interpolant's error; false (f and the track unchanged)
+// phases recorded) where every phase stays that margin clear of the odd multiples of pi or passes
+// one cleanly (clear_or_clean_passage), so that no conjugate point can hide in the interpolant's
+// error; the passages are then located on exact frames. False (f and the track unchanged)
 // otherwise, and where the sub-steps would be shorter than 1 / 256 of the step.
 bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double observed, PhaseTrack* track) {
   if (near_passage(track->lifted, track->lifted)) return false;
@@ -812,19 +852,23 @@ bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double observed, 
   const Observation before_step = last_observation_;
   const double h = s1 - f->s;
   double t = 0.0, dt = std::min(1.0, observation_step(observed) / h);
+  seen_.clear();
   while (t < 1.0) {
     const double t1 = std::min(1.0, t + dt);
     if (t1 < 1.0) hermite(*f, next, t1, &interpolated_);
     else interpolated_ = next;
     canonical_blocks(&interpolated_);
-    orthonormalise(&interpolated_);
-    const Eigen::VectorXd phases = lift(lifted, eigenphases(interpolated_.U, interpolated_.P, true));
+    // Only the frame arrived at is kept (and so kept orthonormal); eigenphases() takes the
+    // others' plane as it is.
+    const bool arrived = t1 == 1.0;
+    if (arrived) orthonormalise(&interpolated_);
+    const Eigen::VectorXd phases = lift(lifted, eigenphases(interpolated_.U, interpolated_.P, arrived));
     const double largest = phases.size() == 0 ? 0.0 : (phases - lifted).cwiseAbs().maxCoeff();
     if (largest > max_phase_step_ && dt > 1.0 / 256) {
       dt *= 0.5;
       continue;
     }
-    if (largest > max_phase_step_ || near_passage(lifted, phases)) {
+    if (largest > max_phase_step_ || !clear_or_clean_passage(lifted, phases, f->s + t * h, f->s + t1 * h, &seen_)) {
       steps_ = before;
       last_observation_ = before_step;
       return false;
@@ -832,10 +876,12 @@ bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double observed, 
     lifted = phases;
     lowest = lowest.cwiseMin(phases);
     last_observation_ = {(t1 - t) * h, largest};
-    if (t1 == 1.0) std::swap(*f, interpolated_);
     t = t1;
     dt = std::min(2.0 * dt, largest > 0 ? dt * kAimedPhaseMove * max_phase_step_ / largest : 2.0 * dt);
   }
+  for (const SeenPassage& p : seen_)
+    track->passages[p.j].emplace_back(p.multiple, locate_passage(*f, p.reference, p.j, p.multiple, p.a, p.b, p.ta, p.tb));
+  std::swap(*f, interpolated_);
   track->lifted = lifted;
   track->lowest = lowest;
   return true;
