@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "kirchhoff/jobs/case_file.hpp"
 #include "kirchhoff/jobs/case_solve.hpp"
 #include "kirchhoff/shooting/newton.hpp"
 #include "kirchhoff/shooting/verification.hpp"
@@ -196,6 +197,44 @@ TEST(ZeroIterationCheck, RefusesAResidualSmallOnlyByTheCasesScale) {
   const ShootingResult again = solve(*first.problem, first.result.x);
   EXPECT_TRUE(again.summary.converged()) << again.summary.message;
   EXPECT_EQ(again.summary.iterations, 0);
+}
+
+// A closed isotropic twisted ring (clamped at both ends at one point, the end frame turned by 2 pi
+// Tw about the tangent): turning the ring about its centreline leaves it an equilibrium, so the
+// equilibria form a continuous family and the Jacobian is singular there. The guess is the
+// circular ring itself (residual 6e-10) and one Newton correction moves it by 2.6e-4: that is the
+// singular matrix, not the case's scale, and the message says so (it said "give lengths ... in
+// units that make them of order 1" for this case of order 1).
+TEST(ZeroIterationCheck, NamesANearlySingularJacobianAsNotIsolatedEquilibria) {
+  const Case ring = load_case_text(R"(
+model = "spatial"
+[parameters]
+Tw = 1.0
+[rod]
+length = "2*_pi"
+B1 = 1.0
+B2 = 1.0
+B3 = 0.8
+[start]
+type = "clamped"
+position = [0, 0, 0]
+[end]
+type = "clamped"
+position = [0, 0, 0]
+orientation = { axis = [0, 0, 1], angle = "2*_pi*Tw" }
+track_turns = true
+[guess]
+force = [0, 0.8, 0]
+moment = [0, 1.0, 0.8]
+[solver]
+tolerance = 1e-8
+)",
+                                   "ring.toml");
+  const ShootingProblem problem(ring.definition);
+  const ShootingResult r = solve(problem, problem.initial_unknowns(ring.start_guess));
+  EXPECT_EQ(r.summary.status, SolverStatus::CheckFailed);
+  EXPECT_NE(r.summary.message.find("the Jacobian is nearly singular there"), std::string::npos) << r.summary.message;
+  EXPECT_EQ(r.summary.message.find("units that make them of order 1"), std::string::npos) << r.summary.message;
 }
 
 // Both steppers give the same equilibrium on every shipped case. Dopri5 returned NaN profiles

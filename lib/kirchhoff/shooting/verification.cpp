@@ -76,6 +76,40 @@ std::string unknowns_failure(const ShootingProblem& problem, const ShootingResul
   return {};
 }
 
+namespace {
+
+// Below this ratio of the smallest singular value of the equilibrated step matrix to its largest,
+// a large first correction of a small residual is put down to equilibria that are not isolated
+// rather than to the case's scale: measured, an isotropic twisted ring closed by clamping both
+// ends at one point (a continuous family: the ring turned about its centreline) gives 1.3e-10.
+constexpr double kNearlySingular = 1e-6;
+// Ruiz's iteration halves the logarithm of each row's and column's scale per pass: 1e300 to 1e-3
+// in 40.
+constexpr int kEquilibrationPasses = 40;
+// Decades from 1 within which a case's length and stiffness count as of unit scale.
+constexpr double kUnitScale = 3.0;
+
+// J scaled by rows and columns until each has its largest |entry| near 1 (Ruiz's iteration: each
+// pass divides them by the square roots of their largest): its singular values then speak of the
+// equations, not of the units the case chose (a rod 1e-100 long has entries over 1e300 apart).
+Eigen::MatrixXd equilibrated(Eigen::MatrixXd J) {
+  for (int pass = 0; pass < kEquilibrationPasses; ++pass) {
+    for (Eigen::Index i = 0; i < J.rows(); ++i)
+      if (const double m = J.row(i).cwiseAbs().maxCoeff(); m > 0) J.row(i) /= std::sqrt(m);
+    for (Eigen::Index j = 0; j < J.cols(); ++j)
+      if (const double m = J.col(j).cwiseAbs().maxCoeff(); m > 0) J.col(j) /= std::sqrt(m);
+  }
+  return J;
+}
+
+// Length and bending stiffness within kUnitScale of 1, either way.
+bool of_unit_scale(const RodModel& model) {
+  const double length = model.length, bending = model.B[0](0.0);
+  return std::abs(std::log10(length)) <= kUnitScale && std::abs(std::log10(bending)) <= kUnitScale;
+}
+
+}  // namespace
+
 std::string zero_iteration_failure(const ShootingProblem& problem, const ShootingResult& result) {
   if (result.summary.iterations > 0) return {};
   Eigen::VectorXd F;
@@ -95,8 +129,22 @@ std::string zero_iteration_failure(const ShootingProblem& problem, const Shootin
   std::ostringstream os;
   os << "the guess meets the residual tolerance as it is (residual " << max_abs_or_nan(F)
      << ", 0 iterations), but one Newton correction from it moves the unknowns by " << step << " against their size "
-     << size - 1.0 << ": the absolute tolerance is not meaningful at this case's scale; give lengths, "
-     << "stiffnesses and loads in units that make them of order 1";
+     << size - 1.0;
+  // A nearly singular matrix makes a large correction of a small residual too, at any scale: the
+  // equilibria there are not isolated (a continuous family the case does not fix) or branch. On a
+  // case far from unit scale the matrix is singular to round-off by its scale alone (a rod 1e-100
+  // long: 7e-34 even equilibrated), so that is said there.
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(equilibrated(J));
+  const Eigen::VectorXd& sigma = svd.singularValues();
+  const double ratio = sigma.size() > 0 && sigma[0] > 0 ? sigma[sigma.size() - 1] / sigma[0] : 0.0;
+  if (ratio < kNearlySingular && of_unit_scale(problem.equations(problem.parameters_at(result.x))->model()))
+    os << ": the Jacobian is nearly singular there (smallest singular value " << ratio
+       << " of the largest), so the equilibrium is not isolated: a continuous family of equilibria (a symmetry "
+       << "the case leaves free, e.g. turning an isotropic ring about its centreline) or a branch point; fix the "
+       << "symmetry in the case, or start from a guess away from the branch point";
+  else
+    os << ": the absolute tolerance is not meaningful at this case's scale; give lengths, stiffnesses and loads in "
+       << "units that make them of order 1";
   return os.str();
 }
 
