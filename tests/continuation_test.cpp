@@ -497,7 +497,9 @@ TEST(TaperedColumn, BranchPointsAndTheTaperedIdentityAlongTheBuckledBranch) {
 
 // The record hook: each point on the branch is described once and recorded once (the buckled
 // branch through its branch point and a stopping event, so located points are among them), and
-// an empty recorder leaves the points with nothing but what the engine computes.
+// an empty recorder leaves the points with nothing but what the engine computes. Each step's
+// candidate is recorded before the detectors look at it (the index-change detector reads its
+// index): the stopping step's candidate, beyond the event, is recorded and not put on the branch.
 TEST(Recorder, DescribesEachPointOnceAndRecordsEveryPointOnTheBranch) {
   RodContinuationOptions o = euler_options();
   o.target = 12.0;
@@ -523,7 +525,7 @@ TEST(Recorder, DescribesEachPointOnceAndRecordsEveryPointOnTheBranch) {
   RodContinuation branch(*run.problem, b);
   const ContinuationResult r = branch.switch_branch(run.result.points.back());
   ASSERT_EQ(r.reason, StopReason::EventStop);
-  EXPECT_EQ(recorded, static_cast<int>(r.points.size()));
+  EXPECT_EQ(recorded, static_cast<int>(r.points.size()) + 1);
   EXPECT_GE(described, recorded);  // trial points of the event's location are described too
   for (const auto& p : r.points) {
     EXPECT_EQ(p.derived.at("describe_calls"), 1.0) << "point " << p.index;

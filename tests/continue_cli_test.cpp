@@ -263,6 +263,77 @@ TEST_F(ContinueCli, ResumeRefusesACsvOfOtherColumnsAndRenamesTheEarlierSpreads) 
 // values, not the count beyond the regular points'), and shallow ripples of the smallest singular
 // value, ~1e-13 everywhere, were reported as branch points (P = 1069.9 and 1349.1, below the
 // first critical load, and 3486.2 and 3865.0). Located to the secant's accuracy: 1e-6 relative.
+// An anisotropic rod (B1 = 1.5, B2 = 1) clamped at both ends half its length apart, the clamps
+// turned by -/+ pi turns about their common axis, without self-contact: as a whole rod, and as the
+// half that plectoneme.toml solves (the half-turn about e1 maps one half onto the other).
+std::string turned_rod_case(bool half) {
+  std::ostringstream text;
+  text << "model = \"spatial\"\n[parameters]\nturns = 0.0\nend_distance = 0.5\n"
+       << "[rod]\nlength = " << (half ? "0.5" : "1.0") << "\nB1 = 1.5\nB2 = 1.0\nB3 = 0.769230769230769\n"
+       << "[start]\ntype = \"clamped\"\nposition = [0, 0, \"-end_distance/2\"]\n"
+       << "orientation = { axis = [0, 0, 1], angle = \"-_pi*turns\" }\ntrack_turns = true\n";
+  if (half)
+    text << "[end]\ntype = \"half_turn\"\naxis = [1, 0, 0]\ndirector = 1\n";
+  else
+    text << "[end]\ntype = \"clamped\"\nposition = [0, 0, \"end_distance/2\"]\n"
+         << "orientation = { axis = [0, 0, 1], angle = \"_pi*turns\" }\ntrack_turns = true\n";
+  // The planar clamped-clamped Elastica's reactions at end_distance = 0.5 (plectoneme.toml).
+  text << "[guess]\nforce = [0, 0, -53.2741126]\nmoment = [0, 9.9437843, 0]\n[solver]\ntolerance = 1e-8\n";
+  return text.str();
+}
+
+// The half rod's Jacobian cannot see the whole rod's bifurcations that break the half-turn
+// symmetry, but its index (both halves' perturbations) changes there: the change is located and
+// reported as an index_change row. Checked against the whole rod, continued the same way: its
+// regular rows have the same index as the half's (0, 1 between the bifurcations, 0), and its
+// branch points, found by the whole problem's determinant, lie at the same turns. The whole rod's
+// Jacobian is ill-conditioned in turns here (its smallest singular value is below 3e-8 of the
+// largest within 1e-4 of each branch point), and both locations are as good as that allows:
+// measured, the whole rod's determinant at fixed turns changes sign at 0.5732216 and 0.861536;
+// the index_change rows are 0.5732190 and 0.8615425 (within ~1e-5 the crossing eigenvalue is
+// within the index's resolution, a zero mode); the whole rod's continuation locates its branch
+// points at 0.573222 and 0.861468 with this --max-step (0.8615343 with --max-step 0.5): hence 1e-4.
+TEST_F(ContinueCli, AHalfRodsBranchMarksWhereTheWholeRodBifurcatesOffItsSymmetry) {
+  auto continued = [&](bool half) {
+    const fs::path toml = dir_ / (half ? "half.toml" : "whole.toml"), csv = dir_ / (half ? "half.csv" : "whole.csv");
+    std::ofstream(toml) << turned_rod_case(half);
+    EXPECT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", toml.string(), "--param", "turns", "--to", "1", "--max-step", "20",
+                          "--out", csv.string()},
+                         dir_ / "run.log"),
+              0);
+    return lines_of(csv);
+  };
+  // (type, turns, stability_index, zero_modes) of the special rows; the regular rows' index is 0,
+  // and 1 between the two bifurcations.
+  auto special_rows = [&](const std::vector<std::string>& rows) {
+    const auto column = csv_header(rows.at(0));
+    std::vector<std::vector<std::string>> special;
+    for (size_t i = 1; i < rows.size(); ++i) {
+      const auto fields = csv_fields(rows[i]);
+      const std::string type = fields[column.at("type")];
+      if (type == "index_change" || type == "branch_point")
+        special.push_back({type, fields[column.at("turns")], fields[column.at("stability_index")],
+                           fields[column.at("zero_modes")]});
+      const double turns = std::stod(fields[column.at("turns")]);
+      if (type == "regular" && std::abs(turns - 0.5732) > 1e-3 && std::abs(turns - 0.8615) > 1e-3)
+        EXPECT_EQ(fields[column.at("stability_index")], turns > 0.5732 && turns < 0.8615 ? "1" : "0") << rows[i];
+    }
+    return special;
+  };
+  const auto half = special_rows(continued(true)), whole = special_rows(continued(false));
+  ASSERT_EQ(half.size(), 2u);
+  ASSERT_EQ(whole.size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    SCOPED_TRACE("bifurcation " + std::to_string(k + 1));
+    EXPECT_EQ(half[k][0], "index_change");
+    EXPECT_EQ(whole[k][0], "branch_point");
+    EXPECT_NEAR(std::stod(half[k][1]), std::stod(whole[k][1]), 1e-4);
+    // At the bifurcation: the smaller index of the two sides, and the crossing eigenvalue's zero mode.
+    EXPECT_EQ(half[k][2], "0");
+    EXPECT_EQ(half[k][3], "1");
+  }
+}
+
 TEST_F(ContinueCli, BranchPointsOfABadlyScaledProblemAreTheCriticalLoadsEachSimple) {
   const fs::path path = dir_ / "foundation.toml";
   std::ofstream(path) << kirchhoff::testing::foundation_column_case(1000.0, 1e6);

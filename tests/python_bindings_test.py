@@ -476,6 +476,35 @@ class ContinuationTest(unittest.TestCase):
         self.assertTrue(np.all(idx[regular & (pts["branch"] == 1) & (theta0 > 2.29)] == 1))
         self.assertGreaterEqual(int(pts["zero_modes"][[t == "branch_point" for t in pts["type"]]].min()), 1)
 
+    def test_index_change_rows_of_a_half_rod(self):
+        # The half of an anisotropic rod clamped at both ends and turned (plectoneme.toml's
+        # symmetry, no self-contact): the whole rod bifurcates off the symmetric branch at turns
+        # 0.57322 and 0.86154 (its determinant at fixed turns), which the half's Jacobian cannot
+        # see; its index (both halves' perturbations) changes there, and the branch has a row at
+        # each, located to ~1e-5 (the index's resolution there; tests/continue_cli_test.cpp).
+        text = "\n".join([
+            'model = "spatial"', "[parameters]", "turns = 0.0",
+            "[rod]", "length = 0.5", "B1 = 1.5", "B2 = 1.0", "B3 = 0.769230769230769",
+            "[start]", 'type = "clamped"', "position = [0, 0, -0.25]",
+            'orientation = { axis = [0, 0, 1], angle = "-_pi*turns" }', "track_turns = true",
+            "[end]", 'type = "half_turn"', "axis = [1, 0, 0]", "director = 1",
+            "[guess]", "force = [0, 0, -53.2741126]", "moment = [0, 9.9437843, 0]",
+            "[solver]", "tolerance = 1e-8", ""])
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "half.toml")
+            with open(path, "w") as f:
+                f.write(text)
+            b = kirchhoff.load_case(path).continue_("turns", to=1.0, max_step=20.0)
+        pts = b.points
+        changes = [i for i, t in enumerate(pts["type"]) if t == "index_change"]
+        self.assertEqual(len(changes), 2)
+        for i, expected in zip(changes, (0.57322, 0.86154)):
+            self.assertAlmostEqual(pts["parameter"][i], expected, delta=2e-5)
+            self.assertEqual(pts["stability_index"][i], 0)
+            self.assertEqual(pts["zero_modes"][i], 1)
+        between = [pts["stability_index"][i] for i in range(changes[0] + 1, changes[1])]
+        self.assertTrue(between and all(v == 1 for v in between))
+
     def test_columns(self):
         pts = self.branch.points
         n = len(self.branch)

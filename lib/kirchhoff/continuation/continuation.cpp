@@ -82,6 +82,7 @@ const char* to_string(PointType type) {
     case PointType::BranchPoint: return "branch_point";
     case PointType::Event: return "event";
     case PointType::Endpoint: return "endpoint";
+    case PointType::IndexChange: return "index_change";
   }
   return "?";
 }
@@ -521,6 +522,9 @@ ContinuationResult Continuation::resume(const MarchState& saved, const PointSink
     return failed;
   }
   state.current = std::move(*current);
+  // Recorded as when it was accepted: the index-change detector compares its stability index
+  // with the next candidate's.
+  if (options_.detect_index_changes) record(&state.current);
   // The point before serves the quadratic predictor (its tangent and arclength, as saved) and,
   // with its test functions evaluated again, minima of the smallest singular value. Dropped, the
   // resumed run's first step was predicted linearly where the uninterrupted one's was quadratic,
@@ -644,7 +648,7 @@ struct Continuation::Marcher {
   // on to `current`, for the next corrector's chord. A long branch keeping every one would hold
   // n^2 doubles per point.
   std::shared_ptr<const Eigen::MatrixXd> newest_matrix;
-  bool candidate_recorded = false;  // the step's candidate was recorded by take_special
+  bool candidate_recorded = false;  // the step's candidate was recorded (before detection, or by take_special)
 
   bool has_room() const { return points_before + static_cast<int>(result.points.size()) < o.max_points; }
 
@@ -772,6 +776,13 @@ struct Continuation::Marcher {
                                 },
                                 [this](const ContinuationPoint& located, double value) {
                                   return c.at_parameter(located, value);
+                                },
+                                [this](double h) {
+                                  const auto curvature = branch_curvature();
+                                  auto p = c.step_from(current, h, PointType::IndexChange,
+                                                       curvature ? &*curvature : nullptr);
+                                  if (p) c.record(&*p);
+                                  return p;
                                 }};
     for (const auto& d : detectors)
       if (d->detect(step, found) == detail::Verdict::RetryShorter) return false;
@@ -786,8 +797,8 @@ struct Continuation::Marcher {
       return d.point.type == PointType::Fold || d.point.type == PointType::BranchPoint;
     });
     // The candidate is recorded first where the step holds a singular point, whose index its
-    // neighbours settle.
-    if (singular) {
+    // neighbours settle (if detect() has not recorded it already).
+    if (singular && !candidate_recorded) {
       c.record(candidate);
       candidate_recorded = true;
     }
@@ -802,7 +813,7 @@ struct Continuation::Marcher {
       return d.point.type == PointType::BranchPoint;
     });
     for (auto& d : found) {
-      accept(d.point, false, singular ? candidate : nullptr);
+      accept(d.point, d.recorded, singular ? candidate : nullptr);
       const ContinuationPoint& p = result.points.back();
       if (auto s = d.detector->act(p, &counters)) return s;
       // An end point stops with its own reason: a contact leg's stopping event found beyond the
@@ -842,7 +853,13 @@ ContinuationResult Continuation::march(MarchState state, const PointSink& sink, 
     if (stop) return m.stop(stop->first, stop->second);
     if (!candidate) continue;
     std::vector<detail::Detection> found;
+    // The index-change detector compares the candidate's stability with the current point's.
+    if (options_.detect_index_changes) {
+      record(&*candidate);
+      m.candidate_recorded = true;
+    }
     if (!m.detect(detectors, *candidate, &found)) {
+      m.candidate_recorded = false;
       m.ds *= kShrink;
       continue;
     }

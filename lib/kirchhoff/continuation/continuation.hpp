@@ -135,6 +135,12 @@ struct DetectionOptions {
   std::vector<ContinuationEvent> events;
   int stop_at_branch_point = 0;       // > 0: stop once this many branch points have been found
   bool stop_at_fold = false;          // stop at the first fold (a homotopy that must not turn back)
+  // Where the recorder gives the stability index (PointRecord::stability_index), a change of it
+  // inside a step with no fold or branch point there is located (PointType::IndexChange): a
+  // bifurcation this problem's Jacobian does not see, such as one breaking the symmetry of a
+  // problem posed on half a rod (BifurcationKit's detection by the count of unstable
+  // eigenvalues). Each step's candidate is then recorded before the detectors look at it.
+  bool detect_index_changes = true;
 
   std::string validate() const;
 };
@@ -166,7 +172,7 @@ struct ContinuationOptions : ContinuationRange, StepControl, CorrectorOptions, D
   std::string validate() const;
 };
 
-enum class PointType { Start, Regular, Fold, BranchPoint, Event, Endpoint };
+enum class PointType { Start, Regular, Fold, BranchPoint, Event, Endpoint, IndexChange };
 const char* to_string(PointType type);
 
 // What the recorder (PointRecorder) fills; the engine computes none of it. The rod layer's

@@ -46,7 +46,7 @@ ContinuationPoint point_from(const nlohmann::json& j) {
 
 PointType point_type_from(const std::string& name) {
   for (PointType t : {PointType::Start, PointType::Regular, PointType::Fold, PointType::BranchPoint, PointType::Event,
-                      PointType::Endpoint})
+                      PointType::Endpoint, PointType::IndexChange})
     if (name == to_string(t)) return t;
   return PointType::Regular;
 }

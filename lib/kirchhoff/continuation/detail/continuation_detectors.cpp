@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace kirchhoff::detail {
 namespace {
@@ -15,6 +16,9 @@ constexpr double kTargetTolerance = 1e-9;
 // not enough: on a badly scaled problem (a column on a stiff foundation) the smallest singular value
 // is ~1e-13 at every point, and its shallow ripples were reported as branch points.
 constexpr double kBranchPointDrop = 1e-3;
+
+// An index change (IndexChange) is located to this fraction of its step: 27 bisections.
+constexpr double kIndexChangeBisection = 1e-8;
 
 // A sign change between a and b (a = 0 exactly is where the last point was located: none).
 bool crossed(double a, double b) { return std::isfinite(a) && std::isfinite(b) && (a < 0) != (b < 0) && a != 0.0; }
@@ -195,6 +199,102 @@ class Event : public SignChange {
   int index_;
 };
 
+// A change of the stability index inside the step that no fold or branch point found in it (by
+// the detectors before this one) accounts for: a bifurcation that the problem's Jacobian does not
+// see, such as one that breaks the symmetry of a problem posed on half a rod, or one the
+// branch-point tests missed. The index is an integer, so the change is located by bisection on the
+// step, each trial corrected and recorded as the march's own point, to kIndexChangeBisection of
+// the step. Near the change the crossing eigenvalue is within the index's resolution and a trial
+// counts it as a zero mode (index min(a, b), the extra zero modes): that window is symmetric about
+// the crossing (the eigenvalue is linear along the branch there), so where a trial falls inside
+// it both its edges are located too and the point is taken at their middle; otherwise at the
+// bracket's far end. A trial whose index is undefined or another keeps the bracket it has. The
+// point is reported with the index of a singular point (singular_point_index.hpp): the smaller
+// of the two, and the eigenvalues that cross as zero modes beside the fewer of the ends' own.
+// Not where either end's index is undefined, where the step starts at a special point (whose own
+// index is its neighbours' business), where the step ends the run (a stopping event: a contact
+// continuation's change of the active set, where the index may change by itself), nor where the
+// located point's bordered matrix is singular (a branch point of the problem: the branch-point
+// detectors' own, found from the next step where it lies behind the current point).
+class IndexChange : public Detector {
+ public:
+  // `singular_below`: where branch points are detected, their tolerance (0: they are not), below
+  // which the located point's bordered matrix is singular after all.
+  explicit IndexChange(double singular_below) : singular_below_(singular_below) {}
+  Verdict detect(const StepView& step, std::vector<Detection>* found) const override {
+    const std::optional<int> a = step.current.stability_index, b = step.candidate.stability_index;
+    if (!a || !b || *a == *b || !step.recorded_step) return Verdict::Nothing;
+    if (step.current.type != PointType::Start && step.current.type != PointType::Regular) return Verdict::Nothing;
+    const bool explained = std::any_of(found->begin(), found->end(), [](const Detection& d) {
+      return d.stop || d.point.type == PointType::Fold || d.point.type == PointType::BranchPoint;
+    });
+    if (explained) return Verdict::Nothing;
+    // (Ends with different zero modes of their own leave no window to tell apart.)
+    const int crossing_zero_modes = std::min(step.current.zero_modes, step.candidate.zero_modes) + std::abs(*a - *b);
+    const Sides sides{*a, *b,
+                      step.current.zero_modes == step.candidate.zero_modes ? crossing_zero_modes
+                                                                           : std::numeric_limits<int>::max()};
+    const double tolerance = kIndexChangeBisection * step.h;
+    Bracket outer{0.0, step.h};
+    std::optional<ContinuationPoint> located;  // the nearest trial on b's side, or in the window
+    double window = -1.0;                      // where a trial fell inside the window
+    while (outer.width() > tolerance) {
+      auto trial = step.recorded_step(outer.middle());
+      const std::optional<int> side = trial ? sides.of(*trial) : std::nullopt;
+      if (!side) break;
+      if (*side >= 0) located = std::move(trial);
+      if (*side == 0) {
+        window = outer.middle();
+        break;
+      }
+      (*side < 0 ? outer.lo : outer.hi) = outer.middle();
+    }
+    if (window >= 0) {
+      // The window's edges: a's side against it below, b's side above.
+      Bracket below{outer.lo, window}, above{window, outer.hi};
+      for (Bracket* edge : {&below, &above})
+        while (edge->width() > tolerance) {
+          auto trial = step.recorded_step(edge->middle());
+          const std::optional<int> side = trial ? sides.of(*trial) : std::nullopt;
+          if (!side) break;
+          const bool in_window = *side == 0;
+          ((edge == &below) == in_window ? edge->hi : edge->lo) = edge->middle();
+        }
+      if (auto middle = step.recorded_step(0.5 * (below.lo + above.hi))) located = std::move(middle);
+    }
+    if (!located) return Verdict::Nothing;  // not located inside the step: the rows show the change alone
+    // The problem's own branch point after all (one of even multiplicity lying behind the next
+    // step's current point, which EvenBranchPoint finds from there): not this detector's.
+    if (located->smallest_singular < singular_below_) return Verdict::Nothing;
+    located->type = PointType::IndexChange;
+    located->stability_index = std::min(*a, *b);
+    located->zero_modes = crossing_zero_modes;
+    found->push_back({std::move(*located), std::nullopt, this, true});
+    return Verdict::Found;
+  }
+
+ private:
+  double singular_below_;
+  struct Bracket {
+    double lo, hi;
+    double width() const { return hi - lo; }
+    double middle() const { return 0.5 * (lo + hi); }
+  };
+  // Which side of the change a recorded trial is on: -1 a's, +1 b's, 0 inside the window (the
+  // smaller index with the crossing eigenvalues among its zero modes); empty: neither.
+  struct Sides {
+    int a, b, window_zero_modes;
+    std::optional<int> of(const ContinuationPoint& p) const {
+      if (!p.stability_index) return std::nullopt;
+      const int index = *p.stability_index;
+      if (index == std::min(a, b) && p.zero_modes >= window_zero_modes) return 0;
+      if (index == a) return -1;
+      if (index == b) return +1;
+      return std::nullopt;
+    }
+  };
+};
+
 }  // namespace
 
 std::optional<Stop> Detector::act(const ContinuationPoint&, MarchCounters*) const { return std::nullopt; }
@@ -210,6 +310,8 @@ std::vector<std::unique_ptr<Detector>> make_detectors(const ContinuationOptions&
     d.push_back(std::make_unique<EvenBranchPoint>(o.stop_at_branch_point, o.branch_point_tolerance));
   }
   for (size_t k = 0; k < o.events.size(); ++k) d.push_back(std::make_unique<Event>(o.events[k], static_cast<int>(k)));
+  if (o.detect_index_changes)
+    d.push_back(std::make_unique<IndexChange>(o.detect_branch_points ? o.branch_point_tolerance : 0.0));
   return d;
 }
 

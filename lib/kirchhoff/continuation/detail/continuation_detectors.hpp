@@ -13,6 +13,9 @@
 //   branch point  smallest singular value, minimal over two steps and below branch_point_tolerance
 //                 (even multiplicity: the determinant keeps its sign)
 //   events        a derived quantity - its value   Event        ends the run when `stop`
+//   index change  the stability index, where no    IndexChange  (reported)
+//                 fold or branch point in the step
+//                 accounts for its change (bisection)
 // (Contact continuations turn their changes of the active set into stopping events: contact.hpp.)
 #pragma once
 
@@ -35,6 +38,9 @@ using Locator = std::function<std::optional<ContinuationPoint>(const Continuatio
 // Continuation::at_parameter: a located point corrected again at exactly that parameter value
 // (empty if that fails).
 using ParameterPin = std::function<std::optional<ContinuationPoint>(const ContinuationPoint& located, double value)>;
+// The point a step h from the step's current point, corrected and recorded (its stability index
+// computed), as the march's own would be; empty where the corrector fails.
+using RecordedStep = std::function<std::optional<ContinuationPoint>(double h)>;
 
 // One step of the march, current -> candidate, as the detectors see it.
 struct StepView {
@@ -47,6 +53,7 @@ struct StepView {
   bool can_shrink;                  // the step may still be halved (above the minimum step)
   Locator locate;
   ParameterPin pin;
+  RecordedStep recorded_step;
 };
 
 // The counts the detectors' actions keep over a march (saved in MarchState).
@@ -64,6 +71,7 @@ struct Detection {
   ContinuationPoint point;
   std::optional<StopReason> stop;
   const Detector* detector = nullptr;
+  bool recorded = false;  // the detector recorded the point itself (and settled its index)
 };
 
 enum class Verdict {
