@@ -266,10 +266,10 @@ TEST_F(ContinueCli, ResumeRefusesACsvOfOtherColumnsAndRenamesTheEarlierSpreads) 
 // An anisotropic rod (B1 = 1.5, B2 = 1) clamped at both ends half its length apart, the clamps
 // turned by -/+ pi turns about their common axis, without self-contact: as a whole rod, and as the
 // half that plectoneme.toml solves (the half-turn about e1 maps one half onto the other).
-std::string turned_rod_case(bool half) {
+std::string turned_rod_case(bool half, double B1 = 1.5) {
   std::ostringstream text;
   text << "model = \"spatial\"\n[parameters]\nturns = 0.0\nend_distance = 0.5\n"
-       << "[rod]\nlength = " << (half ? "0.5" : "1.0") << "\nB1 = 1.5\nB2 = 1.0\nB3 = 0.769230769230769\n"
+       << "[rod]\nlength = " << (half ? "0.5" : "1.0") << "\nB1 = " << B1 << "\nB2 = 1.0\nB3 = 0.769230769230769\n"
        << "[start]\ntype = \"clamped\"\nposition = [0, 0, \"-end_distance/2\"]\n"
        << "orientation = { axis = [0, 0, 1], angle = \"-_pi*turns\" }\ntrack_turns = true\n";
   if (half)
@@ -286,13 +286,14 @@ std::string turned_rod_case(bool half) {
 // symmetry, but its index (both halves' perturbations) changes there: the change is located and
 // reported as an index_change row. Checked against the whole rod, continued the same way: its
 // regular rows have the same index as the half's (0, 1 between the bifurcations, 0), and its
-// branch points, found by the whole problem's determinant, lie at the same turns. The whole rod's
-// Jacobian is ill-conditioned in turns here (its smallest singular value is below 3e-8 of the
-// largest within 1e-4 of each branch point), and both locations are as good as that allows:
-// measured, the whole rod's determinant at fixed turns changes sign at 0.5732216 and 0.861536;
-// the index_change rows are 0.5732190 and 0.8615425 (within ~1e-5 the crossing eigenvalue is
-// within the index's resolution, a zero mode); the whole rod's continuation locates its branch
-// points at 0.573222 and 0.861468 with this --max-step (0.8615343 with --max-step 0.5): hence 1e-4.
+// branch points, found by the whole problem's determinant, lie at the same turns with the same
+// index and zero mode. Measured: the whole rod's determinant at fixed turns changes sign at
+// 0.5732216 and 0.861536; its branch points are located at 0.5732220 and 0.8615332; the
+// index_change rows are 0.5732190 and 0.8615425, the middle of the window (~2e-5 wide) where the
+// crossing eigenvalue is within the index's resolution: hence 2e-5. (The whole rod's Jacobian is
+// ill-conditioned in turns here, its smallest singular value below 3e-8 of the largest within 1e-4
+// of each branch point: before the located branch point had to lie well below the step's ends,
+// the second was located at 0.861468, with no index.)
 TEST_F(ContinueCli, AHalfRodsBranchMarksWhereTheWholeRodBifurcatesOffItsSymmetry) {
   auto continued = [&](bool half) {
     const fs::path toml = dir_ / (half ? "half.toml" : "whole.toml"), csv = dir_ / (half ? "half.csv" : "whole.csv");
@@ -327,10 +328,44 @@ TEST_F(ContinueCli, AHalfRodsBranchMarksWhereTheWholeRodBifurcatesOffItsSymmetry
     SCOPED_TRACE("bifurcation " + std::to_string(k + 1));
     EXPECT_EQ(half[k][0], "index_change");
     EXPECT_EQ(whole[k][0], "branch_point");
-    EXPECT_NEAR(std::stod(half[k][1]), std::stod(whole[k][1]), 1e-4);
+    EXPECT_NEAR(std::stod(half[k][1]), std::stod(whole[k][1]), 2e-5);
     // At the bifurcation: the smaller index of the two sides, and the crossing eigenvalue's zero mode.
-    EXPECT_EQ(half[k][2], "0");
-    EXPECT_EQ(half[k][3], "1");
+    for (const auto* row : {&half[k], &whole[k]}) {
+      EXPECT_EQ((*row)[2], "0");
+      EXPECT_EQ((*row)[3], "1");
+    }
+  }
+}
+
+// The same whole rod with B1 = 2: near its first branch point the secant's trials on a long step
+// landed on the crossing branch, and the branch point came out at turns 0.506293 (--max-step 5,
+// 2.3e-3 off) and 0.508476 (--max-step 20, 1e-4 off, with no zero mode). The located point must
+// now lie well below the step's ends in the smallest singular value, else the step is retaken
+// shorter. Reference: the half rod's index change, where the whole rod's own determinant changes
+// sign (0.5085800 measured by bisection on solve's zero-mode window; 0.5085799 with --max-step 1).
+TEST_F(ContinueCli, ABranchPointIsLocatedOnItsOwnBranchWhateverTheStep) {
+  const fs::path toml = dir_ / "whole.toml";
+  std::ofstream(toml) << turned_rod_case(false, 2.0);
+  for (const char* max_step : {"5", "20"}) {
+    SCOPED_TRACE(std::string("--max-step ") + max_step);
+    const fs::path csv = dir_ / (std::string("whole") + max_step + ".csv");
+    ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", toml.string(), "--param", "turns", "--to", "0.6", "--max-step",
+                          max_step, "--out", csv.string()},
+                         dir_ / "run.log"),
+              0);
+    const auto rows = lines_of(csv);
+    const auto column = csv_header(rows.at(0));
+    int branch_points = 0;
+    for (size_t i = 1; i < rows.size(); ++i) {
+      const auto fields = csv_fields(rows[i]);
+      if (fields[column.at("type")] != "branch_point") continue;
+      ++branch_points;
+      // Within the index's zero-mode window (~1e-5 wide) of the crossing.
+      EXPECT_NEAR(std::stod(fields[column.at("turns")]), 0.50858, 1e-5) << rows[i];
+      EXPECT_EQ(fields[column.at("stability_index")], "0") << rows[i];
+      EXPECT_EQ(fields[column.at("zero_modes")], "1") << rows[i];
+    }
+    EXPECT_EQ(branch_points, 1);
   }
 }
 

@@ -45,7 +45,7 @@ class SignChange : public Detector {
     // as before: their correctors fail where the bordered matrix is near singular, which a
     // shorter step approaches rather than avoids.
     if (!p) return must_locate() && step.can_shrink ? Verdict::RetryShorter : Verdict::Nothing;
-    if (!close_enough(*p) && step.can_shrink) return Verdict::RetryShorter;
+    if (!close_enough(step, *p) && step.can_shrink) return Verdict::RetryShorter;
     refine(step, &*p);
     finish(step, &*p);
     found->push_back({std::move(*p), stop(), this});
@@ -56,9 +56,9 @@ class SignChange : public Detector {
   virtual double value(const ContinuationPoint& p) const = 0;
   virtual PointType type() const = 0;
   virtual std::optional<StopReason> stop() const { return std::nullopt; }
-  // False: the located point missed (a corrector failed inside the step) and the step is retried
-  // shorter while it can be.
-  virtual bool close_enough(const ContinuationPoint&) const { return true; }
+  // False: the located point missed (a corrector failed inside the step, or left the branch) and
+  // the step is retried shorter while it can be.
+  virtual bool close_enough(const StepView&, const ContinuationPoint&) const { return true; }
   // True: a crossing whose location failed retries the step shorter instead of being passed over.
   virtual bool must_locate() const { return false; }
   // The located point made exact where the test function allows it (the parameter's value).
@@ -78,7 +78,9 @@ class ParameterValue : public SignChange {
   bool must_locate() const override { return true; }
   // A corrector that failed inside the step leaves the location short of the target (or the whole
   // step's point, beyond it): retried with a shorter step rather than stopped off the target.
-  bool close_enough(const ContinuationPoint& p) const override { return reason_ != StopReason::ReachedTarget || near(p); }
+  bool close_enough(const StepView&, const ContinuationPoint& p) const override {
+    return reason_ != StopReason::ReachedTarget || near(p);
+  }
   // The secant leaves the parameter within round-off of the value, on whichever side; corrected
   // again at the value itself, the end lies on it (a run started from it sets exactly that value).
   // Kept as located if that corrector fails.
@@ -123,7 +125,7 @@ std::optional<Stop> count_branch_point(int stop_at, MarchCounters* counters) {
 
 class SimpleBranchPoint : public SignChange {
  public:
-  explicit SimpleBranchPoint(int stop_at) : stop_at_(stop_at) {}
+  SimpleBranchPoint(int stop_at, double tolerance) : stop_at_(stop_at), tolerance_(tolerance) {}
   std::optional<Stop> act(const ContinuationPoint&, MarchCounters* counters) const override {
     return count_branch_point(stop_at_, counters);
   }
@@ -131,12 +133,26 @@ class SimpleBranchPoint : public SignChange {
  protected:
   double value(const ContinuationPoint& p) const override { return p.determinant; }
   PointType type() const override { return PointType::BranchPoint; }
+  // The located point's smallest singular value lies kBranchPointDrop below the farther of the
+  // step's ends, as a branch point's does. Where the secant's trials left the branch (near a
+  // branch point a long step's corrector can land on the crossing branch, whose determinant
+  // wrecks the bracket) it does not: the anisotropic turned rod of tests/continue_cli_test.cpp at
+  // B1 = 2 and --max-step 5 had its branch point located at turns 0.506293 (singular value 1.1e-6,
+  // ends 2.3e-5 and 1.5e-6) instead of 0.508580 (1.3e-17), and with --max-step 20 at 0.508476
+  // (5.1e-8 against ends of 1.3e-5). The step is then taken again, shorter. Not where the ends are
+  // below the tolerance themselves: a badly scaled problem (a stiff foundation, ~1e-13 at every
+  // point) leaves the singular values nothing to say, and the determinant's location stands.
+  bool close_enough(const StepView& step, const ContinuationPoint& p) const override {
+    const double farther = std::max(step.current.smallest_singular, step.candidate.smallest_singular);
+    return !(farther >= tolerance_) || p.smallest_singular < kBranchPointDrop * farther;
+  }
   void finish(const StepView& step, ContinuationPoint* p) const override {
     p->multiplicity = multiplicity(*p, step.current);
   }
 
  private:
   int stop_at_;
+  double tolerance_;
 };
 
 // Branch points that keep the determinant's sign (even multiplicity): a local minimum of the
@@ -214,12 +230,13 @@ class Event : public SignChange {
 // Not where either end's index is undefined, where the step starts at a special point (whose own
 // index is its neighbours' business), where the step ends the run (a stopping event: a contact
 // continuation's change of the active set, where the index may change by itself), nor where the
-// located point's bordered matrix is singular (a branch point of the problem: the branch-point
-// detectors' own, found from the next step where it lies behind the current point).
+// located point's bordered matrix is singular, its smallest singular value far below the step's
+// ends (a branch point of the problem: the branch-point detectors' own, found from the next step
+// where it lies behind the current point).
 class IndexChange : public Detector {
  public:
-  // `singular_below`: where branch points are detected, their tolerance (0: they are not), below
-  // which the located point's bordered matrix is singular after all.
+  // `singular_below`: where branch points are detected, their tolerance (0: they are not); the
+  // step's ends below it leave the singular values nothing to say.
   explicit IndexChange(double singular_below) : singular_below_(singular_below) {}
   Verdict detect(const StepView& step, std::vector<Detection>* found) const override {
     const std::optional<int> a = step.current.stability_index, b = step.candidate.stability_index;
@@ -264,8 +281,11 @@ class IndexChange : public Detector {
     }
     if (!located) return Verdict::Nothing;  // not located inside the step: the rows show the change alone
     // The problem's own branch point after all (one of even multiplicity lying behind the next
-    // step's current point, which EvenBranchPoint finds from there): not this detector's.
-    if (located->smallest_singular < singular_below_) return Verdict::Nothing;
+    // step's current point, which EvenBranchPoint finds from there): not this detector's. As for
+    // the branch-point detectors, the singular values say so only where the step's ends are not
+    // that small themselves (plectoneme.toml's 20-segment matrix: below the tolerance everywhere).
+    const double farther = std::max(step.current.smallest_singular, step.candidate.smallest_singular);
+    if (farther >= singular_below_ && located->smallest_singular < kBranchPointDrop * farther) return Verdict::Nothing;
     located->type = PointType::IndexChange;
     located->stability_index = std::min(*a, *b);
     located->zero_modes = crossing_zero_modes;
@@ -306,7 +326,7 @@ std::vector<std::unique_ptr<Detector>> make_detectors(const ContinuationOptions&
     if (std::isfinite(bound)) d.push_back(std::make_unique<ParameterValue>(bound, StopReason::ParameterBounds));
   if (o.detect_folds) d.push_back(std::make_unique<Fold>(n, o.stop_at_fold, o.parameter));
   if (o.detect_branch_points) {
-    d.push_back(std::make_unique<SimpleBranchPoint>(o.stop_at_branch_point));
+    d.push_back(std::make_unique<SimpleBranchPoint>(o.stop_at_branch_point, o.branch_point_tolerance));
     d.push_back(std::make_unique<EvenBranchPoint>(o.stop_at_branch_point, o.branch_point_tolerance));
   }
   for (size_t k = 0; k < o.events.size(); ++k) d.push_back(std::make_unique<Event>(o.events[k], static_cast<int>(k)));
