@@ -369,6 +369,78 @@ TEST_F(ContinueCli, ABranchPointIsLocatedOnItsOwnBranchWhateverTheStep) {
   }
 }
 
+// The straight twisted rod (twisted_clamped.toml, T = 0) has double branch points where the
+// twisting moment M = C phi / L meets M L / B = 2 x_k, x_k the roots of tan x = x (the clamped
+// rod's Greenhill points; the first is analytic.hpp's clamped_twisted_critical_moment): phi =
+// 11.6829, 20.0857, 28.3507. Their determinant keeps its sign, and the two-step minimum of the
+// smallest singular value missed the second and third with --max-step 20 (samples at phi = 16.2
+// and 21.3 around 20.09, the next step holding 28.35): the index jumped 2 -> 4 -> 6 between
+// regular rows. The index change now finds them, at every step size, to the located minimum's
+// accuracy (1e-10 of phi at the first and second, measured), each with its two zero modes.
+TEST_F(ContinueCli, EveryGreenhillPointIsFoundWhateverTheStep) {
+  const double C = 0.769230769230769, B = 1.0, L = 1.0;
+  std::vector<double> expected;
+  for (int k = 1; k <= 3; ++k) {
+    double lo = k * M_PI, hi = (k + 0.5) * M_PI - 1e-9;  // tan x - x goes from - to + on it
+    for (int i = 0; i < 200; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (std::tan(mid) - mid < 0 ? lo : hi) = mid;
+    }
+    expected.push_back(2.0 * lo * B / C);  // phi = M L / C with M L / B = 2 x
+  }
+  ASSERT_NEAR(expected[0] * C / L, kirchhoff::analytic::clamped_twisted_critical_moment(B, 0.0, L), 1e-12);
+  for (const char* max_step : {"20", "5"}) {
+    SCOPED_TRACE(std::string("--max-step ") + max_step);
+    const fs::path csv = dir_ / (std::string("twist") + max_step + ".csv");
+    ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/twisted_clamped.toml",
+                          "--param", "phi", "--to", "30", "--set", "phi=6", "--set", "tension=0", "--max-step", max_step,
+                          "--out", csv.string()},
+                         dir_ / "run.log"),
+              0);
+    const auto rows = lines_of(csv);
+    const auto column = csv_header(rows.at(0));
+    std::vector<double> found;
+    for (size_t i = 1; i < rows.size(); ++i) {
+      const auto fields = csv_fields(rows[i]);
+      const std::string type = fields[column.at("type")];
+      EXPECT_NE(type, "index_change") << rows[i];
+      if (type != "branch_point") continue;
+      found.push_back(std::stod(fields[column.at("phi")]));
+      EXPECT_EQ(fields[column.at("multiplicity")], "2") << rows[i];
+      EXPECT_EQ(fields[column.at("zero_modes")], "2") << rows[i];
+      EXPECT_EQ(fields[column.at("stability_index")], std::to_string(2 * (found.size() - 1))) << rows[i];
+    }
+    ASSERT_EQ(found.size(), 3u);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(found[k], expected[k], 1e-8 * expected[k]);
+  }
+}
+
+// Just past the branch point a branch starts from, the eigenvalue that crossed there is still
+// within the index's resolution: the first rows count it as a zero mode (index 2, two zero modes
+// on the branch leaving the twisted rod's second Greenhill point), the next as negative (3, one).
+// That is the branch point's own exchange of stability, not another bifurcation: no index_change
+// row (there was one at arclength 0.1375 from the branch point).
+TEST_F(ContinueCli, NoIndexChangeWhereALeavingBranchResolvesItsBranchPointsEigenvalue) {
+  const fs::path csv = dir_ / "switched.csv";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/twisted_clamped.toml", "--param",
+                        "phi", "--to", "22", "--set", "phi=6", "--set", "tension=0", "--max-step", "1", "--switch-at-bp",
+                        "2", "--event", "end_to_end=0.3", "--out", csv.string()},
+                       dir_ / "run.log"),
+            0);
+  const auto rows = lines_of(csv);
+  const auto column = csv_header(rows.at(0));
+  int on_the_new_branch = 0, resolved = 0;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    const auto fields = csv_fields(rows[i]);
+    EXPECT_NE(fields[column.at("type")], "index_change") << rows[i];
+    if (fields[column.at("branch")] != "1" || fields[column.at("type")] != "regular") continue;
+    ++on_the_new_branch;
+    resolved += fields[column.at("stability_index")] == "3" && fields[column.at("zero_modes")] == "1";
+  }
+  EXPECT_GT(on_the_new_branch, 20);
+  EXPECT_GE(resolved, on_the_new_branch - 3);  // all but the first rows past the branch point
+}
+
 TEST_F(ContinueCli, BranchPointsOfABadlyScaledProblemAreTheCriticalLoadsEachSimple) {
   const fs::path path = dir_ / "foundation.toml";
   std::ofstream(path) << kirchhoff::testing::foundation_column_case(1000.0, 1e6);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace kirchhoff::detail {
 namespace {
@@ -217,49 +216,57 @@ class Event : public SignChange {
 
 // A change of the stability index inside the step that no fold or branch point found in it (by
 // the detectors before this one) accounts for: a bifurcation that the problem's Jacobian does not
-// see, such as one that breaks the symmetry of a problem posed on half a rod, or one the
-// branch-point tests missed. The index is an integer, so the change is located by bisection on the
-// step, each trial corrected and recorded as the march's own point, to kIndexChangeBisection of
-// the step. Near the change the crossing eigenvalue is within the index's resolution and a trial
-// counts it as a zero mode (index min(a, b), the extra zero modes): that window is symmetric about
-// the crossing (the eigenvalue is linear along the branch there), so where a trial falls inside
-// it both its edges are located too and the point is taken at their middle; otherwise at the
-// bracket's far end. A trial whose index is undefined or another keeps the bracket it has. The
-// point is reported with the index of a singular point (singular_point_index.hpp): the smaller
-// of the two, and the eigenvalues that cross as zero modes beside the fewer of the ends' own.
-// Not where either end's index is undefined, where the step starts at a special point (whose own
-// index is its neighbours' business), where the step ends the run (a stopping event: a contact
-// continuation's change of the active set, where the index may change by itself), nor where the
-// located point's bordered matrix is singular, its smallest singular value far below the step's
-// ends (a branch point of the problem: the branch-point detectors' own, found from the next step
-// where it lies behind the current point).
+// see, such as one that breaks the symmetry of a problem posed on half a rod, or a branch point
+// the branch-point tests missed. The index is an integer, so the change is located by bisection
+// on the step, each trial corrected and recorded as the march's own point, to
+// kIndexChangeBisection of the step. Near the change the crossing eigenvalue is within the
+// index's resolution and a trial counts it as a zero mode (index min(a, b), the extra zero
+// modes): that window is symmetric about the crossing (the eigenvalue is linear along the branch
+// there), so where a trial falls inside it both its edges are located too and the point is taken
+// at their middle; otherwise at the bracket's far end. A trial whose index is undefined or
+// another keeps the bracket it has.
+//  - Where the located point's bordered matrix is singular (its smallest singular value far
+//    below the step's ends, which are not below the tolerance themselves), it is the problem's
+//    own branch point, which the tests missed: one of even multiplicity between two long steps'
+//    samples of the singular value (the twisted rod's second Greenhill point at --max-step 20,
+//    with a third one in the next step). It is reported as a branch point, its minimum located
+//    as EvenBranchPoint does; a branch point reported in a step keeps EvenBranchPoint from
+//    reporting it again from the next.
+//  - Otherwise an index_change row, with the index of a singular point
+//    (singular_point_index.hpp): the smaller of the two, and the eigenvalues that cross as zero
+//    modes beside the ends' own.
+// Not where either end's index is undefined, where the ends' zero modes differ (one side counts
+// the crossing eigenvalue as a zero mode, still within its resolution, as just past a branch
+// point the branch starts from: no other crossing), where the step starts at a special point
+// (whose own index is its neighbours' business), or where the step ends the run (a stopping
+// event: a contact continuation's change of the active set, where the index may change by itself).
 class IndexChange : public Detector {
  public:
   // `singular_below`: where branch points are detected, their tolerance (0: they are not); the
-  // step's ends below it leave the singular values nothing to say.
-  explicit IndexChange(double singular_below) : singular_below_(singular_below) {}
+  // step's ends below it leave the singular values nothing to say. `stop_at`: as the branch-point
+  // detectors', for the branch points it finds.
+  IndexChange(double singular_below, int stop_at) : singular_below_(singular_below), stop_at_(stop_at) {}
   Verdict detect(const StepView& step, std::vector<Detection>* found) const override {
     const std::optional<int> a = step.current.stability_index, b = step.candidate.stability_index;
     if (!a || !b || *a == *b || !step.recorded_step) return Verdict::Nothing;
+    if (step.current.zero_modes != step.candidate.zero_modes) return Verdict::Nothing;
     if (step.current.type != PointType::Start && step.current.type != PointType::Regular) return Verdict::Nothing;
     const bool explained = std::any_of(found->begin(), found->end(), [](const Detection& d) {
       return d.stop || d.point.type == PointType::Fold || d.point.type == PointType::BranchPoint;
     });
     if (explained) return Verdict::Nothing;
-    // (Ends with different zero modes of their own leave no window to tell apart.)
-    const int crossing_zero_modes = std::min(step.current.zero_modes, step.candidate.zero_modes) + std::abs(*a - *b);
-    const Sides sides{*a, *b,
-                      step.current.zero_modes == step.candidate.zero_modes ? crossing_zero_modes
-                                                                           : std::numeric_limits<int>::max()};
+    const int crossing_zero_modes = step.current.zero_modes + std::abs(*a - *b);
+    const Sides sides{*a, *b, crossing_zero_modes};
     const double tolerance = kIndexChangeBisection * step.h;
     Bracket outer{0.0, step.h};
     std::optional<ContinuationPoint> located;  // the nearest trial on b's side, or in the window
+    double at = step.h;                        // where along the step
     double window = -1.0;                      // where a trial fell inside the window
     while (outer.width() > tolerance) {
       auto trial = step.recorded_step(outer.middle());
       const std::optional<int> side = trial ? sides.of(*trial) : std::nullopt;
       if (!side) break;
-      if (*side >= 0) located = std::move(trial);
+      if (*side >= 0) located = std::move(trial), at = outer.middle();
       if (*side == 0) {
         window = outer.middle();
         break;
@@ -277,24 +284,44 @@ class IndexChange : public Detector {
           const bool in_window = *side == 0;
           ((edge == &below) == in_window ? edge->hi : edge->lo) = edge->middle();
         }
-      if (auto middle = step.recorded_step(0.5 * (below.lo + above.hi))) located = std::move(middle);
+      at = 0.5 * (below.lo + above.hi);
+      if (auto middle = step.recorded_step(at)) located = std::move(middle);
     }
     if (!located) return Verdict::Nothing;  // not located inside the step: the rows show the change alone
-    // The problem's own branch point after all (one of even multiplicity lying behind the next
-    // step's current point, which EvenBranchPoint finds from there): not this detector's. As for
-    // the branch-point detectors, the singular values say so only where the step's ends are not
-    // that small themselves (plectoneme.toml's 20-segment matrix: below the tolerance everywhere).
     const double farther = std::max(step.current.smallest_singular, step.candidate.smallest_singular);
-    if (farther >= singular_below_ && located->smallest_singular < kBranchPointDrop * farther) return Verdict::Nothing;
+    if (farther >= singular_below_ && located->smallest_singular < kBranchPointDrop * farther) {
+      found->push_back({branch_point(step, std::move(*located), at), std::nullopt, this});
+      return Verdict::Found;
+    }
     located->type = PointType::IndexChange;
     located->stability_index = std::min(*a, *b);
     located->zero_modes = crossing_zero_modes;
     found->push_back({std::move(*located), std::nullopt, this, true});
     return Verdict::Found;
   }
+  std::optional<Stop> act(const ContinuationPoint& p, MarchCounters* counters) const override {
+    if (p.type != PointType::BranchPoint) return std::nullopt;
+    return count_branch_point(stop_at_, counters);
+  }
+
+ private:
+  // The branch point near `near` (at h = at along the step): the minimum of the smallest singular
+  // value over [0, 2 at] from the current point, which `near` brackets in its middle (as
+  // EvenBranchPoint locates one), or `near` itself where that finds none lower. Recorded when put
+  // on the branch, where its neighbours settle its index.
+  ContinuationPoint branch_point(const StepView& step, ContinuationPoint near, double at) const {
+    auto minimum = step.locate(step.current, 2.0 * at, [](const ContinuationPoint& q) { return q.smallest_singular; },
+                               true, PointType::BranchPoint);
+    ContinuationPoint p = minimum && minimum->smallest_singular < near.smallest_singular ? std::move(*minimum)
+                                                                                         : std::move(near);
+    p.type = PointType::BranchPoint;
+    p.multiplicity = multiplicity(p, step.current.small_count <= step.candidate.small_count ? step.current : step.candidate);
+    return p;
+  }
 
  private:
   double singular_below_;
+  int stop_at_;
   struct Bracket {
     double lo, hi;
     double width() const { return hi - lo; }
@@ -331,7 +358,8 @@ std::vector<std::unique_ptr<Detector>> make_detectors(const ContinuationOptions&
   }
   for (size_t k = 0; k < o.events.size(); ++k) d.push_back(std::make_unique<Event>(o.events[k], static_cast<int>(k)));
   if (o.detect_index_changes)
-    d.push_back(std::make_unique<IndexChange>(o.detect_branch_points ? o.branch_point_tolerance : 0.0));
+    d.push_back(std::make_unique<IndexChange>(o.detect_branch_points ? o.branch_point_tolerance : 0.0,
+                                              o.stop_at_branch_point));
   return d;
 }
 
