@@ -29,7 +29,8 @@ std::string at(double s) {
 // (the exact ply at L/2R = 1000) a dense factorisation takes seconds. Small or dense ones, and
 // those the sparse LU cannot factorise, by partial pivoting: after the equilibration the rows are
 // of one size; on 1300 unknowns its blocked factorisation takes 0.5 s against full pivoting's 5-6 s.
-Eigen::VectorXd equilibrated_newton_correction(const Eigen::MatrixXd& J, const Eigen::VectorXd& F) {
+// `rcond`: the equilibrated matrix's reciprocal condition estimate.
+Eigen::VectorXd equilibrated_newton_correction(const Eigen::MatrixXd& J, const Eigen::VectorXd& F, double* rcond) {
   const auto power_of_two_inverse = [](double m) { return m > 0.0 ? std::exp2(-std::ilogb(m)) : 1.0; };
   Eigen::VectorXd rows(J.rows()), columns(J.cols());
   for (int i = 0; i < J.rows(); ++i) rows[i] = power_of_two_inverse(J.row(i).lpNorm<Eigen::Infinity>());
@@ -42,11 +43,13 @@ Eigen::VectorXd equilibrated_newton_correction(const Eigen::MatrixXd& J, const E
   if (JacobianLU::sparse_enough(equilibrated)) {
     const JacobianLU lu(equilibrated);
     if (lu.sparse()) {
+      *rcond = lu.reciprocal_condition();
       if (!(lu.reciprocal_condition() > 1e-12)) return Eigen::VectorXd::Constant(F.size(), std::nan(""));
       return columns.asDiagonal() * lu.solve(scaled_F);
     }
   }
   const Eigen::PartialPivLU<Eigen::MatrixXd> lu(equilibrated);
+  *rcond = lu.rcond();
   if (!(lu.rcond() > 1e-12)) return Eigen::VectorXd::Constant(F.size(), std::nan(""));
   return columns.asDiagonal() * lu.solve(scaled_F);
 }
@@ -78,29 +81,13 @@ std::string unknowns_failure(const ShootingProblem& problem, const ShootingResul
 
 namespace {
 
-// Below this ratio of the smallest singular value of the equilibrated step matrix to its largest,
-// a large first correction of a small residual is put down to equilibria that are not isolated
-// rather than to the case's scale: measured, an isotropic twisted ring closed by clamping both
-// ends at one point (a continuous family: the ring turned about its centreline) gives 1.3e-10.
+// Below this reciprocal condition of the equilibrated step matrix (equilibrated_newton_correction's
+// estimate), a large first correction of a small residual is put down to equilibria that are not
+// isolated rather than to the case's scale: measured, an isotropic twisted ring closed by clamping
+// both ends at one point (a continuous family: the ring turned about its centreline) gives 5.2e-11.
 constexpr double kNearlySingular = 1e-6;
-// Ruiz's iteration halves the logarithm of each row's and column's scale per pass: 1e300 to 1e-3
-// in 40.
-constexpr int kEquilibrationPasses = 40;
 // Decades from 1 within which a case's length and stiffness count as of unit scale.
 constexpr double kUnitScale = 3.0;
-
-// J scaled by rows and columns until each has its largest |entry| near 1 (Ruiz's iteration: each
-// pass divides them by the square roots of their largest): its singular values then speak of the
-// equations, not of the units the case chose (a rod 1e-100 long has entries over 1e300 apart).
-Eigen::MatrixXd equilibrated(Eigen::MatrixXd J) {
-  for (int pass = 0; pass < kEquilibrationPasses; ++pass) {
-    for (Eigen::Index i = 0; i < J.rows(); ++i)
-      if (const double m = J.row(i).cwiseAbs().maxCoeff(); m > 0) J.row(i) /= std::sqrt(m);
-    for (Eigen::Index j = 0; j < J.cols(); ++j)
-      if (const double m = J.col(j).cwiseAbs().maxCoeff(); m > 0) J.col(j) /= std::sqrt(m);
-  }
-  return J;
-}
 
 // Length and bending stiffness within kUnitScale of 1, either way.
 bool of_unit_scale(const RodModel& model) {
@@ -121,7 +108,8 @@ std::string zero_iteration_failure(const ShootingProblem& problem, const Shootin
   const double step_tolerance = problem.definition().options.newton.step_matrix_tolerance;
   if (!problem.evaluate_for_step(result.x, &F, &J, step_tolerance, &failure) || !J.allFinite())
     return {};  // unknowns_failure's job
-  const Eigen::VectorXd correction = equilibrated_newton_correction(J, F);
+  double rcond = 0.0;
+  const Eigen::VectorXd correction = equilibrated_newton_correction(J, F, &rcond);
   if (!correction.allFinite()) return {};  // singular even when equilibrated: a branch point, say
   const double size = 1.0 + result.x.lpNorm<Eigen::Infinity>();
   const double step = correction.lpNorm<Eigen::Infinity>();
@@ -133,13 +121,10 @@ std::string zero_iteration_failure(const ShootingProblem& problem, const Shootin
   // A nearly singular matrix makes a large correction of a small residual too, at any scale: the
   // equilibria there are not isolated (a continuous family the case does not fix) or branch. On a
   // case far from unit scale the matrix is singular to round-off by its scale alone (a rod 1e-100
-  // long: 7e-34 even equilibrated), so that is said there.
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(equilibrated(J));
-  const Eigen::VectorXd& sigma = svd.singularValues();
-  const double ratio = sigma.size() > 0 && sigma[0] > 0 ? sigma[sigma.size() - 1] / sigma[0] : 0.0;
-  if (ratio < kNearlySingular && of_unit_scale(problem.equations(problem.parameters_at(result.x))->model()))
-    os << ": the Jacobian is nearly singular there (smallest singular value " << ratio
-       << " of the largest), so the equilibrium is not isolated: a continuous family of equilibria (a symmetry "
+  // long), so that is said there.
+  if (rcond < kNearlySingular && of_unit_scale(problem.equations(problem.parameters_at(result.x))->model()))
+    os << ": the Jacobian is nearly singular there (reciprocal condition " << rcond
+       << ", rows and columns equilibrated), so the equilibrium is not isolated: a continuous family of equilibria (a symmetry "
        << "the case leaves free, e.g. turning an isotropic ring about its centreline) or a branch point; fix the "
        << "symmetry in the case, or start from a guess away from the branch point";
   else
