@@ -148,10 +148,12 @@ std::vector<PointContact> lying_contacts(const ShootingProblem& problem, const E
 // Thresholds as the conjugate-point count's (stability.cpp): a force below 1e-10 B/L^2 is zero
 // (weakly active: the index depends on higher-order terms), and g'' below 1e-9 / L means the rod
 // is flattening onto the obstacle (the sliding term f (dg')^2 / g'' is unbounded).
-std::string contacts_not_covered(const ShootingProblem& problem, const Eigen::VectorXd& x, const RodModel& model) {
+// `contacts`: lying_contacts's.
+std::string contacts_not_covered(const ShootingProblem& problem, const Eigen::VectorXd& x, const RodModel& model,
+                                 const std::vector<PointContact>& contacts) {
   const std::vector<Obstacle> obstacles = problem.obstacles(problem.parameters_at(x));
   const double B = model.B[1](0.5 * model.length), L = model.length;
-  for (const PointContact& c : lying_contacts(problem, x, model)) {
+  for (const PointContact& c : contacts) {
     if (obstacles[c.obstacle].shape() == Obstacle::Shape::LevelSet)
       return "a contact with a level-set obstacle: not modelled by the discrete check (planes and discs are)";
     // The rod lying on a plane or a disc: its nodes there held (discrete_stability_lying.hpp).
@@ -181,14 +183,15 @@ std::string contacts_not_covered(const ShootingProblem& problem, const Eigen::Ve
 }
 
 // Spatial, extensible, half rods, sleeves, some contacts: what this discretisation does not model.
-std::string not_covered(const ShootingProblem& problem, const Eigen::VectorXd& x, const RodModel& model) {
+std::string not_covered(const ShootingProblem& problem, const Eigen::VectorXd& x, const RodModel& model,
+                        const std::vector<PointContact>& contacts) {
   const ProblemDefinition& d = problem.definition();
   if (d.kind != RodKind::Planar) return "a spatial rod: the discrete check is planar";
   if (model.extensible) return "an extensible rod: the discrete check is for inextensible rods";
   for (int i : {0, 2})
     if (!model.v_hat[i].is_constant() || model.v_hat[i](0.0) != (i == 2 ? 1.0 : 0.0))
       return "natural shear or stretch (v_hat is not (0, 0, 1)): not modelled by the discrete check";
-  if (std::string why = contacts_not_covered(problem, x, model); !why.empty()) return why;
+  if (std::string why = contacts_not_covered(problem, x, model, contacts); !why.empty()) return why;
   for (const EndCondition* end : {&d.start, &d.end})
     if (end->is_half_turn_symmetry()) return "half of a symmetric rod: the discrete check needs the whole rod";
   return "";
@@ -981,10 +984,11 @@ bool independent_constraints(const DiscreteRod& rod, const std::vector<RodPoint>
 }
 
 // The active point contacts as constraints, the extended ones as intervals lying on their obstacle
-// (contacts_not_covered has refused the others).
-void read_contacts(const ShootingProblem& problem, const Eigen::VectorXd& x, const RodModel& model, Reading* out) {
+// (contacts_not_covered has refused the others). `contacts`: lying_contacts's.
+void read_contacts(const ShootingProblem& problem, const Eigen::VectorXd& x, const std::vector<PointContact>& contacts,
+                   Reading* out) {
   const std::vector<Obstacle> obstacles = problem.obstacles(problem.parameters_at(x));
-  for (const PointContact& c : lying_contacts(problem, x, model)) {
+  for (const PointContact& c : contacts) {
     if (c.extended) {
       // A flat contact without a field carries no force inside (n' = 0, m = 0 there): weakly active
       // (contacts_not_covered refuses one under a field); a wrap presses with N / radius > 0.
@@ -1137,7 +1141,8 @@ DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen
   const std::shared_ptr<const RodEquations> eq = problem.equations(p);
   const RodModel& model = eq->model();
   Reading reading;
-  out.reason = not_covered(problem, x, model);
+  const std::vector<PointContact> contacts = lying_contacts(problem, x, model);
+  out.reason = not_covered(problem, x, model, contacts);
   if (out.reason.empty()) out.reason = read_sliding_length(problem, x, &reading);
   std::vector<std::string> multipliers;
   if (out.reason.empty()) out.reason = multiplier_loads(problem, p, reading.sliding, &multipliers);
@@ -1155,7 +1160,7 @@ DiscreteStability discrete_stability(const ShootingProblem& problem, const Eigen
                  "straight along a fixed line, and its energy is not known";
     return out;
   }
-  read_contacts(problem, x, model, &reading);
+  read_contacts(problem, x, contacts, &reading);
   if (std::string why = unresolved_lying_part(reading, nodes, elements / 2); !why.empty()) {
     out.reason = why;
     return out;
