@@ -273,8 +273,11 @@ struct PhaseTrack {
   double reversed_at = 0.0;
 };
 
+// The smallest m with (2m + 1) pi > a.
+long first_odd_multiple_above(double a) { return static_cast<long>(std::floor((a / kPi - 1) / 2)) + 1; }
+
 int odd_multiples_between(double a, double b) {  // odd k with a < k pi < b (a < b)
-  const long lo = static_cast<long>(std::floor((a / kPi - 1) / 2)) + 1;
+  const long lo = first_odd_multiple_above(a);
   const long hi = static_cast<long>(std::ceil((b / kPi - 1) / 2)) - 1;
   return static_cast<int>(std::max(0L, hi - lo + 1));
 }
@@ -643,7 +646,7 @@ void StabilityAnalysis::record(const Frame& f, const Eigen::VectorXd& phases, do
     auto& stack = track->passages[j];
     const double lo = std::min(lifted[j], before[j]), hi = std::max(lifted[j], before[j]);
     const int passed = odd_multiples_between(lo, hi);
-    const long first = static_cast<long>(std::floor((lo / kPi - 1) / 2)) + 1;  // lowest m of (2m+1) pi passed
+    const long first = first_odd_multiple_above(lo);  // lowest m of (2m+1) pi passed
     for (int k = 0; k < passed; ++k) {
       const long multiple = 2 * (lifted[j] < before[j] ? first + passed - 1 - k : first + k) + 1;
       if (lifted[j] < before[j]) {
@@ -790,7 +793,7 @@ bool StabilityAnalysis::clear_or_clean_passage(const Eigen::VectorXd& from, cons
     if (near == 0) continue;
     if (!(to[j] < from[j]) || near != 1 || odd_multiples_between(lo + kPassageMargin, hi - kPassageMargin) != 1)
       return false;
-    const long multiple = 2 * (static_cast<long>(std::floor((lo / kPi - 1) / 2)) + 1) + 1;
+    const long multiple = 2 * first_odd_multiple_above(lo) + 1;
     seen->push_back({j, multiple, a, b, std::tan(0.5 * (from[j] - multiple * kPi)),
                      std::tan(0.5 * (to[j] - multiple * kPi)), from});
   }
