@@ -19,6 +19,16 @@ constexpr double kBranchPointDrop = 1e-3;
 // An index change (IndexChange) is located to this fraction of its step: 27 bisections.
 constexpr double kIndexChangeBisection = 1e-8;
 
+// Whether `located` lies kBranchPointDrop below the farther of the step's ends in the smallest
+// singular value, as a branch point does; nullopt where the ends are below `tolerance` themselves
+// (a badly scaled problem, ~1e-13 at every point on a stiff foundation, or plectoneme.toml's
+// 20-segment matrix): the singular values then say nothing.
+std::optional<bool> singular_against_ends(const ContinuationPoint& located, const StepView& step, double tolerance) {
+  const double farther = std::max(step.current.smallest_singular, step.candidate.smallest_singular);
+  if (!(farther >= tolerance)) return std::nullopt;
+  return located.smallest_singular < kBranchPointDrop * farther;
+}
+
 // A sign change between a and b (a = 0 exactly is where the last point was located: none).
 bool crossed(double a, double b) { return std::isfinite(a) && std::isfinite(b) && (a < 0) != (b < 0) && a != 0.0; }
 
@@ -138,12 +148,10 @@ class SimpleBranchPoint : public SignChange {
   // wrecks the bracket) it does not: the anisotropic turned rod of tests/continue_cli_test.cpp at
   // B1 = 2 and --max-step 5 had its branch point located at turns 0.506293 (singular value 1.1e-6,
   // ends 2.3e-5 and 1.5e-6) instead of 0.508580 (1.3e-17), and with --max-step 20 at 0.508476
-  // (5.1e-8 against ends of 1.3e-5). The step is then taken again, shorter. Not where the ends are
-  // below the tolerance themselves: a badly scaled problem (a stiff foundation, ~1e-13 at every
-  // point) leaves the singular values nothing to say, and the determinant's location stands.
+  // (5.1e-8 against ends of 1.3e-5). The step is then taken again, shorter. Where the singular
+  // values say nothing (singular_against_ends), the determinant's location stands.
   bool close_enough(const StepView& step, const ContinuationPoint& p) const override {
-    const double farther = std::max(step.current.smallest_singular, step.candidate.smallest_singular);
-    return !(farther >= tolerance_) || p.smallest_singular < kBranchPointDrop * farther;
+    return singular_against_ends(p, step, tolerance_).value_or(true);
   }
   void finish(const StepView& step, ContinuationPoint* p) const override {
     p->multiplicity = multiplicity(*p, step.current);
@@ -262,9 +270,15 @@ class IndexChange : public Detector {
     std::optional<ContinuationPoint> located;  // the nearest trial on b's side, or in the window
     double at = step.h;                        // where along the step
     double window = -1.0;                      // where a trial fell inside the window
+    // The side of the change at h along the step (the trial kept in *trial), empty where its
+    // corrector failed or its index is neither side's.
+    const auto side_at = [&](double h, std::optional<ContinuationPoint>* trial) -> std::optional<int> {
+      *trial = step.recorded_step(h);
+      return *trial ? sides.of(**trial) : std::nullopt;
+    };
     while (outer.width() > tolerance) {
-      auto trial = step.recorded_step(outer.middle());
-      const std::optional<int> side = trial ? sides.of(*trial) : std::nullopt;
+      std::optional<ContinuationPoint> trial;
+      const std::optional<int> side = side_at(outer.middle(), &trial);
       if (!side) break;
       if (*side >= 0) located = std::move(trial), at = outer.middle();
       if (*side == 0) {
@@ -278,8 +292,8 @@ class IndexChange : public Detector {
       Bracket below{outer.lo, window}, above{window, outer.hi};
       for (Bracket* edge : {&below, &above})
         while (edge->width() > tolerance) {
-          auto trial = step.recorded_step(edge->middle());
-          const std::optional<int> side = trial ? sides.of(*trial) : std::nullopt;
+          std::optional<ContinuationPoint> trial;
+          const std::optional<int> side = side_at(edge->middle(), &trial);
           if (!side) break;
           const bool in_window = *side == 0;
           ((edge == &below) == in_window ? edge->hi : edge->lo) = edge->middle();
@@ -288,8 +302,7 @@ class IndexChange : public Detector {
       if (auto middle = step.recorded_step(at)) located = std::move(middle);
     }
     if (!located) return Verdict::Nothing;  // not located inside the step: the rows show the change alone
-    const double farther = std::max(step.current.smallest_singular, step.candidate.smallest_singular);
-    if (farther >= singular_below_ && located->smallest_singular < kBranchPointDrop * farther) {
+    if (singular_against_ends(*located, step, singular_below_).value_or(false)) {
       found->push_back({branch_point(step, std::move(*located), at), std::nullopt, this});
       return Verdict::Found;
     }
@@ -319,7 +332,6 @@ class IndexChange : public Detector {
     return p;
   }
 
- private:
   double singular_below_;
   int stop_at_;
   struct Bracket {
