@@ -242,16 +242,30 @@ PointRecord counted(std::optional<int> index, int zero_modes) {
   return r;
 }
 
-// A fold or branch point between regular points of indices a and b has index min(a, b): a count
-// that agrees is kept; one that differs is replaced where the point's zero modes beyond its
-// neighbours' explain the change (|a - b| of them: a simple and a double crossing, with a
-// symmetry's zero mode on both sides), and made undefined where they do not; an undefined count,
-// here or at a neighbour, is left as it is, and so is the count between equal neighbours.
+// A fold or branch point between regular points of indices a and b has index min(a, b) and the
+// |a - b| crossing eigenvalues among its zero modes, where its own count lies between a and b or
+// its zero modes beyond its neighbours' explain the change (|a - b| of them: a simple and a double
+// crossing, with a symmetry's zero mode on both sides); it is made undefined where neither holds; an
+// undefined count, here or at a neighbour, is left as it is, and so is the count between equal
+// neighbours.
 TEST(SingularPointIndex, IsTheNeighboursLowerIndexWhereTheZeroModesExplainTheChange) {
   auto settled = [](PointRecord p, const PointRecord& a, const PointRecord& b) {
     detail::settle_singular_point_index(&p, a, b);
     return p.stability_index;
   };
+  auto zero_modes = [](PointRecord p, const PointRecord& a, const PointRecord& b) {
+    detail::settle_singular_point_index(&p, a, b);
+    return p.zero_modes;
+  };
+  // The crossing eigenvalue decisively positive at the located point (the soft wall's branch point
+  // with its fields at the state's tolerance; clamped_clamped.toml's where the ends meet): the row
+  // still has it as its zero mode.
+  EXPECT_EQ(settled(counted(0, 0), counted(0, 0), counted(1, 0)), 0);
+  EXPECT_EQ(zero_modes(counted(0, 0), counted(0, 0), counted(1, 0)), 1);
+  EXPECT_EQ(settled(counted(1, 0), counted(0, 0), counted(1, 0)), 0);  // or negative
+  EXPECT_EQ(zero_modes(counted(1, 0), counted(0, 0), counted(1, 0)), 1);
+  EXPECT_EQ(zero_modes(counted(2, 1), counted(1, 1), counted(2, 1)), 2);  // beside a symmetry's zero mode
+  EXPECT_EQ(zero_modes(counted(0, 1), counted(0, 0), counted(0, 0)), 1);  // equal neighbours: its own
   EXPECT_EQ(settled(counted(0, 1), counted(0, 0), counted(1, 0)), 0);
   EXPECT_EQ(settled(counted(2, 1), counted(0, 0), counted(1, 0)), 0);  // the soft wall's branch point
   EXPECT_EQ(settled(counted(2, 1), counted(1, 0), counted(0, 0)), 0);  // the same, walked the other way
@@ -260,7 +274,9 @@ TEST(SingularPointIndex, IsTheNeighboursLowerIndexWhereTheZeroModesExplainTheCha
   EXPECT_EQ(settled(counted(1, 1), counted(1, 1), counted(2, 1)), 1);  // agrees
   EXPECT_EQ(settled(counted(0, 1), counted(1, 0), counted(1, 0)), 0);  // no change: an eigenvalue touching zero from below
   EXPECT_EQ(settled(counted(2, 0), counted(0, 0), counted(1, 0)), std::nullopt);  // no zero mode to explain it
-  EXPECT_EQ(settled(counted(1, 2), counted(0, 1), counted(2, 1)), std::nullopt);  // one crossing mode for two
+  EXPECT_EQ(settled(counted(1, 2), counted(0, 1), counted(2, 1)), 0);  // of two crossing, one negative, one zero
+  EXPECT_EQ(zero_modes(counted(1, 2), counted(0, 1), counted(2, 1)), 3);
+  EXPECT_EQ(settled(counted(3, 0), counted(0, 1), counted(2, 1)), std::nullopt);  // past both, no zero mode
   EXPECT_EQ(settled(counted(std::nullopt, 1), counted(0, 0), counted(1, 0)), std::nullopt);
   EXPECT_EQ(settled(counted(2, 1), counted(std::nullopt, 0), counted(1, 0)), 2);
 }

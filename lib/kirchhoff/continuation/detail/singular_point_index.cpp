@@ -10,12 +10,20 @@ void settle_singular_point_index(PointRecord* singular, const PointRecord& befor
   const int upper = std::max(*before.stability_index, *after.stability_index);
   // Equal neighbours: the zero eigenvalue may touch zero from either side without crossing, and
   // only the point's own count can say which.
-  if (lower == upper || *singular->stability_index == lower) return;
-  const int crossing_zero_modes = singular->zero_modes - std::min(before.zero_modes, after.zero_modes);
-  if (crossing_zero_modes >= upper - lower)
-    singular->stability_index = lower;
-  else
+  if (lower == upper) return;
+  const int own = *singular->stability_index;
+  const int common = std::min(before.zero_modes, after.zero_modes);
+  const int crossing = upper - lower;
+  // The crossing eigenvalues are small at the located point, of either sign or zero within their
+  // resolution: a count between the neighbours' says so, and so does one outside it whose extra
+  // zero modes account for the change.
+  const bool explained = (own >= lower && own <= upper) || singular->zero_modes - common >= crossing;
+  if (!explained) {
     singular->stability_index.reset();
+    return;
+  }
+  singular->stability_index = lower;
+  singular->zero_modes = std::max(singular->zero_modes, common + crossing);
 }
 
 }  // namespace kirchhoff::detail

@@ -18,11 +18,13 @@
 
 namespace kirchhoff::detail {
 
-// Sets `singular`'s index to min(a, b), a and b the indices of the regular points before and after
-// it, where its own count differs and its extra zero modes (beyond the fewer of its neighbours')
-// account for the change from a to b; a count that the zero modes do not explain becomes undefined
-// (an empty index). Leaves the point alone where it agrees, where a = b, or where an index is
-// undefined.
+// Sets `singular`'s index to min(a, b) and its zero modes to at least the fewer of its neighbours'
+// plus |a - b| (the crossing eigenvalues), a and b the indices of the regular points before and
+// after it, where its own count lies between a and b (the crossing eigenvalues came out of either
+// sign there: the soft wall's branch point, located to 1e-8 of its step, has its crossing
+// eigenvalue decisively positive with the fields at the state's 1e-12) or its extra zero modes
+// account for the change; a count that neither explains becomes undefined (an empty index).
+// Leaves the point alone where a = b, or where an index is undefined.
 void settle_singular_point_index(PointRecord* singular, const PointRecord& before, const PointRecord& after);
 
 }  // namespace kirchhoff::detail
