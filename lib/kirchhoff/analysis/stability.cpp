@@ -1217,6 +1217,20 @@ int whole_problem_zero_modes(const Eigen::MatrixXd& conditions, const Eigen::Jac
   return static_cast<int>(null_space(all, static_cast<int>(m + k), tol).cols());
 }
 
+// Of D's undecided eigenvalues (within kDecisiveResolutions of their resolution), the `zeros` closest
+// to zero relative to their resolution are the whole problem's zero modes that change the chord: how
+// many of those were counted positive. A zero mode is neither positive nor negative - counted
+// positive as well, one eigenvalue entered the index twice (as the zero mode and through n_+(D)):
+// on plectoneme.toml's ply at turns = 2.8293 the rod's turn about the clamps' axis had D's
+// eigenvalue -2.4e-7, then 1.6e-5 a parameter step of 1e-9 further, at a resolution of 3e-6, and
+// the index rose from 0 to 1 with the zero mode kept.
+int undecided_counted_positive(std::vector<std::pair<double, bool>>* undecided, int zeros) {
+  std::sort(undecided->begin(), undecided->end());
+  int counted = 0;
+  for (int i = 0; i < std::min<int>(zeros, static_cast<int>(undecided->size())); ++i) counted += (*undecided)[i].second;
+  return counted;
+}
+
 // The isoperimetric correction (Maddocks; Manning, Rogers & Maddocks 1998): with the end
 // positions held along k directions, index = index_dead + r_Z + n_+(D) - k, where D = dg/dF is how
 // the chord g = r(L) - r(0) along them moves per unit change of the end load (the multiplier),
@@ -1288,12 +1302,16 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
     // lie there than it has (one past the tolerance but within the resolution) D does not say.
     int positive = 0, unresolved = 0, not_decisive = 0;
     double unresolved_value = 0.0, unresolved_resolution = 0.0;
+    std::vector<std::pair<double, bool>> undecided;  // (|lambda| / resolution, counted positive)
     if (D.rows() > 0) {
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(D);
       for (int i = 0; i < eig.eigenvalues().size(); ++i) {
         const double lambda = eig.eigenvalues()[i];
         const double resolution = near.resolution(quiet * eig.eigenvectors().col(i), tol);
-        if (std::abs(lambda) <= kDecisiveResolutions * resolution) ++not_decisive;
+        if (std::abs(lambda) <= kDecisiveResolutions * resolution) {
+          ++not_decisive;
+          undecided.push_back({std::abs(lambda) / resolution, lambda > resolution});
+        }
         if (lambda > resolution) ++positive;
         else if (std::abs(lambda) <= resolution) {
           ++unresolved;
@@ -1325,6 +1343,7 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
       const int unchanging = static_cast<int>(zero_modes.cols()) -
                              static_cast<int>(column_basis(frame_values * zero_modes, tol).cols());
       report->zero_modes = std::min(report->zero_modes, unchanging + not_decisive);
+      positive -= undecided_counted_positive(&undecided, report->zero_modes - unchanging);
     }
     correction = r_z + positive - k;
   }
@@ -1577,6 +1596,19 @@ bool in_stiffening_field(const ShootingProblem& problem, const Eigen::VectorXd& 
   return field != nullptr && field->stiffens_perturbations();
 }
 
+// In a field that stiffens the perturbations the Jacobi fields are integrated at the state's
+// tolerance, never at a looser StabilityOptions::field_tolerance (a branch's 1e-8): across the
+// barrier's spike their error is amplified past the resolution the count assumes. On
+// plectoneme.toml's branch (turns 0 .. 3, 263 points) fields at 1e-8 left 36 points undefined and
+// 27 with index 1 and no zero mode past turns = 2.83 (D's eigenvalue of the rod's turn about the
+// clamps' axis, a zero mode by symmetry, came out 3.7e-4 at a resolution of 3.4e-5); at the case's
+// 1e-13 every point has an index, 0 with that zero mode on the whole ply past the fold at 2.7257.
+StabilityOptions with_field_tolerance(const ShootingProblem& problem, const Eigen::VectorXd& x,
+                                      StabilityOptions options) {
+  if (in_stiffening_field(problem, x)) options.field_tolerance = 0.0;
+  return options;
+}
+
 // `confirm`: run_resolved's, for a rod in a field (in_stiffening_field).
 StabilityReport run_plain(const ShootingProblem& problem, const Eigen::VectorXd& x, const StabilityOptions& options,
                           const EndCondition& end, bool confirm) {
@@ -1591,7 +1623,8 @@ StabilityReport run_plain(const ShootingProblem& problem, const Eigen::VectorXd&
 }  // namespace
 
 StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::VectorXd& x,
-                                  const StabilityOptions& options) {
+                                  const StabilityOptions& requested) {
+  const StabilityOptions options = with_field_tolerance(problem, x, requested);
   try {
     // An unknown that changes the rod (a sleeve's sliding length): reduced on it, or null with why.
     if (!rod_changing_unknown(problem).empty()) return analyse_free_length_stability(problem, x, options);
