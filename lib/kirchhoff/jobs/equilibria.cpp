@@ -727,15 +727,26 @@ class Search {
     }
     push_contact_variants(*f.problem, x, name, priority);
     const std::string key = family_key(f.problem->definition().contacts);
-    const auto modes = low_mode_directions(*f.problem, x, f.deflation.scale(), options_.low_modes);
+    // On a single-shooting problem (its unknowns one state and a few contacts) every singular
+    // direction is tried, the ones past the low modes at the first amplitude only: a 3D
+    // cantilever under 4 times its critical load (B1 = 1, B2 = 1.5, P = 10) has its buckled rods
+    // (tip deflection 0.62 L, clamping moment 6.2) along directions the straight rod's smallest
+    // singular values do not point to, and the search listed the straight rod alone (22 Newton
+    // runs; now the four buckled rods too, in 239).
+    const int unknowns = static_cast<int>(x.size());
+    const auto modes = low_mode_directions(*f.problem, x, f.deflation.scale(),
+                                           f.problem->segments() == 1 ? unknowns : options_.low_modes);
+    const size_t low = static_cast<size_t>(options_.low_modes);
     for (const bool far : {false, true})
       for (const double amplitude : far ? options_.far_mode_amplitudes : options_.mode_amplitudes)
-        for (size_t k = 0; k < modes.size(); ++k)
+        for (size_t k = 0; k < modes.size(); ++k) {
+          if (k >= low && (far || amplitude != options_.mode_amplitudes.front())) continue;
           for (const double sign : {1.0, -1.0})
             push_unknowns(key, x + sign * amplitude * modes[k],
-                          std::string(far ? "far kick along low mode " : "low mode ") + std::to_string(k + 1) +
-                              (sign > 0 ? "+" : "-") + " of " + name,
+                          std::string(far ? "far kick along low mode " : k < low ? "low mode " : "mode ") +
+                              std::to_string(k + 1) + (sign > 0 ? "+" : "-") + " of " + name,
                           priority, far);
+        }
   }
 
   ProblemDefinition definition_;
