@@ -421,25 +421,28 @@ TEST(StabilitySymmetric, TheSlightlyTwistedArchIsStable) {
 // first 149 points); observed again with denser steps (run_resolved in stability.cpp) every
 // point has an index: 0 with the turn about the axis as its zero mode, the stable ply that the
 // branch holds until its fold at turns = 2.8642 (docs/stability.md).
+// The index of a point of the ply's branch (case `c`), with the one zero mode of the turn about the
+// clamps' axis, its fields at a branch's 1e-8 as a continuation asks for them.
+void expect_ply_index(const Case& c, const ContinuationPoint& p, int expected) {
+  ShootingProblem here(c.definition);
+  here.set_parameter("turns", p.parameter);
+  StabilityOptions options;
+  options.field_tolerance = 1e-8;
+  const StabilityReport r = analyse_stability(here, p.x, options);
+  ASSERT_TRUE(r.defined()) << "turns = " << p.parameter << ": " << r.reason;
+  EXPECT_EQ(*r.index, expected) << "turns = " << p.parameter;
+  EXPECT_EQ(r.zero_modes, 1) << "turns = " << p.parameter;
+}
+
 TEST(StabilitySymmetric, ThePlyHasAnIndexWhereTheBarrierIsStiff) {
   const Case c = load_case_text(half_rod_text(true), "half.toml");
   ShootingProblem problem(c.definition);
   const ContinuationResult branch = follow_onto_the_ply(problem, c, 2.5);
   ASSERT_FALSE(branch.points.empty());
   ASSERT_NEAR(branch.points.back().parameter, 2.5, 1e-9);
-  StabilityOptions options;
-  options.field_tolerance = 1e-8;  // as along a branch
   int checked = 0, between = 0;
   bool past_the_closing = false;  // the loop closes at the fold at turns = 1.1492
   bool past_the_first = false;    // the end loop starts to form at the fold at turns = 1.7704
-  const auto expect_index = [&](const ContinuationPoint& p, int expected) {
-    ShootingProblem here(c.definition);
-    here.set_parameter("turns", p.parameter);
-    const StabilityReport r = analyse_stability(here, p.x, options);
-    ASSERT_TRUE(r.defined()) << "turns = " << p.parameter << ": " << r.reason;
-    EXPECT_EQ(*r.index, expected) << "turns = " << p.parameter;
-    EXPECT_EQ(r.zero_modes, 1) << "turns = " << p.parameter;
-  };
   for (const ContinuationPoint& p : branch.points) {
     if (p.type == PointType::Fold && p.parameter > 1.7) past_the_first = true;
     if (p.type == PointType::Fold && p.parameter < 1.2) past_the_closing = true;
@@ -447,11 +450,11 @@ TEST(StabilitySymmetric, ThePlyHasAnIndexWhereTheBarrierIsStiff) {
     // (ContinueCli.PlectonemeIndexAlongTheLoopFormingFolds checks the point near the closing
     // where the default observations alone counted 2).
     if (past_the_first && !past_the_closing && p.type == PointType::Regular) {
-      expect_index(p, 1);
+      expect_ply_index(c, p, 1);
       ++between;
     }
     if (!past_the_closing || p.parameter < 2.2) continue;
-    expect_index(p, 0);
+    expect_ply_index(c, p, 0);
     ++checked;
   }
   EXPECT_GE(checked, 5);
@@ -472,18 +475,11 @@ TEST(StabilitySymmetric, ThePlyPastItsSecondFoldsIsStableWithItsZeroMode) {
   const ContinuationResult branch = follow_onto_the_ply(problem, c, 3.0);
   ASSERT_FALSE(branch.points.empty());
   ASSERT_NEAR(branch.points.back().parameter, 3.0, 1e-9);
-  StabilityOptions options;
-  options.field_tolerance = 1e-8;  // as along a branch
   int ply_folds = 0, checked = 0;
   for (const ContinuationPoint& p : branch.points) {
     if (p.type == PointType::Fold && p.parameter > 2.7) ++ply_folds;
     if (ply_folds < 2 || p.type != PointType::Regular) continue;
-    ShootingProblem here(c.definition);
-    here.set_parameter("turns", p.parameter);
-    const StabilityReport r = analyse_stability(here, p.x, options);
-    ASSERT_TRUE(r.defined()) << "turns = " << p.parameter << ": " << r.reason;
-    EXPECT_EQ(*r.index, 0) << "turns = " << p.parameter;
-    EXPECT_EQ(r.zero_modes, 1) << "turns = " << p.parameter;
+    expect_ply_index(c, p, 0);
     ++checked;
   }
   EXPECT_EQ(ply_folds, 2);
