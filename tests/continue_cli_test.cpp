@@ -389,12 +389,14 @@ TEST_F(ContinueCli, EveryGreenhillPointIsFoundWhateverTheStep) {
     expected.push_back(2.0 * lo * B / C);  // phi = M L / C with M L / B = 2 x
   }
   ASSERT_NEAR(expected[0] * C / L, kirchhoff::analytic::clamped_twisted_critical_moment(B, 0.0, L), 1e-12);
-  for (const char* max_step : {"20", "5"}) {
-    SCOPED_TRACE(std::string("--max-step ") + max_step);
-    const fs::path csv = dir_ / (std::string("twist") + max_step + ".csv");
+  // From phi = 1 at --max-step 20 the third point lies in the step that reaches phi = 30.
+  const std::pair<const char*, const char*> runs[] = {{"6", "20"}, {"6", "5"}, {"1", "20"}};
+  for (const auto& [start, max_step] : runs) {
+    SCOPED_TRACE(std::string("from phi = ") + start + ", --max-step " + max_step);
+    const fs::path csv = dir_ / (std::string("twist") + start + "_" + max_step + ".csv");
     ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/twisted_clamped.toml",
-                          "--param", "phi", "--to", "30", "--set", "phi=6", "--set", "tension=0", "--max-step", max_step,
-                          "--out", csv.string()},
+                          "--param", "phi", "--to", "30", "--set", std::string("phi=") + start, "--set", "tension=0",
+                          "--max-step", max_step, "--out", csv.string()},
                          dir_ / "run.log"),
               0);
     const auto rows = lines_of(csv);
@@ -832,6 +834,38 @@ normal = [0, -1, 0]
 [output]
 derived = ["theta0", "y_max", "contact_force", "contact_length"]
 )toml";
+
+// The branch switched at a branch point starts from that point as its own branch settled it (the
+// smaller of its neighbours' indices, the crossing eigenvalue a zero mode). The soft wall's branch
+// point at log_b = -4, Delta = 0.029511 counts 2 with one zero mode by itself (a conjugate point of
+// the clamped problem within 4e-8 of its end counts negative; stability.md) between neighbours of
+// 0 and 1: its row on the first branch said 0, the switched branch's first row 2.
+TEST_F(ContinueCli, ASwitchedBranchStartsWithItsBranchPointsSettledIndex) {
+  const fs::path csv = dir_ / "switched.csv";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/soft_wall.toml", "--set",
+                        "log_b=-4", "--set", "Delta=0.02", "--param", "Delta", "--to", "0.04", "--switch-at-bp", "1",
+                        "--max-points", "230", "--out", csv.string()},
+                       dir_ / "run.log"),
+            0);
+  const auto rows = lines_of(csv);
+  const auto column = csv_header(rows.at(0));
+  std::vector<std::vector<std::string>> branch_points;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    auto fields = csv_fields(rows[i]);
+    if (fields[column.at("type")] == "branch_point") branch_points.push_back(std::move(fields));
+  }
+  ASSERT_GE(branch_points.size(), 2u);
+  const auto& found = branch_points[0];
+  const auto& started = branch_points[1];
+  EXPECT_EQ(found[column.at("branch")], "0");
+  EXPECT_EQ(started[column.at("branch")], "1");
+  EXPECT_EQ(started[column.at("Delta")], found[column.at("Delta")]);
+  EXPECT_NEAR(std::stod(found[column.at("Delta")]), 0.029511, 1e-6);
+  for (const auto* row : {&found, &started}) {
+    EXPECT_EQ((*row)[column.at("stability_index")], "0");
+    EXPECT_EQ((*row)[column.at("zero_modes")], "1");
+  }
+}
 
 // --switch-at-bp on a case with obstacles: the straight column to its branch point, then the
 // buckled branch through first contact (the closed form above) and the flattening of the

@@ -567,7 +567,7 @@ Eigen::MatrixXd Continuation::bifurcation_directions(const ContinuationPoint& po
 }
 
 ContinuationResult Continuation::run_along(const Eigen::VectorXd& x, double lambda, const Eigen::VectorXd& direction,
-                                           PointType start_type, const PointSink& sink) {
+                                           PointType start_type, const PointSink& sink, const PointRecord* known) {
   ContinuationResult result;
   const Eigen::VectorXd z_bp = join(x, lambda);
   const Eigen::VectorXd d = direction.normalized();
@@ -592,6 +592,12 @@ ContinuationResult Continuation::run_along(const Eigen::VectorXd& x, double lamb
     return result;
   }
   record(&origin);
+  // A branch point's own count is on a knife's edge (its crossing eigenvalue is zero): the
+  // soft wall's at Delta = 0.029511 counts 2 with a zero mode, 0 with it as its branch settled it.
+  if (known && known->stability_index && origin.stability_index) {
+    origin.stability_index = known->stability_index;
+    origin.zero_modes = known->zero_modes;
+  }
   if (sink) sink(origin);
   first->step = options_.initial_step;
   MarchState state;
@@ -610,7 +616,7 @@ ContinuationResult Continuation::switch_branch(const ContinuationPoint& bp, cons
       d *= sign_of(d[i]) * sign_of(sign);
       break;
     }
-  return run_along(bp.x, bp.parameter, d, PointType::BranchPoint, sink);
+  return run_along(bp.x, bp.parameter, d, PointType::BranchPoint, sink, &bp);
 }
 
 // The march's working state: MarchState's fields, the result so far and the step size. One step

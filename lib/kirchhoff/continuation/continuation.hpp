@@ -281,9 +281,12 @@ class Continuation {
                                    double sign = 1.0);
   // Starts at z = (x, lambda) (a branch point of another formulation, say) along the unit
   // direction d: the first point is reached by a step of initial_step along d, corrected on the
-  // hyperplane normal to d. The start point itself is reported with the given type.
+  // hyperplane normal to d. The start point itself is reported with the given type, and with the
+  // stability of `known` where that has an index (the branch point switched at, as its own
+  // branch settled it from both neighbours: singular_point_index.hpp).
   ContinuationResult run_along(const Eigen::VectorXd& x, double lambda, const Eigen::VectorXd& direction,
-                               PointType start_type, const PointSink& sink = {});
+                               PointType start_type, const PointSink& sink = {},
+                               const PointRecord* known = nullptr);
 
   // Null vectors of [F_x F_lambda] at a point, orthonormal, orthogonal to its tangent.
   Eigen::MatrixXd bifurcation_directions(const ContinuationPoint& point, int count);

@@ -246,8 +246,12 @@ class Event : public SignChange {
 // Not where either end's index is undefined, where the ends' zero modes differ (one side counts
 // the crossing eigenvalue as a zero mode, still within its resolution, as just past a branch
 // point the branch starts from: no other crossing), where the step starts at a special point
-// (whose own index is its neighbours' business), or where the step ends the run (a stopping
-// event: a contact continuation's change of the active set, where the index may change by itself).
+// (whose own index is its neighbours' business), or where a stopping event ends the run inside
+// the step (a contact continuation's change of the active set, where the index may change by
+// itself). Where the target or a bound of the parameter ends it, the change is looked for up to
+// there, against the index at the run's end: the twisted rod's third Greenhill point (phi =
+// 28.3507) in the last step of `--to 30 --max-step 20` from phi = 1 had no row, the index
+// jumping 4 -> 6 at the endpoint.
 class IndexChange : public Detector {
  public:
   // `singular_below`: where branch points are detected, their tolerance (0: they are not); the
@@ -255,20 +259,31 @@ class IndexChange : public Detector {
   // detectors', for the branch points it finds.
   IndexChange(double singular_below, int stop_at) : singular_below_(singular_below), stop_at_(stop_at) {}
   Verdict detect(const StepView& step, std::vector<Detection>* found) const override {
-    const std::optional<int> a = step.current.stability_index, b = step.candidate.stability_index;
-    if (!a || !b || *a == *b || !step.recorded_step) return Verdict::Nothing;
-    if (step.current.zero_modes != step.candidate.zero_modes) return Verdict::Nothing;
+    const std::optional<int> a = step.current.stability_index;
+    if (!a || !step.candidate.stability_index || *a == *step.candidate.stability_index || !step.recorded_step)
+      return Verdict::Nothing;
     if (step.current.type != PointType::Start && step.current.type != PointType::Regular) return Verdict::Nothing;
-    const bool explained = std::any_of(found->begin(), found->end(), [](const Detection& d) {
-      return d.stop || d.point.type == PointType::Fold || d.point.type == PointType::BranchPoint;
+    const Detection* end = parameter_end(*found);
+    const bool explained = std::any_of(found->begin(), found->end(), [&](const Detection& d) {
+      return (d.stop && &d != end) || d.point.type == PointType::Fold || d.point.type == PointType::BranchPoint;
     });
     if (explained) return Verdict::Nothing;
+    // The far side: the candidate, or the point where the run ends inside the step.
+    double far = step.h;
+    std::optional<ContinuationPoint> at_end;
+    if (end) {
+      far = end->point.arclength - step.current.arclength;
+      if (!(far > 0.0 && far <= step.h) || !(at_end = step.recorded_step(far))) return Verdict::Nothing;
+    }
+    const ContinuationPoint& far_point = at_end ? *at_end : step.candidate;
+    const std::optional<int> b = far_point.stability_index;
+    if (!b || *a == *b || step.current.zero_modes != far_point.zero_modes) return Verdict::Nothing;
     const int crossing_zero_modes = step.current.zero_modes + std::abs(*a - *b);
     const Sides sides{*a, *b, crossing_zero_modes};
-    const double tolerance = kIndexChangeBisection * step.h;
-    Bracket outer{0.0, step.h};
+    const double tolerance = kIndexChangeBisection * far;
+    Bracket outer{0.0, far};
     std::optional<ContinuationPoint> located;  // the nearest trial on b's side, or in the window
-    double at = step.h;                        // where along the step
+    double at = far;                           // where along the step
     double window = -1.0;                      // where a trial fell inside the window
     // The side of the change at h along the step (the trial kept in *trial), empty where its
     // corrector failed or its index is neither side's.
@@ -318,6 +333,13 @@ class IndexChange : public Detector {
   }
 
  private:
+  // The detection of the parameter's target or bound ending the run inside the step, if any.
+  static const Detection* parameter_end(const std::vector<Detection>& found) {
+    for (const Detection& d : found)
+      if (d.stop == StopReason::ReachedTarget || d.stop == StopReason::ParameterBounds) return &d;
+    return nullptr;
+  }
+
   // The branch point near `near` (at h = at along the step): the minimum of the smallest singular
   // value over [0, 2 at] from the current point, which `near` brackets in its middle (as
   // EvenBranchPoint locates one), or `near` itself where that finds none lower. Recorded when put
