@@ -415,6 +415,27 @@ TEST(StabilitySymmetric, TheSlightlyTwistedArchIsStable) {
   }
 }
 
+// The same arch at slenderness 50: the strands' barrier reaches it, so the positions join the
+// frame (9 held directions), and the antisymmetric end conditions have modes the decomposition
+// drops beside the one that vanishes with the twist (singular value ~ 22 turns^2). That one's part
+// of D grows as turns^-2 along the dropped modes' chord changes, where it outgrew the rest 2e6
+// times and was taken as exact too: index 1 at turns 1e-6 .. 2e-4 between 0 at turns = 0 and
+// past 2.1e-4 (two index_change rows on the branch). Compared off those directions, it cancels
+// the rest as without the barrier.
+TEST(StabilitySymmetric, TheSlightlyTwistedArchWithItsBarrierInTheFrameIsStable) {
+  const Case c = load_case_text(half_rod_text(true), "half.toml", {{"slenderness", 50.0}});
+  for (const double turns : {1e-6, 1e-5, 1e-4, 2e-4, 1e-3}) {
+    ShootingProblem problem(c.definition);
+    problem.set_parameter("turns", turns);
+    const ShootingResult solved = solve(problem, problem.initial_unknowns(c.start_guess));
+    ASSERT_TRUE(solved.summary.converged()) << "turns = " << turns << ": " << solved.summary.brief_report();
+    const StabilityReport r = analyse_stability(problem, solved.x);
+    ASSERT_TRUE(r.defined()) << "turns = " << turns << ": " << r.reason;
+    EXPECT_EQ(*r.index, 0) << "turns = " << turns << ": " << describe(r);
+    EXPECT_EQ(r.zero_modes, 1) << "turns = " << turns;
+  }
+}
+
 // On the ply past the loop's closing (turns 2.2 .. 2.5, the barrier acting), the symmetric half's
 // eigenphases were paired wrongly at the default observation steps where the barrier is stiff (a
 // passage "against the Legendre direction" near s = 0.27, index undefined on 40 of the branch's
