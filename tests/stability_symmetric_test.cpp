@@ -491,7 +491,7 @@ TEST(StabilitySymmetric, ThePlyHasAnIndexWhereTheBarrierIsStiff) {
 // of the turn about the clamps' axis (a zero mode by symmetry) came out up to 3.7e-4 at a
 // resolution of 3.4e-5, and of the 263 points of the CLI's branch to turns = 3, 36 had no index,
 // 27 index 1 without the zero mode and one an index change at 2.8293. A rod in a field that
-// stiffens its perturbations now has its fields at the state's tolerance (with_field_tolerance in
+// stiffens its perturbations now has its fields at the state's tolerance (analyse_stability in
 // stability.cpp): past the second fold every point is the stable ply with its one zero mode.
 TEST(StabilitySymmetric, ThePlyPastItsSecondFoldsIsStableWithItsZeroMode) {
   const Case c = load_case_text(half_rod_text(true), "half.toml");

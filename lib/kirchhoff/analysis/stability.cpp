@@ -1141,6 +1141,7 @@ struct NearZeroModes {
   // Whether the modes between round-off and the tolerance are exact too (their part of D outgrows
   // the rest), not only those the decomposition drops.
   bool exact_below_tolerance = false;
+  Eigen::MatrixXd dropped;  // the modes the decomposition drops (dropped_modes), frame coefficients
   std::vector<std::pair<Eigen::MatrixXd, double>> parts;  // (symmetrised part, its relative error)
   double resolution(const Eigen::VectorXd& v, double tol) const {
     double r = tol;
@@ -1167,10 +1168,11 @@ NearZeroModes near_zero_modes(const Eigen::JacobiSVD<Eigen::MatrixXd>& svd, cons
   NearZeroModes out;
   const Eigen::VectorXd& sigma = svd.singularValues();
   if (sigma.size() == 0) return out;
+  out.dropped = dropped_modes(svd);
+  out.exact = out.dropped.cols() > 0;
   Eigen::MatrixXd below = Eigen::MatrixXd::Zero(loads.cols(), loads.cols()), rest = particular_values;
   for (Eigen::Index j = 0; j < sigma.size(); ++j) {
     if (sigma[j] <= kRoundOffZero * sigma[0]) {  // dropped by the decomposition: no part of D
-      out.exact = true;
       out.parts.push_back({Eigen::MatrixXd::Zero(loads.cols(), loads.cols()), 0.0});
       continue;
     }
@@ -1184,7 +1186,7 @@ NearZeroModes near_zero_modes(const Eigen::JacobiSVD<Eigen::MatrixXd>& svd, cons
   // (g^2 / sigma, 4e6 at turns = 1e-4 and growing as turns^-2) lies along those, 2e6 times the
   // rest, but on the others it cancels the rest to leave the rod's turn about its axis as a zero
   // mode (D = -1e-6 at turns = 1e-3, the mode above the tolerance).
-  const Eigen::MatrixXd quiet = null_space((frame_values * dropped_modes(svd)).transpose(),
+  const Eigen::MatrixXd quiet = null_space((frame_values * out.dropped).transpose(),
                                            static_cast<int>(loads.cols()), tol);
   out.exact_below_tolerance = (quiet.transpose() * below * quiet).norm() >
                               kExactZeroShare * std::max((quiet.transpose() * rest * quiet).norm(), tol);
@@ -1318,7 +1320,7 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
     // of a slightly twisted arch, singular value 2.2e-7 at turns = 1e-4) stays in D. Taken as exact
     // with them, it gave plectoneme.toml at slenderness 50 (positions in the frame, 9 held
     // directions) index 1 at turns 1e-6 .. 2e-4 between 0 on either side.
-    const Eigen::MatrixXd exact_zero_modes = near.exact_below_tolerance ? zero_modes : dropped_modes(svd);
+    const Eigen::MatrixXd exact_zero_modes = near.exact_below_tolerance ? zero_modes : near.dropped;
     const Eigen::MatrixXd chord_zero = near.exact ? Eigen::MatrixXd(frame_values * exact_zero_modes)  // k x z
                                                   : Eigen::MatrixXd(k, 0);
     const int r_z = static_cast<int>(column_basis(chord_zero, tol).cols());
@@ -1625,19 +1627,6 @@ bool in_stiffening_field(const ShootingProblem& problem, const Eigen::VectorXd& 
   return field != nullptr && field->stiffens_perturbations();
 }
 
-// In a field that stiffens the perturbations the Jacobi fields are integrated at the state's
-// tolerance, never at a looser StabilityOptions::field_tolerance (a branch's 1e-8): across the
-// barrier's spike their error is amplified past the resolution the count assumes. On
-// plectoneme.toml's branch (turns 0 .. 3, 263 points) fields at 1e-8 left 36 points undefined and
-// 27 with index 1 and no zero mode past turns = 2.83 (D's eigenvalue of the rod's turn about the
-// clamps' axis, a zero mode by symmetry, came out 3.7e-4 at a resolution of 3.4e-5); at the case's
-// 1e-13 every point has an index, 0 with that zero mode on the whole ply past the fold at 2.7257.
-StabilityOptions with_field_tolerance(const ShootingProblem& problem, const Eigen::VectorXd& x,
-                                      StabilityOptions options) {
-  if (in_stiffening_field(problem, x)) options.field_tolerance = 0.0;
-  return options;
-}
-
 // `confirm`: run_resolved's, for a rod in a field (in_stiffening_field).
 StabilityReport run_plain(const ShootingProblem& problem, const Eigen::VectorXd& x, const StabilityOptions& options,
                           const EndCondition& end, bool confirm) {
@@ -1653,8 +1642,18 @@ StabilityReport run_plain(const ShootingProblem& problem, const Eigen::VectorXd&
 
 StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::VectorXd& x,
                                   const StabilityOptions& requested) {
-  const StabilityOptions options = with_field_tolerance(problem, x, requested);
   try {
+    // In a field that stiffens the perturbations (its counts are confirmed by denser observations)
+    // the Jacobi fields are integrated at the state's tolerance, never at a looser
+    // StabilityOptions::field_tolerance (a branch's 1e-8): across the barrier's spike their error
+    // is amplified past the resolution the count assumes. On plectoneme.toml's branch (turns 0 .. 3,
+    // 263 points) fields at 1e-8 left 36 points undefined and 27 with index 1 and no zero mode past
+    // turns = 2.83 (D's eigenvalue of the rod's turn about the clamps' axis, a zero mode by
+    // symmetry, came out 3.7e-4 at a resolution of 3.4e-5); at the case's 1e-13 every point has an
+    // index, 0 with that zero mode on the whole ply past the fold at 2.7257.
+    const bool confirm = in_stiffening_field(problem, x);
+    StabilityOptions options = requested;
+    if (confirm) options.field_tolerance = 0.0;
     // An unknown that changes the rod (a sleeve's sliding length): reduced on it, or null with why.
     if (!rod_changing_unknown(problem).empty()) return analyse_free_length_stability(problem, x, options);
     // The rod lying on an obstacle: its own treatment (the discretised energy for planar rods).
@@ -1666,7 +1665,6 @@ StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::V
       return report;
     }
     const EndCondition& end = problem.definition().end;
-    const bool confirm = in_stiffening_field(problem, x);
     if (!end.is_half_turn_symmetry() || !unsupported(problem, x).empty())
       return run_plain(problem, x, options, end, confirm);
     // Half of a half-turn symmetric rod: the end as stated holds the symmetric perturbations; the
