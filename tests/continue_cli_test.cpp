@@ -840,19 +840,25 @@ derived = ["theta0", "y_max", "contact_force", "contact_length"]
 // point at log_b = -4, Delta = 0.029511 counts 2 with one zero mode by itself (a conjugate point of
 // the clamped problem within 4e-8 of its end counts negative; stability.md) between neighbours of
 // 0 and 1: its row on the first branch said 0, the switched branch's first row 2.
+// Further along that branch the rod is all but straight (Delta ~ 8e-10) and folds at P = 112.1:
+// the eigenvalue of D (the chord's response to the loads) that crosses zero there is ~1e-10, out of
+// terms of ~1e-9. A discretisation of the energy (200-800 elements) gives index 1 without a zero
+// mode up to the fold and 2 past it; against the absolute zero tolerance the rows from P = 104.7
+// to 119.2 said 1 with a zero mode.
 TEST_F(ContinueCli, ASwitchedBranchStartsWithItsBranchPointsSettledIndex) {
   const fs::path csv = dir_ / "switched.csv";
   ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/soft_wall.toml", "--set",
                         "log_b=-4", "--set", "Delta=0.02", "--param", "Delta", "--to", "0.04", "--switch-at-bp", "1",
-                        "--max-points", "230", "--out", csv.string()},
+                        "--max-points", "420", "--out", csv.string()},
                        dir_ / "run.log"),
             0);
   const auto rows = lines_of(csv);
   const auto column = csv_header(rows.at(0));
-  std::vector<std::vector<std::string>> branch_points;
+  std::vector<std::vector<std::string>> branch_points, folds;
   for (size_t i = 1; i < rows.size(); ++i) {
     auto fields = csv_fields(rows[i]);
-    if (fields[column.at("type")] == "branch_point") branch_points.push_back(std::move(fields));
+    if (fields[column.at("type")] == "branch_point") branch_points.push_back(fields);
+    if (fields[column.at("type")] == "fold" && std::stod(fields[column.at("Delta")]) < 1e-8) folds.push_back(fields);
   }
   ASSERT_GE(branch_points.size(), 2u);
   const auto& found = branch_points[0];
@@ -865,6 +871,30 @@ TEST_F(ContinueCli, ASwitchedBranchStartsWithItsBranchPointsSettledIndex) {
     EXPECT_EQ((*row)[column.at("stability_index")], "0");
     EXPECT_EQ((*row)[column.at("zero_modes")], "1");
   }
+  // The nearly straight rod's fold: P within 0.1 of the discretisation's 112.1 (the rows are ~0.5
+  // apart in P there), the crossing eigenvalue its zero mode, index 1 before and 2 after it.
+  ASSERT_EQ(folds.size(), 1u);
+  const double fold_P = std::stod(folds[0][column.at("P")]);
+  EXPECT_NEAR(fold_P, 112.1, 0.1);
+  EXPECT_EQ(folds[0][column.at("stability_index")], "1");
+  EXPECT_EQ(folds[0][column.at("zero_modes")], "1");
+  int before = 0, after = 0;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    const auto fields = csv_fields(rows[i]);
+    const double P = std::stod(fields[column.at("P")]);
+    if (fields[column.at("type")] != "regular" || std::stod(fields[column.at("Delta")]) > 1e-8) continue;
+    if (P > 104 && P < fold_P - 0.1) {
+      ++before;
+      EXPECT_EQ(fields[column.at("stability_index")], "1") << rows[i];
+      EXPECT_EQ(fields[column.at("zero_modes")], "0") << rows[i];
+    } else if (P > fold_P + 0.1 && P < 120) {
+      ++after;
+      EXPECT_EQ(fields[column.at("stability_index")], "2") << rows[i];
+      EXPECT_EQ(fields[column.at("zero_modes")], "0") << rows[i];
+    }
+  }
+  EXPECT_GE(before, 10);
+  EXPECT_GE(after, 10);
 }
 
 // --switch-at-bp on a case with obstacles: the straight column to its branch point, then the

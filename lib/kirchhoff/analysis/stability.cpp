@@ -1132,10 +1132,11 @@ Eigen::MatrixXd StabilityAnalysis::end_terms(const Frame& f, const Held& end, St
 //    goes to zero, sigma ~ twist^2 and g ~ twist, so that g^2 / sigma stays finite - and D is
 //    taken with it, as with any other mode: counting it as exact there gave the plectoneme arch at
 //    turns 1e-6 .. 2.5e-4 index 1 between index 0 at turns 0 and past 2.6e-4.
-//  - `resolution(v)`: how far an eigenvalue of D along v is known. Each part carries the relative
-//    error of its sigma_j, `noise` of the largest over sigma_j: on the plectoneme arch a part of
-//    0.04 through sigma = 2e-11 of 0.36 came out 12 % off, and with the fields at a branch's 1e-8
-//    one through sigma = 8e-6 left D = 1e-5 where the rod's turn makes it 0.
+//  - `resolution(v, floor)`: how far an eigenvalue of D along v is known: `floor` (below) plus, for
+//    each part, the relative error of its sigma_j, `noise` of the largest over sigma_j: on the
+//    plectoneme arch a part of 0.04 through sigma = 2e-11 of 0.36 came out 12 % off, and with the
+//    fields at a branch's 1e-8 one through sigma = 8e-6 left D = 1e-5 where the rod's turn makes
+//    it 0.
 struct NearZeroModes {
   bool exact = false;
   // Whether the modes between round-off and the tolerance are exact too (their part of D outgrows
@@ -1143,8 +1144,8 @@ struct NearZeroModes {
   bool exact_below_tolerance = false;
   Eigen::MatrixXd dropped;  // the modes the decomposition drops (dropped_modes), frame coefficients
   std::vector<std::pair<Eigen::MatrixXd, double>> parts;  // (symmetrised part, its relative error)
-  double resolution(const Eigen::VectorXd& v, double tol) const {
-    double r = tol;
+  double resolution(const Eigen::VectorXd& v, double floor) const {
+    double r = floor;
     for (const auto& [part, error] : parts) r += error * std::abs(v.dot(part * v));
     return r;
   }
@@ -1195,6 +1196,21 @@ NearZeroModes near_zero_modes(const Eigen::JacobiSVD<Eigen::MatrixXd>& svd, cons
     for (Eigen::Index j = 0; j < sigma.size(); ++j)
       if (sigma[j] <= tol) out.parts[static_cast<size_t>(j)].second = 0.0;
   return out;
+}
+
+// The zero tolerance of an eigenvalue of D along v (unit): `tol` of the size of the terms D is
+// made of along v, |v|.(|frame_values| |c| + |particular_values|) |v| - not of the sum, which cancels
+// where D is near zero - and never more than `tol` itself. A constraint that the load barely moves
+// is not a zero mode: on the soft wall's switched branch at log_b = -4, where the rod is all but
+// straight (Delta ~ 8e-10), D's eigenvalue along the load that crosses zero at the fold at P =
+// 112.1 is -1e-10 .. +9e-11 out of terms of 3e-10 .. 2e-9, smooth along the branch to three digits.
+// Against the absolute tolerance 1e-6 it was taken as a zero mode from P = 104.7 to 119.2 (index
+// 1 with a zero mode, where the discretised energy has 1 without one to the fold, 2 after it).
+double eigenvalue_floor(const Eigen::VectorXd& v, const Eigen::MatrixXd& frame_values, const Eigen::MatrixXd& c,
+                        const Eigen::MatrixXd& particular_values, double tol) {
+  const Eigen::VectorXd a = v.cwiseAbs();
+  const double terms = a.dot((frame_values.cwiseAbs() * c.cwiseAbs() + particular_values.cwiseAbs()) * a);
+  return tol * std::min(1.0, terms);
 }
 
 // An eigenvalue of D farther from zero than this many times its resolution is decisively not zero:
@@ -1338,7 +1354,9 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(D);
       for (int i = 0; i < eig.eigenvalues().size(); ++i) {
         const double lambda = eig.eigenvalues()[i];
-        const double resolution = near.resolution(quiet * eig.eigenvectors().col(i), tol);
+        const Eigen::VectorXd v = quiet * eig.eigenvectors().col(i);
+        const double resolution =
+            near.resolution(v, eigenvalue_floor(v, frame_values, c, particular_values, tol));
         if (std::abs(lambda) <= kDecisiveResolutions * resolution) {
           ++not_decisive;
           undecided.push_back({std::abs(lambda) / resolution, lambda > resolution});
