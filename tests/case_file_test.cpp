@@ -353,6 +353,28 @@ TEST_F(CaseFileTest, PlanarPositionOutOfThePlane) {
   expect_refused(text, "start.position", {"planar"});
 }
 
+// A planar rod reads B2, u_hat[1], A1, A3, v_hat[0] and v_hat[2] only. The others were accepted
+// and ignored: u_hat = [0, 0, k] left the rod straight (the Euler column's buckled solve gave the
+// same theta0 to every digit with and without it). Refused, naming the key, line and component;
+// the in-plane curvature (and a zero written as a parameter-free 0) is accepted.
+TEST_F(CaseFileTest, PlanarRodRefusesPropertiesItsEquationsDoNotRead) {
+  for (const char* key : {"B1", "B3"}) {
+    const std::string text = replaced(kBase, "B = \"EI\"", std::string("B2 = \"EI\"\n") + key + " = 2");
+    expect_refused(text, std::string("rod.") + key, {"planar rod bends about d2 only", "model = \"spatial\""},
+                   line_of(text, std::string(key) + " = 2"));
+  }
+  const std::string shear = replaced(kBase, "B = \"EI\"", "B = \"EI\"\nextensible = true\nA1 = 10\nA2 = 10\nA3 = 10");
+  expect_refused(shear, "rod.A2", {"A2 does not enter"}, line_of(shear, "A2"));
+  const std::string twist = replaced(kBase, "B = \"EI\"", "B = \"EI\"\nu_hat = [0, 0, \"EI\"]");
+  expect_refused(twist, "rod.u_hat", {"component 3 must be 0 for a planar rod", "u_hat = [0, kappa, 0]"},
+                 line_of(twist, "u_hat"));
+  const std::string first = replaced(kBase, "B = \"EI\"", "B = \"EI\"\nu_hat = [0.5, 0, 0]");
+  expect_refused(first, "rod.u_hat", {"component 1 must be 0"}, line_of(first, "u_hat"));
+  const std::string shear_strain = replaced(kBase, "B = \"EI\"", "B = \"EI\"\nv_hat = [0, \"s\", 1]");
+  expect_refused(shear_strain, "rod.v_hat", {"component 2 must be 0"}, line_of(shear_strain, "v_hat"));
+  EXPECT_NO_THROW(load_case(write(replaced(kBase, "B = \"EI\"", "B2 = \"EI\"\nu_hat = [0, \"EI\", 0.0]\nv_hat = [0.1, 0, 1]"))));
+}
+
 // An unknown that no expression of the problem reads (here: the load is a number, so P balances
 // nothing) could take any value: Newton's Jacobian has a zero column, and a solve stopped wherever
 // it started. Refused where the unknowns are named; a parameter used only through another

@@ -188,6 +188,30 @@ void check_rod_profiles(const Reader& reader, const RodSpec& r, const Parameters
   }
 }
 
+// A planar rod bends in its plane only (about d2, stiffness B2, natural curvature u_hat[1]) and,
+// when extensible, shears along d1 (A1, v_hat[0]) and stretches along d3 (A3, v_hat[2]). The
+// other stiffnesses and natural strains do not enter its equations: given, they would be ignored
+// in silence (a natural curvature written as u_hat = [0, 0, k] left the rod straight), so they are
+// refused. A natural strain component is accepted only where it is literally zero.
+void refuse_out_of_plane_properties(const Reader& reader, const Value& rod, const RodSpec& r) {
+  for (const char* key : {"B1", "B3", "A2"})
+    if (const Value* v = Reader::find(rod, key))
+      reader.fail(*v, std::string("rod.") + key,
+                  "a planar rod bends about d2 only (B or B2), shears along d1 (A1) and stretches along d3 (A3): " +
+                      std::string(key) + " does not enter its equations (use model = \"spatial\" for it)");
+  const auto must_be_zero = [&](const ProfileSpec& spec, int component, const char* what) {
+    const bool zero = spec.expression.used_parameters().empty() && !spec.expression.depends_on_s() &&
+                      spec.expression(Parameters{}) == 0.0;
+    if (!zero && spec.source)
+      reader.fail(*spec.source, spec.key,
+                  "component " + std::to_string(component + 1) + " must be 0 for a planar rod: " + what);
+  };
+  for (int i : {0, 2})
+    must_be_zero(r.u_hat[i], i,
+                 "its natural curvature is the second component, u_hat = [0, kappa, 0] (bending about d2 in the plane)");
+  must_be_zero(r.v_hat[1], 1, "its natural shear is the first component and its natural stretch the third");
+}
+
 // d->model, the rod as a function of the parameters, and the parameters it uses.
 void define_model(const RodSpec& r, FieldAdder add_fields, const std::set<std::string>& field_parameters,
                   ProblemDefinition* d) {
@@ -222,6 +246,7 @@ void read_rod(const Reader& reader, const Value& root, const Parameters& paramet
   reader.allow_keys(*rod, "rod", {"length", "B", "B1", "B2", "B3", "extensible", "A1", "A2", "A3", "u_hat",
                                   "v_hat", "gravity", "barrier", "self_contact"});
   const RodSpec r = read_rod_profiles(reader, *rod);
+  if (d->kind == RodKind::Planar) refuse_out_of_plane_properties(reader, *rod, r);
   std::set<std::string> field_parameters;
   FieldAdder add_fields = read_fields(reader, *rod, d->kind, parameters, r.B[0].expression, &field_parameters);
   check_rod_profiles(reader, r, parameters);
