@@ -231,8 +231,8 @@ class Event : public SignChange {
 // index's resolution and a trial counts it as a zero mode (index min(a, b), the extra zero
 // modes): that window is symmetric about the crossing (the eigenvalue is linear along the branch
 // there), so where a trial falls inside it both its edges are located too and the point is taken
-// at their middle; otherwise at the bracket's far end. A trial whose index is undefined or
-// another keeps the bracket it has.
+// at their middle (unless that trial is singular: the branch point below); otherwise at the
+// bracket's far end. A trial whose index is undefined or another keeps the bracket it has.
 //  - Where the located point's bordered matrix is singular (its smallest singular value far
 //    below the step's ends, which are not below the tolerance themselves), it is the problem's
 //    own branch point, which the tests missed: one of even multiplicity between two long steps'
@@ -302,7 +302,13 @@ class IndexChange : public Detector {
       }
       (*side < 0 ? outer.lo : outer.hi) = outer.middle();
     }
-    if (window >= 0) {
+    // A window trial that is singular against the step's ends marks the problem's own branch point
+    // (below): its edges, another two bisections of the index (31 trials at the twisted rod's first
+    // Greenhill point, each corrected with its index), would only centre the point the minimum
+    // of the singular value is located from, which brackets it from either side.
+    const bool window_is_singular =
+        window >= 0 && located && singular_against_ends(*located, step, singular_below_).value_or(false);
+    if (window >= 0 && !window_is_singular) {
       // The window's edges: a's side against it below, b's side above.
       Bracket below{outer.lo, window}, above{window, outer.hi};
       for (Bracket* edge : {&below, &above})
