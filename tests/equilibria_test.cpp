@@ -181,16 +181,9 @@ void expect_isolated_rods_whose_ends_meet(const std::vector<const Equilibrium*>&
   }
 }
 
-// A spatial cantilever (B1 = 1 < B2 = 1.5, B3 = 0.8) under a dead compressive end load P = 10,
-// past its critical loads pi^2/4 B1 = 2.47 and pi^2/4 B2 = 3.70 (and below 9 pi^2/4 B1 = 22.2):
-// besides the straight rod (index 2, energy P L) it has the rods buckled in the weak plane (stable)
-// and in the stiff plane (index 1), each with its mirror image. Each is half of the pinned Elastica
-// of length 2L under P (its mid-span is the clamp), with theta0 from P = 4 K(k)^2 B / (2L)^2; with
-// H = B kappa^2/2 - P cos(theta) = -P cos(theta0) its energy is bending P (c - L cos theta0) plus
-// the load's P c, c = half the pinned chord (the tip's height). The search from the straight rod's
-// smallest singular directions alone listed the straight rod only.
-TEST(Equilibria, SpatialCantileverListsItsBuckledRodsInBothPlanes) {
-  const std::string text = R"(
+// A spatial cantilever (B1 = 1 < B2 = 1.5, B3 = 0.8) under a dead compressive end load P, its
+// file's value 10.
+const char* const kSpatialCantilever = R"(
 title = "spatial cantilever under a dead compressive end load"
 model = "spatial"
 [parameters]
@@ -211,22 +204,33 @@ moment = [0, 0, 0]
 force = [0, 0, "-P"]
 moment = [0, 0, 0]
 )";
+
+// The energy of the cantilever of length L buckled in its first mode in a plane of stiffness B
+// under P: half of the pinned Elastica of length 2L under P (its mid-span is the clamp), with
+// theta0 from P = 4 K(k)^2 B / (2L)^2; with H = B kappa^2/2 - P cos(theta) = -P cos(theta0) its
+// energy is bending P (c - L cos theta0) plus the load's P c, c = half the pinned chord (the tip's
+// height).
+double buckled_cantilever_energy(double P, double B, double L) {
+  double lo = 1e-6, hi = M_PI - 1e-9;  // load(theta0) increases from pi^2 B / (2L)^2 to infinity
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (analytic::PinnedElastica{2 * L, B, mid}.load() < P ? lo : hi) = mid;
+  }
+  const analytic::PinnedElastica half{2 * L, B, 0.5 * (lo + hi)};
+  const double chord = 0.5 * half.end_to_end();
+  return P * (2 * chord - L * std::cos(half.theta0));
+}
+
+// At P = 10, past its critical loads pi^2/4 B1 = 2.47 and pi^2/4 B2 = 3.70 (and below 9 pi^2/4 B1 =
+// 22.2), besides the straight rod (index 2, energy P L) it has the rods buckled in the weak plane
+// (stable) and in the stiff plane (index 1), each with its mirror image. The search from the
+// straight rod's smallest singular directions alone listed the straight rod only.
+TEST(Equilibria, SpatialCantileverListsItsBuckledRodsInBothPlanes) {
   const double P = 10.0, L = 1.0;
-  const Case c = load_case_text(text, "cantilever.toml");
+  const Case c = load_case_text(kSpatialCantilever, "cantilever.toml");
   const EquilibriaSearch s = find_equilibria(c.definition, c.start_guess, c.derived, c.samples, {});
   ASSERT_EQ(s.equilibria.size(), 5u);
-  // The closed form of the rod buckled in a plane of stiffness B.
-  const auto buckled_energy = [&](double B) {
-    double lo = 1e-6, hi = M_PI - 1e-9;  // load(theta0) increases from pi^2 B / (2L)^2 to infinity
-    for (int i = 0; i < 200; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      (analytic::PinnedElastica{2 * L, B, mid}.load() < P ? lo : hi) = mid;
-    }
-    const analytic::PinnedElastica half{2 * L, B, 0.5 * (lo + hi)};
-    const double chord = 0.5 * half.end_to_end();
-    return P * (2 * chord - L * std::cos(half.theta0));
-  };
-  const double weak = buckled_energy(1.0), stiff = buckled_energy(1.5);
+  const double weak = buckled_cantilever_energy(P, 1.0, L), stiff = buckled_cantilever_energy(P, 1.5, L);
   const double expected_energy[5] = {weak, weak, stiff, stiff, P * L};
   const int expected_index[5] = {0, 0, 1, 1, 2};
   for (int k = 0; k < 5; ++k) {
@@ -237,6 +241,36 @@ moment = [0, 0, 0]
     EXPECT_EQ(*e.stability.index, expected_index[k]) << k;
     EXPECT_EQ(e.stability.zero_modes, 0) << k;  // B1 != B2: no rotational symmetry
   }
+}
+
+// Under P = 30 (12 times its first critical load) the cantilever's stable equilibria are its
+// first-mode rods in the weak plane, looped back past the clamp (tip height -0.6346 L, energy
+// -8.0926 P L / 30, the global minimum): far from every starting point the search makes at P = 30,
+// which listed the second-mode rods and the straight one and missed them ("seeds exhausted"). At
+// the file's P = 10 the search finds them beside the straight rod, and each follows the load to 30
+// along its homotopy: with P = 30 set, the list starts with them. The search at the requested
+// values stops at the four rods the homotopies bring (max_equilibria), which keeps the test short.
+TEST(Equilibria, AHeavilyLoadedRodsGlobalMinimumIsCarriedFromTheFilesValues) {
+  const double P = 30.0, L = 1.0;
+  const Case c = load_case_text(kSpatialCantilever, "cantilever.toml", {{"P", P}});
+  EquilibriaOptions options;
+  options.max_equilibria = 4;
+  const EquilibriaSearch s = find_case_equilibria(c, c.samples, options);
+  ASSERT_GE(s.equilibria.size(), 2u);
+  const double weak = buckled_cantilever_energy(P, 1.0, L);  // -8.092630080
+  int carried = 0;
+  for (int k = 0; k < 2; ++k) {
+    const Equilibrium& e = s.equilibria[static_cast<size_t>(k)];
+    EXPECT_NEAR(e.energy, weak, 1e-8 * P * L) << k;  // as above
+    ASSERT_TRUE(e.stability.index) << e.stability.reason;
+    EXPECT_EQ(*e.stability.index, 0) << k;
+    carried += e.found_by.find("homotopy from the file's values") != std::string::npos;  // the other: its mirror
+  }
+  EXPECT_GE(carried, 1);
+  // The two are mirror images: their tips on either side of the clamp's plane.
+  const auto tip = [&](int k) { return s.equilibria[static_cast<size_t>(k)].solution.profile.back().r; };
+  EXPECT_NEAR(tip(0).y(), -tip(1).y(), 1e-8);
+  EXPECT_GT(std::abs(tip(0).y()), 0.3);
 }
 
 TEST(Equilibria, EulerColumnAtP50) {

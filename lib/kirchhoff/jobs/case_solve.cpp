@@ -19,20 +19,6 @@ bool only_a_guess(const Case& c, const std::string& name) {
   return solved_for(c.definition, name) || !c.problem_parameters.count(name);
 }
 
-// The case at its file's values, keeping the overrides of parameters only its [guess] uses: they
-// choose the equilibrium the homotopy starts from (the straight column, the S-shaped mode).
-// Guesses of solved-for parameters are guesses at the requested values, which the path carries
-// there itself: the start is the case's own solve.
-Case case_at_file_values(const Case& c) {
-  ParameterOverrides guesses;
-  for (const auto& [name, value] : c.overrides)
-    if (!solved_for(c.definition, name) && !c.problem_parameters.count(name)) guesses.emplace_back(name, value);
-  Case start = reload_case(c, guesses);
-  // The solver settings as the case was given them (a wall-clock limit, command-line settings).
-  start.definition.options = c.definition.options;
-  return start;
-}
-
 CaseSolve by_homotopy(const Case& c, std::vector<ParameterChange> changes, HomotopyOptions options) {
   CaseSolve out;
   out.path.method = "homotopy";
@@ -122,6 +108,19 @@ void analyse(const Case& c, const CaseSolveOptions& options, CaseSolve* out) {
 }
 
 }  // namespace
+
+// The overrides of parameters only the [guess] uses choose the equilibrium the homotopy starts
+// from (the straight column, the S-shaped mode). Guesses of solved-for parameters are guesses at
+// the requested values, which the path carries there itself: the start is the case's own solve.
+Case case_at_file_values(const Case& c) {
+  ParameterOverrides guesses;
+  for (const auto& [name, value] : c.overrides)
+    if (!solved_for(c.definition, name) && !c.problem_parameters.count(name)) guesses.emplace_back(name, value);
+  Case start = reload_case(c, guesses);
+  // The solver settings as the case was given them (a wall-clock limit, command-line settings).
+  start.definition.options = c.definition.options;
+  return start;
+}
 
 std::vector<ParameterChange> homotopy_changes(const Case& c) {
   std::vector<ParameterChange> changes;

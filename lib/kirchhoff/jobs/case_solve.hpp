@@ -97,4 +97,9 @@ CaseSolve solve_case(const Case& c, const CaseSolveOptions& options = {});
 // for and differ from the file's values.
 std::vector<ParameterChange> homotopy_changes(const Case& c);
 
+// The case at its file's values, where a homotopy to the requested ones starts: the overrides of
+// parameters only its [guess] uses are kept (they choose the equilibrium it starts from), and the
+// solver settings as the case was given them.
+Case case_at_file_values(const Case& c);
+
 }  // namespace kirchhoff

@@ -17,6 +17,7 @@
 #include "kirchhoff/contact/contact.hpp"
 #include "kirchhoff/equations/integrator.hpp"
 #include "kirchhoff/jobs/case_continue.hpp"
+#include "kirchhoff/jobs/case_equilibria.hpp"
 #include "kirchhoff/jobs/case_solve.hpp"
 #include "kirchhoff/jobs/continue_outputs.hpp"
 #include "kirchhoff/jobs/equilibria.hpp"
@@ -124,13 +125,13 @@ void run_solve(const SweepJob& job, const Case& c, const fs::path& folder, json*
   }
 }
 
-// An equilibria job: find_equilibria as `kirchhoff equilibria` does; the row describes the
+// An equilibria job: find_case_equilibria as `kirchhoff equilibria` does; the row describes the
 // lowest-energy equilibrium, and lists every contact state found and the stable ones.
 void run_equilibria(const SweepJob& job, const Case& c, const fs::path& folder, json* result) {
   EquilibriaOptions options;
   options.max_equilibria = job.max_equilibria;
   options.max_seconds = job.max_seconds;
-  const EquilibriaSearch search = find_equilibria(c.definition, c.start_guess, c.derived, c.samples, options);
+  const EquilibriaSearch search = find_case_equilibria(c, c.samples, options);
   (*result)["stopped_because"] = search.stopped_because;
   (*result)["newton_runs"] = search.newton_runs;
   (*result)["equilibria"] = static_cast<int>(search.equilibria.size());
