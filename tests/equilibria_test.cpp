@@ -360,6 +360,28 @@ TEST(Equilibria, EulerColumnAtP100ListsTheRodInTensionAndEveryMode) {
   }
 }
 
+// As `kirchhoff equilibria cases/euler_column.toml --set P=100` lists them (find_case_equilibria):
+// the first mode's two mirror rods (theta0 = +-3.0876433, energy -20.0145392, index 1), carried
+// from the file's P = 12 to residuals of 1.6e-10, were rejected by the residual test and deflated,
+// and with them the search's own root: one of the two was missing at every --max.
+TEST(Equilibria, EulerColumnSetToP100ListsBothFirstModesAsTheCliDoes) {
+  const double P = 100.0, EI = 1.0, L = 1.0;
+  const Case c = load_case(case_path("euler_column.toml"), {{"P", P}});
+  EquilibriaOptions options;
+  options.max_equilibria = 8;
+  const EquilibriaSearch s = find_case_equilibria(c, c.samples, options);
+  expect_all_sound(s, c.definition.options.newton.residual_tolerance);
+  const double closed = elastica_theta0(P, EI, L, 1);
+  for (const double side : {1.0, -1.0}) {
+    const auto mode = std::find_if(s.equilibria.begin(), s.equilibria.end(), [&](const Equilibrium& e) {
+      return std::abs(e.solution.profile.front().turn_angle - side * closed) < 1e-8;  // as above
+    });
+    ASSERT_NE(mode, s.equilibria.end()) << "theta0 = " << side * closed;
+    ASSERT_TRUE(mode->stability.index);
+    EXPECT_EQ(*mode->stability.index, 1);
+  }
+}
+
 TEST(Equilibria, ClampedClampedModesAgreeWithTheirSolvesFromTheCaseGuess) {
   const EquilibriaSearch s = search("clamped_clamped.toml", {});
   // The default search stops at 16 equilibria: the first eight modes.

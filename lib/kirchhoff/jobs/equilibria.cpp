@@ -617,7 +617,11 @@ class Search {
   }
 
   // An equilibrium known beforehand, on its active set (a start that does not fit the problem is
-  // logged and left out).
+  // logged and left out). One whose residual, polished, is still above the tolerance is not
+  // deflated (which would keep the search from the root it approximates) but searched from:
+  // the Euler column's first mode at P = 100, carried from the file's P = 12 to a residual of
+  // 1.6e-10 (its sensitivity grows like exp(sqrt(P) L)), was rejected and deflated, and with it
+  // the rod the search had found before.
   void consider_known(const EquilibriaOptions::KnownRoot& known) {
     try {
       Family& f = family(known.contacts);
@@ -625,7 +629,18 @@ class Search {
         out_.log.push_back(known.found_by + ": its unknowns do not fit the problem; not used");
         return;
       }
-      consider(f, known.x, known.found_by);
+      Eigen::VectorXd x = known.x;
+      polish(*f.problem, f.deflation, x);
+      std::string failure;
+      const RootCheck root = check_root(*f.problem, x, &failure);
+      if (root.evaluated && !is_root(root, x)) {
+        std::ostringstream why;
+        why << known.found_by << ": residual " << root.residual << " above the tolerance; searched from instead";
+        out_.log.push_back(why.str());
+        push_unknowns(family_key(known.contacts), std::move(x), known.found_by, -INFINITY);
+        return;
+      }
+      consider(f, std::move(x), known.found_by);
     } catch (const std::exception& e) {
       out_.log.push_back(known.found_by + ": " + e.what());
     }
