@@ -373,6 +373,9 @@ TEST_F(CaseFileTest, PlanarRodRefusesPropertiesItsEquationsDoNotRead) {
   const std::string shear_strain = replaced(kBase, "B = \"EI\"", "B = \"EI\"\nv_hat = [0, \"s\", 1]");
   expect_refused(shear_strain, "rod.v_hat", {"component 2 must be 0"}, line_of(shear_strain, "v_hat"));
   EXPECT_NO_THROW(load_case(write(replaced(kBase, "B = \"EI\"", "B2 = \"EI\"\nu_hat = [0, \"EI\", 0.0]\nv_hat = [0.1, 0, 1]"))));
+  // A zero written as an expression ("0"): it was evaluated without the case's parameters, and
+  // the load failed with "unknown parameter" and no file or key.
+  EXPECT_NO_THROW(load_case(write(replaced(kBase, "B = \"EI\"", "B = \"EI\"\nu_hat = [\"0\", 0.5, \"0\"]"))));
 }
 
 // An unknown that no expression of the problem reads (here: the load is a number, so P balances

@@ -193,7 +193,8 @@ void check_rod_profiles(const Reader& reader, const RodSpec& r, const Parameters
 // other stiffnesses and natural strains do not enter its equations: given, they would be ignored
 // in silence (a natural curvature written as u_hat = [0, 0, k] left the rod straight), so they are
 // refused. A natural strain component is accepted only where it is literally zero.
-void refuse_out_of_plane_properties(const Reader& reader, const Value& rod, const RodSpec& r) {
+void refuse_out_of_plane_properties(const Reader& reader, const Value& rod, const RodSpec& r,
+                                    const Parameters& parameters) {
   for (const char* key : {"B1", "B3", "A2"})
     if (const Value* v = Reader::find(rod, key))
       reader.fail(*v, std::string("rod.") + key,
@@ -201,7 +202,7 @@ void refuse_out_of_plane_properties(const Reader& reader, const Value& rod, cons
                       std::string(key) + " does not enter its equations (use model = \"spatial\" for it)");
   const auto must_be_zero = [&](const ProfileSpec& spec, int component, const char* what) {
     const bool zero = spec.expression.used_parameters().empty() && !spec.expression.depends_on_s() &&
-                      spec.expression(Parameters{}) == 0.0;
+                      spec.expression(parameters) == 0.0;
     if (!zero && spec.source)
       reader.fail(*spec.source, spec.key,
                   "component " + std::to_string(component + 1) + " must be 0 for a planar rod: " + what);
@@ -246,7 +247,7 @@ void read_rod(const Reader& reader, const Value& root, const Parameters& paramet
   reader.allow_keys(*rod, "rod", {"length", "B", "B1", "B2", "B3", "extensible", "A1", "A2", "A3", "u_hat",
                                   "v_hat", "gravity", "barrier", "self_contact"});
   const RodSpec r = read_rod_profiles(reader, *rod);
-  if (d->kind == RodKind::Planar) refuse_out_of_plane_properties(reader, *rod, r);
+  if (d->kind == RodKind::Planar) refuse_out_of_plane_properties(reader, *rod, r, parameters);
   std::set<std::string> field_parameters;
   FieldAdder add_fields = read_fields(reader, *rod, d->kind, parameters, r.B[0].expression, &field_parameters);
   check_rod_profiles(reader, r, parameters);
