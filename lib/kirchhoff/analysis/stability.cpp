@@ -1206,6 +1206,8 @@ NearZeroModes near_zero_modes(const Eigen::JacobiSVD<Eigen::MatrixXd>& svd, cons
 // 112.1 is -1e-10 .. +9e-11 out of terms of 3e-10 .. 2e-9, smooth along the branch to three digits.
 // Against the absolute tolerance 1e-6 it was taken as a zero mode from P = 104.7 to 119.2 (index
 // 1 with a zero mode, where the discretised energy has 1 without one to the fold, 2 after it).
+// (A direction whose terms all vanish, a constraint no load moves, never gets here: the
+// degenerate-constraint test above leaves the index undefined first.)
 double eigenvalue_floor(const Eigen::VectorXd& v, const Eigen::MatrixXd& frame_values, const Eigen::MatrixXd& c,
                         const Eigen::MatrixXd& particular_values, double tol) {
   const Eigen::VectorXd a = v.cwiseAbs();
