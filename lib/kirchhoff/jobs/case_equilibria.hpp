@@ -4,6 +4,9 @@
 // that equilibrium is reached by homotopy from the file's own (case_solve.hpp): one the case's
 // guess need not lead the search to (the wall's flat contact at Delta = 0.04, which the active-set
 // loop from the arch's guess does not settle on), and which a user who ran `solve` expects listed.
+// Then the equilibria found at the file's values, each carried to the requested ones along its own
+// homotopy (case_equilibria.cpp): a rod loaded far past its critical loads, whose stable
+// equilibria the search at that load does not reach, gets them from a moderate file's value.
 #pragma once
 
 #include "kirchhoff/jobs/case_file.hpp"
