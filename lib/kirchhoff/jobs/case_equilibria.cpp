@@ -27,10 +27,10 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 // follow the load smoothly. Each path is followed as `solve` follows its own; one that folds
 // back before the requested values carries nothing (its equilibrium has no counterpart there
 // on that branch).
-void carry_from_file_values(const Case& c, int samples, const EquilibriaOptions& options,
-                            std::vector<EquilibriaOptions::KnownRoot>* roots, std::vector<std::string>* log) {
+void carry_from_file_values(const Case& c, const std::vector<ParameterChange>& changes, int samples,
+                            const EquilibriaOptions& options, std::vector<EquilibriaOptions::KnownRoot>* roots,
+                            std::vector<std::string>* log) {
   const auto t0 = std::chrono::steady_clock::now();
-  const std::vector<ParameterChange> changes = homotopy_changes(c);
   const Case start = case_at_file_values(c);
   EquilibriaOptions at_file = options;
   at_file.known_roots.clear();
@@ -68,7 +68,8 @@ void carry_from_file_values(const Case& c, int samples, const EquilibriaOptions&
 EquilibriaSearch find_case_equilibria(const Case& c, int samples, EquilibriaOptions options) {
   // Without changed values `solve` is Newton from the case's guess, which the search's first seed
   // is already: only a homotopy adds an equilibrium the search might not reach.
-  if (homotopy_changes(c).empty()) return find_equilibria(c.definition, c.start_guess, c.derived, samples, options);
+  const std::vector<ParameterChange> changes = homotopy_changes(c);
+  if (changes.empty()) return find_equilibria(c.definition, c.start_guess, c.derived, samples, options);
   const auto t0 = std::chrono::steady_clock::now();
   CaseSolveOptions solve;
   solve.solution = solve.stability = solve.stability_check = false;
@@ -79,7 +80,7 @@ EquilibriaSearch find_case_equilibria(const Case& c, int samples, EquilibriaOpti
   std::vector<EquilibriaOptions::KnownRoot> carried;
   std::vector<std::string> log;
   try {
-    carry_from_file_values(c, samples, options, &carried, &log);
+    carry_from_file_values(c, changes, samples, options, &carried, &log);
   } catch (const std::exception& error) {
     log.push_back(std::string("the equilibria at the file's values: ") + error.what());
   }

@@ -684,7 +684,7 @@ class Search {
     for (size_t i = 0; i < out_.equilibria.size(); ++i) {
       const Equilibrium& e = out_.equilibria[i];
       const bool forceless = forceless_edge || has_forceless_edge(e.solution.contacts);
-      const bool loose = flat || forceless || has_extended_contact(e.solution.contacts);
+      const bool loose = flat || has_extended_contact(e.solution.contacts);  // (a forceless edge is one's)
       const double d = profile_distance(*e.problem, e.solution.result.x, *f.problem, x, force_scale_,
                                         options_.compare_samples, !forceless);
       const bool same = d < (loose ? singular_root_distance() : options_.distinct_tolerance) ||
