@@ -247,7 +247,7 @@ PointRecord counted(std::optional<int> index, int zero_modes) {
 // its zero modes beyond its neighbours' explain the change (|a - b| of them: a simple and a double
 // crossing, with a symmetry's zero mode on both sides); it is made undefined where neither holds; an
 // undefined count, here or at a neighbour, is left as it is, and so is the count between equal
-// neighbours.
+// neighbours where it has a zero mode beyond theirs (made undefined where it has not).
 TEST(SingularPointIndex, IsTheNeighboursLowerIndexWhereTheZeroModesExplainTheChange) {
   auto settled = [](PointRecord p, const PointRecord& a, const PointRecord& b) {
     detail::settle_singular_point_index(&p, a, b);
@@ -273,6 +273,13 @@ TEST(SingularPointIndex, IsTheNeighboursLowerIndexWhereTheZeroModesExplainTheCha
   EXPECT_EQ(settled(counted(3, 2), counted(1, 1), counted(2, 1)), 1);  // beside a symmetry's zero mode
   EXPECT_EQ(settled(counted(1, 1), counted(1, 1), counted(2, 1)), 1);  // agrees
   EXPECT_EQ(settled(counted(0, 1), counted(1, 0), counted(1, 0)), 0);  // no change: an eigenvalue touching zero from below
+  // No change and no zero mode of its own: the touching eigenvalue was taken for one sign, which
+  // may be wrong either way (the soft wall's branch point revisited: 1 and none, where it is 0
+  // with one). Undefined, with the zero mode every singular point has.
+  EXPECT_EQ(settled(counted(1, 0), counted(1, 0), counted(1, 0)), std::nullopt);
+  EXPECT_EQ(zero_modes(counted(1, 0), counted(1, 0), counted(1, 0)), 1);
+  EXPECT_EQ(settled(counted(0, 1), counted(0, 1), counted(0, 1)), std::nullopt);  // beside a symmetry's
+  EXPECT_EQ(zero_modes(counted(0, 1), counted(0, 1), counted(0, 1)), 2);
   EXPECT_EQ(settled(counted(2, 0), counted(0, 0), counted(1, 0)), std::nullopt);  // no zero mode to explain it
   EXPECT_EQ(settled(counted(1, 2), counted(0, 1), counted(2, 1)), 0);  // of two crossing, one negative, one zero
   EXPECT_EQ(zero_modes(counted(1, 2), counted(0, 1), counted(2, 1)), 3);

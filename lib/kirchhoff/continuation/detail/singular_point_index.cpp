@@ -8,11 +8,17 @@ void settle_singular_point_index(PointRecord* singular, const PointRecord& befor
   if (!singular->stability_index || !before.stability_index || !after.stability_index) return;
   const int lower = std::min(*before.stability_index, *after.stability_index);
   const int upper = std::max(*before.stability_index, *after.stability_index);
-  // Equal neighbours: the zero eigenvalue may touch zero from either side without crossing, and
-  // only the point's own count can say which.
-  if (lower == upper) return;
-  const int own = *singular->stability_index;
   const int common = std::min(before.zero_modes, after.zero_modes);
+  // Equal neighbours: the zero eigenvalue may touch zero from either side without crossing, and
+  // only the point's own count can say which - where it sees that eigenvalue as zero. A count
+  // without it took the eigenvalue for negative or positive, and which was right is not known.
+  if (lower == upper) {
+    if (singular->zero_modes > common) return;
+    singular->stability_index.reset();
+    singular->zero_modes = common + 1;
+    return;
+  }
+  const int own = *singular->stability_index;
   const int crossing = upper - lower;
   // The crossing eigenvalues are small at the located point, of either sign or zero within their
   // resolution: a count between the neighbours' says so, and so does one outside it whose extra

@@ -11,7 +11,11 @@
 // index at the singular point is the smaller of its neighbours' indices, and the zero eigenvalues
 // there are those that cross, |a - b| of them, besides the symmetries' zero modes. Where a = b
 // nothing crossed, and an eigenvalue that only touches zero there may do so from below (index
-// a - 1 with a zero mode) or above (a): the point's own count stands.
+// a - 1 with a zero mode) or above (a): the point's own count stands where it has that zero mode.
+// Where it has not (its count took the eigenvalue for one sign, as at the soft wall's branch
+// point at log_b = -5 revisited along the branch switched to there: index 1 and no zero mode, a
+// conjugate point 5e-8 before the end, where the first visit settled 0 with one), nothing says
+// which sign was right: the index is undefined and the zero mode is reported.
 #pragma once
 
 #include "kirchhoff/continuation/continuation.hpp"
@@ -24,7 +28,8 @@ namespace kirchhoff::detail {
 // sign there: the soft wall's branch point, located to 1e-8 of its step, has its crossing
 // eigenvalue decisively positive with the fields at the state's 1e-12) or its extra zero modes
 // account for the change; a count that neither explains becomes undefined (an empty index).
-// Leaves the point alone where a = b, or where an index is undefined.
+// Where a = b, leaves a count with a zero mode beyond its neighbours' alone and makes one without
+// undefined, with that zero mode. Leaves the point alone where an index is undefined.
 void settle_singular_point_index(PointRecord* singular, const PointRecord& before, const PointRecord& after);
 
 }  // namespace kirchhoff::detail
