@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <string>
 #include <thread>
@@ -21,6 +22,12 @@
 namespace kirchhoff::testing {
 
 namespace fs = std::filesystem;
+
+// A text file's whole contents.
+inline std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
 
 // The non-empty lines of a text file.
 inline std::vector<std::string> lines_of(const fs::path& p) {
