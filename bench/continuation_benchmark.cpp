@@ -253,14 +253,14 @@ struct Run {
 template <class Go>
 Run timed(RodContinuation& branch, Go&& go) {
   Run run;
-  const long rhs0 = branch.problem().rhs_evaluations();
+  const long rhs0 = branch.rhs_evaluations();
   const Continuation::EvaluationCount e0 = branch.evaluations();
   const double c0 = cpu_seconds();
   const auto t0 = Clock::now();
   run.result = go();
   run.seconds = seconds_since(t0);
   run.cpu = cpu_seconds() - c0;
-  run.rhs = branch.problem().rhs_evaluations() - rhs0;
+  run.rhs = branch.rhs_evaluations() - rhs0;
   run.evaluations.residuals = branch.evaluations().residuals - e0.residuals;
   run.evaluations.matrices = branch.evaluations().matrices - e0.matrices;
   run.ok = run.result.reason == StopReason::EventStop;
@@ -787,6 +787,16 @@ void cost_breakdown(const char* label, const ShootingProblem& base, const Contin
     std::printf("    F + J, sensitivity_tol %.0e            %8.1f us  %6.0f rhs  (|J - J_tight| / |J| = %.1e)\n",
                 kLooseSensitivityTol, t_loose, rhs_loose,
                 (J_loose - J).lpNorm<Eigen::Infinity>() / J.lpNorm<Eigen::Infinity>());
+    // The same matrix alone, where F is known (a converged point's tangent, a corrector's matrix
+    // after its residual): one pass of state and variations at the looser tolerance.
+    Eigen::MatrixXd J_alone;
+    const long before_alone = loose.rhs_evaluations();
+    const double t_alone =
+        median_us(reps, [&] { loose.matrix_at_sensitivity_tolerance(x, &J_alone, &y_end, &failure); });
+    const double rhs_alone = static_cast<double>(loose.rhs_evaluations() - before_alone) / (reps + 1);
+    std::printf("    J alone, sensitivity_tol %.0e          %8.1f us  %6.0f rhs  (|J - J_tight| / |J| = %.1e)\n",
+                kLooseSensitivityTol, t_alone, rhs_alone,
+                (J_alone - J).lpNorm<Eigen::Infinity>() / J.lpNorm<Eigen::Infinity>());
   }
   std::printf("    F_lambda column (parameter_derivative)  %8.1f us  %6.0f rhs\n", t_dl, rhs_dl);
   std::printf("    LU of the bordered matrix               %8.2f us\n", t_lu);

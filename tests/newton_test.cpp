@@ -218,6 +218,52 @@ TEST(StepMatrices, ShootingKeepsTheResidualAndCountsTheWork) {
   EXPECT_GT(step_rhs, problem.rhs_evaluations() - before_alone);
 }
 
+// A step or coarse matrix alone (for a caller that has F): the variational equations' pass
+// without the state's own, so exactly the right-hand sides F + J costs less those of F alone, and
+// the matrix evaluate_for_step (evaluate_coarse) gives to its tolerance - the end conditions' rows
+// now read the looser pass's end state, which moves them by about that tolerance. On the planar
+// Elastica (written-out variations, whose pass once left the flow's state unset) and a buckled
+// spatial rod.
+TEST(StepMatrices, AMatrixAloneSkipsTheStatesPass) {
+  struct Setup {
+    const char* file;
+    ParameterOverrides set;
+  };
+  for (const Setup& setup : {Setup{"simply_supported.toml", {{"theta0", 2.8}}},
+                             Setup{"twisted_clamped.toml", {{"phi", 11.58}, {"m_lateral", -1.7}, {"n_lateral", 3.4}}}}) {
+    SCOPED_TRACE(setup.file);
+    Case c = load_case(testing::case_path(setup.file), setup.set);
+    const ShootingProblem problem(c.definition);
+    const double tol = c.definition.options.newton.step_matrix_tolerance;
+    const double coarse_tol = c.definition.options.newton.coarse_tolerance;
+    ASSERT_TRUE(problem.has_step_matrices(tol));
+    ASSERT_TRUE(problem.has_coarse_evaluations(coarse_tol));
+    const Eigen::VectorXd x = problem.initial_unknowns(c.start_guess);
+    Eigen::VectorXd F;
+    Eigen::MatrixXd J_step, J_alone, J_coarse, J_coarse_alone;
+    std::string failure;
+    auto rhs_of = [&](auto&& evaluation) {
+      const long before = problem.rhs_evaluations();
+      EXPECT_TRUE(evaluation());
+      return problem.rhs_evaluations() - before;
+    };
+    const long f_rhs = rhs_of([&] { return problem.evaluate(x, &F, nullptr, &failure); });
+    const long step_rhs = rhs_of([&] { return problem.evaluate_for_step(x, &F, &J_step, tol, &failure); });
+    const long alone_rhs = rhs_of([&] { return problem.step_matrix(x, &J_alone, tol, &failure); });
+    EXPECT_EQ(alone_rhs, step_rhs - f_rhs);
+    // 10 x the tolerance: both matrices are within about it of the exact one.
+    EXPECT_LE((J_alone - J_step).lpNorm<Eigen::Infinity>(), 10 * tol * J_step.lpNorm<Eigen::Infinity>());
+    const long coarse_f_rhs =
+        rhs_of([&] { return problem.evaluate_coarse(x, &F, nullptr, coarse_tol, &failure); });
+    const long coarse_rhs = rhs_of([&] { return problem.evaluate_coarse(x, &F, &J_coarse, coarse_tol, &failure); });
+    const long coarse_alone_rhs = rhs_of([&] { return problem.coarse_matrix(x, &J_coarse_alone, coarse_tol, &failure); });
+    EXPECT_EQ(coarse_alone_rhs, coarse_rhs - coarse_f_rhs);
+    // The coarse matrices at 10 x coarse_tol (evaluate_coarse's), the same margin.
+    EXPECT_LE((J_coarse_alone - J_coarse).lpNorm<Eigen::Infinity>(),
+              100 * coarse_tol * J_coarse.lpNorm<Eigen::Infinity>());
+  }
+}
+
 TEST(StepMatrices, NotOfferedWithObstaclesOrLooserOwnMatrices) {
   Case c = load_case(testing::case_path("simply_supported.toml"), {{"theta0", 1.0}});
   const double tol = 1e-8;

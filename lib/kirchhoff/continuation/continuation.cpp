@@ -190,6 +190,15 @@ bool Continuation::evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen:
   return system_->matrix(x, lambda, F, A, failure, march);
 }
 
+bool Continuation::matrix_alone(const Eigen::VectorXd& z, Eigen::MatrixXd* A, std::string* failure, bool march) {
+  if (!march || !system_->has_approximate_matrices()) {
+    Eigen::VectorXd F;
+    return evaluate(z, &F, A, failure, march);
+  }
+  ++evaluations_.matrices;
+  return system_->approximate_matrix(z.head(n_), z[n_], A, failure);
+}
+
 bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicted, const Eigen::VectorXd& normal,
                            int* iterations, const Eigen::MatrixXd* chord, bool* by_chord, bool march,
                            std::shared_ptr<const Eigen::MatrixXd>* matrix_at_z) {
@@ -227,16 +236,18 @@ bool Continuation::correct(Eigen::VectorXd& z, const Eigen::VectorXd& z_predicte
   double best = INFINITY, previous = INFINITY;
   std::optional<JacobianLU> lu;  // the matrix of the current (modified) Newton iteration
   for (; it <= 2 * options_.corrector_max_iterations; ++it) {
+    bool have_F = false;  // F (and G) at z, evaluated just now
     if (lu) {
       if (!evaluate(z, &F, nullptr, &failure)) {
         last_corrector_failure_ = failure;
         return false;
       }
       G << F, normal.dot(z - z_predicted);
+      have_F = true;
       if (!(max_abs_or_nan(G) <= kModifiedNewtonContraction * previous)) lu.reset();
     }
     if (!lu) {
-      if (!evaluate(z, &F, &A, &failure, march)) {
+      if (!(have_F ? matrix_alone(z, &A, &failure, march) : evaluate(z, &F, &A, &failure, march))) {
         last_corrector_failure_ = failure;
         return false;
       }
@@ -280,11 +291,10 @@ std::optional<ContinuationPoint> Continuation::point_at(const Eigen::VectorXd& z
   const bool is_reused = given != nullptr && !given_is_own;
   std::shared_ptr<const Eigen::MatrixXd> A = std::move(given);
   if (!A) {
-    Eigen::VectorXd F;
     Eigen::MatrixXd own;
     std::string failure;
     // The march's matrix at the points it can resume from (restore() evaluates the same one).
-    if (!evaluate(z, &F, &own, &failure, resumable_type(type))) return std::nullopt;
+    if (!matrix_alone(z, &own, &failure, resumable_type(type))) return std::nullopt;
     A = std::make_shared<const Eigen::MatrixXd>(std::move(own));
   }
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n_ + 1);
@@ -332,10 +342,9 @@ ContinuationPoint Continuation::make_point(const Eigen::VectorXd& z, const Eigen
 std::optional<ContinuationPoint> Continuation::restore(const ContinuationPoint& saved, bool with_description) {
   if (saved.x.size() != n_ || saved.tangent.size() != n_ + 1) return std::nullopt;
   const Eigen::VectorXd z = join(saved.x, saved.parameter);
-  Eigen::VectorXd F;
   Eigen::MatrixXd A;
   std::string failure;
-  if (!evaluate(z, &F, &A, &failure, resumable_type(saved.type))) return std::nullopt;
+  if (!matrix_alone(z, &A, &failure, resumable_type(saved.type))) return std::nullopt;
   // The saved tangent, not one solved for again: bordered by another row (the point's own
   // tangent instead of its predecessor's) the solve gives the same direction to round-off only.
   ContinuationPoint p = make_point(z, saved.tangent, std::make_shared<const Eigen::MatrixXd>(std::move(A)), false,

@@ -313,6 +313,9 @@ class Continuation {
   // the system's approximate one (ParameterisedSystem::has_approximate_matrices).
   bool evaluate(const Eigen::VectorXd& z, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
                 bool march = false);
+  // A at z alone, where F is known there or not needed: the march's approximate matrix without
+  // F's evaluation (ParameterisedSystem::approximate_matrix), else evaluate's, F thrown away.
+  bool matrix_alone(const Eigen::VectorXd& z, Eigen::MatrixXd* A, std::string* failure, bool march);
   // Newton on [F; normal.(z - z_predicted)] = 0. With `chord` (the Jacobian at a nearby point)
   // it first iterates with that fixed matrix, one integration without sensitivities per
   // iteration, and turns to (modified, with options_.modified_newton) Newton only if those

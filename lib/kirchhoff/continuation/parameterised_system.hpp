@@ -34,6 +34,12 @@ class ParameterisedSystem {
   // Whether matrix(..., approximate = true) may differ from the exact one: a corrector that fails
   // on it is then retried with the exact matrix.
   virtual bool has_approximate_matrices() const { return false; }
+  // The matrix of matrix(..., approximate = true) alone, for a caller that has F at (x, lambda)
+  // or does not need it; a system may save F's evaluation. The default: matrix's, F thrown away.
+  virtual bool approximate_matrix(const Eigen::VectorXd& x, double lambda, Eigen::MatrixXd* A, std::string* failure) {
+    Eigen::VectorXd F;
+    return matrix(x, lambda, &F, A, failure, true);
+  }
   // The start x0 corrected at fixed lambda. The default: Newton on F(., lambda) with F_x from
   // matrix(), to max |F| <= tolerance, at most 50 iterations, undamped (a system whose starts
   // need damping or a global search provides its own).

@@ -46,6 +46,10 @@ const ShootingProblem& RodContinuation::problem() const {
   return static_cast<const ShootingSystem&>(system()).problem();
 }
 
+long RodContinuation::rhs_evaluations() const {
+  return static_cast<const ShootingSystem&>(system()).rhs_evaluations();
+}
+
 SymmetricBranchStart axial_symmetry_branch(RodContinuation& straight, const ContinuationPoint& bp, double sign) {
   const ShootingProblem& problem = straight.problem();
   const Eigen::MatrixXd N = straight.bifurcation_directions(bp, 2);

@@ -63,6 +63,9 @@ class RodContinuation : public Continuation {
 
   // The rod's shooting problem followed.
   const ShootingProblem& problem() const;
+  // The right-hand sides its evaluations integrated so far: the problem's and those of the
+  // march's looser twin (ShootingSystem), which problem() does not count.
+  long rhs_evaluations() const;
 };
 
 // Branch switching at the double branch point of an isotropic twisted rod (the straight rod's

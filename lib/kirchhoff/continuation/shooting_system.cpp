@@ -57,16 +57,33 @@ bool ShootingSystem::residual(const Eigen::VectorXd& x, double lambda, Eigen::Ve
 
 bool ShootingSystem::matrix(const Eigen::VectorXd& x, double lambda, Eigen::VectorXd* F, Eigen::MatrixXd* A,
                             std::string* failure, bool approximate) {
-  // The looser twin's residual is the same number as problem_'s: its state is integrated at the
-  // same tolerance.
-  ShootingProblem& p = approximate && march_problem_ ? *march_problem_ : problem_;
-  return at(p, lambda, failure, [&] { return matrix_of(p, x, F, A, failure); });
+  if (approximate && march_problem_)
+    return at(*march_problem_, lambda, failure,
+              [&] { return problem_.evaluate(x, F, nullptr, failure) && march_matrix_of(x, A, failure); });
+  return at(problem_, lambda, failure, [&] { return matrix_of(problem_, x, F, A, failure); });
+}
+
+bool ShootingSystem::approximate_matrix(const Eigen::VectorXd& x, double lambda, Eigen::MatrixXd* A,
+                                        std::string* failure) {
+  if (!march_problem_) return ParameterisedSystem::approximate_matrix(x, lambda, A, failure);
+  return at(*march_problem_, lambda, failure, [&] { return march_matrix_of(x, A, failure); });
+}
+
+bool ShootingSystem::march_matrix_of(const Eigen::VectorXd& x, Eigen::MatrixXd* A, std::string* failure) {
+  Eigen::VectorXd y_end;
+  return march_problem_->matrix_at_sensitivity_tolerance(x, A, &y_end, failure) &&
+         append_parameter_column(*march_problem_, x, y_end, A, failure);
 }
 
 bool ShootingSystem::matrix_of(ShootingProblem& p, const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* A,
                                std::string* failure) {
-  Eigen::VectorXd y_end, F_lambda;
-  if (!p.evaluate_with_end(x, F, A, &y_end, failure)) return false;
+  Eigen::VectorXd y_end;
+  return p.evaluate_with_end(x, F, A, &y_end, failure) && append_parameter_column(p, x, y_end, A, failure);
+}
+
+bool ShootingSystem::append_parameter_column(const ShootingProblem& p, const Eigen::VectorXd& x,
+                                             const Eigen::VectorXd& y_end, Eigen::MatrixXd* A, std::string* failure) {
+  Eigen::VectorXd F_lambda;
   if (!p.parameter_derivative(x, parameter_, &F_lambda, failure, &y_end)) return false;
   // A column appended in place: the matrices of long rods are tens of megabytes, and realloc
   // extends such blocks without copying them.

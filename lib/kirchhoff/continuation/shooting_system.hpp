@@ -28,6 +28,12 @@ class ShootingSystem final : public ParameterisedSystem {
   bool residual(const Eigen::VectorXd& x, double lambda, Eigen::VectorXd* F, std::string* failure) override;
   bool matrix(const Eigen::VectorXd& x, double lambda, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
               bool approximate) override;
+  // The march's matrix (approximate, with the twin) is the same function of (x, lambda) whether
+  // or not F comes with it: the twin integrates the state with the variational equations in one
+  // pass at its tolerance (ShootingProblem::matrix_at_sensitivity_tolerance), the end conditions'
+  // rows and F_lambda read that pass's end state, and F, where asked, is problem_'s own residual.
+  // So a resumed run's restored matrices are the uninterrupted run's, however they were reached.
+  bool approximate_matrix(const Eigen::VectorXd& x, double lambda, Eigen::MatrixXd* A, std::string* failure) override;
   bool has_approximate_matrices() const override { return march_problem_.has_value(); }
   // The shooting solve (damped Newton, its fallback search, its checks) at fixed lambda.
   FixedParameterSolve solve_at(const Eigen::VectorXd& x0, double lambda, double tolerance) override;
@@ -36,12 +42,21 @@ class ShootingSystem final : public ParameterisedSystem {
   double default_corrector_tolerance() const override;
 
   const ShootingProblem& problem() const { return problem_; }
+  // Right-hand sides integrated by the problem and its looser twin together.
+  long rhs_evaluations() const {
+    return problem_.rhs_evaluations() + (march_problem_ ? march_problem_->rhs_evaluations() : 0);
+  }
   // The problem with the continued parameter at lambda: what a recorder describes a point on.
   const ShootingProblem& problem_at(double lambda);
 
  private:
   bool matrix_of(ShootingProblem& p, const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* A,
                  std::string* failure);
+  // The twin's matrix alone (approximate_matrix), lambda set.
+  bool march_matrix_of(const Eigen::VectorXd& x, Eigen::MatrixXd* A, std::string* failure);
+  // F_lambda appended to A = F_x in place, from the problem p and its end state y_end.
+  bool append_parameter_column(const ShootingProblem& p, const Eigen::VectorXd& x, const Eigen::VectorXd& y_end,
+                               Eigen::MatrixXd* A, std::string* failure);
   // Runs `evaluation` of p (problem_ or its twin) at lambda, an invalid parameter value turned
   // into a failure.
   template <class Evaluation>

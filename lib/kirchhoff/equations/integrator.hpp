@@ -29,6 +29,10 @@ struct IntegratorOptions {
   // times fewer on the duals that are most of a long rod's cost. Branch-point location, whose
   // smallest singular values reach ~1e-12, needs Phi as accurate as the state: leave it 0 there.
   double sensitivity_tol = 0.0;
+  // With sensitivity_tol looser than abs_tol: the looser pass alone, the flow's state that pass's
+  // (to sensitivity_tol), without the state's own pass - for a caller that needs Phi and has F
+  // (ShootingProblem::step_matrix).
+  bool sensitivities_only = false;
 
   // Returns an empty string when valid, else the reason.
   std::string validate() const;

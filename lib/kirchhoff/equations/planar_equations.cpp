@@ -232,6 +232,7 @@ class PlanarEquations final : public RodEquations {
       rhs_with_variations(y.data(), dy.data(), s);
     };
     out->steps = detail::march(x, s0, s1, system, options);
+    out->y = Eigen::Map<const Eigen::Matrix<double, kStateSize, 1>>(x.data());  // (to these options' tolerance)
     out->Phi.setIdentity(kStateSize, kStateSize);
     for (int r = 0; r < kRows; ++r)
       for (int j = 0; j < kColumns; ++j) out->Phi(kRowOf[r], kColumnOf[j]) = x[kStateSize + r * kColumns + j];

@@ -171,6 +171,20 @@ class Evaluations {
     return true;
   }
 
+  // J at `at`, where *f is F already (at the same accuracy the phase evaluates F to): a step or
+  // coarse matrix alone (NonlinearSystem::step_matrix, coarse_matrix), else F and J again.
+  bool matrix(const Eigen::VectorXd& at, Eigen::VectorXd* f, Eigen::MatrixXd* jac) {
+    if (!coarse_ && !step_matrices_) return (*this)(at, f, jac);
+    ++summary_->evaluations;
+    not_finite_ = false;
+    const bool ok = coarse_ ? system_.coarse_matrix(at, jac, options_.coarse_tolerance, &failure_)
+                            : system_.step_matrix(at, jac, options_.step_matrix_tolerance, &failure_);
+    if (ok && jac->allFinite()) return true;
+    // As a failed evaluation: made again (exactly, where the coarse phase ends), F with it.
+    if (coarse_) end_coarse_phase();
+    return (*this)(at, f, jac);
+  }
+
   bool step_matrices() const { return step_matrices_; }
   void use_exact_matrices() { step_matrices_ = false; }
   bool coarse() const { return coarse_; }
@@ -269,7 +283,8 @@ NewtonSummary newton_until(const NonlinearSystem& system, Eigen::VectorXd& x, co
       summary.message = "the wall-clock limit was reached";
       return summary;
     }
-    if (!have_matrix && !evaluate(x, &F, &J)) return evaluate.failed(norm);
+    // (F is at x: the start's, a step's trial or the coarse phase's end.)
+    if (!have_matrix && !evaluate.matrix(x, &F, &J)) return evaluate.failed(norm);
     have_matrix = false;
     const JacobianLU lu(J);
     const double rcond = lu.reciprocal_condition();

@@ -45,6 +45,21 @@ class NonlinearSystem {
     (void)tolerance;
     return evaluate(x, F, J, failure);
   }
+
+  // The step matrix, or the coarse one, alone at x, for a caller that has F there already (Newton
+  // after a step accepted without its matrix). Where F comes from a pass of its own at a tighter
+  // tolerance than J (evaluate_for_step, evaluate_coarse), a system may skip that pass; J is then
+  // the same matrix to about `tolerance`. The default: evaluate_for_step's (evaluate_coarse's) J.
+  virtual bool step_matrix(const Eigen::VectorXd& x, Eigen::MatrixXd* J, double tolerance,
+                           std::string* failure) const {
+    Eigen::VectorXd F;
+    return evaluate_for_step(x, &F, J, tolerance, failure);
+  }
+  virtual bool coarse_matrix(const Eigen::VectorXd& x, Eigen::MatrixXd* J, double tolerance,
+                             std::string* failure) const {
+    Eigen::VectorXd F;
+    return evaluate_coarse(x, &F, J, tolerance, failure);
+  }
 };
 
 enum class SolverStatus {

@@ -293,6 +293,39 @@ bool ShootingProblem::evaluate_coarse(const Eigen::VectorXd& x, Eigen::VectorXd*
   return evaluate_with(x, F, J, &y_end, coarse, failure);
 }
 
+// The looser pass of evaluate_for_step and evaluate_coarse alone, the variational equations with
+// the state at `tolerance` (IntegratorOptions::sensitivities_only: the equations' cheaper
+// written-out variations where they have them); F is not returned.
+bool ShootingProblem::matrix_in_one_pass(const Eigen::VectorXd& x, Eigen::MatrixXd* J, double tolerance,
+                                         Eigen::VectorXd* y_end, std::string* failure) const {
+  IntegratorOptions one_pass = definition_.options.integrator;
+  one_pass.sensitivity_tol = tolerance;
+  one_pass.sensitivities_only = one_pass.sensitivity_tol > one_pass.abs_tol;
+  return evaluate_with(x, &workspace_.buffers().F_unused, J, y_end, one_pass, failure);
+}
+
+bool ShootingProblem::step_matrix(const Eigen::VectorXd& x, Eigen::MatrixXd* J, double tolerance,
+                                  std::string* failure) const {
+  Eigen::VectorXd& y_end = workspace_.buffers().y_end;
+  if (!has_step_matrices(tolerance)) return evaluate_with_end(x, &workspace_.buffers().F_unused, J, &y_end, failure);
+  return matrix_in_one_pass(x, J, tolerance, &y_end, failure);
+}
+
+bool ShootingProblem::coarse_matrix(const Eigen::VectorXd& x, Eigen::MatrixXd* J, double tolerance,
+                                    std::string* failure) const {
+  Eigen::VectorXd& y_end = workspace_.buffers().y_end;
+  if (!has_coarse_evaluations(tolerance))
+    return evaluate_with_end(x, &workspace_.buffers().F_unused, J, &y_end, failure);
+  return matrix_in_one_pass(x, J, 10.0 * tolerance, &y_end, failure);  // (evaluate_coarse's matrices' tolerance)
+}
+
+bool ShootingProblem::matrix_at_sensitivity_tolerance(const Eigen::VectorXd& x, Eigen::MatrixXd* J,
+                                                      Eigen::VectorXd* y_end, std::string* failure) const {
+  const IntegratorOptions& own = definition_.options.integrator;
+  if (!(own.sensitivity_tol > own.abs_tol)) return evaluate_with_end(x, &workspace_.buffers().F_unused, J, y_end, failure);
+  return matrix_in_one_pass(x, J, own.sensitivity_tol, y_end, failure);
+}
+
 bool ShootingProblem::parameter_derivative(const Eigen::VectorXd& x, const std::string& name, Eigen::VectorXd* dF,
                                            std::string* failure, const Eigen::VectorXd* y_end) const {
   const double value = definition_.parameters.get(name);

@@ -134,6 +134,19 @@ class ShootingProblem final : public NonlinearSystem {
   bool has_coarse_evaluations(double tolerance) const override;
   bool evaluate_coarse(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, double tolerance,
                        std::string* failure) const override;
+  // Their matrices alone: the state and the variational equations in the one pass at the
+  // matrices' tolerance, without the state's own pass at the tighter one (the end conditions'
+  // rows then read the end state to the matrices' tolerance too). Where the problem offers no
+  // such matrices, the exact one (with F evaluated and thrown away).
+  bool step_matrix(const Eigen::VectorXd& x, Eigen::MatrixXd* J, double tolerance,
+                   std::string* failure) const override;
+  bool coarse_matrix(const Eigen::VectorXd& x, Eigen::MatrixXd* J, double tolerance,
+                     std::string* failure) const override;
+  // The matrix alone with the variational equations at this problem's own sensitivity_tol (where
+  // it is looser than abs_tol, as the continuation's march problem: ShootingSystem), in one pass;
+  // the end state is left in *y_end (to that tolerance) for the parameter columns.
+  bool matrix_at_sensitivity_tolerance(const Eigen::VectorXd& x, Eigen::MatrixXd* J, Eigen::VectorXd* y_end,
+                                       std::string* failure) const;
 
   // Unknown vector from a state guess at s = 0 (completed with the start conditions) by
   // integrating across the segments; throws IntegrationError when that integration fails.
@@ -217,6 +230,9 @@ class ShootingProblem final : public NonlinearSystem {
   // evaluate_with_end with the flows of x itself integrated with `integrator`.
   bool evaluate_with(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, Eigen::VectorXd* y_end,
                      const IntegratorOptions& integrator, std::string* failure) const;
+  // J alone from one pass of the state with the variational equations at `tolerance`.
+  bool matrix_in_one_pass(const Eigen::VectorXd& x, Eigen::MatrixXd* J, double tolerance, Eigen::VectorXd* y_end,
+                          std::string* failure) const;
   // Sizes F (and J) and fills the gauge and start-condition rows; returns the next row.
   int start_rows(const RodEquations& eq, const Eigen::VectorXd& y0, const Parameters& p, Eigen::VectorXd* F,
                  Eigen::MatrixXd* J) const;

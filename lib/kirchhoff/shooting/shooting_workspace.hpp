@@ -61,6 +61,7 @@ class ShootingWorkspace {
   struct Buffers {
     Parameters parameters;                // at the unknowns (evaluate)
     Eigen::VectorXd y_end;                // the last segment's end state (evaluate)
+    Eigen::VectorXd F_unused;             // F of a matrix evaluated alone (step_matrix), not returned
     std::vector<Eigen::VectorXd> starts;  // each segment's start state, out of the unknowns
     std::vector<SegmentFlow> flows;       // each segment's flow (a residual's)
     // Each segment's flow with its sensitivities (a Jacobian's), apart from `flows` so that the

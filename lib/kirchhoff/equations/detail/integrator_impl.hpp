@@ -121,7 +121,8 @@ void flow_state_into(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, doubl
 
 // Phi at opt.sensitivity_tol by phi_pass(the looser options, out), which fills out's Phi (and
 // dy_dunfolding), steps and right-hand sides; then the state at the state's own tolerance
-// (IntegratorOptions) in a pass of its own into out->y, so F is bit for bit a residual's alone.
+// (IntegratorOptions) in a pass of its own into out->y, so F is bit for bit a residual's alone
+// (unless opt.sensitivities_only: out->y is then the looser pass's).
 template <int N, class Rhs, class PhiPass>
 void flow_with_loose_pass_into(const Rhs& rhs, const Eigen::VectorXd& y0, double s0, double s1,
                                const IntegratorOptions& opt, const PhiPass& phi_pass, SegmentFlow* out) {
@@ -129,6 +130,7 @@ void flow_with_loose_pass_into(const Rhs& rhs, const Eigen::VectorXd& y0, double
   loose.abs_tol = loose.rel_tol = opt.sensitivity_tol;
   loose.sensitivity_tol = 0.0;
   phi_pass(loose, out);
+  if (opt.sensitivities_only) return;
   out->steps += march_state_into<N>(rhs, y0, s0, s1, opt, &out->y, &out->rhs_evaluations);
 }
 
