@@ -292,6 +292,21 @@ class IndexChange : public Detector {
       return unexplained && step.can_shrink ? Verdict::RetryShorter : Verdict::Nothing;
     }
     if (!b || *a == *b || step.current.zero_modes != far_point.zero_modes) return Verdict::Nothing;
+    // Where branch points are detected, a change at one of them (of even multiplicity, which the
+    // determinant does not see, and which the two-step minimum misses with long steps) is looked
+    // for first as the minimum of the smallest singular value over the step, whose trials are
+    // corrected but not recorded: the index's bisection below records each of its trials with its
+    // index (about 15 to reach the window at the twisted rod's Greenhill point). A minimum that is
+    // not singular leaves the change to the bisection.
+    if (singular_below_ > 0) {
+      if (auto p = singular_minimum(step, far)) {
+        if (std::max(1, p->multiplicity) >= std::abs(*a - *b)) {
+          found->push_back({std::move(*p), std::nullopt, this});
+          return Verdict::Found;
+        }
+        if (step.can_shrink) return Verdict::RetryShorter;  // another crossing in the step besides it
+      }
+    }
     const int crossing_zero_modes = step.current.zero_modes + std::abs(*a - *b);
     const Sides sides{*a, *b, crossing_zero_modes};
     const double tolerance = kIndexChangeBisection * far;
@@ -376,6 +391,18 @@ class IndexChange : public Detector {
     for (const Detection& d : found)
       if (d.stop == StopReason::ReachedTarget || d.stop == StopReason::ParameterBounds) return &d;
     return nullptr;
+  }
+
+  // The minimum of the smallest singular value over [0, far] of the step, as a branch point,
+  // where it is singular against the step's ends; none otherwise.
+  std::optional<ContinuationPoint> singular_minimum(const StepView& step, double far) const {
+    auto minimum = step.locate(step.current, far, [](const ContinuationPoint& q) { return q.smallest_singular; },
+                               true, PointType::BranchPoint);
+    if (!minimum || !singular_against_ends(*minimum, step, singular_below_).value_or(false)) return std::nullopt;
+    minimum->type = PointType::BranchPoint;
+    minimum->multiplicity =
+        multiplicity(*minimum, step.current.small_count <= step.candidate.small_count ? step.current : step.candidate);
+    return minimum;
   }
 
   // The branch point near `near` (at h = at along the step): the minimum of the smallest singular
