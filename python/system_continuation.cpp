@@ -125,7 +125,11 @@ py::dict continue_system(py::function F, py::function J, const Eigen::VectorXd& 
   if (n == 0) throw py::value_error("x0 is empty");
   ContinuationOptions o;
   o.parameter = "lambda";
-  if (!to.is_none()) o.target = to.cast<double>();
+  if (!to.is_none()) {
+    o.target = to.cast<double>();
+    // (NaN is the options' "no target": given, it is a mistake, as --to nan is.)
+    if (!std::isfinite(o.target)) throw py::value_error("to must be a finite number (None: no target)");
+  }
   o.initial_step = step;
   o.min_step = min_step;
   o.max_step = max_step;

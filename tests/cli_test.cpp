@@ -692,6 +692,21 @@ TEST_F(CliTest, TargetAtTheStartingValueIsRefused) {
   EXPECT_FALSE(fs::exists(csv));
 }
 
+// --to nan was taken for no target (NaN is the engine's "none"), --to inf and 1e300 as targets
+// never reached: each run marched to its point budget with exit 0 (a probe). A --to is now
+// finite and within +-1e100, as every number a case holds; Python's to= is the same request.
+TEST_F(CliTest, TargetThatIsNotAFiniteNumberIsRefused) {
+  for (const char* to : {"nan", "inf", "-inf", "1e300"}) {
+    SCOPED_TRACE(to);
+    const fs::path csv = dir_ / "b.csv";
+    const CliRun r = run("continue " + quoted(case_path("euler_column.toml")) + " --param P --to " + to + " --out " +
+                         quoted(csv.string()));
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_THAT(r.err, HasSubstr("--to must be a finite number within +-1e100"));
+    EXPECT_FALSE(fs::exists(csv));
+  }
+}
+
 // continue in a computed parameter: exit 2 naming the one to continue in.
 TEST_F(CliTest, ContinueInAComputedParameterIsRefused) {
   const std::string path = variant("simply_supported.toml", "EI = 1.0", "r = 0.5\nEI = \"pi*r^2\"");

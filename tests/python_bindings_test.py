@@ -132,6 +132,14 @@ class LoadCaseTest(unittest.TestCase):
             case.continue_("P", to=12)
         self.assertIn("--to 12 is P's starting value: nothing to continue", str(cm.exception))
 
+    def test_target_that_is_not_a_finite_number_is_refused(self):
+        # tests/cli_test.cpp (TargetThatIsNotAFiniteNumberIsRefused) expects the same text.
+        case = kirchhoff.load_case(case_path("euler_column.toml"))
+        for to in (float("nan"), float("inf"), 1e300):
+            with self.assertRaises(kirchhoff.CaseError) as cm:
+                case.continue_("P", to=to, max_points=5)
+            self.assertIn("--to must be a finite number within +-1e100", str(cm.exception))
+
     def test_missing_file_raises_value_error(self):
         with self.assertRaises(ValueError):
             kirchhoff.load_case(case_path("does_not_exist.toml"))
@@ -1120,6 +1128,8 @@ class SystemContinuationTest(unittest.TestCase):
             kirchhoff.continue_system(raises, wrong_shape, [0.0], 0.0)
         with self.assertRaisesRegex(ValueError, "components of x"):
             kirchhoff.continue_system(F, wrong_shape, [0.0], 0.0, events={"y": 1.0})
+        with self.assertRaisesRegex(ValueError, "to must be a finite number"):
+            kirchhoff.continue_system(F, wrong_shape, [0.0], 0.0, to=float("nan"))
 
 
 if __name__ == "__main__":

@@ -109,6 +109,7 @@ std::string ContinuationRange::validate() const {
   // branch and still fits; more is a typo.
   if (max_points < 1 || max_points > 10000000) return "max_points must be in [1, 1e7]";
   if (!(parameter_min < parameter_max)) return "parameter_min must be < parameter_max";
+  if (std::isinf(target)) return "the target must be finite (NaN: none)";
   return {};
 }
 

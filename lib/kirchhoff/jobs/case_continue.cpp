@@ -40,7 +40,7 @@ std::string text(double value) {
 RodContinuationOptions options_for(const Case& c, const ContinueRequest& r) {
   RodContinuationOptions o;
   o.parameter = r.parameter;
-  o.target = r.target;
+  o.target = r.target.value_or(std::numeric_limits<double>::quiet_NaN());
   o.direction = r.direction;
   o.initial_step = r.initial_step;
   o.min_step = r.min_step;
@@ -393,11 +393,13 @@ std::string ContinueRequest::validate(const Case& c) const {
     if (!std::isfinite(e.value) || std::abs(e.value) > case_limits::kMaxMagnitude)
       return "--event/--record: " + e.quantity + "'s value must be finite, within +-1e100";
   }
+  if (target && !(std::isfinite(*target) && std::abs(*target) <= case_limits::kMaxMagnitude))
+    return "--to must be a finite number within +-1e100 (leave it out for no target)";
   // A target at the starting value is never crossed: the run would march off to its point budget.
-  if (!start && !resume && target == c.definition.parameters.get(parameter)) {
+  if (!start && !resume && target && *target == c.definition.parameters.get(parameter)) {
     std::ostringstream why;
     why.precision(17);
-    why << c.path << ": --to " << target << " is " << parameter
+    why << c.path << ": --to " << *target << " is " << parameter
         << "'s starting value: nothing to continue (start elsewhere with --set " << parameter << "=...)";
     return why.str();
   }

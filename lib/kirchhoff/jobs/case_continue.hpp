@@ -41,7 +41,9 @@ bool ended_normally(StopReason reason);
 
 struct ContinueRequest {
   std::string parameter;  // the continued parameter: a [parameters] name, not a dependent one
-  double target = std::numeric_limits<double>::quiet_NaN();  // stop on reaching it (NaN: none)
+  // Stop on reaching it (none: no target). Finite and within +-1e100 where given: a NaN target
+  // was taken for none, and `--to nan` marched on to the point budget reporting success.
+  std::optional<double> target;
   double direction = 1.0;     // initial direction of the parameter (+1/-1) when there is no target
   double initial_step = 0.05;  // pseudo-arclength steps (RodContinuationOptions)
   double min_step = 1e-7;

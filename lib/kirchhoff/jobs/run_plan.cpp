@@ -71,10 +71,10 @@ std::string run_identity(const RunPlanInputs& in, const ContinueRequest& r) {
   for (const auto& [name, value] : in.overrides) o << " set=" << name << "=" << value;
   for (const auto& [key, value] : in.solver) o << " solver=" << key << "=" << value;
   o << " phase=" << (in.phase_condition.empty() ? "none" : in.phase_condition) << " to=";
-  if (std::isnan(r.target))
+  if (!r.target)
     o << "none";
   else
-    o << r.target;
+    o << *r.target;
   o << " direction=" << r.direction << " step=" << r.initial_step << " min_step=" << r.min_step
     << " max_step=" << r.max_step << " max_points=" << r.max_points << " switch_at_bp=" << r.switch_at_bp
     << " side=" << r.switch_side << " branch_points=" << r.detect_branch_points

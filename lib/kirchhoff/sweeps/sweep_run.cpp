@@ -186,7 +186,7 @@ void run_equilibria(const SweepJob& job, const Case& c, const fs::path& folder, 
 void run_continue(const SweepJob& job, const Case& c, const fs::path& folder, json* result) {
   ContinueRequest request;
   request.parameter = job.param;
-  request.target = job.to;
+  if (!std::isnan(job.to)) request.target = job.to;  // (NaN: the job gives no `to`)
   request.max_points = job.max_points;
   request.initial_step = job.step;
   request.min_step = job.min_step;
