@@ -380,6 +380,32 @@ TEST(Vibration, StraightColumnAtP50HasExactlyTwoNegativeOmega2) {
   EXPECT_DOUBLE_EQ(vib.sigma_max(), 2 * vib.sigma_bound());
 }
 
+// Two negative omega^2 closer than the grid step: near P = 5 pi^2 the straight column's growth
+// rates for k = 1 and 2, sqrt(P (k pi)^2 - (k pi)^4), meet (at 5 pi^2 both are 2 pi^2). At P =
+// 49.3 they are 19.7272 and 19.6911, 0.036 apart on a step of 0.2: the determinant kept its sign
+// at every sample and `vibrate` said "no mode with omega^2 < 0" where `solve` says index 2 (a
+// probe). The dip of the determinant between them is now searched: a sign change at its minimum
+// splits the pair, a matching matrix of nullity 2 there is the double root.
+TEST(Vibration, NegativeOmega2CloserThanTheGridStepAreBothFound) {
+  for (const double P : {49.3, 49.34, 5 * M_PI * M_PI, 49.36}) {
+    SCOPED_TRACE(P);
+    const auto column = straight_euler_column(P);
+    VibrationOptions options;
+    options.modes = 1;
+    const VibrationProblem vib(*column.problem, column.solution.result.x, options);
+    const std::vector<double> found = vib.negative_omega2();
+    ASSERT_EQ(found.size(), 2u);
+    std::vector<double> exact;
+    for (int k = 1; k <= 2; ++k) exact.push_back(std::pow(k * M_PI, 2) * (std::pow(k * M_PI, 2) - P));
+    std::sort(exact.begin(), exact.end());
+    // A simple root to the frequencies' tolerance; the double root is the dip's minimum, located
+    // to 1.5e-8 in sigma (Brent's precision in double), so to about 3e-8 in omega^2.
+    const bool double_root = P == 5 * M_PI * M_PI;
+    for (int k = 0; k < 2; ++k)
+      EXPECT_LE(relative_error(found[k], exact[k]), double_root ? 1e-7 : kFrequencyTolerance) << "mode " << k;
+  }
+}
+
 TEST(Vibration, StableBuckledColumnHasNoNegativeOmega2) {
   const auto buckled = testing::solve_case("euler_column.toml", {{"P", 12.0}, {"theta_guess", 1.0}});
   VibrationOptions options;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <boost/math/tools/minima.hpp>
 #include <boost/math/tools/roots.hpp>
 #include <cmath>
 #include <cstdint>
@@ -381,46 +382,87 @@ double VibrationProblem::bracketed_root(double a, double fa, double b, double fb
   return root;
 }
 
-std::vector<double> VibrationProblem::frequencies() const {
+// Brent's minimum of the dip to 2^-26 (1.5e-8) relative, the precision a minimum's location has
+// in double precision (the function is flat to second order there).
+constexpr int kDipMinimumBits = 26;
+
+template <class Omega2>
+void VibrationProblem::dip_roots(double a, double fa, double fm, double b, double fb, const Omega2& omega2_of,
+                                 const char* name, std::vector<double>* found) const {
+  const double sign = fm > 0.0 ? 1.0 : -1.0;
+  auto signed_det = [&](double v) { return sign * scaled_determinant_at(omega2_of(v)); };
+  std::uintmax_t iterations = kRootMaxIterations;
+  const auto [v_min, g_min] = boost::math::tools::brent_find_minima(signed_det, a, b, kDipMinimumBits, iterations);
+  if (g_min < 0.0) {  // two simple roots, one on either side of the minimum
+    found->push_back(bracketed_root(a, fa, v_min, sign * g_min, omega2_of, name));
+    found->push_back(bracketed_root(v_min, sign * g_min, b, fb, omega2_of, name));
+    return;
+  }
+  // No sign change: a multiple root where the matching matrix loses rank at the minimum.
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(matching(omega2_of(v_min)).M);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  int nullity = 0;
+  for (Eigen::Index j = 0; j < sv.size(); ++j) nullity += sv[j] <= kMatchingResidualLimit * sv[0];
+  if (nullity >= 2)
+    for (int k = 0; k < nullity; ++k) found->push_back(v_min);
+}
+
+template <class Omega2, class At, class GoOn>
+std::vector<double> VibrationProblem::grid_roots(const At& at, const GoOn& go_on, const Omega2& omega2_of,
+                                                 const char* name) const {
   std::vector<double> found;
-  auto omega_at = [&](int i) { return omega_scale_ * (options_.omega_min + i * options_.grid_step); };
-  auto det = [&](double omega) { return scaled_determinant(omega); };
-  double previous_omega = omega_at(0), previous = det(previous_omega);
-  for (int i = 1; static_cast<int>(found.size()) < options_.modes; ++i) {
-    const double omega = omega_at(i);
-    if (i >= options_.max_grid_points || (options_.omega_max > 0.0 && omega > options_.omega_max * omega_scale_))
-      throw std::invalid_argument("vibrations: found " + std::to_string(found.size()) + " of the " +
-                                  std::to_string(options_.modes) + " frequencies requested below omega = " +
-                                  format(previous_omega) + " (end of the search grid: raise omega_max or max_grid_points)");
-    const double value = det(omega);
-    if (value == 0.0 || (value > 0.0) != (previous > 0.0))
-      found.push_back(bracketed_root(previous_omega, previous, omega, value, [](double w) { return w * w; }, "omega"));
-    previous_omega = omega;
-    previous = value;
+  auto det = [&](double v) { return scaled_determinant_at(omega2_of(v)); };
+  struct Sample {
+    double v, f;
+  };
+  Sample before{NAN, NAN}, previous{at(0), det(at(0))};
+  for (int i = 1; go_on(i, found); ++i) {
+    const Sample current{at(i), det(at(i))};
+    const bool changed = current.f == 0.0 || (current.f > 0.0) != (previous.f > 0.0);
+    if (changed) {
+      found.push_back(bracketed_root(previous.v, previous.f, current.v, current.f, omega2_of, name));
+    } else if (std::isfinite(before.f) && (before.f > 0.0) == (previous.f > 0.0) &&
+               std::abs(previous.f) <= std::min(std::abs(before.f), std::abs(current.f))) {
+      // Between simple roots |det| swings up and back down to zero through a maximum: a minimum
+      // of it among three samples of one sign is a dip, where two roots may hide.
+      dip_roots(before.v, before.f, previous.f, current.v, current.f, omega2_of, name, &found);
+    }
+    before = previous;
+    previous = current;
   }
   return found;
 }
 
+std::vector<double> VibrationProblem::frequencies() const {
+  auto omega_at = [&](int i) { return omega_scale_ * (options_.omega_min + i * options_.grid_step); };
+  auto go_on = [&](int i, const std::vector<double>& found) {
+    if (static_cast<int>(found.size()) >= options_.modes) return false;
+    if (i >= options_.max_grid_points || (options_.omega_max > 0.0 && omega_at(i) > options_.omega_max * omega_scale_))
+      throw std::invalid_argument("vibrations: found " + std::to_string(found.size()) + " of the " +
+                                  std::to_string(options_.modes) + " frequencies requested below omega = " +
+                                  format(omega_at(i - 1)) + " (end of the search grid: raise omega_max or max_grid_points)");
+    return true;
+  };
+  std::vector<double> found = grid_roots(omega_at, go_on, [](double w) { return w * w; }, "omega");
+  std::sort(found.begin(), found.end());
+  if (static_cast<int>(found.size()) > options_.modes) found.resize(options_.modes);  // (a dip's pair at the end)
+  return found;
+}
+
 std::vector<double> VibrationProblem::negative_omega2() const {
-  std::vector<double> found;
   auto omega2_of = [](double sigma) { return -sigma * sigma; };
-  auto det = [&](double sigma) { return scaled_determinant_at(omega2_of(sigma)); };
-  double previous_sigma = omega_scale_ * options_.omega_min;
-  if (!(sigma_max_ > previous_sigma)) return found;  // no compression, no field gradient: none exist
-  double previous = det(previous_sigma);
-  for (int i = 1;; ++i) {
-    const double sigma = omega_scale_ * (options_.omega_min + i * options_.grid_step);
-    if (sigma > sigma_max_) break;
+  auto sigma_at = [&](int i) { return omega_scale_ * (options_.omega_min + i * options_.grid_step); };
+  if (!(sigma_max_ > sigma_at(0))) return {};  // no compression, no field gradient: none exist
+  auto go_on = [&](int i, const std::vector<double>&) {
+    if (sigma_at(i) > sigma_max_) return false;
     if (i >= options_.max_grid_points)
       throw std::invalid_argument("vibrations: the search for omega^2 < 0 needs more than max_grid_points = " +
                                   std::to_string(options_.max_grid_points) + " points to reach sigma = " +
                                   format(sigma_max_));
-    const double value = det(sigma);
-    if (value == 0.0 || (value > 0.0) != (previous > 0.0))
-      found.push_back(omega2_of(bracketed_root(previous_sigma, previous, sigma, value, omega2_of, "sigma")));
-    previous_sigma = sigma;
-    previous = value;
-  }
+    return true;
+  };
+  std::vector<double> found;
+  for (double sigma : grid_roots(sigma_at, go_on, omega2_of, "sigma")) found.push_back(omega2_of(sigma));
   std::sort(found.begin(), found.end());
   return found;
 }

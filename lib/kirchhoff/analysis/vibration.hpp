@@ -157,8 +157,9 @@ class VibrationProblem {
   // The lowest options.modes frequencies above omega_min, increasing. Throws std::invalid_argument
   // when the grid ends (omega_max or max_grid_points) before enough are found.
   std::vector<double> frequencies() const;
-  // Every omega^2 < 0 with sigma = sqrt(-omega^2) between omega_min and sigma_max() (two closer
-  // than one grid step in sigma can be missed, as for the frequencies), increasing.
+  // Every omega^2 < 0 with sigma = sqrt(-omega^2) between omega_min and sigma_max(), increasing
+  // (two closer than one grid step in sigma are found from the determinant's dip between them,
+  // a double root as two; as for the frequencies).
   std::vector<double> negative_omega2() const;
   // The mode at an eigenfrequency omega (as returned by frequencies()), sampled along the rod.
   VibrationMode mode(double omega) const;
@@ -188,6 +189,18 @@ class VibrationProblem {
   // to be a singular matching matrix; `omega2_of` maps the variable to omega^2.
   template <class Omega2>
   double bracketed_root(double a, double fa, double b, double fb, const Omega2& omega2_of, const char* name) const;
+  // The roots a dip of the determinant hides: samples at a, between (fm) and b of one sign, |fm|
+  // the smallest (two roots closer than the grid step keep the sign at every sample). The minimum
+  // of the determinant times sign(fm) over [a, b] splits them where it changes sign (each then
+  // bracketed); a matching matrix of nullity k at that minimum is a k-fold root. Appends what it
+  // finds to *found (in the variable, not omega^2).
+  template <class Omega2>
+  void dip_roots(double a, double fa, double fm, double b, double fb, const Omega2& omega2_of, const char* name,
+                 std::vector<double>* found) const;
+  // The roots of the determinant in the variable v = at(i) on the grid i = 0, 1, ... while
+  // go_on(i, found) (sign changes and dips), in the order found.
+  template <class Omega2, class At, class GoOn>
+  std::vector<double> grid_roots(const At& at, const GoOn& go_on, const Omega2& omega2_of, const char* name) const;
   // sigma_bound from the equilibrium sampled at `points` (see the header comment).
   void bound_growth_rate(const std::vector<RodPoint>& points, const ProblemDefinition& definition);
   // start_basis_, end_basis_, row_projection_ and axial_indeterminate_ from the ends' linearised
