@@ -321,9 +321,8 @@ bool ShootingProblem::coarse_matrix(const Eigen::VectorXd& x, Eigen::MatrixXd* J
 
 bool ShootingProblem::matrix_at_sensitivity_tolerance(const Eigen::VectorXd& x, Eigen::MatrixXd* J,
                                                       Eigen::VectorXd* y_end, std::string* failure) const {
-  const IntegratorOptions& own = definition_.options.integrator;
-  if (!(own.sensitivity_tol > own.abs_tol)) return evaluate_with_end(x, &workspace_.buffers().F_unused, J, y_end, failure);
-  return matrix_in_one_pass(x, J, own.sensitivity_tol, y_end, failure);
+  // (Where sensitivity_tol is not looser than abs_tol the one pass is evaluate_with_end's.)
+  return matrix_in_one_pass(x, J, definition_.options.integrator.sensitivity_tol, y_end, failure);
 }
 
 bool ShootingProblem::parameter_derivative(const Eigen::VectorXd& x, const std::string& name, Eigen::VectorXd* dF,

@@ -393,16 +393,26 @@ class IndexChange : public Detector {
     return nullptr;
   }
 
+  // The minimum of the smallest singular value over [0, h] of the step from its current point.
+  static std::optional<ContinuationPoint> singular_value_minimum(const StepView& step, double h) {
+    return step.locate(step.current, h, [](const ContinuationPoint& q) { return q.smallest_singular; }, true,
+                       PointType::BranchPoint);
+  }
+
+  // p as a branch point, its multiplicity counted against the step's end with fewer small singular
+  // values.
+  static ContinuationPoint as_branch_point(const StepView& step, ContinuationPoint p) {
+    p.type = PointType::BranchPoint;
+    p.multiplicity = multiplicity(p, step.current.small_count <= step.candidate.small_count ? step.current : step.candidate);
+    return p;
+  }
+
   // The minimum of the smallest singular value over [0, far] of the step, as a branch point,
   // where it is singular against the step's ends; none otherwise.
   std::optional<ContinuationPoint> singular_minimum(const StepView& step, double far) const {
-    auto minimum = step.locate(step.current, far, [](const ContinuationPoint& q) { return q.smallest_singular; },
-                               true, PointType::BranchPoint);
+    auto minimum = singular_value_minimum(step, far);
     if (!minimum || !singular_against_ends(*minimum, step, singular_below_).value_or(false)) return std::nullopt;
-    minimum->type = PointType::BranchPoint;
-    minimum->multiplicity =
-        multiplicity(*minimum, step.current.small_count <= step.candidate.small_count ? step.current : step.candidate);
-    return minimum;
+    return as_branch_point(step, std::move(*minimum));
   }
 
   // The branch point near `near` (at h = at along the step): the minimum of the smallest singular
@@ -410,13 +420,9 @@ class IndexChange : public Detector {
   // EvenBranchPoint locates one), or `near` itself where that finds none lower. Recorded when put
   // on the branch, where its neighbours settle its index.
   ContinuationPoint branch_point(const StepView& step, ContinuationPoint near, double at) const {
-    auto minimum = step.locate(step.current, 2.0 * at, [](const ContinuationPoint& q) { return q.smallest_singular; },
-                               true, PointType::BranchPoint);
-    ContinuationPoint p = minimum && minimum->smallest_singular < near.smallest_singular ? std::move(*minimum)
-                                                                                         : std::move(near);
-    p.type = PointType::BranchPoint;
-    p.multiplicity = multiplicity(p, step.current.small_count <= step.candidate.small_count ? step.current : step.candidate);
-    return p;
+    auto minimum = singular_value_minimum(step, 2.0 * at);
+    return as_branch_point(step, minimum && minimum->smallest_singular < near.smallest_singular ? std::move(*minimum)
+                                                                                                : std::move(near));
   }
 
   double singular_below_;
