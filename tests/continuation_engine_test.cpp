@@ -66,6 +66,29 @@ class Pitchfork final : public ScalarSystem {
   double f_lambda(double x, double) const override { return x; }
 };
 
+// x1 (lambda - 2 x1) = 0, x2 = x1^2: the trivial branch x = 0 and the line x1 = lambda / 2 cross
+// transversally at the origin, not at right angles (a transcritical point).
+class Transcritical final : public ParameterisedSystem {
+ public:
+  explicit Transcritical(double lambda0) : lambda0_(lambda0) {}
+  int size() const override { return 2; }
+  double parameter() const override { return lambda0_; }
+  bool residual(const Eigen::VectorXd& x, double l, Eigen::VectorXd* F, std::string*) override {
+    *F = Eigen::Vector2d(x[0] * (l - 2.0 * x[0]), x[1] - x[0] * x[0]);
+    return true;
+  }
+  bool matrix(const Eigen::VectorXd& x, double l, Eigen::VectorXd* F, Eigen::MatrixXd* A, std::string* failure,
+              bool) override {
+    residual(x, l, F, failure);
+    A->resize(2, 3);
+    *A << l - 4.0 * x[0], 0.0, x[0], -2.0 * x[0], 1.0, 0.0;
+    return true;
+  }
+
+ private:
+  double lambda0_;
+};
+
 ContinuationOptions options_for(const char* parameter) {
   ContinuationOptions o;
   o.parameter = parameter;
@@ -160,6 +183,39 @@ TEST(ContinuationEngine, FindsThePitchforkAndSwitchesOntoTheParabola) {
   EXPECT_EQ(s.points.back().type, PointType::Event);
   EXPECT_NEAR(s.points.back().x[0], 0.5, 1e-9);
   EXPECT_NEAR(s.points.back().parameter, 0.25, 1e-8);
+}
+
+// At a transcritical point the branch switched onto leaves along its own tangent,
+// (dx1, dx2, dlambda) = (1, 0, 2) / sqrt(5), from the algebraic bifurcation equation: not along the
+// null vector orthogonal to the trivial branch's tangent (1, 0, 0), which is no branch's.
+TEST(ContinuationEngine, SwitchesAtATranscriticalPointAlongTheOtherBranchsTangent) {
+  ContinuationOptions o = options_for("lambda");
+  o.target = 1.0;
+  o.stop_at_branch_point = 1;
+  Continuation trivial(std::make_unique<Transcritical>(-1.0), o);
+  const ContinuationResult r = trivial.run(Eigen::Vector2d(0.05, 0.0));
+  ASSERT_EQ(r.reason, StopReason::BranchPointStop) << r.message;
+  const ContinuationPoint& bp = r.points.back();
+  ASSERT_EQ(bp.type, PointType::BranchPoint);
+  EXPECT_NEAR(bp.parameter, 0.0, 1e-9);
+  // The branch point's tangent is the trivial branch's, (0, 0, 1): the second differences of F
+  // (steps 1e-3) are exact on this quadratic F up to round-off, ~1e-16 / 1e-6.
+  EXPECT_NEAR(std::abs(bp.tangent[2]), 1.0, 1e-8);
+
+  Continuation other(std::make_unique<Transcritical>(bp.parameter), options_for("lambda"));
+  const Eigen::MatrixXd d = other.bifurcation_directions(bp, 1);
+  const Eigen::Vector3d expected = Eigen::Vector3d(1.0, 0.0, 2.0) / std::sqrt(5.0);
+  EXPECT_NEAR(std::abs(d.col(0).dot(expected)), 1.0, 1e-8) << d.transpose();
+  o = options_for("lambda");
+  o.max_points = 20;
+  Continuation line(std::make_unique<Transcritical>(bp.parameter), o);
+  const ContinuationResult s = line.switch_branch(bp);
+  ASSERT_GE(s.points.size(), 5u);
+  for (size_t i = 1; i < s.points.size(); ++i) {
+    const ContinuationPoint& p = s.points[i];
+    EXPECT_NEAR(p.x[0], 0.5 * p.parameter, kOnBranch) << "point " << p.index;
+    EXPECT_GT(std::abs(p.x[0]), 1e-3) << "point " << p.index;
+  }
 }
 
 // A march resumed from its state at one of its points takes the same steps as the uninterrupted

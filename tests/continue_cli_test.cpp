@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <algorithm>
+#include <map>
 #include <cstdlib>
 #include <iomanip>
 #include <nlohmann/json.hpp>
@@ -886,11 +887,15 @@ derived = ["theta0", "y_max", "contact_force", "contact_length"]
 // point at log_b = -4, Delta = 0.029511 counts 2 with one zero mode by itself (a conjugate point of
 // the clamped problem within 4e-8 of its end counts negative; stability.md) between neighbours of
 // 0 and 1: its row on the first branch said 0, the switched branch's first row 2.
-// Further along that branch the rod is all but straight (Delta ~ 8e-10) and folds at P = 112.1:
-// the eigenvalue of D (the chord's response to the loads) that crosses zero there is ~1e-10, out of
-// terms of ~1e-9. A discretisation of the energy (200-800 elements) gives index 1 without a zero
-// mode up to the fold and 2 past it; against the absolute zero tolerance the rows from P = 104.7
-// to 119.2 said 1 with a zero mode.
+// It is the pitchfork where the symmetric arch (P rising with Delta) loses stability to
+// asymmetric ones. The switched branch is theirs: it leaves with P falling as Delta grows, stable
+// (the symmetric arch has index 1 past the branch point), and comes back to the all but straight
+// rod (Delta < 1e-8) where that rod meets its antisymmetric clamped-clamped mode,
+// P = 4 x^2 with tan x = x, x = 4.4934094579: 80.763. The barrier's foundation stiffness
+// 2b/a^3 = 0.2 raises that by about 0.2 times the mode's int w^2 / int w'^2 (~1/80): 0.0025, so
+// within 0.01. (The symmetric arch meets the straight rod at the first mode's 4 pi^2 = 39.5.) The
+// branch point's bordered tangent had come out along the asymmetric branch, and the switch went
+// back down the symmetric arch (branch_crossing.hpp).
 TEST_F(ContinueCli, ASwitchedBranchStartsWithItsBranchPointsSettledIndex) {
   const fs::path csv = dir_ / "switched.csv";
   ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/soft_wall.toml", "--set",
@@ -900,11 +905,11 @@ TEST_F(ContinueCli, ASwitchedBranchStartsWithItsBranchPointsSettledIndex) {
             0);
   const auto rows = lines_of(csv);
   const auto column = csv_header(rows.at(0));
-  std::vector<std::vector<std::string>> branch_points, folds;
+  std::vector<std::vector<std::string>> branch_points, switched;
   for (size_t i = 1; i < rows.size(); ++i) {
     auto fields = csv_fields(rows[i]);
     if (fields[column.at("type")] == "branch_point") branch_points.push_back(fields);
-    if (fields[column.at("type")] == "fold" && std::stod(fields[column.at("Delta")]) < 1e-8) folds.push_back(fields);
+    if (fields[column.at("branch")] == "1") switched.push_back(fields);
   }
   ASSERT_GE(branch_points.size(), 2u);
   const auto& found = branch_points[0];
@@ -917,8 +922,41 @@ TEST_F(ContinueCli, ASwitchedBranchStartsWithItsBranchPointsSettledIndex) {
     EXPECT_EQ((*row)[column.at("stability_index")], "0");
     EXPECT_EQ((*row)[column.at("zero_modes")], "1");
   }
-  // The nearly straight rod's fold: P within 0.1 of the discretisation's 112.1 (the rows are ~0.5
-  // apart in P there), the crossing eigenvalue its zero mode, index 1 before and 2 after it.
+  const double Delta_bp = std::stod(found[column.at("Delta")]), P_bp = std::stod(found[column.at("P")]);
+  ASSERT_GE(switched.size(), 12u);
+  for (size_t i = 1; i < 12; ++i) {
+    EXPECT_GT(std::stod(switched[i][column.at("Delta")]), Delta_bp) << i;
+    EXPECT_LT(std::stod(switched[i][column.at("P")]), P_bp) << i;
+    EXPECT_EQ(switched[i][column.at("stability_index")], "0") << i;
+  }
+  const auto straight = std::find_if(switched.begin(), switched.end(), [&](const auto& fields) {
+    return std::stod(fields[column.at("Delta")]) < 1e-8;
+  });
+  ASSERT_NE(straight, switched.end());
+  EXPECT_NEAR(std::stod((*straight)[column.at("P")]), 4.0 * 4.4934094579 * 4.4934094579, 0.01);
+}
+
+// The soft wall's all but straight rod (Delta ~ 8e-10), reached from Delta = 0.02 down the
+// symmetric arch, folds at P = 112.1: the eigenvalue of D (the chord's response to the loads) that
+// crosses zero there is ~1e-10, out of terms of ~1e-9. A discretisation of the energy (200-800
+// elements) gives index 1 without a zero mode up to the fold and 2 past it; against the absolute
+// zero tolerance the rows from P = 104.7 to 119.2 said 1 with a zero mode.
+TEST_F(ContinueCli, TheAllButStraightRodUnderABarrierFoldsWithItsIndexChanging) {
+  const fs::path csv = dir_ / "down.csv";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/soft_wall.toml", "--set",
+                        "log_b=-4", "--set", "Delta=0.02", "--param", "Delta", "--to", "0", "--max-points", "240",
+                        "--out", csv.string()},
+                       dir_ / "run.log"),
+            0);
+  const auto rows = lines_of(csv);
+  const auto column = csv_header(rows.at(0));
+  std::vector<std::vector<std::string>> folds;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    auto fields = csv_fields(rows[i]);
+    if (fields[column.at("type")] == "fold" && std::stod(fields[column.at("Delta")]) < 1e-8) folds.push_back(fields);
+  }
+  // P within 0.1 of the discretisation's 112.1 (the rows are ~0.5 apart in P there), the crossing
+  // eigenvalue its zero mode, index 1 before and 2 after it.
   ASSERT_EQ(folds.size(), 1u);
   const double fold_P = std::stod(folds[0][column.at("P")]);
   EXPECT_NEAR(fold_P, 112.1, 0.1);
@@ -1001,6 +1039,131 @@ TEST_F(ContinueCli, SwitchesAtABranchPointOfACaseWithObstacles) {
     resume.push_back("--resume");
     ASSERT_EQ(run_to_end(resume, dir_ / "resume.log"), 0);
     EXPECT_EQ(lines_of(csv), rows);
+  }
+}
+
+// wall.toml with a disc of radius 0.5 for its wall, centred over the middle of the chord: the
+// symmetric point contact at s = 0.5 loses stability at the pitchfork Delta = 0.0271376 to a pair
+// of asymmetric contacts, mirror images of each other (s and 1 - s, the same contact force; P is
+// not mirror-invariant, the disc's force having a horizontal part off the middle). Switching
+// there followed the symmetric contact back (s = 0.5 on both sides): the branch point's bordered
+// tangent was along the asymmetric branch (branch_crossing.hpp).
+const char* kArchUnderDisc = R"toml(title = "Clamped-clamped arch below a disc"
+model = "planar"
+[parameters]
+Delta = 0.026
+a = 0.1
+L = 1.0
+[rod]
+length = "L"
+B = 1.0
+[start]
+type = "clamped"
+position = [0, 0]
+[end]
+type = "clamped"
+position = ["L - Delta", 0]
+[[obstacles]]
+type = "cylinder"
+name = "disc"
+centre = ["(L - Delta)/2", "a + 0.5"]
+radius = 0.5
+[solver]
+tolerance = 1e-12
+[guess]
+force = [-40, 0]
+moment = [0, 0, 2]
+[output]
+derived = ["P", "contact_force", "contact_s"]
+)toml";
+
+// The value of `key` at Delta on a branch's rows, by the cubic through the four nearest rows (its
+// error, measured against the rows between, is below 1e-6 in s from Delta = 0.035 on, where s
+// no longer grows like the square root of Delta - Delta_bp).
+double at_Delta(const std::vector<std::vector<std::string>>& rows, const std::map<std::string, int>& column,
+                const std::string& key, double Delta) {
+  auto nearest = rows;
+  std::sort(nearest.begin(), nearest.end(), [&](const auto& a, const auto& b) {
+    return std::abs(std::stod(a[column.at("Delta")]) - Delta) < std::abs(std::stod(b[column.at("Delta")]) - Delta);
+  });
+  double value = 0.0;
+  for (size_t i = 0; i < 4; ++i) {
+    double weight = 1.0;
+    const double xi = std::stod(nearest[i][column.at("Delta")]);
+    for (size_t j = 0; j < 4; ++j)
+      if (j != i) weight *= (Delta - std::stod(nearest[j][column.at("Delta")])) / (xi - std::stod(nearest[j][column.at("Delta")]));
+    value += weight * std::stod(nearest[i][column.at(key)]);
+  }
+  return value;
+}
+
+TEST_F(ContinueCli, SwitchingAtADiscContactsPitchforkFollowsTheAsymmetricContacts) {
+  const fs::path case_path = dir_ / "arch_disc.toml";
+  std::ofstream(case_path) << kArchUnderDisc;
+  std::map<std::string, std::vector<std::vector<std::string>>> switched;
+  std::map<std::string, int> column;
+  for (const std::string side : {"1", "-1"}) {
+    const fs::path csv = dir_ / ("side" + side + ".csv");
+    ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", case_path.string(), "--param", "Delta", "--to", "0.029",
+                          "--switch-at-bp", "1", "--side", side, "--max-points", "80", "--out", csv.string()},
+                         dir_ / "run.log"),
+              0);
+    const auto rows = lines_of(csv);
+    column = csv_header(rows.at(0));
+    bool branch_point = false;
+    // The branch's first leg: the asymmetric contacts up to their lift-off.
+    for (size_t i = 1; i < rows.size(); ++i) {
+      auto fields = csv_fields(rows[i]);
+      if (fields[column.at("branch")] != "1") continue;
+      if (fields[column.at("type")] == "event") break;
+      if (fields[column.at("type")] == "branch_point") {
+        branch_point = true;
+        EXPECT_NEAR(std::stod(fields[column.at("Delta")]), 0.0271376, 1e-7);
+      } else if (fields[column.at("type")] == "regular") {
+        // The asymmetric contacts take over the symmetric one's stability.
+        EXPECT_EQ(fields[column.at("stability_index")], "0") << rows[i];
+        switched[side].push_back(fields);
+      }
+    }
+    EXPECT_TRUE(branch_point);
+    ASSERT_GE(switched[side].size(), 30u);
+  }
+  // The asymmetric contact lifts off the disc at Delta = 0.1644. A run whose points are spent
+  // exactly there (the switched branch's first leg reports the branch point besides its
+  // max_points) stopped with "max_points must be in [1, 1e7]" (exit 1) when it set up the next
+  // leg with none left; it stops at the event as max_points.
+  // (Past the lift-off the free rod turns into the disc at once, and the run stops as
+  // inadmissible, exit 1: contact.md, not modelled.)
+  const fs::path through = dir_ / "through.csv";
+  run_to_end({KIRCHHOFF_CLI, "continue", case_path.string(), "--param", "Delta", "--to", "0.029", "--switch-at-bp", "1",
+              "--max-points", "150", "--out", through.string()},
+             dir_ / "through.log");
+  const auto rows = lines_of(through);
+  int on_switched = 0, to_lift_off = 0;
+  for (size_t i = 1; i < rows.size() && to_lift_off == 0; ++i) {
+    const auto fields = csv_fields(rows[i]);
+    if (fields[column.at("branch")] != "1") continue;
+    ++on_switched;
+    if (fields[column.at("event")].find("contact_lifts_off") != std::string::npos) to_lift_off = on_switched;
+  }
+  ASSERT_GT(to_lift_off, 0);
+  const fs::path spent = dir_ / "spent.csv";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", case_path.string(), "--param", "Delta", "--to", "0.029",
+                        "--switch-at-bp", "1", "--max-points", std::to_string(to_lift_off - 1), "--out",
+                        spent.string()},
+                       dir_ / "spent.log"),
+            0);
+  const auto spent_rows = lines_of(spent);
+  EXPECT_NE(spent_rows.back().find("contact_lifts_off"), std::string::npos) << spent_rows.back();
+  EXPECT_EQ(read_text(dir_ / "spent.log").find("max_points must be"), std::string::npos);
+  for (const double Delta : {0.035, 0.05}) {
+    const double s_plus = at_Delta(switched["1"], column, "contact_s", Delta);
+    const double s_minus = at_Delta(switched["-1"], column, "contact_s", Delta);
+    EXPECT_GT(std::abs(s_plus - 0.5), 0.05) << Delta;
+    EXPECT_NEAR(s_plus + s_minus, 1.0, 1e-5) << Delta;
+    EXPECT_NEAR(at_Delta(switched["1"], column, "contact_force", Delta),
+                at_Delta(switched["-1"], column, "contact_force", Delta), 1e-4)
+        << Delta;
   }
 }
 

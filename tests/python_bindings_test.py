@@ -449,6 +449,29 @@ class ContactTest(unittest.TestCase):
         self.assertEqual(branches[contacts[0]], 1)
         self.assertAlmostEqual(b.points["y_max"][contacts[0]], 0.2, places=8)
 
+    def test_switch_at_a_disc_contacts_pitchfork_onto_the_asymmetric_contacts(self):
+        # wall.toml with a disc of radius 0.5 for its wall (as tests/continue_cli_test.cpp): the
+        # symmetric contact at s = 0.5 loses stability at Delta = 0.0271376 to asymmetric ones,
+        # mirror images (s, 1 - s) on the two sides, stable. The switch went back along the
+        # symmetric contact.
+        with open(case_path("wall.toml")) as f:
+            text = f.read().replace('type = "plane"', 'type = "cylinder"').replace(
+                'point = [0, "a"]', 'centre = ["(L - Delta)/2", "a + 0.5"]\nradius = 0.5').replace(
+                'normal = [0, -1, 0]', '')
+        with tempfile.TemporaryDirectory() as tmp:
+            path = pathlib.Path(tmp) / "arch_disc.toml"
+            path.write_text(text)
+            case = kirchhoff.load_case(str(path))
+            sides = [case.continue_("Delta", to=0.029, switch_at_bp=1, side=side, max_points=80) for side in (1, -1)]
+        last_s = []
+        for b in sides:
+            self.assertTrue(b.switched, b.message)
+            on = (b.points["branch"] == 1) & (np.array(b.points["type"]) == "regular")
+            self.assertTrue(all(k == 0 for k in b.points["stability_index"][on]))
+            last_s.append(b.points["contact_s"][on][-1])
+        self.assertGreater(last_s[0], 0.6)
+        self.assertLess(last_s[1], 0.4)
+
 
 class ContinuationTest(unittest.TestCase):
     """The Euler column from P = 1 along the straight branch, switching at the first branch point

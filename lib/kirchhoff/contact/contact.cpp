@@ -687,6 +687,13 @@ class LegMarch {
       run_first_leg_ = false;
       if (r.reason != StopReason::EventStop || r.points.empty()) return out;
       if (!change_active_set(problem, r.points.back(), &out)) return out;
+      // The leg ended on its event with the run's points spent: the next leg would have none
+      // beyond its start (the event point, reported).
+      if (reported_ >= options_.max_points) {
+        out.result.reason = StopReason::MaxPoints;
+        out.result.message.clear();
+        return out;
+      }
     }
   }
 

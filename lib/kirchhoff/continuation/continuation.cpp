@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "kirchhoff/continuation/detail/branch_crossing.hpp"
 #include "kirchhoff/continuation/detail/broyden_steps.hpp"
 #include "kirchhoff/continuation/detail/continuation_detectors.hpp"
 #include "kirchhoff/continuation/detail/kinked_minimum.hpp"
@@ -563,11 +564,32 @@ ContinuationResult Continuation::resume(const ContinuationPoint& last, const Poi
   return resume(state, sink);
 }
 
+std::optional<Continuation::Crossing> Continuation::crossing_at(const ContinuationPoint& point, const Eigen::MatrixXd& A,
+                                                                const Eigen::VectorXd& arrival) {
+  const detail::ResidualAt residual = [this](const Eigen::VectorXd& z, Eigen::VectorXd* F) {
+    std::string failure;
+    return evaluate(z, F, nullptr, &failure);
+  };
+  const auto crossing = detail::branch_crossing(A, residual, join(point.x, point.parameter), arrival,
+                                                options_.branch_point_tolerance);
+  if (!crossing) return std::nullopt;
+  return Crossing{crossing->arriving, crossing->leaving};
+}
+
+void Continuation::settle_branch_point_tangent(ContinuationPoint* point, const Eigen::VectorXd& arrival) {
+  if (!point->jacobian || point->jacobian->rows() != n_) return;
+  if (const auto crossing = crossing_at(*point, *point->jacobian, arrival)) point->tangent = crossing->arriving;
+}
+
 Eigen::MatrixXd Continuation::bifurcation_directions(const ContinuationPoint& point, int count) {
   Eigen::VectorXd F;
   Eigen::MatrixXd A;
   std::string failure;
   if (!evaluate(join(point.x, point.parameter), &F, &A, &failure)) throw std::runtime_error(failure);
+  if (count == 1)
+    if (const auto crossing = crossing_at(point, A, point.tangent)) return crossing->leaving;
+  // A multiple branch point (or a simple one whose crossing cannot be resolved): the null
+  // vectors orthogonal to the tangent.
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
   // The last count + 1 right singular vectors span the null space (tangent included).
   Eigen::MatrixXd N = svd.matrixV().rightCols(count + 1);
@@ -711,6 +733,7 @@ struct Continuation::Marcher {
     if (after && (p.type == PointType::Fold || p.type == PointType::BranchPoint)) {
       // An even branch point may lie just behind `current` (between `before` and it).
       const bool behind = before && p.arclength < current.arclength;
+      if (p.type == PointType::BranchPoint) c.settle_branch_point_tangent(&p, behind ? before->tangent : current.tangent);
       detail::settle_singular_point_index(&p, behind ? *before : current, behind ? current : *after);
     }
     result.points.push_back(std::move(p));

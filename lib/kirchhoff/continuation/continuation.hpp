@@ -288,7 +288,11 @@ class Continuation {
                                PointType start_type, const PointSink& sink = {},
                                const PointRecord* known = nullptr);
 
-  // Null vectors of [F_x F_lambda] at a point, orthonormal, orthogonal to its tangent.
+  // Directions leaving a branch point along the branches that bifurcate there, unit vectors.
+  // count = 1, a simple branch point: the other branch's tangent, from the algebraic bifurcation
+  // equation (detail/branch_crossing.hpp), the point's tangent being the arriving branch's. Where
+  // that equation cannot be resolved, and for count > 1: null vectors of [F_x F_lambda],
+  // orthonormal, orthogonal to the point's tangent.
   Eigen::MatrixXd bifurcation_directions(const ContinuationPoint& point, int count);
 
   const ParameterisedSystem& system() const { return *system_; }
@@ -316,6 +320,17 @@ class Continuation {
   // A at z alone, where F is known there or not needed: the march's approximate matrix without
   // F's evaluation (ParameterisedSystem::approximate_matrix), else evaluate's, F thrown away.
   bool matrix_alone(const Eigen::VectorXd& z, Eigen::MatrixXd* A, std::string* failure, bool march);
+  // The tangents of the two branches crossing at a simple branch point whose matrix is A, the
+  // arriving one closest to `arrival` (detail/branch_crossing.hpp); empty where not resolved.
+  struct Crossing {
+    Eigen::VectorXd arriving, leaving;
+  };
+  std::optional<Crossing> crossing_at(const ContinuationPoint& point, const Eigen::MatrixXd& A,
+                                      const Eigen::VectorXd& arrival);
+  // A located branch point's bordered tangent solves a singular system: its component along the
+  // second null vector is noise over a vanishing singular value, of order one. Replaced by the
+  // arriving branch's tangent where the crossing is resolved.
+  void settle_branch_point_tangent(ContinuationPoint* point, const Eigen::VectorXd& arrival);
   // Newton on [F; normal.(z - z_predicted)] = 0. With `chord` (the Jacobian at a nearby point)
   // it first iterates with that fixed matrix, one integration without sensitivities per
   // iteration, and turns to (modified, with options_.modified_newton) Newton only if those
