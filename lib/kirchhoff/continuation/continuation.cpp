@@ -578,7 +578,10 @@ std::optional<Continuation::Crossing> Continuation::crossing_at(const Continuati
 
 void Continuation::settle_branch_point_tangent(ContinuationPoint* point, const Eigen::VectorXd& arrival) {
   if (!point->jacobian || point->jacobian->rows() != n_) return;
-  if (const auto crossing = crossing_at(*point, *point->jacobian, arrival)) point->tangent = crossing->arriving;
+  // The arrival projected onto the null space, not the crossing's root: that costs a dozen
+  // residuals at every branch point, where only a switch needs it (and solves for it then).
+  if (const auto t = detail::arrival_in_null_space(*point->jacobian, arrival, options_.branch_point_tolerance))
+    point->tangent = *t;
 }
 
 Eigen::MatrixXd Continuation::bifurcation_directions(const ContinuationPoint& point, int count) {

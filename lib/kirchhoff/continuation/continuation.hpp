@@ -328,8 +328,9 @@ class Continuation {
   std::optional<Crossing> crossing_at(const ContinuationPoint& point, const Eigen::MatrixXd& A,
                                       const Eigen::VectorXd& arrival);
   // A located branch point's bordered tangent solves a singular system: its component along the
-  // second null vector is noise over a vanishing singular value, of order one. Replaced by the
-  // arriving branch's tangent where the crossing is resolved.
+  // second null vector is noise over a vanishing singular value, of order one. Replaced, where the
+  // null space is two-dimensional, by `arrival` (the tangent of the regular point before it)
+  // projected onto it, by which the switch tells the arriving branch's root from the other.
   void settle_branch_point_tangent(ContinuationPoint* point, const Eigen::VectorXd& arrival);
   // Newton on [F; normal.(z - z_predicted)] = 0. With `chord` (the Jacobian at a nearby point)
   // it first iterates with that fixed matrix, one integration without sensitivities per

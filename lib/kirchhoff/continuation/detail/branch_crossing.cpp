@@ -29,18 +29,33 @@ std::optional<std::array<double, 3>> quadratic_form(const ResidualAt& residual, 
 
 }  // namespace
 
-std::optional<BranchCrossing> branch_crossing(const Eigen::MatrixXd& A, const ResidualAt& residual,
-                                              const Eigen::VectorXd& z, const Eigen::VectorXd& arrival,
-                                              double singular_tolerance) {
+std::optional<NullSpace> two_dimensional_null_space(const Eigen::MatrixXd& A, double singular_tolerance) {
   const Eigen::Index n = A.rows();
-  if (n < 2 || A.cols() != n + 1 || z.size() != n + 1 || arrival.size() != n + 1) return std::nullopt;
+  if (n < 2 || A.cols() != n + 1) return std::nullopt;
   Eigen::BDCSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Eigen::VectorXd& s = svd.singularValues();
   if (!(s[0] > 0.0) || !(s[n - 1] < singular_tolerance * s[0]) || !(s[n - 2] >= singular_tolerance * s[0]))
     return std::nullopt;
-  const Eigen::VectorXd phi1 = svd.matrixV().col(n);
-  const Eigen::VectorXd phi2 = svd.matrixV().col(n - 1);
-  const Eigen::VectorXd psi = svd.matrixU().col(n - 1);
+  return NullSpace{svd.matrixV().col(n), svd.matrixV().col(n - 1), svd.matrixU().col(n - 1)};
+}
+
+std::optional<Eigen::VectorXd> arrival_in_null_space(const Eigen::MatrixXd& A, const Eigen::VectorXd& arrival,
+                                                     double singular_tolerance) {
+  const auto null = two_dimensional_null_space(A, singular_tolerance);
+  if (!null || arrival.size() != A.cols()) return std::nullopt;
+  Eigen::VectorXd t = null->phi1 * null->phi1.dot(arrival) + null->phi2 * null->phi2.dot(arrival);
+  if (!(t.norm() > 0.0)) return std::nullopt;
+  return t.normalized();
+}
+
+std::optional<BranchCrossing> branch_crossing(const Eigen::MatrixXd& A, const ResidualAt& residual,
+                                              const Eigen::VectorXd& z, const Eigen::VectorXd& arrival,
+                                              double singular_tolerance) {
+  const auto null = two_dimensional_null_space(A, singular_tolerance);
+  if (!null || z.size() != A.cols() || arrival.size() != A.cols()) return std::nullopt;
+  const Eigen::VectorXd& phi1 = null->phi1;
+  const Eigen::VectorXd& phi2 = null->phi2;
+  const Eigen::VectorXd& psi = null->psi;
   Eigen::VectorXd F0;
   if (!residual(z, &F0)) return std::nullopt;
   // Steps of 1e-3 and 2e-3 along unit null vectors: the rod's residuals vary on scales of order

@@ -32,6 +32,21 @@ struct BranchCrossing {
   double cosine = 0.0;       // |cos| of the angle between the two (1: they cannot be told apart)
 };
 
+// The null space of A (n x (n+1)) where it is two-dimensional: its smallest singular value below
+// `singular_tolerance` of its largest, the one before above it.
+struct NullSpace {
+  Eigen::VectorXd phi1, phi2;  // orthonormal right null vectors
+  Eigen::VectorXd psi;         // the unit left null vector
+};
+std::optional<NullSpace> two_dimensional_null_space(const Eigen::MatrixXd& A, double singular_tolerance);
+
+// `arrival` projected onto that null space, normalised: a branch point's tangent from the regular
+// point before it, within O(step x curvature) of the arriving branch's (closer to it than to the
+// other branch's wherever the step resolves the branch), for branch_crossing to pick the arriving
+// root by. Empty where the null space is not two-dimensional.
+std::optional<Eigen::VectorXd> arrival_in_null_space(const Eigen::MatrixXd& A, const Eigen::VectorXd& arrival,
+                                                     double singular_tolerance);
+
 // The two branches' tangents at z, where A = F'(z) (n x (n+1)) has a two-dimensional null space
 // (its smallest singular value below `singular_tolerance` of its largest, the one before above
 // it). `arrival` picks which root is the branch arrived on (the tangent of a regular point
