@@ -88,7 +88,6 @@ std::optional<BranchCrossing> branch_crossing(const Eigen::MatrixXd& A, const Re
   BranchCrossing crossing;
   crossing.arriving = roots[closer] * (roots[closer].dot(arrival) < 0.0 ? -1.0 : 1.0);
   crossing.leaving = roots[1 - closer];
-  crossing.cosine = std::abs(roots[0].dot(roots[1]));
   return crossing;
 }
 

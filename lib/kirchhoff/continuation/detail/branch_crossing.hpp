@@ -29,7 +29,6 @@ using ResidualAt = std::function<bool(const Eigen::VectorXd& z, Eigen::VectorXd*
 struct BranchCrossing {
   Eigen::VectorXd arriving;  // unit tangent of the branch closest to `arrival`, oriented along it
   Eigen::VectorXd leaving;   // unit tangent of the other branch (its orientation is the caller's)
-  double cosine = 0.0;       // |cos| of the angle between the two (1: they cannot be told apart)
 };
 
 // The null space of A (n x (n+1)) where it is two-dimensional: its smallest singular value below
