@@ -115,8 +115,9 @@ CLI::App* add_continue_command(CLI::App& app, ContinueArguments* args, std::stri
   command->add_option("--max-step", args->max_step, "Largest step")->capture_default_str();
   command->add_option("--max-points", args->max_points, "Largest number of points of each branch (a switched branch counts its own)")->capture_default_str();
   command->add_option("--switch-at-bp", args->switch_at_bp,
-                      "Switch onto the branch bifurcating at the K-th branch point found (double branch points\n"
-                      "of isotropic twisted rods switch with the axial phase condition)");
+                      "Switch onto the branch bifurcating at the K-th branch point found, K >= 1 (0, the default:\n"
+                      "no switch; double branch points of isotropic twisted rods switch with the axial phase\n"
+                      "condition)");
   command->add_flag("--no-stability", args->no_stability,
                     "Skip the stability index of every point (column stability_index left empty)");
   command->add_flag("--no-branch-points", args->no_branch_points,
@@ -132,7 +133,7 @@ CLI::App* add_continue_command(CLI::App& app, ContinueArguments* args, std::stri
   command->add_option("--start-param", args->start_param,
                       "The parameter of a --start-from state file that does not name it");
   add_seed_options(command, seed, &args->seed);
-  command->add_option("--side", args->switch_side, "Which side of the bifurcating branch: 1 or -1")
+  command->add_option("--side", args->switch_side, "Which side of the bifurcating branch (with --switch-at-bp): 1 or -1")
       ->capture_default_str();
   command->add_option("--event", args->stop_events, "Stop when a derived quantity crosses a value: NAME=VALUE");
   command->add_option("--record", args->record_events, "Record (without stopping) a crossing: NAME=VALUE");

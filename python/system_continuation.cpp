@@ -123,6 +123,7 @@ py::dict continue_system(py::function F, py::function J, const Eigen::VectorXd& 
                          bool branch_points, py::object events, int switch_at_bp, double side, double tolerance) {
   const int n = static_cast<int>(x0.size());
   if (n == 0) throw py::value_error("x0 is empty");
+  if (side != 1.0 && side != -1.0) throw py::value_error("side must be 1 or -1");
   ContinuationOptions o;
   o.parameter = "lambda";
   if (!to.is_none()) {

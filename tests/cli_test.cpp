@@ -707,6 +707,23 @@ TEST_F(CliTest, TargetThatIsNotAFiniteNumberIsRefused) {
   }
 }
 
+// --side is 1 or -1 and picks a side of a switched branch: 0, 2, 0.5 and nan ran the +1 side with
+// exit 0, and --side -1 without --switch-at-bp was ignored (from a probe).
+TEST_F(CliTest, SideThatIsNotOneOrMinusOneIsRefused) {
+  const std::string head = "continue " + quoted(case_path("euler_column.toml")) + " --param P --to 12 --set P=1";
+  for (const char* side : {"0", "2", "0.5", "nan", "-0.001"}) {
+    SCOPED_TRACE(side);
+    const fs::path csv = dir_ / "b.csv";
+    const CliRun r = run(head + " --switch-at-bp 1 --side " + side + " --out " + quoted(csv.string()));
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_THAT(r.err, HasSubstr("--side must be 1 or -1"));
+    EXPECT_FALSE(fs::exists(csv));
+  }
+  const CliRun r = run(head + " --side -1 --out " + quoted((dir_ / "b.csv").string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("it needs --switch-at-bp K"));
+}
+
 // continue in a computed parameter: exit 2 naming the one to continue in.
 TEST_F(CliTest, ContinueInAComputedParameterIsRefused) {
   const std::string path = variant("simply_supported.toml", "EI = 1.0", "r = 0.5\nEI = \"pi*r^2\"");

@@ -140,6 +140,17 @@ class LoadCaseTest(unittest.TestCase):
                 case.continue_("P", to=to, max_points=5)
             self.assertIn("--to must be a finite number within +-1e100", str(cm.exception))
 
+    def test_side_that_is_not_one_or_minus_one_is_refused(self):
+        # tests/cli_test.cpp (SideThatIsNotOneOrMinusOneIsRefused) expects the same text.
+        case = kirchhoff.load_case(case_path("euler_column.toml"), set={"P": 1.0})
+        for side in (0.0, 2.0, float("nan")):
+            with self.assertRaises(kirchhoff.CaseError) as cm:
+                case.continue_("P", to=12.0, switch_at_bp=1, side=side, max_points=5)
+            self.assertIn("--side must be 1 or -1", str(cm.exception))
+        with self.assertRaises(ValueError):
+            kirchhoff.continue_system(lambda x, lam: [x[0] * (lam - x[0] ** 2)], lambda x, lam: [[lam - 3 * x[0] ** 2, x[0]]],
+                                      [0.1], -1.0, to=1.0, switch_at_bp=1, side=0.0)
+
     def test_missing_file_raises_value_error(self):
         with self.assertRaises(ValueError):
             kirchhoff.load_case(case_path("does_not_exist.toml"))

@@ -643,6 +643,7 @@ ContinuationResult Continuation::run_along(const Eigen::VectorXd& x, double lamb
 }
 
 ContinuationResult Continuation::switch_branch(const ContinuationPoint& bp, const PointSink& sink, double sign) {
+  if (sign != 1.0 && sign != -1.0) throw std::invalid_argument("switch_branch: the side must be 1 or -1");
   Eigen::VectorXd d = bifurcation_directions(bp, 1).col(0);
   // Orientation: the first significant component positive for sign = +1 (e.g. theta(0) > 0 on
   // the buckled Euler column), the mirror branch for sign = -1.

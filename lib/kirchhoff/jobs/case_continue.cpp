@@ -384,6 +384,9 @@ std::string ContinueRequest::validate(const Case& c) const {
     return c.path + ": --param " + parameter + ": " + why;
   if (!(max_seconds >= 0 && max_seconds <= 1e9)) return "--max-seconds must be in [0, 1e9]";
   if (switch_at_bp < 0) return "switch_at_bp must be >= 0";
+  if (switch_side != 1.0 && switch_side != -1.0) return "--side must be 1 or -1 (Python: side=1 or side=-1)";
+  if (switch_side == -1.0 && switch_at_bp == 0)
+    return "--side -1 picks a side of a switched branch: it needs --switch-at-bp K (Python: switch_at_bp=K)";
   if (switch_at_bp > 0 && !detect_branch_points)
     return "--switch-at-bp needs branch points: drop --no-branch-points (Python: branch_points=True)";
   for (const auto& e : events) {
