@@ -340,7 +340,13 @@ TEST(SingularPointIndex, IsTheNeighboursLowerIndexWhereTheZeroModesExplainTheCha
   EXPECT_EQ(settled(counted(1, 2), counted(0, 1), counted(2, 1)), 0);  // of two crossing, one negative, one zero
   EXPECT_EQ(zero_modes(counted(1, 2), counted(0, 1), counted(2, 1)), 3);
   EXPECT_EQ(settled(counted(3, 0), counted(0, 1), counted(2, 1)), std::nullopt);  // past both, no zero mode
-  EXPECT_EQ(settled(counted(std::nullopt, 1), counted(0, 0), counted(1, 0)), std::nullopt);
+  // Its own count undefined (degenerate exactly there: the clamped column where its ends meet,
+  // from a probe): the neighbours settle it where they differ, not where they agree.
+  EXPECT_EQ(settled(counted(std::nullopt, 0), counted(0, 0), counted(1, 0)), 0);
+  EXPECT_EQ(zero_modes(counted(std::nullopt, 0), counted(0, 0), counted(1, 0)), 1);
+  EXPECT_EQ(settled(counted(std::nullopt, 0), counted(3, 1), counted(1, 1)), 1);
+  EXPECT_EQ(zero_modes(counted(std::nullopt, 0), counted(3, 1), counted(1, 1)), 3);
+  EXPECT_EQ(settled(counted(std::nullopt, 0), counted(1, 0), counted(1, 0)), std::nullopt);
   EXPECT_EQ(settled(counted(2, 1), counted(std::nullopt, 0), counted(1, 0)), 2);
 }
 

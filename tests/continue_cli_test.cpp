@@ -1042,6 +1042,58 @@ TEST_F(ContinueCli, SwitchesAtABranchPointOfACaseWithObstacles) {
   }
 }
 
+// A column clamped at both ends, the far clamp sliding under a dead load P: its first buckled
+// branch (from 4 pi^2) reaches the point where the ends meet at P = 16 K(k)^2 with 2 E(k) = K(k),
+// 86.19634977407 (elliptic integrals, scipy), a branch point where the index goes from 0 to 1.
+// The count there is undefined (the chord's constraint degenerates exactly where the ends meet),
+// and the row said nothing; its neighbours settle it: 0 with the crossing zero mode (from a probe).
+TEST_F(ContinueCli, TheClampedColumnsEndsMeetWithTheIndexItsNeighboursSettle) {
+  const fs::path case_path = dir_ / "clamped_column.toml";
+  std::ofstream(case_path) << R"toml(title = "Clamped column, the far clamp sliding under a dead load"
+model = "planar"
+[parameters]
+P = 1.0
+[rod]
+length = 1.0
+B = 1.0
+[start]
+type = "clamped"
+position = [0, 0]
+[end]
+type = "sliding"
+axis = [1, 0, 0]
+position = [0, 0]
+force = ["-P", 0]
+orientation = { axis = [0, 0, 1], angle = 0 }
+[guess]
+force = ["-P", 0]
+[output]
+derived = ["end_to_end"]
+)toml";
+  const fs::path csv = dir_ / "clamped.csv";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", case_path.string(), "--param", "P", "--to", "170", "--switch-at-bp",
+                        "1", "--max-step", "2", "--max-points", "120", "--out", csv.string()},
+                       dir_ / "run.log"),
+            0);
+  const auto rows = lines_of(csv);
+  const auto column = csv_header(rows.at(0));
+  size_t meet = 0;
+  for (size_t i = 1; i < rows.size() && meet == 0; ++i) {
+    const auto fields = csv_fields(rows[i]);
+    if (fields[column.at("branch")] == "1" && fields[column.at("type")] == "branch_point" &&
+        std::stod(fields[column.at("end_to_end")]) < 1e-6)
+      meet = i;
+  }
+  ASSERT_GT(meet, 1u);
+  const auto at = csv_fields(rows[meet]);
+  // Located to the corrector's tolerance: 1e-10 of P at least (measured 1e-12).
+  EXPECT_NEAR(std::stod(at[column.at("P")]), 86.19634977407, 1e-8);
+  EXPECT_EQ(csv_fields(rows[meet - 1])[column.at("stability_index")], "0");
+  EXPECT_EQ(csv_fields(rows[meet + 1])[column.at("stability_index")], "1");
+  EXPECT_EQ(at[column.at("stability_index")], "0");
+  EXPECT_EQ(at[column.at("zero_modes")], "1");
+}
+
 // wall.toml with a disc of radius 0.5 for its wall, centred over the middle of the chord: the
 // symmetric point contact at s = 0.5 loses stability at the pitchfork Delta = 0.0271376 to a pair
 // of asymmetric contacts, mirror images of each other (s and 1 - s, the same contact force; P is

@@ -5,10 +5,19 @@
 namespace kirchhoff::detail {
 
 void settle_singular_point_index(PointRecord* singular, const PointRecord& before, const PointRecord& after) {
-  if (!singular->stability_index || !before.stability_index || !after.stability_index) return;
+  if (!before.stability_index || !after.stability_index) return;
   const int lower = std::min(*before.stability_index, *after.stability_index);
   const int upper = std::max(*before.stability_index, *after.stability_index);
   const int common = std::min(before.zero_modes, after.zero_modes);
+  // A count that is undefined at the singular point itself (its constraints degenerate exactly
+  // there: a clamped column where its ends meet) between neighbours that differ: continuity
+  // settles it as it settles a count between theirs. Between equal ones nothing does.
+  if (!singular->stability_index) {
+    if (lower == upper) return;
+    singular->stability_index = lower;
+    singular->zero_modes = common + (upper - lower);
+    return;
+  }
   // Equal neighbours: the zero eigenvalue may touch zero from either side without crossing, and
   // only the point's own count can say which - where it sees that eigenvalue as zero. A count
   // without it took the eigenvalue for negative or positive, and which was right is not known.

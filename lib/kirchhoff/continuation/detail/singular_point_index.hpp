@@ -29,7 +29,9 @@ namespace kirchhoff::detail {
 // eigenvalue decisively positive with the fields at the state's 1e-12) or its extra zero modes
 // account for the change; a count that neither explains becomes undefined (an empty index).
 // Where a = b, leaves a count with a zero mode beyond its neighbours' alone and makes one without
-// undefined, with that zero mode. Leaves the point alone where an index is undefined.
+// undefined, with that zero mode. A point whose own count is undefined gets min(a, b) and the
+// crossing zero modes where a != b, and stays undefined where a = b; a point is left alone where
+// a neighbour's index is undefined.
 void settle_singular_point_index(PointRecord* singular, const PointRecord& before, const PointRecord& after);
 
 }  // namespace kirchhoff::detail
