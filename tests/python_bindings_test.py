@@ -239,6 +239,7 @@ class SolveTest(unittest.TestCase):
                         1e-4 * abs(sleeve["reduced_energy_curvature"]))
         couple = kirchhoff.load_case(case_path("reissner.toml")).solve()  # a dead couple on a 3D end
         self.assertIsNone(couple.stability["index"])
+        self.assertIsNone(couple.stability["zero_modes"])
         self.assertIn("not conservative", couple.stability["reason"])
 
     def test_the_discretised_energy_decides_where_the_conjugate_points_do_not(self):

@@ -65,7 +65,8 @@ nlohmann::json stability_json(const StabilityReport& st, const DiscreteStability
   j["index"] = st.index ? nlohmann::json(*st.index) : nlohmann::json();
   // (false without an index where an admissible perturbation is known to lower the energy.)
   j["stable"] = st.index ? nlohmann::json(st.stable()) : st.unstable ? nlohmann::json(false) : nlohmann::json();
-  j["zero_modes"] = st.zero_modes;
+  // (Null with the index: a count that is not defined has no zero modes to report either.)
+  j["zero_modes"] = st.index ? nlohmann::json(st.zero_modes) : nlohmann::json();
   j["conjugate_points"] = st.conjugate_points;
   // The conjugate-point count gives no eigenvalues; the planar discretised check does, once it
   // has passed its own checks.
