@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -275,7 +276,9 @@ TEST_F(ResumeTest, UnresumableRunsAreRefusedWithTheReason) {
   EXPECT_EQ(run_to_end(with_resume(other), dir_ / "other.log"), 2);
   const auto other_log = lines_of(dir_ / "other.log");
   ASSERT_FALSE(other_log.empty());
-  EXPECT_NE(other_log.front().find("other arguments"), std::string::npos) << other_log.front();
+  EXPECT_NE(other_log.front().find("other arguments (saved max_step=1, now max_step=0.5)"), std::string::npos)
+      << other_log.front();
+  EXPECT_EQ(other_log.front().find("cannot be read"), std::string::npos) << other_log.front();  // (from a probe)
   EXPECT_EQ(lines_of(csv), before);
 
   fs::remove(csv.string() + ".state.json");
@@ -284,6 +287,44 @@ TEST_F(ResumeTest, UnresumableRunsAreRefusedWithTheReason) {
   ASSERT_FALSE(log.empty());
   EXPECT_NE(log.front().find("has 31 rows but there is no state file"), std::string::npos) << log.front();
   EXPECT_EQ(lines_of(csv), before);
+}
+
+// A CSV that lost rows its state file counts on (cut, a row deleted, a row cut short, or the
+// file gone) is refused with the reason and left as it is: the resume appended after the gap with
+// exit 0 (from a probe; a kill cannot do this, each row being flushed before the state is saved).
+TEST_F(ResumeTest, ACsvThatLostRowsBeforeItsSavedOneIsRefused) {
+  const fs::path csv = dir_ / "run.csv";
+  auto args = euler_args(csv);
+  args.insert(args.end(), {"--checkpoint", "0"});
+  ASSERT_NO_FATAL_FAILURE(run_killed_after(args, csv, 30));  // state saved after row 29
+  const auto killed = lines_of(csv);
+  const auto write = [&](const std::vector<std::string>& lines) {
+    std::ofstream out(csv, std::ios::trunc);
+    for (const auto& line : lines) out << line << "\n";
+  };
+  const auto expect_refused = [&](const std::string& reason) {
+    SCOPED_TRACE(reason);
+    const auto before = fs::exists(csv) ? lines_of(csv) : std::vector<std::string>{};
+    EXPECT_EQ(run_to_end(with_resume(args), dir_ / "refused.log"), 2);
+    const std::string log = kirchhoff::testing::read_text(dir_ / "refused.log");
+    EXPECT_NE(log.find(reason), std::string::npos) << log;
+    EXPECT_EQ(fs::exists(csv) ? lines_of(csv) : std::vector<std::string>{}, before);
+  };
+  write({killed.begin(), killed.begin() + 11});  // the header and rows 0..9
+  expect_refused("it ends at row 9, where its state file saved the run after row 29");
+  auto cut = killed;
+  cut[21] = cut[21].substr(0, 30);  // row 20 cut short
+  write(cut);
+  expect_refused("the row after row 19 is not whole");
+  auto gap = killed;
+  gap.erase(gap.begin() + 16);  // row 15 deleted
+  write(gap);
+  expect_refused("row 16 follows row 14");
+  fs::remove(csv);
+  expect_refused("is missing, while its state file is there");
+  // Restored, it resumes.
+  write(killed);
+  EXPECT_EQ(run_to_end(with_resume(args), dir_ / "resumed.log"), 0);
 }
 
 }  // namespace

@@ -370,6 +370,24 @@ ContinueRunResult Run::with_contacts(const Eigen::VectorXd& start_point, bool re
   return out;
 }
 
+// The words (key=value) of two run identities that differ: "saved max_step=1, now max_step=0.5".
+std::string identity_difference(const std::string& saved, const std::string& now) {
+  const auto words = [](const std::string& text) {
+    std::istringstream in(text);
+    std::vector<std::string> out;
+    for (std::string w; in >> w;) out.push_back(w);
+    return out;
+  };
+  const auto only_in = [](const std::vector<std::string>& a, const std::vector<std::string>& b) {
+    std::string out;
+    for (const auto& w : a)
+      if (std::find(b.begin(), b.end(), w) == b.end()) out += (out.empty() ? "" : " ") + w;
+    return out;
+  };
+  const auto a = words(saved), b = words(now);
+  return "saved " + only_in(a, b) + ", now " + only_in(b, a);
+}
+
 }  // namespace
 
 std::string ContinueRequest::validate(const Case& c) const {
@@ -502,8 +520,9 @@ RunState resumable_state(const std::string& path, const std::string& identity) {
                     ": it was written by an older kirchhoff that did not save the march's whole state, so a resumed "
                     "run would not repeat the uninterrupted one; run again without --resume");
   if (saved.arguments != identity)
-    throw CaseError("cannot resume from " + path + ": it belongs to a run with other arguments\n  saved: " +
-                    saved.arguments + "\n  now:   " + identity);
+    throw CaseError("cannot resume from " + path + ": it belongs to a run with other arguments (" +
+                    identity_difference(saved.arguments, identity) + ")\n  saved: " + saved.arguments +
+                    "\n  now:   " + identity);
   return saved;
 }
 

@@ -38,6 +38,9 @@ std::string csv_header(const std::string& parameter, const std::vector<std::stri
 // the same as an earlier version wrote it (truncate_csv then renames it). Anything else was
 // written with other outputs, and rows appended to it would not line up with its columns.
 void check_resumed_header(const fs::path& path, const std::string& header, const std::string& earlier) {
+  if (!fs::exists(path))
+    throw std::runtime_error(path.string() + " is missing, while its state file is there: the rows it held cannot be "
+                             "resumed from (restore it, or run again without --resume)");
   std::ifstream in(path);
   std::string found;
   std::getline(in, found);

@@ -54,6 +54,8 @@ auto reading_state(const std::string& path, Read&& read) {
     return read();
   } catch (const std::invalid_argument&) {
     throw;
+  } catch (const CaseError&) {
+    throw;  // read, and refused with its reason (a run with other arguments, say)
   } catch (const std::exception& e) {
     throw CaseError(path + ": the state file cannot be read: " + e.what());
   }

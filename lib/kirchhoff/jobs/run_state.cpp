@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -297,22 +300,55 @@ void set_contact_march_state(RunState* s, const ContactMarchState& m) {
   s->branch_points_before = m.branch_points_before;
 }
 
+namespace {
+
+// The row's index (its first field) where the row is complete (at least `fields` fields: an
+// event's text may hold commas, a row a kill cut short has fewer), else nothing.
+std::optional<int> complete_row_index(const std::string& line, size_t fields) {
+  if (static_cast<size_t>(std::count(line.begin(), line.end(), ',')) + 1 < fields) return std::nullopt;
+  const std::string first = line.substr(0, line.find(','));
+  char* end = nullptr;
+  const long index = std::strtol(first.c_str(), &end, 10);
+  if (first.empty() || *end != '\0' || index < 0 || index > std::numeric_limits<int>::max()) return std::nullopt;
+  return static_cast<int>(index);
+}
+
+std::runtime_error rows_lost(const std::filesystem::path& path, int last_index, const std::string& what) {
+  return std::runtime_error(path.string() + ": " + what + ", where its state file saved the run after row " +
+                            std::to_string(last_index) +
+                            ": the file was cut or edited, and resuming would lose rows. Restore it, or run again "
+                            "without --resume");
+}
+
+}  // namespace
+
 // Keeps the header and the rows up to and including `last_index` (rows written after the state
 // was last saved are dropped and computed again, so no point is duplicated on resume). Rows are
 // in order of their index: reading stops after row last_index, so a line a kill cut short after
-// it is dropped whatever its first characters read as.
-void truncate_csv(const std::filesystem::path& path, int last_index, const std::string& header) {
+// it is dropped whatever its first characters read as. The rows kept must all be there, whole
+// and in order (a kill cannot lose them: each is flushed before the state is saved), or the
+// resumed file would have a gap.
+void truncate_csv(const std::filesystem::path& path, int last_index, const std::string& header, CsvRows rows) {
   std::ifstream in(path);
   std::string kept_header, line, kept;
   std::getline(in, kept_header);
+  const size_t fields = static_cast<size_t>(std::count(kept_header.begin(), kept_header.end(), ',')) + 1;
   if (!header.empty()) kept_header = header;
-  while (std::getline(in, line)) {
+  int previous = -1;
+  while (previous < last_index && std::getline(in, line)) {
     if (line.empty()) continue;
-    const int index = std::stoi(line.substr(0, line.find(',')));
-    if (index > last_index) break;
+    const std::optional<int> index = complete_row_index(line, fields);
+    if (!index) throw rows_lost(path, last_index, "the row after row " + std::to_string(previous) + " is not whole");
+    if (*index > last_index) break;
+    const bool in_order = rows == CsvRows::EveryIndex ? *index == previous + 1 : *index > previous;
+    if (!in_order)
+      throw rows_lost(path, last_index,
+                      "row " + std::to_string(*index) + " follows row " + std::to_string(previous));
     kept += line + "\n";
-    if (index == last_index) break;
+    previous = *index;
   }
+  if (rows == CsvRows::EveryIndex && previous < last_index)
+    throw rows_lost(path, last_index, previous < 0 ? "it holds no rows" : "it ends at row " + std::to_string(previous));
   in.close();
   std::ofstream out(path, std::ios::trunc);
   out << kept_header << "\n" << kept;

@@ -94,9 +94,16 @@ struct RunStart {
 RunStart plan_start_from(const std::filesystem::path& state_path, const std::string& start_param,
                          const std::vector<std::pair<std::string, double>>& command_line);
 
+// Which indices a CSV's rows carry: every one from 0 (a branch's rows), or some, increasing (the
+// hard-contact re-solutions of some of a branch's rows, keyed by their row).
+enum class CsvRows { EveryIndex, SomeIndices };
+
 // Keeps the header and the rows of a branch CSV up to and including the one whose index (first
 // column) is `last_index`; the rows after it, and a row cut short by a kill, are dropped.
-// `header`, where not empty, replaces the file's (a renamed column).
-void truncate_csv(const std::filesystem::path& path, int last_index, const std::string& header = "");
+// `header`, where not empty, replaces the file's (a renamed column). Throws std::runtime_error
+// naming the file where a row up to last_index is missing (EveryIndex), cut short or out of order:
+// resuming would lose it.
+void truncate_csv(const std::filesystem::path& path, int last_index, const std::string& header = "",
+                  CsvRows rows = CsvRows::EveryIndex);
 
 }  // namespace kirchhoff

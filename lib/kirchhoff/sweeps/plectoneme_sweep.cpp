@@ -178,7 +178,7 @@ class HardContactCsv {
                  int resumed_row, PlectonemeBranchSummary* summary)
       : problem_(problem), EI_(EI), options_(options), summary_(summary) {
     const bool resuming = resumed_row >= 0 && std::filesystem::exists(path);
-    if (resuming) truncate_csv(path, resumed_row);
+    if (resuming) truncate_csv(path, resumed_row, "", CsvRows::SomeIndices);
     csv_.open(path, resuming ? std::ios::app : std::ios::trunc);
     if (!csv_) throw std::runtime_error("cannot write " + path);
     csv_ << std::setprecision(12);
