@@ -338,6 +338,9 @@ void truncate_csv(const std::filesystem::path& path, int last_index, const std::
   while (previous < last_index && std::getline(in, line)) {
     if (line.empty()) continue;
     const std::optional<int> index = complete_row_index(line, fields);
+    // (Some indices: the rows the state knows of are not known, and a kill may have cut the
+    // file's last row, written after the saved one - dropped with the rest, as before.)
+    if (!index && rows == CsvRows::SomeIndices) break;
     if (!index) throw rows_lost(path, last_index, "the row after row " + std::to_string(previous) + " is not whole");
     if (*index > last_index) break;
     const bool in_order = rows == CsvRows::EveryIndex ? *index == previous + 1 : *index > previous;
