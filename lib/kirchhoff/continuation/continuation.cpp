@@ -564,16 +564,15 @@ ContinuationResult Continuation::resume(const ContinuationPoint& last, const Poi
   return resume(state, sink);
 }
 
-std::optional<Continuation::Crossing> Continuation::crossing_at(const ContinuationPoint& point, const Eigen::MatrixXd& A,
-                                                                const Eigen::VectorXd& arrival) {
+std::optional<Eigen::VectorXd> Continuation::leaving_tangent(const ContinuationPoint& point, const Eigen::MatrixXd& A) {
   const detail::ResidualAt residual = [this](const Eigen::VectorXd& z, Eigen::VectorXd* F) {
     std::string failure;
     return evaluate(z, F, nullptr, &failure);
   };
-  const auto crossing = detail::branch_crossing(A, residual, join(point.x, point.parameter), arrival,
-                                                options_.branch_point_tolerance);
+  auto crossing = detail::branch_crossing(A, residual, join(point.x, point.parameter), point.tangent,
+                                          options_.branch_point_tolerance);
   if (!crossing) return std::nullopt;
-  return Crossing{crossing->arriving, crossing->leaving};
+  return std::move(crossing->leaving);
 }
 
 void Continuation::settle_branch_point_tangent(ContinuationPoint* point, const Eigen::VectorXd& arrival) {
@@ -590,7 +589,7 @@ Eigen::MatrixXd Continuation::bifurcation_directions(const ContinuationPoint& po
   std::string failure;
   if (!evaluate(join(point.x, point.parameter), &F, &A, &failure)) throw std::runtime_error(failure);
   if (count == 1)
-    if (const auto crossing = crossing_at(point, A, point.tangent)) return crossing->leaving;
+    if (auto leaving = leaving_tangent(point, A)) return *leaving;
   // A multiple branch point (or a simple one whose crossing cannot be resolved): the null
   // vectors orthogonal to the tangent.
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);

@@ -320,13 +320,10 @@ class Continuation {
   // A at z alone, where F is known there or not needed: the march's approximate matrix without
   // F's evaluation (ParameterisedSystem::approximate_matrix), else evaluate's, F thrown away.
   bool matrix_alone(const Eigen::VectorXd& z, Eigen::MatrixXd* A, std::string* failure, bool march);
-  // The tangents of the two branches crossing at a simple branch point whose matrix is A, the
-  // arriving one closest to `arrival` (detail/branch_crossing.hpp); empty where not resolved.
-  struct Crossing {
-    Eigen::VectorXd arriving, leaving;
-  };
-  std::optional<Crossing> crossing_at(const ContinuationPoint& point, const Eigen::MatrixXd& A,
-                                      const Eigen::VectorXd& arrival);
+  // The tangent of the branch crossing the point's own at a simple branch point whose matrix is
+  // A, the point's tangent telling the arriving root (detail/branch_crossing.hpp); empty where not
+  // resolved.
+  std::optional<Eigen::VectorXd> leaving_tangent(const ContinuationPoint& point, const Eigen::MatrixXd& A);
   // A located branch point's bordered tangent solves a singular system: its component along the
   // second null vector is noise over a vanishing singular value, of order one. Replaced, where the
   // null space is two-dimensional, by `arrival` (the tangent of the regular point before it)
