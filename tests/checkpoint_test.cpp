@@ -105,7 +105,7 @@ TEST_F(CheckpointTest, ContactRunKilledBetweenCheckpointsResumesToTheSameRows) {
   const fs::path full = dir_ / "wall_full.csv", csv = dir_ / "wall.csv";
   ASSERT_EQ(run_to_end(wall_args(full, "0"), dir_ / "wall_full.log"), 0);
   const auto expected = lines_of(full);
-  ASSERT_EQ(expected.size(), 302u);  // the header and --max-points 300 points (row 0 the start)
+  ASSERT_EQ(expected.size(), 301u);  // the header and --max-points 300 rows (row 0 the start)
   ASSERT_NE(expected[85].find("contact_flattens"), std::string::npos) << expected[85];
   for (int row : {50, 120}) {
     SCOPED_TRACE("killed after row " + std::to_string(row));

@@ -1181,8 +1181,7 @@ TEST_F(ContinueCli, SwitchingAtADiscContactsPitchforkFollowsTheAsymmetricContact
     ASSERT_GE(switched[side].size(), 30u);
   }
   // The asymmetric contact lifts off the disc at Delta = 0.1644. A run whose points are spent
-  // exactly there (the switched branch's first leg reports the branch point besides its
-  // max_points) stopped with "max_points must be in [1, 1e7]" (exit 1) when it set up the next
+  // exactly there stopped with "max_points must be in [1, 1e7]" (exit 1) when it set up the next
   // leg with none left; it stops at the event as max_points.
   // (Past the lift-off the free rod turns into the disc at once, and the run stops as
   // inadmissible, exit 1: contact.md, not modelled.)
@@ -1201,7 +1200,7 @@ TEST_F(ContinueCli, SwitchingAtADiscContactsPitchforkFollowsTheAsymmetricContact
   ASSERT_GT(to_lift_off, 0);
   const fs::path spent = dir_ / "spent.csv";
   ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", case_path.string(), "--param", "Delta", "--to", "0.029",
-                        "--switch-at-bp", "1", "--max-points", std::to_string(to_lift_off - 1), "--out",
+                        "--switch-at-bp", "1", "--max-points", std::to_string(to_lift_off), "--out",
                         spent.string()},
                        dir_ / "spent.log"),
             0);
@@ -1217,6 +1216,47 @@ TEST_F(ContinueCli, SwitchingAtADiscContactsPitchforkFollowsTheAsymmetricContact
                 at_Delta(switched["-1"], column, "contact_force", Delta), 1e-4)
         << Delta;
   }
+}
+
+// --max-points N gives N rows on each branch, whatever ends the run. The Euler column switched
+// at P = pi^2 reaches its touching-ends branch point, found inside a step besides the step's own
+// point, about 40 rows on; the wall's contact run starts a hanging-fold leg (run_along) at row
+// 676 and finds a fold at row 712. Each of those gave one row more than N: the switched branch
+// did not count the branch point it starts at, and a step's special point was not counted
+// against the budget before its candidate was added.
+TEST_F(ContinueCli, MaxPointsGivesThatManyRowsOnEachBranch) {
+  const std::string euler = std::string(KIRCHHOFF_CASES_DIR) + "/euler_column.toml";
+  bool ended_on_a_special_point = false;
+  for (int n = 33; n <= 48; ++n) {
+    const fs::path csv = dir_ / ("euler" + std::to_string(n) + ".csv");
+    ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", euler, "--param", "P", "--set", "P=1", "--set", "theta_guess=0",
+                          "--to", "20", "--switch-at-bp", "1", "--max-points", std::to_string(n), "--out",
+                          csv.string()},
+                         dir_ / "euler.log"),
+              0)
+        << n;
+    const auto rows = lines_of(csv);
+    const auto column = csv_header(rows[0]);
+    int on_switched = 0;
+    for (size_t i = 1; i < rows.size(); ++i) on_switched += csv_fields(rows[i])[column.at("branch")] == "1";
+    EXPECT_EQ(on_switched, n);
+    const auto last = csv_fields(rows.back());
+    if (last[column.at("type")] == "branch_point" && last[column.at("branch")] == "1") ended_on_a_special_point = true;
+  }
+  EXPECT_TRUE(ended_on_a_special_point);  // (else the loop no longer covers a step's special point)
+  const std::string wall = std::string(KIRCHHOFF_CASES_DIR) + "/wall.toml";
+  for (const int n : {677, 678, 713}) {
+    const fs::path csv = dir_ / ("wall" + std::to_string(n) + ".csv");
+    ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", wall, "--param", "Delta", "--to", "0.06", "--max-points",
+                          std::to_string(n), "--out", csv.string()},
+                         dir_ / "wall.log"),
+              0)
+        << n;
+    EXPECT_EQ(lines_of(csv).size(), static_cast<size_t>(n) + 1) << n;  // (the header)
+  }
+  const auto rows = lines_of(dir_ / "wall713.csv");
+  EXPECT_EQ(csv_fields(rows.back())[csv_header(rows[0]).at("type")], "fold");
+  EXPECT_NE(read_text(dir_ / "wall.log").find("hanging fold"), std::string::npos);
 }
 
 TEST_F(ContinueCli, ContinuingAnUnknownParameterIsRefused) {

@@ -636,6 +636,7 @@ ContinuationResult Continuation::run_along(const Eigen::VectorXd& x, double lamb
   first->step = options_.initial_step;
   MarchState state;
   state.current = std::move(*first);
+  state.points = 2;  // the origin, reported, counts against max_points as a run's start does
   result = march(std::move(state), sink);
   result.points.insert(result.points.begin(), origin);
   return result;
@@ -863,6 +864,8 @@ struct Continuation::Marcher {
       if (step_stop && p.type == PointType::Endpoint) return detail::Stop{d.stop.value_or(*step_stop), ""};
       if (step_stop == StopReason::EventStop && p.type == PointType::Event)
         return detail::Stop{StopReason::EventStop, "event " + p.event};
+      // A step can hold special points besides its candidate: the run's points are spent at one.
+      if (!has_room()) return detail::Stop{StopReason::MaxPoints, ""};
     }
     return std::nullopt;
   }
