@@ -52,7 +52,32 @@ struct Scales {
   // The force's momentum is divided by it too where positions are configuration variables (the
   // full frame below): the same factor on every momentum keeps the rescaling symplectic.
   double force_rate = 1.0;
+  // A spatial rod whose stiffnesses differ by more than kImbalance (a cantilever stiff in its
+  // loading plane, soft across it): one B cannot scale every direction's momentum. The rotation
+  // pair is then balanced direction by direction, u -> A u, p -> A^-1 p with A = R diag(c) R^T,
+  // R the frame and c_k = (B_k B_min)^(1/4) / sqrt(B) (balancing), which puts each direction's
+  // momentum at its rotation's size where the force sets the fields' wavenumber sqrt(|n| / B_k).
+  // Symplectic at every s (A symmetric and invertible; it varies with s as the frame turns): det U
+  // vanishes where it did, so no conjugate point moves, and the boundary forms keep their inertia.
+  // Unbalanced, the soft direction's momentum was B_min / B of its rotation: its eigenphase
+  // passed pi within that fraction of the rod, between observations, and its end form's
+  // eigenvalues fell inside the zero tolerance (an index 0 with a zero mode 2 % past a critical
+  // load). 0: not balanced.
+  double stiffness_min = 0.0;
 };
+
+// Stiffness ratios up to this are left to the one scale B: a twisted rod's twist to bending
+// stiffness 1 / (1 + nu) moves its momenta by less than a factor 1.5.
+constexpr double kImbalance = 4.0;
+
+// The balancing A of the rotation pair (Scales::stiffness_min) at a point with frame R, in the
+// lab's rotation coordinates; the identity where the rod is not balanced.
+Mat3 balancing(const RodModel& model, const Scales& sc, const Mat3& R, double s) {
+  if (!(sc.stiffness_min > 0)) return Mat3::Identity();
+  Vec3 c;
+  for (int k = 0; k < 3; ++k) c[k] = std::pow(model.B[k](s) * sc.stiffness_min, 0.25) / std::sqrt(sc.bending);
+  return R * c.asDiagonal() * R.transpose();
+}
 
 // Canonical coordinates of the rod's configuration (position, then rotation, along the
 // directions the equations admit) and their momenta.
@@ -93,10 +118,17 @@ void update_rotation_part(const RodEquations& eq, const Coordinates& c, const Sc
   const int n = c.size(), kr = c.kr();
   const RodPoint point = eq.point(y, s);
   const SlotMap rotation_jacobian = lab_rotation_jacobian(eq, y, point.R);
+  const double momentum = sc.length / (sc.bending * sc.rate);
+  if (sc.stiffness_min > 0) {  // (balanced: the rotation coordinates are the lab's three)
+    const Mat3 A = balancing(eq.model(), sc, point.R, s), A_inv = A.inverse();
+    map->T.middleRows(kr, 3).noalias() = A * rotation_jacobian;
+    map->T.bottomRows(3).noalias() = (momentum * A_inv) * eq.slot_map(Slot::Moment);
+    map->G.bottomRightCorner(3, 3).noalias() = (0.5 * momentum) * A_inv * cross_matrix(point.m) * A_inv;
+    return;
+  }
   map->T.middleRows(kr, n - kr).noalias() = c.rotation_dirs.transpose() * rotation_jacobian;
   map->G.bottomRightCorner(n - kr, n - kr).noalias() =
-      0.5 * (sc.length / (sc.bending * sc.rate)) * c.rotation_dirs.transpose() * cross_matrix(point.m) *
-      c.rotation_dirs;
+      0.5 * momentum * c.rotation_dirs.transpose() * cross_matrix(point.m) * c.rotation_dirs;
 }
 
 CanonicalMap canonical_map(const RodEquations& eq, const Coordinates& c, const Scales& sc, const Eigen::VectorXd& y,
@@ -271,6 +303,10 @@ struct PhaseTrack {
   std::vector<std::vector<std::pair<long, double>>> passages;  // (k of k pi, s) per eigenphase
   bool reversed = false;  // a genuine passage against the Legendre direction
   double reversed_at = 0.0;
+  // A step whose det U changed sign an odd number of times against the passages its eigenphases
+  // showed, at the halvings' end (advance): a passage turned a whole turn between observations.
+  bool unresolved = false;
+  double unresolved_at = 0.0;
 };
 
 // The smallest m with (2m + 1) pi > a.
@@ -309,10 +345,26 @@ class StabilityAnalysis {
       for (size_t i = 0; i < s.size(); ++i) s[i] = scales_.length * static_cast<double>(i) / (s.size() - 1);
       profile_ = problem_.sample(x_, s, &field_integrator_);
     }
+    scales_.stiffness_min = imbalanced_stiffness_min();
     full_ = options_.positions_as_configuration || positions_are_configuration();
     const int n = coords_.size(), kr = coords_.kr();
     offset_ = full_ ? 0 : kr;
     mU_ = full_ ? n : n - kr;
+  }
+
+  // The smallest stiffness of a spatial rod whose stiffnesses differ by more than kImbalance
+  // along it (Scales::stiffness_min), else 0.
+  double imbalanced_stiffness_min() const {
+    if (eq_->is_planar() || coords_.rotation_dirs.cols() != 3) return 0.0;
+    const RodModel& model = eq_->model();
+    double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+    for (int i = 0; i <= 16; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const double B = model.B[k](scales_.length * i / 16.0);
+        lo = std::min(lo, B);
+        hi = std::max(hi, B);
+      }
+    return hi > kImbalance * lo ? lo : 0.0;
   }
 
   // The wavenumber of the Jacobi fields, L sqrt(|n| / B) and L |m| / B at their largest over the
@@ -350,6 +402,10 @@ class StabilityAnalysis {
     Eigen::MatrixXd rotation;  // kpsi x b, rotation coordinates
   };
   Held held_at(const EndCondition& end, const std::vector<std::string>& multipliers) const;
+  // The same with the rotations in the balanced coordinates at state y, arclength s (Scales).
+  Held held_at(const EndCondition& end, const std::vector<std::string>& multipliers, const Eigen::VectorXd& y,
+               double s) const;
+  Mat3 balancing_at(const Eigen::VectorXd& y, double s) const;
   bool positions_are_configuration() const;
   // The configuration directions (the frame's U coordinates) an end holds in the load-controlled
   // problem: its held rotations; positions are never held there.
@@ -379,6 +435,8 @@ class StabilityAnalysis {
   bool interpolant_is_close(const Frame& a, const Frame& b) const;
   double observation_step(double longest) const;
   void advance(Frame* f, double s1, PhaseTrack* track, int depth);
+  static bool determinant_flipped(const Frame& from, const Frame& to);
+  static bool parity_contradicted(const Eigen::VectorXd& from, const Eigen::VectorXd& to, bool det_flipped);
   void record(const Frame& f, const Eigen::VectorXd& after, double s1, PhaseTrack* track);
   double locate_passage(const Frame& f, const Eigen::VectorXd& reference, int j, long multiple, double a, double b,
                         double ta, double tb);
@@ -397,7 +455,7 @@ class StabilityAnalysis {
                     const Held& end, const Eigen::MatrixXd& constraints, StabilityReport* report) const;
   // The shear of the canonical momenta a point quadratic form 1/2 z^T S z of the lab
   // perturbation z = (dr, dpsi) makes (p += S_c u), in the frame's U coordinates.
-  Eigen::MatrixXd canonical_shear(const Eigen::MatrixXd& lab_S) const;
+  Eigen::MatrixXd canonical_shear(const Eigen::MatrixXd& lab_S, const Frame& at) const;
 
   const ShootingProblem& problem_;
   const Eigen::VectorXd& x_;
@@ -448,6 +506,19 @@ StabilityAnalysis::Held StabilityAnalysis::held_at(const EndCondition& end,
   h.position = column_basis(C.topRows(kr));
   h.rotation = column_basis(C.bottomRows(kpsi));
   return h;
+}
+
+// A held rotation e (e.dpsi = 0) is e.A^-1 u = 0 in the balanced u = A dpsi: the column A^-1 e.
+StabilityAnalysis::Held StabilityAnalysis::held_at(const EndCondition& end, const std::vector<std::string>& multipliers,
+                                                   const Eigen::VectorXd& y, double s) const {
+  Held h = held_at(end, multipliers);
+  if (scales_.stiffness_min > 0 && h.rotation.cols() > 0)
+    h.rotation = column_basis(balancing_at(y, s).inverse() * h.rotation);
+  return h;
+}
+
+Mat3 StabilityAnalysis::balancing_at(const Eigen::VectorXd& y, double s) const {
+  return balancing(eq_->model(), scales_, eq_->point(y, s).R, s);
 }
 
 // Whether positions are configuration variables of their own, beside the rotation: where the
@@ -864,6 +935,7 @@ bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double observed, 
     // Only the frame arrived at is kept (and so kept orthonormal); eigenphases() takes the
     // others' plane as it is.
     const bool arrived = t1 == 1.0;
+    const bool det_flipped = arrived && determinant_flipped(*f, interpolated_);
     if (arrived) orthonormalise(&interpolated_);
     const Eigen::VectorXd phases = lift(lifted, eigenphases(interpolated_.U, interpolated_.P, arrived));
     const double largest = phases.size() == 0 ? 0.0 : (phases - lifted).cwiseAbs().maxCoeff();
@@ -871,7 +943,8 @@ bool StabilityAnalysis::interpolated_step(Frame* f, double s1, double observed, 
       dt *= 0.5;
       continue;
     }
-    if (largest > max_phase_step_ || !clear_or_clean_passage(lifted, phases, f->s + t * h, f->s + t1 * h, &seen_)) {
+    if (largest > max_phase_step_ || !clear_or_clean_passage(lifted, phases, f->s + t * h, f->s + t1 * h, &seen_) ||
+        (arrived && det_flipped != (seen_.size() % 2 == 1))) {
       steps_ = before;
       last_observation_ = before_step;
       return false;
@@ -920,25 +993,58 @@ double StabilityAnalysis::observation_step(double longest) const {
   return std::clamp(grown, 0.25 * longest, 2.0 * longest);
 }
 
+// Whether det U changed sign from frame `from` to `to`, the fields carried from it (to's U before
+// it is orthonormalised: the columns are then the same fields, continuous in s in between).
+// U(s) is singular exactly at conjugate points, so its determinant changes sign an odd number of
+// times where an odd number of eigenphases pass odd multiples of pi, counted with multiplicity.
+bool StabilityAnalysis::determinant_flipped(const Frame& from, const Frame& to) {
+  if (from.U.size() == 0) return false;
+  return (from.U.determinant() < 0) != (to.U.determinant() < 0);
+}
+
+// Whether the passages of the lifted eigenphases from `from` to `to` contradict the parity of det
+// U's sign changes over the step. A phase that turns a whole turn between two observations (a
+// field whose momentum is small against its rotation in the canonical scales, as the soft bending
+// of a rod much stiffer in its other direction: the lateral-torsional buckling of a 3D cantilever,
+// whose passages then take a thousandth of the rod) looks from its ends like a small move, and
+// its conjugate point was lost; det U still changed sign. Not decided where a phase lies within
+// 1e-6 of an odd multiple of pi at either end (det U then within round-off of zero).
+bool StabilityAnalysis::parity_contradicted(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                                            bool det_flipped) {
+  int passages = 0;
+  for (Eigen::Index j = 0; j < from.size(); ++j) {
+    if (std::abs(wrap(from[j] - kPi)) < 1e-6 || std::abs(wrap(to[j] - kPi)) < 1e-6) return false;
+    passages += odd_multiples_between(std::min(from[j], to[j]), std::max(from[j], to[j]));
+  }
+  return det_flipped != (passages % 2 == 1);
+}
+
 // One observation step, halved while an eigenphase moves more than max_phase_step over it as
-// record() pairs them (so that it pairs none wrongly, nor misses a turn).
+// record() pairs them (so that it pairs none wrongly, nor misses a turn), or while its passages
+// contradict det U's change of sign (parity_contradicted).
 void StabilityAnalysis::advance(Frame* f, double s1, PhaseTrack* track, int depth) {
   const CarriedSteps before = steps_;
   Frame& next = arriving_;
   flowed(*f, s1, &steps_, false, &next);
   canonical_blocks(&next);
+  const bool det_flipped = determinant_flipped(*f, next);
   orthonormalise(&next);
   const Eigen::VectorXd phases = eigenphases(next.U, next.P, true);
   // The moves of the phases as record() pairs them: where two phases come close, a long step can
   // pair them wrongly though each lies near some new phase.
-  const double largest =
-      phases.size() == 0 ? 0.0 : (lift(track->lifted, phases) - track->lifted).cwiseAbs().maxCoeff();
-  if (largest > max_phase_step_ && depth < options_.max_halvings) {
+  const Eigen::VectorXd lifted = lift(track->lifted, phases);
+  const double largest = phases.size() == 0 ? 0.0 : (lifted - track->lifted).cwiseAbs().maxCoeff();
+  const bool parity_fails = parity_contradicted(track->lifted, lifted, det_flipped);
+  if ((largest > max_phase_step_ || parity_fails) && depth < options_.max_halvings) {
     const double mid = 0.5 * (f->s + s1);
     steps_ = before;  // the halves continue from f, not from the step taken past them
     advance(f, mid, track, depth + 1);
     advance(f, s1, track, depth + 1);
     return;
+  }
+  if (parity_fails && !track->unresolved) {
+    track->unresolved = true;
+    track->unresolved_at = s1;
   }
   record(*f, phases, s1, track);
   last_observation_ = {s1 - f->s, largest};
@@ -996,7 +1102,7 @@ std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contac
   Eigen::Matrix<double, 6, 6> S_lab = Eigen::Matrix<double, 6, 6>::Zero();
   if (options_.contact_sliding) S_lab += (contact.force / g2) * a * a.transpose();
   S_lab.topLeftCorner<3, 3>() -= contact.force * K;
-  const Eigen::MatrixXd S = canonical_shear(S_lab);
+  const Eigen::MatrixXd S = canonical_shear(S_lab, *f);
   *shear = S.norm();
   // The shear leaves U, so no eigenphase passes -1 through it: each stays in its sheet between
   // consecutive odd multiples of pi (it may turn almost a whole turn inside it, so it is not
@@ -1038,11 +1144,13 @@ std::string StabilityAnalysis::pass_contact(Frame* f, const PointContact& contac
 // coordinates, and the momenta (dn, dm) are scaled by (L^2, L) / (B rate): S_c = L / (B rate)
 // J^T S J with J = diag(L position_dirs, rotation_dirs) - symmetric, as a point form must be.
 // The rotation-only frame keeps the rotation block (S has no position part there).
-Eigen::MatrixXd StabilityAnalysis::canonical_shear(const Eigen::MatrixXd& lab_S) const {
+Eigen::MatrixXd StabilityAnalysis::canonical_shear(const Eigen::MatrixXd& lab_S, const Frame& at) const {
   const int kr = coords_.kr(), kpsi = coords_.size() - kr;
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(6, coords_.size());
   J.topLeftCorner(3, kr) = scales_.length * coords_.position_dirs;
-  J.bottomRightCorner(3, kpsi) = coords_.rotation_dirs;
+  // (Balanced coordinates: dpsi = A^-1 u.)
+  if (scales_.stiffness_min > 0) J.bottomRightCorner(3, 3) = balancing_at(at.y, at.s).inverse();
+  else J.bottomRightCorner(3, kpsi) = coords_.rotation_dirs;
   const Eigen::MatrixXd S = (scales_.length / (scales_.bending * scales_.rate)) * J.transpose() * lab_S * J;
   return S.bottomRightCorner(mU_, mU_);
 }
@@ -1469,6 +1577,13 @@ std::string StabilityAnalysis::carry_across(Frame* f, const std::vector<PointCon
 void StabilityAnalysis::count_at_end(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start_phases,
                                      const Held& start, const Held& end, const Eigen::MatrixXd& constraints,
                                      StabilityReport* report) const {
+  if (track.unresolved && !track.reversed) {
+    std::ostringstream reason;
+    reason << "a conjugate point near s = " << track.unresolved_at
+           << " is not resolved: det U changes sign where the eigenphases show no passage, at the finest steps";
+    report->reason = reason.str();
+    return;
+  }
   if (track.reversed) {
     std::ostringstream reason;
     reason << "an eigenphase passed against the Legendre direction near s = " << track.reversed_at
@@ -1506,7 +1621,8 @@ StabilityReport StabilityAnalysis::run() {
     return report;
   }
   const ProblemDefinition& d = problem_.definition();
-  const Held start = held_at(d.start, multipliers), end = held_at(end_, multipliers);
+  const Held start = held_at(d.start, multipliers, x_.head(problem_.state_size()), 0.0);
+  const Held end = held_at(end_, multipliers);  // (its rotations balanced at s = L, below)
   // The isoperimetric constraints read at s = L: the held chord, or with the full frame every
   // position the end holds (and those the start holds, read at s = 0).
   const Eigen::MatrixXd constraints = full_ ? end.position : constraint_directions(start, end);
@@ -1533,8 +1649,9 @@ StabilityReport StabilityAnalysis::run() {
     return report;
   }
   report.rhs_evaluations = rhs_;
-  reversed_ = track.reversed;
-  count_at_end(f, track, start_phases, start, end, constraints, &report);
+  reversed_ = track.reversed || track.unresolved;
+  count_at_end(f, track, start_phases, start, scales_.stiffness_min > 0 ? held_at(end_, multipliers, f.y, f.s) : end,
+               constraints, &report);
   return report;
 }
 
