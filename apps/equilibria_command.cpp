@@ -86,7 +86,8 @@ void print_table(const Case& c, const EquilibriaSearch& search) {
   std::cout << "  " << std::setw(3) << "#" << std::setw(16) << "energy" << std::setw(12) << "index";
   if (families) std::cout << std::setw(8) << "family";
   std::cout << std::setw(11) << "residual" << std::setw(11) << "H spread";
-  for (const auto& name : c.derived) std::cout << std::setw(15) << name;
+  // (A space before each: a name of 15 characters or more would run into the one before.)
+  for (const auto& name : c.derived) std::cout << ' ' << std::setw(14) << name;
   std::cout << "  contacts\n";
   for (size_t i = 0; i < search.equilibria.size(); ++i) {
     const Equilibrium& e = search.equilibria[i];
@@ -96,7 +97,7 @@ void print_table(const Case& c, const EquilibriaSearch& search) {
     if (families) std::cout << std::setw(8) << (e.family > 0 ? std::to_string(e.family) : "-");
     std::cout << std::setw(11) << std::setprecision(2) << sol.result.summary.residual_norm
               << std::setw(11) << sol.invariants.H.relative_spread() << std::setprecision(8);
-    for (const auto& name : c.derived) std::cout << std::setw(15) << sol.derived.at(name);
+    for (const auto& name : c.derived) std::cout << ' ' << std::setw(14) << sol.derived.at(name);
     std::cout << "  " << contacts_text(sol) << "\n";
   }
   print_family_notes(search);
@@ -185,7 +186,8 @@ int run_equilibria(const EquilibriaArguments& args) {
   else
     print_table(c, search);
   if (search.equilibria.empty()) {
-    std::cerr << "error: " << c.path << ": no equilibrium found (" << search.stopped_because << ")\n";
+    std::cerr << "error: " << c.path << ": no equilibrium found (" << search.stopped_because << ")"
+              << (search.log.empty() ? "" : "; the search's last line: " + search.log.back()) << "\n";
     return kExitNotConverged;
   }
   return kExitOk;

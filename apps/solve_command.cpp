@@ -164,6 +164,10 @@ int run_check(const std::string& case_path, const std::vector<std::string>& over
   try {
     const Case c = load_case(case_path, parse_overrides(overrides), "", parse_solver_overrides(solver));
     const ShootingProblem problem(c.definition);
+    if (const std::string why = imposed_end_inside_obstacle(c.definition); !why.empty()) {
+      std::cerr << "error: " << case_path << ": " << why << "\n";
+      return kExitBadInput;
+    }
     std::cout << case_path << ": ok (" << (c.definition.kind == RodKind::Planar ? "planar" : "spatial") << ", "
               << problem.size() << " unknowns, " << c.definition.options.segments << " segment(s))\n";
     return kExitOk;

@@ -568,6 +568,22 @@ TEST_F(CliTest, NonFiniteOverrideExitsTwo) {
   EXPECT_THAT(overflow.err, HasSubstr("--set theta0: inf is not a finite number"));
 }
 
+// The wall's clamps at y = 0 below a wall moved to y = a = -0.1 lie inside it: `check` said "ok",
+// `solve` reported the fold its homotopy met on the way, `equilibria` "seeds exhausted". Now
+// check refuses it (exit 2), and solve and equilibria stop at once as infeasible (exit 1).
+TEST_F(CliTest, AnEndImposedInsideAnObstacleIsNamed) {
+  const std::string wall = quoted(case_path("wall.toml")) + " --set a=-0.1";
+  const CliRun check = run("check " + wall);
+  EXPECT_EQ(check.status, 2) << check.out;
+  EXPECT_THAT(check.err, HasSubstr("is imposed inside obstacle 'wall'"));
+  for (const char* command : {"solve", "equilibria"}) {
+    const CliRun r = run(std::string(command) + " " + wall);
+    EXPECT_EQ(r.status, 1) << command << ": " << r.err;
+    EXPECT_THAT(r.out + r.err, HasSubstr("infeasible")) << command;
+    EXPECT_THAT(r.out + r.err, HasSubstr("inside obstacle 'wall'")) << command;
+  }
+}
+
 TEST_F(CliTest, UnknownVariableInExpressionExitsTwo) {
   // Must be refused as input (exit 2, naming the key), not abort the program.
   for (const auto& [from, to, key] : {std::tuple<std::string, std::string, std::string>{"length = \"L\"", "length = \"Q\"", "rod.length"},

@@ -499,6 +499,50 @@ TEST(Equilibria, CaseEquilibriaIncludeSolvesEquilibrium) {
   for (const auto& e : s.equilibria) expect_admissible(e);
 }
 
+// The shallow arch (kappa0 = -1, clamped ends 0.9 apart) under w = 150 has one stable
+// equilibrium, the arch snapped through and hanging below its chord in tension; the rest (at the
+// arch's height, index 2 and 3) are unstable. It is carried from the file's values (w = 0) along
+// its homotopy, whose Newton at w = 150 ends at a residual recomputed as 1.7e-9 against the
+// tolerance 1e-10 (forces of ~150 integrated to 1e-12 relative): it was dropped there, and the
+// search listed no stable equilibrium. Now the search's own root test takes it. Its energy,
+// -10.4337, and index 0 (lowest eigenvalue +170) are a discretised energy's at 200 elements (a
+// probe's, O(h^2) accurate: 1e-3 relative).
+TEST(Equilibria, TheShallowArchSnappedThroughIsListedFarPastItsFold) {
+  const Case c = load_case(case_path("shallow_arch.toml"), {{"w", 150.0}});
+  const EquilibriaSearch s = find_case_equilibria(c, c.samples);
+  const auto hanging = std::find_if(s.equilibria.begin(), s.equilibria.end(), [](const Equilibrium& e) {
+    return e.stability.index && *e.stability.index == 0;
+  });
+  ASSERT_NE(hanging, s.equilibria.end()) << s.log.size();
+  EXPECT_NEAR(hanging->energy, -10.4337, 1e-3 * 10.4337);
+  EXPECT_NE(hanging->found_by.find("homotopy from the file's values"), std::string::npos) << hanging->found_by;
+}
+
+// --max N holds for the equilibria carried from the file's values and the Ipopt seeds too (the
+// wall at Delta = 0.033 listed 5 for --max 3), and the Newton runs count both searches'.
+TEST(Equilibria, MaxEquilibriaHoldsWithChangedValues) {
+  const Case c = load_case(case_path("wall.toml"), {{"Delta", 0.033}});
+  EquilibriaOptions options;
+  options.max_equilibria = 3;
+  const EquilibriaSearch s = find_case_equilibria(c, c.samples, options);
+  EXPECT_EQ(s.equilibria.size(), 3u);
+  EXPECT_EQ(s.stopped_because, "max_equilibria reached");
+  EXPECT_GT(s.newton_runs, 2);  // (the file's values' search alone made 7)
+}
+
+// An end imposed inside an obstacle (the wall's clamps at y = 0 with the wall at y = a = -0.1)
+// has no admissible equilibrium: solve says so at once (it reported the fold a homotopy from the
+// file's values met on the way, at a = 0.0757), and the search too (it said "seeds exhausted").
+TEST(Equilibria, AnEndImposedInsideAnObstacleIsInfeasible) {
+  const Case c = load_case(case_path("wall.toml"), {{"a", -0.1}});
+  const CaseSolve solved = solve_case(c);
+  EXPECT_EQ(solved.failure, "infeasible");
+  EXPECT_NE(solved.message.find("inside obstacle 'wall'"), std::string::npos) << solved.message;
+  const EquilibriaSearch s = find_case_equilibria(c, c.samples);
+  EXPECT_TRUE(s.equilibria.empty());
+  EXPECT_EQ(s.stopped_because, "infeasible");
+}
+
 TEST(Equilibria, WallNearFlatteningHasSymmetricAndAsymmetricContacts) {
   const EquilibriaSearch s = search("wall.toml", {{"Delta", 0.0307}});
   int symmetric = 0, asymmetric = 0, far = 0, free_down = 0;

@@ -247,23 +247,30 @@ ShootingResult solve_on_active_set(const ShootingProblem& problem, const Eigen::
   return r;
 }
 
-ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& guess, const ContactOptions& options) {
-  ContactSolveResult out;
-  std::sort(d.contacts.begin(), d.contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
-  auto problem = std::make_unique<ShootingProblem>(d);
-  // Imposed end positions must be admissible (other positions are what the loop corrects).
-  const auto eq = problem->equations(d.parameters);
+std::string imposed_end_inside_obstacle(const ProblemDefinition& d, double penetration_tolerance) {
+  if (d.obstacles.empty()) return "";
+  const ShootingProblem problem(d);
   for (bool at_start : {true, false}) {
     const EndCondition& end = at_start ? d.start : d.end;
     for (const auto& condition : end.conditions()) {
       if (condition.slot != Slot::Position || condition.directions != Directions::All || condition.extra) continue;
       const Vec3 r = condition.value(d.parameters);
-      for (const auto& o : problem->obstacles(d.parameters))
-        if (o.gap(r) < -options.penetration_tolerance)
-          throw InfeasibleContact(std::string("the rod's ") + (at_start ? "start" : "end") + " is imposed inside obstacle '" +
-                                  o.name + "' (gap " + std::to_string(o.gap(r)) + ")");
+      for (const auto& o : problem.obstacles(d.parameters))
+        if (o.gap(r) < -penetration_tolerance)
+          return std::string("the rod's ") + (at_start ? "start" : "end") + " is imposed inside obstacle '" + o.name +
+                 "' (gap " + std::to_string(o.gap(r)) + "): no admissible equilibrium";
     }
   }
+  return "";
+}
+
+ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& guess, const ContactOptions& options) {
+  ContactSolveResult out;
+  std::sort(d.contacts.begin(), d.contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
+  auto problem = std::make_unique<ShootingProblem>(d);
+  // Imposed end positions must be admissible (other positions are what the loop corrects).
+  if (const std::string why = imposed_end_inside_obstacle(d, options.penetration_tolerance); !why.empty())
+    throw InfeasibleContact(why);
   const std::vector<PointContact> stated = d.contacts;
   Eigen::VectorXd x = problem->initial_unknowns(guess);
   for (int round = 0; round < options.max_rounds; ++round) {

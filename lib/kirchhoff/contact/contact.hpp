@@ -44,6 +44,12 @@ struct InfeasibleContact : std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+// Why no admissible equilibrium exists because an end's imposed position lies inside an obstacle
+// (its gap below -penetration_tolerance), or "" where none does: what solve_with_contacts throws
+// as InfeasibleContact, for the callers that check a definition before they start (a homotopy to
+// requested values, `check`, the equilibria search).
+std::string imposed_end_inside_obstacle(const ProblemDefinition& definition, double penetration_tolerance = 1e-9);
+
 // Whether an active set has an extended contact, and a hanging fold: two neighbouring point
 // contacts on the same obstacle (the rod leaves it between them).
 bool has_extended_contact(const std::vector<PointContact>& contacts);

@@ -151,6 +151,10 @@ std::string StartSeed::validate() const {
 CaseSolve solve_case(const Case& c, const CaseSolveOptions& options) {
   if (const std::string why = options.seed.validate(); !why.empty()) throw std::invalid_argument(why);
   CaseSolve out;
+  // (At the requested values: a homotopy from the file's would otherwise follow the rod until its
+  // imposed end enters the obstacle and report where it stopped, a fold say, not why.)
+  if (const std::string why = imposed_end_inside_obstacle(c.definition); !why.empty())
+    return stopped_before_newton(solve_method(c, options), "infeasible", why);
   try {
     out = reach_equilibrium(c, options);
   } catch (const InfeasibleContact& e) {

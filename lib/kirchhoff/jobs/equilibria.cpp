@@ -454,6 +454,7 @@ class Search {
 
   void push_discrete_seeds() {
     for (const double amplitude : {0.05, -0.05}) {
+      if (should_stop()) return;  // (max_equilibria may be reached by the known roots already)
       const std::string label = std::string("Ipopt seed, buckled ") + (amplitude > 0 ? "up" : "down");
       try {
         ContactSolveResult r = solve_from_discrete_seed(definition_, 200, amplitude);
@@ -637,7 +638,16 @@ class Search {
         std::ostringstream why;
         why << known.found_by << ": residual " << root.residual << " above the tolerance; searched from instead";
         out_.log.push_back(why.str());
-        push_unknowns(family_key(known.contacts), std::move(x), known.found_by, -INFINITY);
+        // In the order of its energy among the other seeds (those of the roots found), as a seed
+        // made from an equilibrium is: first of all, it took --max's places from the mirror of a
+        // lower equilibrium (the spatial cantilever at P = 30: its global minimum's mirror).
+        double priority = -INFINITY;
+        try {
+          if (const double energy = total_potential_energy(*f.problem, x); std::isfinite(energy)) priority = energy;
+        } catch (const std::exception&) {
+          // (Not integrable: first, as before.)
+        }
+        push_unknowns(family_key(known.contacts), std::move(x), known.found_by, priority);
         return;
       }
       consider(f, std::move(x), known.found_by);
