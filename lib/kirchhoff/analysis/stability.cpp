@@ -71,12 +71,14 @@ struct Scales {
 constexpr double kImbalance = 4.0;
 
 // The balancing A of the rotation pair (Scales::stiffness_min) at a point with frame R, in the
-// lab's rotation coordinates; the identity where the rod is not balanced.
-Mat3 balancing(const RodModel& model, const Scales& sc, const Mat3& R, double s) {
+// rotation coordinates (the orthonormal basis `rotation_dirs` of the lab's three); the identity
+// where the rod is not balanced.
+Mat3 balancing(const RodModel& model, const Scales& sc, const Eigen::MatrixXd& rotation_dirs, const Mat3& R, double s) {
   if (!(sc.stiffness_min > 0)) return Mat3::Identity();
   Vec3 c;
   for (int k = 0; k < 3; ++k) c[k] = std::pow(model.B[k](s) * sc.stiffness_min, 0.25) / std::sqrt(sc.bending);
-  return R * c.asDiagonal() * R.transpose();
+  const Mat3 in_lab = R * c.asDiagonal() * R.transpose();
+  return rotation_dirs.transpose() * in_lab * rotation_dirs;
 }
 
 // Canonical coordinates of the rod's configuration (position, then rotation, along the
@@ -119,11 +121,12 @@ void update_rotation_part(const RodEquations& eq, const Coordinates& c, const Sc
   const RodPoint point = eq.point(y, s);
   const SlotMap rotation_jacobian = lab_rotation_jacobian(eq, y, point.R);
   const double momentum = sc.length / (sc.bending * sc.rate);
-  if (sc.stiffness_min > 0) {  // (balanced: the rotation coordinates are the lab's three)
-    const Mat3 A = balancing(eq.model(), sc, point.R, s), A_inv = A.inverse();
-    map->T.middleRows(kr, 3).noalias() = A * rotation_jacobian;
-    map->T.bottomRows(3).noalias() = (momentum * A_inv) * eq.slot_map(Slot::Moment);
-    map->G.bottomRightCorner(3, 3).noalias() = (0.5 * momentum) * A_inv * cross_matrix(point.m) * A_inv;
+  if (sc.stiffness_min > 0) {  // (balanced: three rotation coordinates)
+    const Mat3 A = balancing(eq.model(), sc, c.rotation_dirs, point.R, s), A_inv = A.inverse();
+    map->T.middleRows(kr, 3).noalias() = A * c.rotation_dirs.transpose() * rotation_jacobian;
+    map->T.bottomRows(3).noalias() = (momentum * A_inv) * c.rotation_dirs.transpose() * eq.slot_map(Slot::Moment);
+    map->G.bottomRightCorner(3, 3).noalias() =
+        (0.5 * momentum) * A_inv * c.rotation_dirs.transpose() * cross_matrix(point.m) * c.rotation_dirs * A_inv;
     return;
   }
   map->T.middleRows(kr, n - kr).noalias() = c.rotation_dirs.transpose() * rotation_jacobian;
@@ -518,7 +521,7 @@ StabilityAnalysis::Held StabilityAnalysis::held_at(const EndCondition& end, cons
 }
 
 Mat3 StabilityAnalysis::balancing_at(const Eigen::VectorXd& y, double s) const {
-  return balancing(eq_->model(), scales_, eq_->point(y, s).R, s);
+  return balancing(eq_->model(), scales_, coords_.rotation_dirs, eq_->point(y, s).R, s);
 }
 
 // Whether positions are configuration variables of their own, beside the rotation: where the
@@ -1149,7 +1152,7 @@ Eigen::MatrixXd StabilityAnalysis::canonical_shear(const Eigen::MatrixXd& lab_S,
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(6, coords_.size());
   J.topLeftCorner(3, kr) = scales_.length * coords_.position_dirs;
   // (Balanced coordinates: dpsi = A^-1 u.)
-  if (scales_.stiffness_min > 0) J.bottomRightCorner(3, 3) = balancing_at(at.y, at.s).inverse();
+  if (scales_.stiffness_min > 0) J.bottomRightCorner(3, 3) = coords_.rotation_dirs * balancing_at(at.y, at.s).inverse();
   else J.bottomRightCorner(3, kpsi) = coords_.rotation_dirs;
   const Eigen::MatrixXd S = (scales_.length / (scales_.bending * scales_.rate)) * J.transpose() * lab_S * J;
   return S.bottomRightCorner(mU_, mU_);
