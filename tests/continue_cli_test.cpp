@@ -1259,6 +1259,28 @@ TEST_F(ContinueCli, MaxPointsGivesThatManyRowsOnEachBranch) {
   EXPECT_NE(read_text(dir_ / "wall.log").find("hanging fold"), std::string::npos);
 }
 
+// A wall-clock limit that passes before the start has converged (or at a new contact leg's
+// start) stops the run as time_limit, which a driver resumes, not start_failed; the resumed run
+// starts from the beginning (no point was saved) and ends as the uninterrupted one.
+TEST_F(ContinueCli, ALimitReachedAtTheStartIsATimeLimit) {
+  const std::string wall = std::string(KIRCHHOFF_CASES_DIR) + "/wall.toml";
+  const fs::path csv = dir_ / "limited.csv", full = dir_ / "full.csv";
+  auto args = [&](const fs::path& out) {
+    return std::vector<std::string>{KIRCHHOFF_CLI, "continue", wall, "--param", "Delta", "--to", "0.04",
+                                    "--max-step", "2", "--out", out.string()};
+  };
+  auto limited = args(csv);
+  limited.insert(limited.end(), {"--max-seconds", "1e-6"});
+  EXPECT_EQ(run_to_end(limited, dir_ / "limited.log"), 1);
+  EXPECT_NE(read_text(dir_ / "limited.log").find("stopped: time_limit"), std::string::npos)
+      << read_text(dir_ / "limited.log");
+  auto resumed = args(csv);
+  resumed.push_back("--resume");
+  ASSERT_EQ(run_to_end(resumed, dir_ / "resumed.log"), 0);
+  ASSERT_EQ(run_to_end(args(full), dir_ / "full.log"), 0);
+  EXPECT_EQ(lines_of(csv), lines_of(full));
+}
+
 TEST_F(ContinueCli, ContinuingAnUnknownParameterIsRefused) {
   const std::vector<std::string> args = {KIRCHHOFF_CLI, "continue",
                                          std::string(KIRCHHOFF_CASES_DIR) + "/simply_supported.toml", "--param",

@@ -516,6 +516,16 @@ TEST(Equilibria, TheShallowArchSnappedThroughIsListedFarPastItsFold) {
   ASSERT_NE(hanging, s.equilibria.end()) << s.log.size();
   EXPECT_NEAR(hanging->energy, -10.4337, 1e-3 * 10.4337);
   EXPECT_NE(hanging->found_by.find("homotopy from the file's values"), std::string::npos) << hanging->found_by;
+  // With --max 1 the list is that lowest equilibrium (w = 100: -6.39298 by the same discretised
+  // energy): the search at the file's values was cut to one equilibrium, not the one that carries
+  // there, and the list held the first known root considered (none at all at w = 100).
+  EquilibriaOptions one;
+  one.max_equilibria = 1;
+  const EquilibriaSearch at_100 = find_case_equilibria(reload_case(c, {{"w", 100.0}}), c.samples, one);
+  ASSERT_EQ(at_100.equilibria.size(), 1u);
+  EXPECT_NEAR(at_100.equilibria[0].energy, -6.39298, 1e-3 * 6.39298);
+  ASSERT_TRUE(at_100.equilibria[0].stability.index);
+  EXPECT_EQ(*at_100.equilibria[0].stability.index, 0);
 }
 
 // --max N holds for the equilibria carried from the file's values and the Ipopt seeds too (the

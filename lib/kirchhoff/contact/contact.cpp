@@ -256,9 +256,12 @@ std::string imposed_end_inside_obstacle(const ProblemDefinition& d, double penet
       if (condition.slot != Slot::Position || condition.directions != Directions::All || condition.extra) continue;
       const Vec3 r = condition.value(d.parameters);
       for (const auto& o : problem.obstacles(d.parameters))
-        if (o.gap(r) < -penetration_tolerance)
-          return std::string("the rod's ") + (at_start ? "start" : "end") + " is imposed inside obstacle '" + o.name +
-                 "' (gap " + std::to_string(o.gap(r)) + "): no admissible equilibrium";
+        if (o.gap(r) < -penetration_tolerance) {
+          std::ostringstream why;  // (%g: a gap of -1e-7 is not "-0.000000")
+          why << "the rod's " << (at_start ? "start" : "end") << " is imposed inside obstacle '" << o.name << "' (gap "
+              << o.gap(r) << "): no admissible equilibrium";
+          return why.str();
+        }
     }
   }
   return "";
@@ -844,7 +847,9 @@ ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodP
   ContactContinuationResult out;
   ContactSolveResult start = solve_with_contacts(d, guess, contact);
   if (!start.result.summary.converged() || !start.complementarity) {
-    out.result.reason = StopReason::StartFailed;
+    // (As Continuation's start: failed once the wall-clock limit had passed, it stopped for it.)
+    out.result.reason =
+        std::chrono::steady_clock::now() >= options.deadline ? StopReason::TimeLimit : StopReason::StartFailed;
     out.result.message = "no admissible starting point: " + start.message;
     return out;
   }

@@ -356,6 +356,7 @@ class Continuation {
   // Marches on from `state` (its `current` reported to the sink first when report_start): the
   // steps, and the special points the detectors (continuation_detectors.hpp) find inside them.
   ContinuationResult march(MarchState state, const PointSink& sink, bool report_start = true);
+  StopReason start_stop() const;
   struct Marcher;  // the march's working state and its parts (continuation.cpp)
   // Locates where `monitor` (of the point reached from `from` by a step h, predicted with the
   // curvature where given) vanishes or is minimal, by the secant method or Brent on h in

@@ -35,7 +35,9 @@ int carry_from_file_values(const Case& c, const std::vector<ParameterChange>& ch
   const Case start = case_at_file_values(c);
   EquilibriaOptions at_file = options;
   at_file.known_roots.clear();
-  at_file.max_equilibria = std::min(options.max_equilibria, kFileValuesMaxEquilibria);
+  // (Not the caller's --max, which bounds the list at the requested values: a small one kept the
+  // equilibrium that carries to the stable one there from being found.)
+  at_file.max_equilibria = kFileValuesMaxEquilibria;
   at_file.max_newton_runs = std::max(1, static_cast<int>(kFileValuesShare * options.max_newton_runs));
   at_file.max_seconds = kFileValuesShare * options.max_seconds;
   const EquilibriaSearch found = find_equilibria(start.definition, start.start_guess, start.derived, samples, at_file);

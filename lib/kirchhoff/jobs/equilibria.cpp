@@ -323,10 +323,10 @@ class Search {
   }
 
   EquilibriaSearch run() {
-    for (const auto& known : options_.known_roots) {
-      if (should_stop()) break;  // max_equilibria holds for known roots too
-      consider_known(known);
-    }
+    // Every known root is considered (each is one polish, not a search), and --max then keeps the
+    // lowest in energy: stopping at the first N kept the order they came in (with --set
+    // shallow_arch.toml at w = 100 and --max 1, an unstable arch instead of the stable one).
+    for (const auto& known : options_.known_roots) consider_known(known);
     push_start(guess_, definition_.contacts, "guess");
     if (options_.mirrors) {
       push_mirrors(guess_, "guess");
@@ -346,6 +346,10 @@ class Search {
     std::stable_sort(out_.equilibria.begin(), out_.equilibria.end(), [](const Equilibrium& a, const Equilibrium& b) {
       return std::isnan(b.energy) ? !std::isnan(a.energy) : a.energy < b.energy;
     });
+    if (static_cast<int>(out_.equilibria.size()) > options_.max_equilibria) {  // (the known roots alone)
+      out_.equilibria.erase(out_.equilibria.begin() + options_.max_equilibria, out_.equilibria.end());
+      out_.stopped_because = "max_equilibria reached";
+    }
     out_.families = group_continuous_families(&out_.equilibria, force_scale_, options_.distinct_tolerance,
                                               options_.family_energy_tolerance, options_.compare_samples);
     return std::move(out_);
