@@ -1281,6 +1281,23 @@ TEST_F(ContinueCli, ALimitReachedAtTheStartIsATimeLimit) {
   EXPECT_EQ(lines_of(csv), lines_of(full));
 }
 
+// A row whose index is undefined has an empty cell and the CSV no column for why: the first such
+// row is noted with the reason (the Reissner rod's dead 3D end couple is not conservative), once.
+TEST_F(ContinueCli, TheFirstRowWithoutAnIndexIsNotedWithWhy) {
+  const fs::path csv = dir_ / "reissner.csv";
+  ASSERT_EQ(run_to_end({KIRCHHOFF_CLI, "continue", std::string(KIRCHHOFF_CASES_DIR) + "/reissner.toml", "--param", "F",
+                        "--to", "2.5", "--out", csv.string()},
+                       dir_ / "reissner.log"),
+            0);
+  const std::string log = read_text(dir_ / "reissner.log");
+  EXPECT_NE(log.find("row 0 (F = 2): stability index undefined: the end's loads are not conservative"), std::string::npos)
+      << log;
+  EXPECT_EQ(log.find("index undefined"), log.rfind("index undefined")) << log;  // (once)
+  const auto rows = lines_of(csv);
+  ASSERT_GT(rows.size(), 3u);
+  EXPECT_EQ(csv_fields(rows[2])[csv_header(rows[0]).at("stability_index")], "");
+}
+
 TEST_F(ContinueCli, ContinuingAnUnknownParameterIsRefused) {
   const std::vector<std::string> args = {KIRCHHOFF_CLI, "continue",
                                          std::string(KIRCHHOFF_CASES_DIR) + "/simply_supported.toml", "--param",

@@ -410,6 +410,12 @@ class ContactTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "planar clamped-clamped"):
             kirchhoff.load_case(case_path("indenter.toml")).solve(seed="ipopt")
 
+    def test_the_first_point_without_an_index_is_noted_with_why(self):
+        b = kirchhoff.load_case(case_path("reissner.toml")).continue_("F", to=2.5)
+        undefined = [n for n in b.notes if "stability index undefined" in n]
+        self.assertEqual(len(undefined), 1, b.notes)
+        self.assertIn("not conservative", undefined[0])
+
     def test_infeasible_wall_is_a_status(self):
         case = kirchhoff.load_case(case_path("wall.toml"), set={"a": -0.01})
         sol = case.solve(direct=True)

@@ -76,6 +76,7 @@ PointRecorder rod_point_recorder(const RodRecordOptions& options, const std::vec
           analyse_stability(problem, point->x, stability_options), problem, point->x, false);
       point->stability_index = stability.index;
       point->zero_modes = stability.zero_modes;
+      point->stability_reason = stability.index ? "" : stability.reason;
     };
   return recorder;
 }

@@ -133,9 +133,22 @@ class Run {
     rp.contacts = contacts;
     rp.problem = problem;
     for (auto* s : sinks_) s->point(rp);
+    note_undefined_index(p);
     state.written = WrittenPoint{state.row, branch, phase, p, contacts ? *contacts : std::vector<PointContact>{}};
     state.written->point.jacobian.reset();
     if (!resumable(p) && state.has_march) emit_state(false);
+  }
+
+  // The first row whose index is undefined, with why (the CSV leaves the cell empty and has no
+  // column for the reason); the rest are not noted one by one.
+  void note_undefined_index(const ContinuationPoint& p) {
+    if (noted_undefined_index_ || p.stability_reason.empty()) return;
+    noted_undefined_index_ = true;
+    std::ostringstream line;
+    line << "row " << state.row << " (" << r_.parameter << " = " << p.parameter
+         << "): stability index undefined: " << p.stability_reason
+         << " (later rows without an index are not noted one by one)";
+    note(line.str());
   }
 
   ContinueRunResult deflated();
@@ -148,6 +161,7 @@ class Run {
   RodContinuationOptions options_;
   const std::vector<ContinueSink*>& sinks_;
   const std::vector<PointContact> no_contacts_;
+  bool noted_undefined_index_ = false;
 };
 
 // Every branch through the equilibria at the start, branch k from the k-th by energy (no state:
