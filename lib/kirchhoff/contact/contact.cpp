@@ -847,9 +847,7 @@ ContactContinuationResult continue_with_contacts(ProblemDefinition d, const RodP
   ContactContinuationResult out;
   ContactSolveResult start = solve_with_contacts(d, guess, contact);
   if (!start.result.summary.converged() || !start.complementarity) {
-    // (As Continuation's start: failed once the wall-clock limit had passed, it stopped for it.)
-    out.result.reason =
-        std::chrono::steady_clock::now() >= options.deadline ? StopReason::TimeLimit : StopReason::StartFailed;
+    out.result.reason = failed_start_reason(options.deadline);
     out.result.message = "no admissible starting point: " + start.message;
     return out;
   }

@@ -88,6 +88,10 @@ const char* to_string(PointType type) {
   return "?";
 }
 
+StopReason failed_start_reason(std::chrono::steady_clock::time_point deadline) {
+  return std::chrono::steady_clock::now() >= deadline ? StopReason::TimeLimit : StopReason::StartFailed;
+}
+
 const char* to_string(StopReason reason) {
   switch (reason) {
     case StopReason::ReachedTarget: return "reached_target";
@@ -492,11 +496,6 @@ std::optional<ContinuationPoint> Continuation::locate(const ContinuationPoint& f
   return best;
 }
 
-// A start that failed once the wall-clock limit had passed (its Newton stopped by the limit, say)
-// stopped for the limit: time_limit, which a driver resumes, not start_failed.
-StopReason Continuation::start_stop() const {
-  return std::chrono::steady_clock::now() >= options_.deadline ? StopReason::TimeLimit : StopReason::StartFailed;
-}
 
 ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink& sink) {
   ContinuationResult result;
@@ -505,7 +504,7 @@ ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink&
   // search of a single solve), then the tangent oriented towards the target.
   const FixedParameterSolve first = system_->solve_at(x0, lambda0, options_.corrector_tolerance);
   if (!first.converged) {
-    result.reason = start_stop();
+    result.reason = failed_start_reason(options_.deadline);
     result.message = "the starting point does not converge at " + options_.parameter + " = " +
                      std::to_string(lambda0) + ": " + first.report;
     return result;
@@ -518,7 +517,7 @@ ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink&
   if (correct(z, z, e, &iterations)) start = point_at(z, direction * e, PointType::Start, 0, 0.0, iterations);
   if (start) describe(&*start);
   if (!start || !start->check_failure.empty()) {
-    result.reason = start_stop();
+    result.reason = failed_start_reason(options_.deadline);
     result.message = "the starting point does not converge at " + options_.parameter + " = " + std::to_string(lambda0) +
                      (start ? ": " + start->check_failure : "");
     return result;
@@ -531,7 +530,7 @@ ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink&
 
 ContinuationResult Continuation::resume(const MarchState& saved, const PointSink& sink) {
   ContinuationResult failed;
-  failed.reason = start_stop();
+  failed.reason = failed_start_reason(options_.deadline);
   MarchState state = saved;
   auto current = restore(saved.current, true);
   if (!current) {
@@ -627,7 +626,7 @@ ContinuationResult Continuation::run_along(const Eigen::VectorXd& x, double lamb
     first = point_at(z, d, PointType::Regular, 1, (z - z_bp).norm(), iterations);
   if (first) describe(&*first);
   if (!first) {
-    result.reason = start_stop();
+    result.reason = failed_start_reason(options_.deadline);
     result.message = "no solution along the switching direction";
     return result;
   }

@@ -245,6 +245,9 @@ struct MarchState {
 enum class StopReason { ReachedTarget, MaxPoints, ParameterBounds, StepTooSmall, EventStop, BranchPointStop, StartFailed,
                         Inadmissible, TimeLimit, FoldStop };
 const char* to_string(StopReason reason);
+// Why a start that did not converge stopped the run: time_limit where the wall-clock limit had
+// passed by then (its Newton stopped by the limit, say), which a driver resumes; else start_failed.
+StopReason failed_start_reason(std::chrono::steady_clock::time_point deadline);
 
 struct ContinuationResult {
   std::vector<ContinuationPoint> points;
@@ -357,7 +360,6 @@ class Continuation {
   // Marches on from `state` (its `current` reported to the sink first when report_start): the
   // steps, and the special points the detectors (continuation_detectors.hpp) find inside them.
   ContinuationResult march(MarchState state, const PointSink& sink, bool report_start = true);
-  StopReason start_stop() const;
   struct Marcher;  // the march's working state and its parts (continuation.cpp)
   // Locates where `monitor` (of the point reached from `from` by a step h, predicted with the
   // curvature where given) vanishes or is minimal, by the secant method or Brent on h in
