@@ -1193,6 +1193,7 @@ bool StabilityAnalysis::count_interior(const Frame& f, const PhaseTrack& track, 
   }
   if (interior < 0) {
     report->reason = "the conjugate-point count came out negative: the Jacobi system is degenerate";
+    report->resolution_limited = true;
     return false;
   }
   report->interior_count = interior;
@@ -1488,6 +1489,7 @@ bool StabilityAnalysis::constraint_correction(const Frame& f, const Held& end, c
           << "eigenvalue " << unresolved_value << " within its resolution " << unresolved_resolution
           << " (a load-controlled mode near zero), and the whole problem not as many zero modes";
       report->reason = why.str();
+      report->resolution_limited = true;
       return false;
     }
     // The isoperimetric theory's count of the whole problem's zero modes: the load-controlled ones
@@ -1580,6 +1582,7 @@ std::string StabilityAnalysis::carry_across(Frame* f, const std::vector<PointCon
 void StabilityAnalysis::count_at_end(const Frame& f, const PhaseTrack& track, const Eigen::VectorXd& start_phases,
                                      const Held& start, const Held& end, const Eigen::MatrixXd& constraints,
                                      StabilityReport* report) const {
+  report->resolution_limited = track.unresolved || track.reversed;
   if (track.unresolved && !track.reversed) {
     std::ostringstream reason;
     reason << "a conjugate point near s = " << track.unresolved_at
@@ -1610,6 +1613,7 @@ void StabilityAnalysis::count_at_end(const Frame& f, const PhaseTrack& track, co
   report->index = report->dead_load_index + report->constraint_correction;
   if (*report->index < 0) {
     report->reason = "the isoperimetric correction exceeds the load-controlled index: degenerate constraints";
+    report->resolution_limited = true;
     report->index.reset();
   }
 }
@@ -1844,9 +1848,10 @@ StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::V
   // count needs (the isoperimetric correction of an anisotropic twisted rod under compression,
   // B1 = 3 B2, phi = 32 .. 40: D's eigenvalues of 1e-4 .. 2e-2 within resolutions of 1e-3 .. 9e-2,
   // where the state's tolerance settles index 9 .. 11, as a discretised energy does). Points whose
-  // index is undefined for what the case is (unsupported, not conservative) integrate nothing.
+  // index is undefined for what the case is (a dead couple on an end free to rotate, a degenerate
+  // constraint) are not counted again: tighter fields would say the same at twice the cost.
   const bool looser = options.field_tolerance > problem.definition().options.integrator.abs_tol;
-  if (report.defined() || report.unstable || !looser || report.rhs_evaluations == 0) return report;
+  if (report.defined() || !report.resolution_limited || !looser) return report;
   StabilityOptions exact = options;
   exact.field_tolerance = 0.0;
   StabilityReport again = analyse_at_field_tolerance(problem, x, exact);

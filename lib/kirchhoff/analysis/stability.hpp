@@ -154,6 +154,10 @@ struct StabilityReport {
   // contact force lifts off with lower energy, where the lowering perturbations form a cone, not
   // a space (detail/stability_extended_contact.hpp).
   bool unstable = false;
+  // The index is undefined for want of accuracy, not for what the case is: a conjugate point or
+  // the isoperimetric correction within the Jacobi fields' resolution. Fields integrated more
+  // tightly may settle it (analyse_stability retries a branch's looser fields only then).
+  bool resolution_limited = false;
   bool defined() const { return index.has_value(); }
   bool stable() const { return index && *index == 0; }
 };

@@ -215,7 +215,11 @@ FreeLengthStability analyse_free_length(const ShootingProblem& problem, const Ei
   }
   const std::string held = "with the length '" + out.parameter + "' held: ";
   out.fixed_length = analyse_stability(*fixed.problem, fixed.x, options);
-  if (!out.fixed_length.defined()) return undefined(out, held + out.fixed_length.reason);
+  if (!out.fixed_length.defined()) {
+    out = undefined(out, held + out.fixed_length.reason);
+    out.report.resolution_limited = out.fixed_length.resolution_limited;
+    return out;
+  }
   if (out.fixed_length.zero_modes > 0)
     return undefined(out, held + "a zero mode (the second variation is singular), so the reduction on the "
                                  "length is not defined");
