@@ -277,6 +277,14 @@ TEST_F(CaseFileTest, TaperedStiffnessGoesNegative) {
   expect_refused(text, "rod.B", {"stiffness must be > 0", "at s = 0.5"}, line_of(text, "B = "));
 }
 
+// A stretch 1e-4 of the rod long where the stiffness is -1 fell between the 101 points it was
+// checked at (a probe's case), and the solve returned the uniform rod's answer; both sides of
+// each located jump are checked now.
+TEST_F(CaseFileTest, AShortStretchOfNegativeStiffnessIsRefused) {
+  const std::string text = replaced(kBase, "B = \"EI\"", "B = \"EI*(1 - 2*(s > 0.4013 && s < 0.4014))\"");
+  expect_refused(text, "rod.B", {"stiffness must be > 0", "-1", "at s = 0.4013"}, line_of(text, "B = "));
+}
+
 TEST_F(CaseFileTest, TaperedStiffnessPositiveIsAccepted) {
   const std::string text = replaced(kBase, "B = \"EI\"", "B = \"1 + 2*s\"");
   EXPECT_NO_THROW(load_case(write(text)));

@@ -182,7 +182,7 @@ struct PointRecord {
   // With compute_stability: the index (empty where it is not defined) and the zero modes.
   std::optional<int> stability_index;
   int zero_modes = 0;
-  std::string stability_reason;  // why stability_index is empty (with compute_stability), else 
+  std::string stability_reason;  // why stability_index is empty (with compute_stability), else empty
   // Why the point failed the checks of a solution (verification.hpp: a profile with NaN, a rod
   // beyond its soft wall), "" when it passed. Such a point is never put on a branch.
   std::string check_failure;

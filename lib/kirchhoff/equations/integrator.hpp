@@ -3,9 +3,12 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "kirchhoff/model/rod_model.hpp"
 
 namespace kirchhoff {
 
@@ -33,6 +36,10 @@ struct IntegratorOptions {
   // (to sensitivity_tol), without the state's own pass - for a caller that needs Phi and has F
   // (ShootingProblem::step_matrix).
   bool sensitivities_only = false;
+  // Where the right-hand side jumps (a material property given piecewise; the equations set it
+  // from RodModel::jumps, not the caller): every integration ends a stretch on a jump's `before`
+  // and goes on from its `after`, so that no step straddles it. Null: none.
+  std::shared_ptr<const std::vector<ProfileJump>> jumps;
 
   // Returns an empty string when valid, else the reason.
   std::string validate() const;

@@ -25,7 +25,8 @@ constexpr int kStateSize = kPlanarStateSize;
 
 class PlanarEquations final : public RodEquations {
  public:
-  explicit PlanarEquations(RodModel model) : model_(std::move(model)), compliances_(model_) {}
+  explicit PlanarEquations(RodModel model)
+      : model_(std::move(model)), compliances_(model_), jumps_(std::make_shared<const std::vector<ProfileJump>>(model_.jumps())) {}
 
   int state_size() const override { return kStateSize; }
   const RodModel& model() const override { return model_; }
@@ -61,8 +62,9 @@ class PlanarEquations final : public RodEquations {
     dy[kMoment] = y[kNx] * dyy - y[kNy] * dx;
   }
 
-  void flow_into(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities, const IntegratorOptions& options,
+  void flow_into(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities, const IntegratorOptions& given,
                  SegmentFlow* out) const override {
+    const IntegratorOptions options = with_jumps(given);
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     if (!sensitivities) return detail::flow_state_into<kStateSize>(f, y0, s0, s1, options, out);
     if (model_.field) {
@@ -79,7 +81,8 @@ class PlanarEquations final : public RodEquations {
   }
 
   DirectionalFlow flow_directions(const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions, double s0, double s1,
-                                  const IntegratorOptions& options, CarriedSteps* carried) const override {
+                                  const IntegratorOptions& given, CarriedSteps* carried) const override {
+    const IntegratorOptions options = with_jumps(given);
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     // The seeds of flow(): all of them with a field, else those x(s0), y(s0) do not enter.
     static const std::vector<int> kAll{kX, kY, kTheta, kNx, kNy, kMoment};
@@ -89,7 +92,8 @@ class PlanarEquations final : public RodEquations {
   }
 
   std::vector<Eigen::VectorXd> sample(const Eigen::VectorXd& y0, const std::vector<double>& s,
-                                      const IntegratorOptions& options) const override {
+                                      const IntegratorOptions& given) const override {
+    const IntegratorOptions options = with_jumps(given);
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     return detail::sample_states<kStateSize>(f, y0, s, options);
   }
@@ -239,8 +243,16 @@ class PlanarEquations final : public RodEquations {
     out->dy_dunfolding.resize(0);
   }
 
+  // The caller's options with this rod's jumps (IntegratorOptions::jumps).
+  IntegratorOptions with_jumps(const IntegratorOptions& given) const {
+    IntegratorOptions options = given;
+    if (!jumps_->empty()) options.jumps = jumps_;
+    return options;
+  }
+
   RodModel model_;
   detail::Compliances compliances_;  // of model_ (declared after it: built from it)
+  std::shared_ptr<const std::vector<ProfileJump>> jumps_;  // of model_: where its properties jump
 };
 
 }  // namespace

@@ -1,24 +1,55 @@
 // [rod] of a case file: the length, the stiffness and natural-strain profiles and the external
 // fields (gravity, barrier, self-contact), checked along the rod, become the problem's RodModel.
+#include <deque>
 #include <functional>
 #include <memory>
+#include <mutex>
 
 #include "kirchhoff/contact/self_contact.hpp"
 #include "kirchhoff/jobs/detail/case_reader.hpp"
+#include "kirchhoff/model/detail/profile_jumps.hpp"
 
 namespace kirchhoff::case_reading {
 namespace {
 
-// Material properties are checked (positive, finite) at this many points along the rod.
-constexpr int kPositivitySamples = 101;
+// The jumps of a piecewise profile last located, with the values they were located at: a model
+// is built for each new set of parameter values, and locating costs ~2e4 evaluations (3 ms), most
+// of a branch's time where only a load changes. A few are kept: a finite difference alternates
+// between two sets of values.
+class JumpCache {
+ public:
+  std::vector<ProfileJump> jumps(const Profile& profile, const std::vector<double>& values) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [at, jumps] : located_)
+      if (at == values) return jumps;
+    if (located_.size() == kKept) located_.pop_front();
+    located_.emplace_back(values, locate_jumps(profile, values.back()));
+    return located_.back().second;
+  }
 
-// A material profile: the expression, checked positive along the rod when required.
+ private:
+  static constexpr size_t kKept = 4;
+  std::mutex mutex_;
+  // (the expression's parameters, then the rod's length; the jumps there), oldest first
+  std::deque<std::pair<std::vector<double>, std::vector<ProfileJump>>> located_;
+};
+
+// A material profile: the expression, checked positive along the rod when required. One given
+// piecewise (may_jump) is built with its jumps located, which the integrations land on.
 struct ProfileSpec {
   Expression expression = Expression::constant(0.0);
   const Value* source = nullptr;
   std::string key;
-  Profile build(const Parameters& p) const {
-    return expression.depends_on_s() ? Profile(expression.bind(p)) : Profile(expression(p));
+  std::shared_ptr<JumpCache> jump_cache = std::make_shared<JumpCache>();
+  Profile build(const Parameters& p, double length) const {
+    if (!expression.depends_on_s()) return Profile(expression(p));
+    Profile profile(expression.bind(p));
+    if (!may_jump(expression.text())) return profile;
+    std::vector<double> values;
+    for (const auto& name : expression.used_parameters()) values.push_back(p.get(name));
+    values.push_back(length);
+    std::vector<ProfileJump> jumps = jump_cache->jumps(profile, values);
+    return std::move(profile).with_jumps(std::move(jumps));
   }
 };
 
@@ -48,8 +79,10 @@ RodSpec read_rod_profiles(const Reader& reader, const Value& rod) {
     u_hat[i] = {Expression::constant(0.0), nullptr, "rod.u_hat"};
     v_hat[i] = {Expression::constant(natural_v[i]), nullptr, "rod.v_hat"};
   }
-  if (const Value* v = Reader::find(rod, "B"))  // isotropic bending: B1 = B2
-    for (int i = 0; i < 2; ++i) B[i] = {reader.expression(*v, "rod.B", true), v, "rod.B"};
+  if (const Value* v = Reader::find(rod, "B")) {  // isotropic bending: B1 = B2, one expression
+    B[0] = {reader.expression(*v, "rod.B", true), v, "rod.B"};
+    B[1] = B[0];
+  }
   for (int i = 0; i < 3; ++i) {
     if (const Value* v = Reader::find(rod, bend_keys[i])) {
       const std::string key = std::string("rod.") + bend_keys[i];
@@ -173,8 +206,11 @@ void check_rod_profiles(const Reader& reader, const RodSpec& r, const Parameters
     if (group == &r.A && !r.extensible) continue;
     const bool stiffness = group == &r.B || group == &r.A;
     for (const auto& spec : *group) {
-      for (int k = 0; k < kPositivitySamples; ++k) {
-        const double s = L * k / (kPositivitySamples - 1);
+      // Densely, and on both sides of each jump: a short stretch of a piecewise property (a
+      // soft zone 1e-4 of the rod long) fell between 101 samples.
+      const std::vector<double> points =
+          spec.expression.depends_on_s() ? check_points(L, spec.build(parameters, L).jumps()) : std::vector<double>{0.0};
+      for (const double s : points) {
         // Defaults have no source; they are constants in range.
         const double value = spec.source ? reader.value(spec.expression, *spec.source, spec.key, s) : spec.expression(parameters, s);
         if (stiffness && !(value > 0)) {
@@ -182,7 +218,6 @@ void check_rod_profiles(const Reader& reader, const RodSpec& r, const Parameters
           if (spec.source) reader.fail(*spec.source, spec.key, reason);
           reader.fail(spec.key, reason);
         }
-        if (!spec.expression.depends_on_s()) break;
       }
     }
   }
@@ -227,10 +262,10 @@ void define_model(const RodSpec& r, FieldAdder add_fields, const std::set<std::s
     m.length = length(p);
     m.extensible = extensible;
     for (int i = 0; i < 3; ++i) {
-      m.B[i] = B[i].build(p);
-      m.A[i] = A[i].build(p);
-      m.u_hat[i] = u_hat[i].build(p);
-      m.v_hat[i] = v_hat[i].build(p);
+      m.B[i] = B[i].build(p, m.length);
+      m.A[i] = A[i].build(p, m.length);
+      m.u_hat[i] = u_hat[i].build(p, m.length);
+      m.v_hat[i] = v_hat[i].build(p, m.length);
     }
     auto fields = std::make_shared<FieldSum>();
     add_fields(p, m.length, fields.get());

@@ -1,5 +1,6 @@
 #include "kirchhoff/model/rod_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -78,13 +79,19 @@ namespace {
 // a profile that dips below zero between samples would still fail in the equations).
 constexpr int kValidationSamples = 101;
 
+void require_positive_at(const Profile& p, double s, const std::string& name) {
+  const double value = p(s);
+  if (!(value > 0.0))
+    throw std::invalid_argument(name + " must be > 0 along the rod, got " + std::to_string(value) +
+                                " at s = " + std::to_string(s));
+}
+
+// (Both sides of each jump too: a stretch between two jumps may be shorter than the samples' spacing.)
 void require_positive(const Profile& p, double length, const std::string& name) {
-  for (int i = 0; i < kValidationSamples; ++i) {
-    const double s = length * i / (kValidationSamples - 1);
-    const double value = p(s);
-    if (!(value > 0.0))
-      throw std::invalid_argument(name + " must be > 0 along the rod, got " + std::to_string(value) +
-                                  " at s = " + std::to_string(s));
+  for (int i = 0; i < kValidationSamples; ++i) require_positive_at(p, length * i / (kValidationSamples - 1), name);
+  for (const ProfileJump& j : p.jumps()) {
+    require_positive_at(p, j.before, name);
+    require_positive_at(p, j.after, name);
   }
 }
 }  // namespace
@@ -106,6 +113,23 @@ bool RodModel::has_constant_properties() const {
     if (extensible && !A[i].is_constant()) return false;
   }
   return true;
+}
+
+std::vector<ProfileJump> RodModel::jumps() const {
+  std::vector<ProfileJump> all;
+  const auto add = [&](const std::array<Profile, 3>& profiles) {
+    for (const Profile& p : profiles) all.insert(all.end(), p.jumps().begin(), p.jumps().end());
+  };
+  add(B);
+  if (extensible) add(A);
+  add(u_hat);
+  add(v_hat);
+  std::sort(all.begin(), all.end(), [](const ProfileJump& a, const ProfileJump& b) { return a.before < b.before; });
+  // Properties read from one expression (B for B1 and B2) jump at the same place.
+  all.erase(std::unique(all.begin(), all.end(),
+                        [](const ProfileJump& a, const ProfileJump& b) { return b.before <= a.after; }),
+            all.end());
+  return all;
 }
 
 }  // namespace kirchhoff

@@ -12,11 +12,18 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace kirchhoff {
 
 using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
+
+// Where a material property given piecewise jumps: its left-hand value holds up to `before`, its
+// right-hand one from `after`, the next double (model/detail/profile_jumps.hpp locates them).
+struct ProfileJump {
+  double before = 0.0, after = 0.0;
+};
 
 // A scalar material property as a function of the arclength s. Constant profiles skip the
 // function call, which matters because the right-hand side evaluates six of them per call.
@@ -28,6 +35,12 @@ class Profile {
 
   double operator()(double s) const { return function_ ? function_(s) : constant_; }
   bool is_constant() const { return !function_; }
+  // The same profile, known to jump at these places (sorted by s, inside the rod).
+  Profile with_jumps(std::vector<ProfileJump> jumps) && {
+    jumps_ = std::move(jumps);
+    return std::move(*this);
+  }
+  const std::vector<ProfileJump>& jumps() const { return jumps_; }
   // d/ds of the profile; central differences when no derivative was supplied (used only for
   // reporting identities such as eq. 57, never inside the equations).
   double derivative(double s) const;
@@ -36,6 +49,7 @@ class Profile {
   double constant_ = 0.0;
   std::function<double(double)> function_;
   std::function<double(double)> derivative_;
+  std::vector<ProfileJump> jumps_;
 };
 
 // A conservative external field per unit length: potential W_ext(s, r), force f = -dW/dr and the
@@ -140,6 +154,9 @@ struct RodModel {
   // True when no stiffness or natural strain depends on s: is_uniform() but for the
   // symmetry-unfolding couple, whose effect on H a caller may bound itself.
   bool has_constant_properties() const;
+  // Every place where a property that enters the equations jumps (the shear and stretch
+  // stiffnesses only where extensible), sorted by s, one entry per place.
+  std::vector<ProfileJump> jumps() const;
 };
 
 }  // namespace kirchhoff

@@ -3,6 +3,7 @@
 // evaluated on double for the state and on Dual<N> for the variational equations.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <boost/numeric/odeint.hpp>
 #include <cmath>
@@ -22,7 +23,7 @@ namespace odeint = boost::numeric::odeint;
 // return *ds is the step the controller proposes next, a step cut short to land on s1 not
 // shrinking it: handed to the next adjacent interval, it continues the same integration.
 template <class State, class System>
-long march_carrying(State& x, double s0, double s1, const System& system, const IntegratorOptions& opt, double* ds_io) {
+long march_stretch(State& x, double s0, double s1, const System& system, const IntegratorOptions& opt, double* ds_io) {
   const double span = s1 - s0;
   if (span == 0.0) return 0;
   double s = s0;
@@ -51,6 +52,31 @@ long march_carrying(State& x, double s0, double s1, const System& system, const 
   for (double v : x)
     if (!std::isfinite(v)) throw IntegrationError("non-finite state");
   return steps;
+}
+
+// march_stretch over [s0, s1] (either way round), the stretch between two jumps of the right-hand
+// side (IntegratorOptions::jumps) at a time: each ends on the side it came from and the next
+// starts on the other, so a step's stages never mix the two sides, and a short stretch is
+// always stepped into. The state is continuous across a jump.
+template <class State, class System>
+long march_carrying(State& x, double s0, double s1, const System& system, const IntegratorOptions& opt, double* ds_io) {
+  if (!opt.jumps || opt.jumps->empty()) return march_stretch(x, s0, s1, system, opt, ds_io);
+  const bool forward = s1 > s0;
+  const double lo = std::min(s0, s1), hi = std::max(s0, s1);
+  long steps = 0;
+  double from = s0;
+  const auto cross = [&](double to, double resume) {
+    steps += march_stretch(x, from, to, system, opt, ds_io);
+    from = resume;
+  };
+  if (forward) {
+    for (const ProfileJump& j : *opt.jumps)
+      if (j.before > lo && j.after < hi) cross(j.before, j.after);
+  } else {
+    for (auto j = opt.jumps->rbegin(); j != opt.jumps->rend(); ++j)
+      if (j->before > lo && j->after < hi) cross(j->after, j->before);
+  }
+  return steps + march_stretch(x, from, s1, system, opt, ds_io);
 }
 
 // One interval on its own: the first trial step is opt.initial_step of it.
@@ -243,10 +269,10 @@ DirectionalFlow flow_directions_through_seeds(const Rhs& rhs, const Eigen::Vecto
   return out;
 }
 
-// States at the requested arclengths (sorted; repeated values allowed). Both steppers step onto
-// each sample point, so profiles keep the integration's accuracy. (Dopri5's dense output is not
-// used: odeint's integrate_times interpolates a sample equal to the start before the first step,
-// from the stepper's uninitialised previous state, and gave NaN there.)
+// States at the requested arclengths (sorted; repeated values allowed). The integration lands on
+// each sample point, so profiles keep its accuracy. (Dopri5's dense output is not used: odeint's
+// integrate_times interpolated a sample equal to the start before the first step, from the
+// stepper's uninitialised previous state, and gave NaN there.)
 template <int N, class Rhs>
 std::vector<Eigen::VectorXd> sample_states(const Rhs& rhs, const Eigen::VectorXd& y0,
                                            const std::vector<double>& s_values,
@@ -257,17 +283,15 @@ std::vector<Eigen::VectorXd> sample_states(const Rhs& rhs, const Eigen::VectorXd
   std::vector<Eigen::VectorXd> out;
   if (s_values.empty()) return out;
   auto system = [&](const State& y, State& dy, double s) { rhs(y.data(), dy.data(), s); };
-  auto observer = [&](const State& y, double) {
-    out.push_back(Eigen::Map<const Eigen::Matrix<double, N, 1>>(y.data()));
-  };
+  // One integration observed at each s (march_carrying continues the step sizes from one to the
+  // next, and lands on the right-hand side's jumps between them).
   const double span = s_values.back() - s_values.front();
-  const double ds = opt.initial_step * (span > 0 ? span : 1.0);
-  if (opt.stepper == IntegratorOptions::Stepper::Dopri5) {
-    auto stepper = odeint::make_controlled(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_dopri5<State>());
-    odeint::integrate_times(stepper, system, x, s_values.begin(), s_values.end(), ds, observer);
-  } else {
-    auto stepper = odeint::make_controlled(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_fehlberg78<State>());
-    odeint::integrate_times(stepper, system, x, s_values.begin(), s_values.end(), ds, observer);
+  double ds = opt.initial_step * (span > 0 ? span : 1.0);
+  out.reserve(s_values.size());
+  out.push_back(Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data()));
+  for (size_t i = 1; i < s_values.size(); ++i) {
+    march_carrying(x, s_values[i - 1], s_values[i], system, opt, &ds);
+    out.push_back(Eigen::Map<const Eigen::Matrix<double, N, 1>>(x.data()));
   }
   return out;
 }

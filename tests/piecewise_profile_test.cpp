@@ -1,0 +1,123 @@
+// Material properties given piecewise along the rod: their jumps are located
+// (model/detail/profile_jumps.hpp) and the integrations land on them, so a short stretch of a
+// different stiffness is never stepped across unseen.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "kirchhoff/continuation/rod_continuation.hpp"
+#include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/model/detail/profile_jumps.hpp"
+#include "kirchhoff/shooting/shooting.hpp"
+#include "test_support.hpp"
+
+namespace kirchhoff {
+namespace {
+
+TEST(ProfileJumps, MayJumpWhereTheTextComparesOrSteps) {
+  EXPECT_TRUE(may_jump("EI*(1 - 0.9*(s > 0.4 && s < 0.5))"));
+  EXPECT_TRUE(may_jump("s < a ? B1 : B2"));
+  EXPECT_TRUE(may_jump("1 + sign(s - 0.5)"));
+  EXPECT_TRUE(may_jump("2 + rint(4*s)"));
+  EXPECT_FALSE(may_jump("EI*(1 + taper*(s/L - 0.5))"));
+  EXPECT_FALSE(may_jump("1 + exp(-s^2) * cos(sinh(s))"));  // (names containing "sign" or "rint": none)
+}
+
+TEST(ProfileJumps, AShortStretchIsLocatedBetweenAdjacentDoubles) {
+  // 1e-3 of the rod long, six samples' spacing: both ends, each to one ulp.
+  const auto f = [](double s) { return 1.0 - 0.99 * (s > 0.4013 && s < 0.4023); };
+  const std::vector<ProfileJump> jumps = locate_jumps(f, 1.0);
+  ASSERT_EQ(jumps.size(), 2u);
+  EXPECT_EQ(jumps[0].after, std::nextafter(jumps[0].before, 1.0));
+  EXPECT_EQ(f(jumps[0].before), 1.0);
+  EXPECT_NEAR(f(jumps[0].after), 0.01, 1e-15);
+  EXPECT_NEAR(jumps[0].before, 0.4013, 1e-15);
+  EXPECT_NEAR(jumps[1].before, 0.4023, 1e-15);
+  EXPECT_EQ(f(jumps[1].after), 1.0);
+  // On a rod of length 3 the same stretch (scaled) is found where it is.
+  const std::vector<ProfileJump> scaled = locate_jumps([&](double s) { return f(s / 3.0); }, 3.0);
+  ASSERT_EQ(scaled.size(), 2u);
+  EXPECT_NEAR(scaled[1].before, 3.0 * 0.4023, 1e-14);
+}
+
+TEST(ProfileJumps, ASteepSmoothProfileDoesNotJumpAndASlopedOneDoes) {
+  // tanh over 1e-3 of the rod changes by ~1e3 ulp-widths' worth of nothing: no jump.
+  EXPECT_TRUE(locate_jumps([](double s) { return 2.0 + std::tanh((s - 0.5) / 1e-3); }, 1.0).empty());
+  // A jump of 0.3 on a slope that changes 1e-4 per sample: found, with its size.
+  const auto sloped = [](double s) { return 1.0 + 2.0 * s + 0.3 * (s > 0.7); };
+  const std::vector<ProfileJump> jumps = locate_jumps(sloped, 1.0);
+  ASSERT_EQ(jumps.size(), 1u);
+  EXPECT_NEAR(jumps[0].before, 0.7, 1e-15);
+  EXPECT_NEAR(sloped(jumps[0].after) - sloped(jumps[0].before), 0.3, 1e-14);
+  // And every check point: the samples and both sides of each jump.
+  EXPECT_EQ(check_points(1.0, jumps).size(), static_cast<size_t>(kJumpSamples + 1 + 2));
+}
+
+// The straight column's buckling loads with bending stiffness EI_i on consecutive stretches of
+// length h_i: (EI theta')' + P theta = 0 with theta' = 0 at both pinned ends. The transfer
+// matrix of a uniform stretch, k = sqrt(P / EI), carries (theta, m = EI theta'); a load is
+// critical where m(L) = 0 from (1, 0).
+double end_moment(double P, const std::vector<std::pair<double, double>>& stretches) {
+  double theta = 1.0, m = 0.0;
+  for (const auto& [EI, h] : stretches) {
+    const double k = std::sqrt(P / EI), c = std::cos(k * h), s = std::sin(k * h);
+    const double next_theta = c * theta + s / (EI * k) * m;
+    m = -EI * k * s * theta + c * m;
+    theta = next_theta;
+  }
+  return m;
+}
+
+std::vector<double> critical_loads(const std::vector<std::pair<double, double>>& stretches, double up_to) {
+  std::vector<double> loads;
+  const int n = 4000;
+  for (int i = 0; i < n; ++i) {
+    double a = up_to * (i + 0.5) / n, b = up_to * (i + 1.5) / n;
+    if (end_moment(a, stretches) * end_moment(b, stretches) > 0) continue;
+    for (int k = 0; k < 200 && b - a > 1e-14 * b; ++k) {
+      const double c = 0.5 * (a + b);
+      (end_moment(a, stretches) * end_moment(c, stretches) <= 0 ? b : a) = c;
+    }
+    loads.push_back(0.5 * (a + b));
+  }
+  return loads;
+}
+
+// The Euler column with a stretch of a hundredth of its stiffness 1e-3 long (a probe's case):
+// before the jumps were located the integrator stepped across it and every branch point was the
+// uniform column's (9.8696 = pi^2, where this column buckles at 8.2975), converged.
+TEST(PiecewiseRod, ColumnWithAShortSoftStretchBucklesAtItsTransferMatrixLoads) {
+  std::string text = testing::case_text("euler_column.toml");
+  const std::string uniform = "B = \"EI\"";
+  ASSERT_NE(text.find(uniform), std::string::npos);
+  text.replace(text.find(uniform), uniform.size(), "B = \"EI*(1 - 0.99*(s > 0.4013 && s < 0.4023))\"");
+  const Case c = load_case_text(text, "soft_stretch.toml", {{"P", 1.0}, {"theta_guess", 0.0}});
+  const ShootingProblem problem(c.definition);
+  RodContinuationOptions o;
+  o.parameter = "P";
+  o.target = 40.0;
+  o.initial_step = 0.5;
+  o.max_step = 5.0;
+  o.samples = 21;
+  o.compute_stability = true;
+  RodContinuation run(problem, o);
+  const ContinuationResult r = run.run(problem.initial_unknowns(c.start_guess));
+  std::vector<ContinuationPoint> branch_points;
+  for (const auto& p : r.points)
+    if (p.type == PointType::BranchPoint) branch_points.push_back(p);
+  const std::vector<double> exact = critical_loads({{1.0, 0.4013}, {0.01, 0.001}, {1.0, 1.0 - 0.4023}}, 40.0);
+  ASSERT_EQ(exact.size(), 2u);  // 8.2975 and 37.159
+  ASSERT_EQ(branch_points.size(), exact.size());
+  // The branch points are located to the continuation's 1e-8 (continuation_test's kLocated).
+  for (size_t k = 0; k < exact.size(); ++k) EXPECT_NEAR(branch_points[k].parameter / exact[k], 1.0, 1e-8);
+  // The straight column is stable below the first load and has index 1 past it.
+  for (const auto& p : r.points) {
+    if (!p.stability_index || p.type == PointType::BranchPoint) continue;
+    EXPECT_EQ(*p.stability_index, p.parameter < exact[0] ? 0 : (p.parameter < exact[1] ? 1 : 2))
+        << "P = " << p.parameter;
+  }
+}
+
+}  // namespace
+}  // namespace kirchhoff
