@@ -219,6 +219,8 @@ VibrationProblem::VibrationProblem(const ShootingProblem& problem, const Eigen::
       model.v_hat[2](0.0) != 1.0)
     throw std::invalid_argument("vibrations: the rod must have v = (0, 0, 1) (no natural shear or stretch)");
   length_ = model.length;
+  if (const auto jumps = model.jumps(); !jumps.empty())  // (its own marches are not the equations')
+    options_.integrator.jumps = std::make_shared<const std::vector<ProfileJump>>(jumps);
   omega_scale_ = std::sqrt(model.B[1](0.0) / (options_.rho_s * std::pow(length_, 4)));
 
   try {
@@ -382,6 +384,10 @@ double VibrationProblem::bracketed_root(double a, double fa, double b, double fb
   return root;
 }
 
+// A double root's matching matrix is this much nearer singular at the dip's minimum than at its
+// ends (a genuine one: ~1e-10 against ~1e-2, the integration error against the modes' spacing).
+constexpr double kDipContrast = 1e3;
+
 // Brent's minimum of the dip to 2^-26 (1.5e-8) relative, the precision a minimum's location has
 // in double precision (the function is flat to second order there).
 constexpr int kDipMinimumBits = 26;
@@ -398,12 +404,23 @@ void VibrationProblem::dip_roots(double a, double fa, double fm, double b, doubl
     found->push_back(bracketed_root(v_min, sign * g_min, b, fb, omega2_of, name));
     return;
   }
-  // No sign change: a multiple root where the matching matrix loses rank at the minimum.
+  // No sign change: a multiple root where the matching matrix loses rank at the minimum - and
+  // only there. Where the perturbations grow by e^(sigma L / 2) towards the middle (a stiff
+  // barrier's field gradient, growth rates of 1e3), the columns shot from one end all turn into
+  // the fastest-growing direction and the matrix is as near singular at the dip's ends as at its
+  // minimum: a probe's soft wall at log_b = -3 showed four such "double roots", omega^2 = -2.1e6
+  // .. -7e5, where the discretised energy has none. A rank lost at the minimum alone is a root.
+  const auto smallest_ratio = [&](double v) {
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(matching(omega2_of(v)).M);
+    return svd.singularValues().tail(1)[0] / svd.singularValues()[0];
+  };
+  const double at_ends = std::min(smallest_ratio(a), smallest_ratio(b));
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(matching(omega2_of(v_min)).M);
   const Eigen::VectorXd& sv = svd.singularValues();
   int nullity = 0;
   for (Eigen::Index j = 0; j < sv.size(); ++j) nullity += sv[j] <= kMatchingResidualLimit * sv[0];
-  if (nullity >= 2)
+  const bool lost_at_minimum_only = sv.tail(1)[0] / sv[0] * kDipContrast < at_ends;
+  if (nullity >= 2 && lost_at_minimum_only)
     for (int k = 0; k < nullity; ++k) found->push_back(v_min);
 }
 
