@@ -157,6 +157,7 @@ int run_continue(const ContinueArguments& args) {
   ContinueRequest request;
   request.parameter = args.parameter;
   if (args.has_to) request.target = args.to;
+  request.direction = args.direction;
   request.initial_step = args.step;
   request.min_step = args.min_step;
   request.max_step = args.max_step;
@@ -181,7 +182,7 @@ int run_continue(const ContinueArguments& args) {
   inputs.start_param = args.start_param;
   RunPlan plan;
   try {
-    for (const auto& t : args.overrides) inputs.overrides.push_back(parse_override(t));
+    inputs.overrides = parse_overrides(args.case_path, args.overrides);
     inputs.solver = parse_solver_overrides(args.solver);
     request.events = parse_events(args.stop_events, true);
     for (auto& e : parse_events(args.record_events, false)) request.events.push_back(e);

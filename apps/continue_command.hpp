@@ -18,6 +18,7 @@ struct ContinueArguments {
   std::string parameter;
   double to = 0.0;
   bool has_to = false;
+  double direction = 1.0;     // +1 / -1: which way the parameter goes first without --to
   double step = 0.05;
   double min_step = 1e-7;
   double max_step = 0.5;

@@ -164,7 +164,7 @@ int run_equilibria(const EquilibriaArguments& args) {
   Case c;
   EquilibriaOptions options;
   try {
-    c = load_case(args.case_path, parse_overrides(args.overrides), "", parse_solver_overrides(args.solver));
+    c = load_case(args.case_path, parse_overrides(args.case_path, args.overrides), "", parse_solver_overrides(args.solver));
     options.max_equilibria = args.max_equilibria;
     options.max_seconds = args.max_seconds;
     if (const std::string why = options.validate(); !why.empty()) throw CaseError(why);

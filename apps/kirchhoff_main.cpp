@@ -110,6 +110,9 @@ CLI::App* add_continue_command(CLI::App& app, ContinueArguments* args, std::stri
   command->add_option("--to", args->to, "Stop when the parameter reaches this value (on the starting branch: a branch switched onto with "
                       "--switch-at-bp runs to an --event or --max-points)")
       ->each([args](const std::string&) { args->has_to = true; });
+  command->add_option("--direction", args->direction,
+                      "Which way the parameter goes first when there is no --to: 1 (up) or -1 (down)")
+      ->capture_default_str();
   command->add_option("--step", args->step, "Initial pseudo-arclength step")->capture_default_str();
   command->add_option("--min-step", args->min_step, "Smallest step before giving up")->capture_default_str();
   command->add_option("--max-step", args->max_step, "Largest step")->capture_default_str();

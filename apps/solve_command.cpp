@@ -57,13 +57,13 @@ void print_path(const SolvePath& path) {
 
 }  // namespace
 
-ParameterOverrides parse_overrides(const std::vector<std::string>& texts) {
+ParameterOverrides parse_overrides(const std::string& case_path, const std::vector<std::string>& texts) {
   ParameterOverrides out;
   for (const auto& t : texts) {
     try {
       out.push_back(parse_override(t));
     } catch (const std::invalid_argument& e) {
-      throw CaseError(std::string("--set: ") + e.what());
+      throw CaseError(case_path + ": --set: " + e.what());
     }
   }
   return out;
@@ -75,7 +75,7 @@ int load_and_solve(const std::string& case_path, const std::vector<std::string>&
                    const std::function<std::string(const Case&)>& refusal) {
   Case& c = out->c;
   try {
-    c = load_case(case_path, parse_overrides(overrides), phase_condition, parse_solver_overrides(solver));
+    c = load_case(case_path, parse_overrides(case_path, overrides), phase_condition, parse_solver_overrides(solver));
     limit_wall_clock(c.definition.options, max_seconds);
   } catch (const CaseError& e) {
     std::cerr << "error: " << e.what() << "\n";
@@ -162,7 +162,7 @@ int run_solve(const SolveArguments& args) {
 int run_check(const std::string& case_path, const std::vector<std::string>& overrides,
               const std::vector<std::string>& solver) {
   try {
-    const Case c = load_case(case_path, parse_overrides(overrides), "", parse_solver_overrides(solver));
+    const Case c = load_case(case_path, parse_overrides(case_path, overrides), "", parse_solver_overrides(solver));
     const ShootingProblem problem(c.definition);
     if (const std::string why = imposed_end_inside_obstacle(c.definition); !why.empty()) {
       std::cerr << "error: " << case_path << ": " << why << "\n";

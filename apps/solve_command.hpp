@@ -31,7 +31,7 @@ struct SolveArguments {
 int run_solve(const SolveArguments& args);
 
 // NAME=VALUE texts as overrides; throws CaseError naming the bad one.
-ParameterOverrides parse_overrides(const std::vector<std::string>& texts);
+ParameterOverrides parse_overrides(const std::string& case_path, const std::vector<std::string>& texts);
 
 // A case loaded and solved the way `solve` does it (case_solve.hpp).
 struct SolvedCase {

@@ -5,7 +5,12 @@
 namespace kirchhoff::python_bindings {
 PyCase py_load_case(const std::string& path, const py::object& set, const std::string& phase_condition,
                     const py::object& solver) {
-  ParameterOverrides overrides = named_values(set);
+  ParameterOverrides overrides;
+  try {
+    overrides = named_values(set);
+  } catch (const CaseError& e) {  // (the CLI's --set words, with the file, as its other refusals)
+    throw CaseError(path + ": set: " + e.what());
+  }
   const SolverOverrides solver_overrides = solver_values(solver);
   PyCase out;
   {
@@ -22,7 +27,7 @@ PyCase py_load_case(const std::string& path, const py::object& set, const std::s
 namespace {
 
 PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::string& seed, int seed_segments,
-                    double max_seconds, bool direct) {
+                    double seed_amplitude, double max_seconds, bool direct) {
   Case c = pc.c;
   // Bad arguments are CaseError (a ValueError), as the module's other bad input.
   try {
@@ -49,6 +54,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
       options.direct = direct;
       options.seed.ipopt = seed == "ipopt";
       options.seed.segments = seed_segments;
+      options.seed.amplitude = seed_amplitude;
       options.samples = samples;
       solved = solve_case(c, options);
     } catch (const std::invalid_argument& e) {  // a case the Ipopt seed does not model
@@ -292,7 +298,8 @@ Attributes:
       .def_property_readonly("samples", [](const PyCase& p) { return p.c.samples; })
       .def_readonly("phase_condition", &PyCase::phase_condition);
   cls.def("solve", &py_solve, py::arg("samples") = py::none(), py::kw_only(), py::arg("seed") = "guess",
-          py::arg("seed_segments") = 200, py::arg("max_seconds") = kDefaultSolveSeconds, py::arg("direct") = false,
+          py::arg("seed_segments") = 200, py::arg("seed_amplitude") = 0.05,
+          py::arg("max_seconds") = kDefaultSolveSeconds, py::arg("direct") = false,
           R"doc(Solves the case by shooting.
 
 Parameters changed from the file's values (load(..., set=...)) are reached by continuation from
@@ -305,6 +312,8 @@ Args:
         discretised energy, its shape and contact set (planar clamped-clamped rods; ValueError
         for other cases).
     seed_segments (int): segments of that discretised rod.
+    seed_amplitude (float): amplitude of the buckling mode Ipopt starts from, as a fraction of L;
+        its sign picks the side (the CLI's --seed-amplitude).
     max_seconds (float): wall-clock limit of the solve (0: none); past it the result's status
         is 'time_limit'.
     direct (bool): Newton from the case's guess at the requested values instead of the homotopy.

@@ -27,7 +27,10 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
                      const py::object& record, int switch_at_bp, double side, int samples, double direction,
                      bool branch_points, bool stability, bool deflate, int deflate_max, double max_seconds,
                      const py::object& state, bool resume, const py::object& start_from,
-                     const std::string& start_param) {
+                     const std::string& start_param, const std::string& seed, int seed_segments,
+                     double seed_amplitude, double checkpoint) {
+  if (seed != "guess" && seed != "ipopt") throw CaseError("seed must be 'guess' or 'ipopt' (got '" + seed + "')");
+  if (!(checkpoint >= 0 && checkpoint <= 1e6)) throw CaseError("checkpoint must be in [0, 1e6] seconds");
   ContinueRequest request;
   request.parameter = parameter;
   if (!to.is_none()) request.target = to.cast<double>();
@@ -47,6 +50,9 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
   request.deflate = deflate;
   request.deflate_max = deflate_max;
   request.max_seconds = max_seconds;
+  request.seed.ipopt = seed == "ipopt";
+  request.seed.segments = seed_segments;
+  request.seed.amplitude = seed_amplitude;
   const std::string state_path = path_text(state), from = path_text(start_from);
   if (deflate && !state_path.empty()) throw CaseError("state: a deflate run is not resumable, so it saves no state");
   RunPlanInputs inputs;  // the case loaded again where the run's parameter values differ from pc's
@@ -60,8 +66,9 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
   inputs.start_param = start_param;
   const Case c = plan_run(inputs, &request, &pc.c).c;
   CollectingSink collect;
-  // The state after every point and at the end, as the CLI's --checkpoint 0.
-  StateFileSink state_file(state_path, std::chrono::steady_clock::duration::zero());
+  // The state at most once per `checkpoint` seconds and at the end, as the CLI's --checkpoint.
+  StateFileSink state_file(state_path, std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                           std::chrono::duration<double>(checkpoint)));
   std::vector<ContinueSink*> sinks = {&collect};
   if (!state_path.empty()) sinks.push_back(&state_file);
   ContinueRunResult result;
@@ -93,7 +100,8 @@ void bind_case_continuation(py::class_<PyCase>& cls) {
           py::arg("direction") = 1.0, py::arg("branch_points") = true, py::arg("stability") = true,
           py::arg("deflate") = false, py::arg("deflate_max") = 16, py::arg("max_seconds") = 0.0,
           py::arg("state") = py::none(), py::arg("resume") = false, py::arg("start_from") = py::none(),
-          py::arg("start_param") = "",
+          py::arg("start_param") = "", py::arg("seed") = "guess", py::arg("seed_segments") = 200,
+          py::arg("seed_amplitude") = 0.05, py::arg("checkpoint") = 0.0,
           R"doc(Pseudo-arclength continuation in one parameter (the CLI's `continue`).
 
 Args:
@@ -108,7 +116,8 @@ Args:
         (a double branch point of a spatial rod switches with the axial phase condition).
     side (float): +1 / -1, which side of the bifurcating branch.
     samples (int): profile points per point for invariants and derived quantities.
-    direction (float): +1 / -1, initial direction when there is no target.
+    direction (float): +1 / -1, initial direction when there is no target (with one, the
+        target gives it, and a direction pointing away from it is refused).
     branch_points (bool): look for branch points (an SVD per point: most of the cost of a run on
         a multiple-shooting case of hundreds of unknowns, such as plectoneme.toml); folds are
         found either way.
@@ -119,7 +128,9 @@ Args:
     max_seconds (float): wall-clock limit of the whole run (0: none); past it the run stops
         with reason 'time_limit', resumable with state= and resume=True.
     state (str or path, optional): the run's state file (the CLI's OUT.csv.state.json), saved
-        after every point and at the end.
+        at most once per `checkpoint` seconds (0: after every point) and at the end; a resumed
+        run recomputes the points after the last save, the same points.
+    checkpoint (float): as the CLI's --checkpoint, in seconds.
     resume (bool): go on from the state file `state` of an interrupted run (time_limit, Ctrl-C)
         made with the same case and arguments (another run's state is refused): the Branch
         holds the points after the last one saved, their `index` continuing the run's, so the
@@ -127,6 +138,9 @@ Args:
     start_from (str or path, optional): another run's state file: start at its last point
         (its unknowns, active contacts and parameter values, then this case's `set`), as the
         CLI's --start-from. start_param names that run's parameter for files too old to say.
+    seed (str): 'guess' (the case's [guess]) or 'ipopt': the first point from Ipopt's minimum of
+        the discretised energy, its shape and contact set (as solve(seed='ipopt'); not with
+        resume, start_from or deflate). seed_segments, seed_amplitude: as solve()'s.
 
 Returns:
     Branch (points of all branches concatenated, with a `branch` column; `index` is the row of

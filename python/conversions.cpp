@@ -14,6 +14,8 @@ std::vector<std::pair<std::string, double>> named_values(const py::object& obj) 
     if (pair.size() != 2) throw py::type_error("expected (name, value) pairs");
     const auto name = pair[0].cast<std::string>();
     try {
+      // (pybind11 casts True to 1.0: a bool is not a number a case's value can be.)
+      if (py::isinstance<py::bool_>(pair[1])) throw py::cast_error();
       out.emplace_back(name, pair[1].cast<double>());
     } catch (const py::cast_error&) {
       // The CLI's words for `--set NAME=abc` (a CaseError, so a ValueError).

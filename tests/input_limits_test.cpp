@@ -163,6 +163,10 @@ TEST(IntegerKeys, SegmentsAsAnExpressionOrIntegerAreBounded) {
   // "1e10" is reported as such, not as the int it used to wrap to (-129542143).
   const std::string text = edited(base, "\\[solver\\]\n", "[solver]\nsegments = \"1e10\"\n");
   expect_refused(text, "solver.segments", {"got 10000000000"}, line_of(text, "segments ="));
+  // A number written as a string is an integer or refused, not rounded in silence (a probe's
+  // "2.5" became 3); an expression of the parameters is rounded (below).
+  const std::string half = edited(base, "\\[solver\\]\n", "[solver]\nsegments = \"2.5\"\n");
+  expect_refused(half, "solver.segments", {"must be an integer", "2.5"}, line_of(half, "segments ="));
   const std::string inf = edited(base, "\\[solver\\]\n", "[solver]\nsegments = \"1/0\"\n");
   expect_refused(inf, "solver.segments", {"finite"}, line_of(inf, "segments ="));
   // The bound itself is accepted (the plectoneme's expression form too).

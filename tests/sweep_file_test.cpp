@@ -45,6 +45,19 @@ TEST(SweepFile, GridExpandsFirstKeySlowestWithRangesAndLogRanges) {
   EXPECT_EQ(spec.jobs[7].values[0].second, 0.25);
 }
 
+// A linear range's interior values are the decimals meant: -0.5 .. 0.7 in three is 0.1, which
+// from + (to - from) / 2 misses by an ulp (0.09999999999999998, in index.csv and every output).
+TEST(SweepFile, LinearRangesRunTheDecimalsMeant) {
+  const SweepSpec spec = load_sweep_text(
+      head() + "[[jobs]]\nname = \"a\"\nkind = \"solve\"\ngrid = { theta0 = { from = -0.5, to = 0.7, count = 3 } }\n"
+               "[[jobs]]\nname = \"b\"\nkind = \"solve\"\ngrid = { theta0 = { from = -0.7, to = 0.5, count = 7 } }\n",
+      "sweep.toml");
+  ASSERT_EQ(spec.jobs.size(), 10u);
+  EXPECT_EQ(spec.jobs[1].values[0].second, 0.1);
+  const double meant[] = {-0.7, -0.5, -0.3, -0.1, 0.1, 0.3, 0.5};
+  for (int k = 0; k < 7; ++k) EXPECT_EQ(spec.jobs[3 + k].values[0].second, meant[k]) << k;
+}
+
 TEST(SweepFile, ErrorsNameFileLineKeyAndReason) {
   EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\ngrid = { theta0 = [1, 2], thetaX = 3 }\n"),
             "bad.toml:4: key 'jobs[1].grid.thetaX': no parameter 'thetaX' in " + kCases +

@@ -721,6 +721,10 @@ void check_unknowns_used(const Reader& reader, const Value& root, const Case& c)
 
 Case load_case_text(const std::string& text, const std::string& path, const ParameterOverrides& overrides,
                     const std::string& phase_condition, const SolverOverrides& solver) {
+  // (An override given by the caller has no line in the file to name.)
+  if (!phase_condition.empty() && phase_condition != "none" && phase_condition != "axial")
+    throw CaseError(path + ": --phase-condition (Python: phase_condition): '" + phase_condition +
+                    "' is not 'none' or 'axial'");
   Value root = parse_case_text(text, path);
   merge_solver_overrides(root, solver, path);
 

@@ -31,14 +31,20 @@ Value solver_value(const std::string& path, const std::string& key, const std::s
 }
 
 // [solver].segments: an integer, or an expression of the parameters rounded (e.g. "slenderness
-// / 5": long slender rods need more segments) evaluated at load time. Either is range-checked
-// before it becomes an int ("1e10" once wrapped to -129542143).
+// / 5": long slender rods need more segments, and a sweep's slenderness need not be a multiple of
+// 5) evaluated at load time. An expression of no parameter is a number written as a string, and
+// must be an integer as a number must. Either is range-checked before it becomes an int ("1e10"
+// once wrapped to -129542143).
 int read_segments(const Reader& reader, const Value& v, const ProblemDefinition& d) {
   const std::string why = " (Newton's Jacobian is dense: 13 x segments unknowns squared)";
   int segments = 1;
   if (v.is_string()) {
-    const double x = reader.value(reader.expression(v, "solver.segments"), v, "solver.segments");
+    const Expression e = reader.expression(v, "solver.segments");
+    const double x = reader.value(e, v, "solver.segments");
     segments = reader.in_range(v, "solver.segments", std::round(x), 1, kMaxSegments, why);
+    if (e.used_parameters().empty() && x != std::round(x))
+      reader.fail(v, "solver.segments",
+                  "must be an integer, got \"" + v.as_string().str + "\" (an expression of the parameters is rounded)");
   } else {
     segments = reader.integer(v, "solver.segments", 1, kMaxSegments, why);
   }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -27,6 +29,19 @@ const char* to_string(SweepJobKind kind) {
 }
 
 namespace {
+
+// An interior value of a linear range, as the decimal the user means: from + (to - from) k / (n - 1)
+// rounded to 15 digits of the range's scale, so that {from = -0.5, to = 0.7, count = 3} runs 0.1,
+// not 0.09999999999999998 (which index.csv and every output wrote). The change is below 1e-15 of
+// the scale, under any tolerance the runs have.
+double decimal_near(double value, double scale) {
+  if (!(scale > 0) || !std::isfinite(value)) return value;
+  const int decimals = std::clamp(15 - static_cast<int>(std::ceil(std::log10(scale))), 0, 300);
+  char text[400];
+  std::snprintf(text, sizeof text, "%.*f", decimals, value);
+  const double near = std::strtod(text, nullptr);
+  return std::abs(near - value) <= 1e-14 * scale ? near : value;
+}
 
 using Value = toml::value;
 using toml_reading::type_name;
@@ -108,7 +123,8 @@ class Reader : public toml_reading::KeyReader<SweepError> {
           out.push_back(std::pow(10.0, std::log10(from) + (std::log10(to) - std::log10(from)) * static_cast<double>(k) /
                                                               static_cast<double>(count - 1)));
         else
-          out.push_back(from + (to - from) * static_cast<double>(k) / static_cast<double>(count - 1));
+          out.push_back(decimal_near(from + (to - from) * static_cast<double>(k) / static_cast<double>(count - 1),
+                                     std::max(std::abs(from), std::abs(to))));
       }
       return out;
     }
