@@ -125,6 +125,24 @@ class LoadCaseTest(unittest.TestCase):
             kirchhoff.load_case(case_path("wall.toml"), set={"Delta": "abc"})
         self.assertIn("'abc' given for 'Delta' is not a number", str(cm.exception))
 
+    def test_a_bool_is_no_number(self):
+        # pybind11 would read True as 1.0; the CLI has no such value (a probe's).
+        with self.assertRaises(kirchhoff.CaseError) as cm:
+            kirchhoff.load_case(case_path("euler_column.toml"), set={"P": True})
+        self.assertIn("euler_column.toml: set: 'True' given for 'P' is not a number", str(cm.exception))
+
+    def test_a_phase_condition_that_is_none_of_them_is_refused_without_a_line(self):
+        with self.assertRaises(kirchhoff.CaseError) as cm:
+            kirchhoff.load_case(case_path("euler_column.toml"), phase_condition="bogus")
+        self.assertIn("euler_column.toml: --phase-condition (Python: phase_condition): 'bogus'", str(cm.exception))
+
+    def test_a_direction_away_from_the_target_is_refused(self):
+        case = kirchhoff.load_case(case_path("euler_column.toml"))
+        with self.assertRaisesRegex(kirchhoff.CaseError, "points away from --to"):
+            case.continue_("P", to=20.0, direction=-1)
+        down = case.continue_("P", None, direction=-1, max_points=3)
+        self.assertLess(down.points["parameter"][-1], 12.0)
+
     def test_target_at_the_starting_value_is_refused(self):
         # tests/cli_test.cpp (TargetAtTheStartingValueIsRefused) expects the same text.
         case = kirchhoff.load_case(case_path("euler_column.toml"))
@@ -407,6 +425,14 @@ class ContactTest(unittest.TestCase):
         self.assertGreaterEqual(sol.derived["min_gap"], -1e-10)
         with self.assertRaisesRegex(ValueError, "seed must be"):
             case.solve(seed="ipop")
+        # The side Ipopt's first mode starts on, as the CLI's --seed-amplitude picks it.
+        clamped = kirchhoff.load_case(case_path("clamped_clamped.toml"))
+        up, down = (clamped.solve(seed="ipopt", seed_amplitude=a, samples=101) for a in (0.05, -0.05))
+        self.assertAlmostEqual(up.profile["y"][50], 0.19492431, places=7)
+        self.assertAlmostEqual(down.profile["y"][50], -up.profile["y"][50], places=10)
+        branch = clamped.continue_("D", to=0.85, seed="ipopt", seed_amplitude=-0.05, max_points=20)
+        self.assertEqual(branch.reason, "reached_target")
+        self.assertTrue(any("Ipopt" in n for n in branch.notes), branch.notes)
         with self.assertRaisesRegex(ValueError, "planar clamped-clamped"):
             kirchhoff.load_case(case_path("indenter.toml")).solve(seed="ipopt")
 

@@ -417,9 +417,9 @@ std::string ContinueRequest::validate(const Case& c) const {
   if (!(max_seconds >= 0 && max_seconds <= 1e9)) return "--max-seconds must be in [0, 1e9]";
   if (switch_at_bp < 0) return "switch_at_bp must be >= 0";
   if (direction != 1.0 && direction != -1.0) return "--direction must be 1 or -1 (Python: direction=1 or direction=-1)";
-  // (With a target the target gives the way; a direction that says the other is refused.)
-  if (!start && !resume && target && (*target - c.definition.parameters.get(parameter)) * direction < 0)
-    return "--direction " + std::string(direction > 0 ? "1" : "-1") + " points away from --to, which gives the way";
+  // With a target the target gives the way; -1 (never the default) asking for the other is refused.
+  if (!start && !resume && target && direction < 0 && *target > c.definition.parameters.get(parameter))
+    return "--direction -1 points away from --to, which gives the way";
   if (switch_side != 1.0 && switch_side != -1.0) return "--side must be 1 or -1 (Python: side=1 or side=-1)";
   if (switch_side == -1.0 && switch_at_bp == 0)
     return "--side -1 picks a side of a switched branch: it needs --switch-at-bp K (Python: switch_at_bp=K)";
