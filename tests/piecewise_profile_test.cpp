@@ -8,6 +8,7 @@
 
 #include "kirchhoff/continuation/rod_continuation.hpp"
 #include "kirchhoff/jobs/case_file.hpp"
+#include "kirchhoff/jobs/case_solve.hpp"
 #include "kirchhoff/model/detail/profile_jumps.hpp"
 #include "kirchhoff/shooting/shooting.hpp"
 #include "test_support.hpp"
@@ -117,6 +118,38 @@ TEST(PiecewiseRod, ColumnWithAShortSoftStretchBucklesAtItsTransferMatrixLoads) {
     EXPECT_EQ(*p.stability_index, p.parameter < exact[0] ? 0 : (p.parameter < exact[1] ? 1 : 2))
         << "P = " << p.parameter;
   }
+}
+
+// A jump on a profile sample (s = 0.3 among 201 samples, on "s > 0.3"): the stretch from it took
+// its first stage's stiffness from the wrong side, which RKF78's error estimate cannot see, and
+// the profile broke the end conditions the solve had met (a probe's: m(L) = 7.7e-4 at the pinned
+// end of tapered.toml, tip off by 3.5e-5 on a 3D rod). The profile must meet them to the
+// solve's residual.
+TEST(PiecewiseRod, AJumpOnAProfileSampleKeepsTheEndConditions) {
+  std::string planar = testing::case_text("tapered.toml");
+  const std::string tapered = "B = \"EI0*(1 + taper*s/L)\"";
+  ASSERT_NE(planar.find(tapered), std::string::npos);
+  planar.replace(planar.find(tapered), tapered.size(), "B = \"EI0*(1 + 0.5*(s > 0.3 && s < 0.35))\"");
+  const CaseSolve pinned = kirchhoff::solve_case(load_case_text(planar, "stepped.toml"));
+  ASSERT_TRUE(pinned.converged()) << pinned.message;
+  const RodPoint& end = pinned.solution->profile.back();
+  EXPECT_NEAR(end.m.z(), 0.0, 1e-9);  // pinned: no moment
+  EXPECT_NEAR(end.r.y(), 0.0, 1e-9);  // on the axis it slides along
+
+  // The Reissner case made inextensible, its B1 stepped up on [0.3, 0.35]: the end's moment is the
+  // one applied, (0, 0.2, 0.3).
+  std::string spatial = testing::case_text("reissner.toml");
+  for (const std::string line : {"extensible = true\n", "A1 = 30.0\n", "A2 = 40.0\n", "A3 = 50.0\n"}) {
+    ASSERT_NE(spatial.find(line), std::string::npos) << line;
+    spatial.erase(spatial.find(line), line.size());
+  }
+  spatial.replace(spatial.find("B1 = 1.0"), 8, "B1 = \"1 + 0.5*(s > 0.3 && s < 0.35)\"");
+  const CaseSolve loaded = kirchhoff::solve_case(load_case_text(spatial, "stepped_3d.toml"));
+  ASSERT_TRUE(loaded.converged()) << loaded.message;
+  const RodPoint& tip = loaded.solution->profile.back();
+  EXPECT_NEAR(tip.m.x(), 0.0, 1e-9);
+  EXPECT_NEAR(tip.m.y(), 0.2, 1e-9);
+  EXPECT_NEAR(tip.m.z(), 0.3, 1e-9);
 }
 
 }  // namespace
