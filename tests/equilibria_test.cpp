@@ -528,6 +528,41 @@ TEST(Equilibria, TheShallowArchSnappedThroughIsListedFarPastItsFold) {
   EXPECT_EQ(*at_100.equilibria[0].stability.index, 0);
 }
 
+// The wall at Delta = 0.05 (a probe's): its hanging fold, the rod touching the wall twice with its
+// middle sagging (s = 0.3036 and 0.6964), is stable and lay on no starting point: the search
+// made at 0.05 left it out, and its path from the file's Delta = 0.026 turns back at a fold at
+// 0.0466 before turning again to reach 0.05. The carried paths now go through folds. Its energy
+// and index are a discretised energy's with a barrier b / gap, b -> 1e-8 (the probe's, 1600
+// elements: 6.35608, index 0, lowest eigenvalue +51..+61). The symmetric rod touching at
+// mid-span (index 1) was missing too: a minimiser held mirror symmetric reaches it (the
+// discretised energy at 200 elements: 4.63968, O(h^2), so 1e-3 relative).
+TEST(Equilibria, TheWallsHangingFoldAndItsMidSpanContactAreListed) {
+  EquilibriaOptions options;
+  options.max_equilibria = 40;
+  const Case c = load_case(case_path("wall.toml"), {{"Delta", 0.05}});
+  const EquilibriaSearch s = find_case_equilibria(c, c.samples, options);  // as `equilibria --set`
+  expect_all_sound(s, c.definition.options.newton.residual_tolerance);
+  int hanging = 0, mid_span = 0;
+  for (const Equilibrium& e : s.equilibria) {
+    const auto& c = e.solution.contacts;
+    if (c.size() == 2 && !c[0].extended && !c[1].extended && std::abs(c[0].s + c[1].s - 1.0) < 1e-8 &&
+        std::abs(std::min(c[0].s, c[1].s) - 0.3036) < 1e-3) {
+      ++hanging;
+      EXPECT_NEAR(e.energy, 6.35608, 2e-4 * 6.35608);
+      ASSERT_TRUE(e.stability.index);
+      EXPECT_EQ(*e.stability.index, 0);
+    }
+    if (c.size() == 1 && !c[0].extended && std::abs(c[0].s - 0.5) < 1e-8 && e.energy < 5.0) {
+      ++mid_span;
+      EXPECT_NEAR(e.energy, 4.63968, 1e-3 * 4.63968);
+      ASSERT_TRUE(e.stability.index);
+      EXPECT_EQ(*e.stability.index, 1);
+    }
+  }
+  EXPECT_EQ(hanging, 1);
+  EXPECT_EQ(mid_span, 1);
+}
+
 // --max N holds for the equilibria carried from the file's values and the Ipopt seeds too (the
 // wall at Delta = 0.033 listed 5 for --max 3), and the Newton runs count both searches'.
 TEST(Equilibria, MaxEquilibriaHoldsWithChangedValues) {

@@ -28,17 +28,40 @@ using Ipopt::Number;
 class ClampedElasticaNLP : public Ipopt::TNLP {
  public:
   ClampedElasticaNLP(DiscreteClampedElastica rod, int N, const DiscreteSolveOptions& options, DiscreteElasticaResult* out)
-      : rod_(std::move(rod)), N_(N), h_(rod_.L / N), amplitude_(options.amplitude),
-        initial_theta_(options.initial_theta), out_(out) {
+      : rod_(std::move(rod)), N_(N), h_(rod_.L / N), amplitude_(options.amplitude), lobes_(options.lobes),
+        initial_theta_(options.initial_theta), symmetric_pairs_(options.mirror_symmetric ? N / 2 : 0), out_(out) {
     for (const auto& o : rod_.obstacles) curved_ = curved_ || !o.is_flat();
     for (int k = 0; k <= N_; ++k) EI_.push_back(rod_.EI(k * h_));
   }
 
   int obstacles() const { return static_cast<int>(rod_.obstacles.size()); }
+
+  // With the mirror symmetry held, the segments' vertical rows are implied by it and the symmetry
+  // rows (the heights of the two halves cancel): a uniform vertical force delta added to every
+  // segment's multiplier, with mu_i + delta h cos theta_i on the symmetry rows, satisfies the
+  // same stationarity, so Ipopt's split between them is arbitrary. The whole problem's is the one
+  // with mu = 0: delta = -mu_i / (h cos theta_i), by least squares over the pairs (exact at a
+  // symmetric equilibrium of a symmetric problem; elsewhere the KKT check, made without the
+  // symmetry, fails).
+  double vertical_force_from_symmetry(const Number* v, const Number* lambda) const {
+    double num = 0.0, den = 0.0;
+    for (int i = 0; i < symmetric_pairs_; ++i) {
+      const double a = h_ * std::cos(v[i]);
+      num += lambda[symmetry_row(i)] * a;
+      den += a * a;
+    }
+    return den > 0.0 ? -num / den : 0.0;
+  }
   // Variable indices: angle i, node k's x and y (k = 1..N-1).
   Index X(int k) const { return N_ + 2 * (k - 1); }
   Index Y(int k) const { return N_ + 2 * (k - 1) + 1; }
   Index gap_row(int o, int k) const { return 2 * N_ + o * (N_ - 1) + (k - 1); }
+  // With mirror_symmetric: theta_i + theta_N-1-i = 2 alpha, i < N / 2, after the gap rows.
+  Index symmetry_row(int i) const { return 2 * N_ + obstacles() * (N_ - 1) + i; }
+  double chord_angle() const {
+    const Vec3 chord = rod_.end - rod_.start;
+    return std::atan2(chord.y(), chord.x());
+  }
   Vec3 node(const Number* v, int k) const {
     if (k == 0) return rod_.start;
     if (k == N_) return rod_.end;
@@ -47,10 +70,10 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
 
   bool get_nlp_info(Index& n, Index& m, Index& nnz_jac, Index& nnz_hess, IndexStyleEnum& style) override {
     n = N_ + 2 * (N_ - 1);
-    m = 2 * N_ + obstacles() * (N_ - 1);
+    m = 2 * N_ + obstacles() * (N_ - 1) + symmetric_pairs_;
     // Segment rows: the angle and the interior nodes among its two ends (N - 2 segments have
     // two, the first and last one), per coordinate.
-    nnz_jac = 2 * (N_ + 2 * (N_ - 1)) + 2 * obstacles() * (N_ - 1);
+    nnz_jac = 2 * (N_ + 2 * (N_ - 1)) + 2 * obstacles() * (N_ - 1) + 2 * symmetric_pairs_;
     // Lower triangle: the angles' tridiagonal; with curved obstacles each node's 2 x 2 block.
     nnz_hess = 2 * N_ - 1 + (curved_ ? 3 * (N_ - 1) : 0);
     style = C_STYLE;
@@ -63,10 +86,11 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
       x_u[i] = 2e19;
     }
     for (Index r = 0; r < 2 * N_; ++r) g_l[r] = g_u[r] = 0.0;
-    for (Index r = 2 * N_; r < m; ++r) {
+    for (Index r = 2 * N_; r < symmetry_row(0); ++r) {
       g_l[r] = 0.0;
       g_u[r] = 2e19;
     }
+    for (Index r = symmetry_row(0); r < m; ++r) g_l[r] = g_u[r] = 0.0;
     return true;
   }
 
@@ -74,14 +98,14 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
     if (!initial_theta_.empty()) {
       std::copy(initial_theta_.begin(), initial_theta_.end(), v);
     } else {
-      // The chord's angle, the clamps' angles blended in linearly, and the slope of the first
-      // clamped-clamped mode y = (A/2)(1 - cos 2 pi s / L) across the chord.
+      // The chord's angle, the clamps' angles blended in linearly, and the slope of
+      // y = (A/2)(1 - cos 2 pi n s / L) across the chord (n = 1: the first clamped-clamped mode).
       const Vec3 chord = rod_.end - rod_.start;
       const double along = std::atan2(chord.y(), chord.x());
       for (int i = 0; i < N_; ++i) {
         const double s = (i + 0.5) * h_, t = s / rod_.L;
         v[i] = along + (1 - t) * (rod_.start_angle - along) + t * (rod_.end_angle - along) +
-               amplitude_ * M_PI / rod_.L * std::sin(2 * M_PI * t);
+               amplitude_ * M_PI * lobes_ / rod_.L * std::sin(2 * M_PI * lobes_ * t);
       }
     }
     // The nodes from the angles (the segment rows hold but for the last one's, the end).
@@ -120,6 +144,7 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
     }
     for (int o = 0; o < obstacles(); ++o)
       for (int k = 1; k < N_; ++k) g[gap_row(o, k)] = rod_.obstacles[o].gap(node(v, k));
+    for (int i = 0; i < symmetric_pairs_; ++i) g[symmetry_row(i)] = v[i] + v[N_ - 1 - i] - 2.0 * chord_angle();
     return true;
   }
 
@@ -153,6 +178,10 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
         entry(gap_row(o, k), X(k), grad.x());
         entry(gap_row(o, k), Y(k), grad.y());
       }
+    for (int i = 0; i < symmetric_pairs_; ++i) {
+      entry(symmetry_row(i), i, 1.0);
+      entry(symmetry_row(i), N_ - 1 - i, 1.0);
+    }
     return true;
   }
 
@@ -215,8 +244,10 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
     // rows' multipliers there are -mu_N-1; the gap rows' multipliers are the same.
     out_->multipliers.assign(2 + obstacles() * (n - 1), 0.0);
     out_->multipliers[0] = -lambda[2 * (n - 1)];
-    out_->multipliers[1] = -lambda[2 * (n - 1) + 1];
-    for (Index r = 2 * n; r < m; ++r) out_->multipliers[2 + (r - 2 * n)] = lambda[r];
+    out_->multipliers[1] = -(lambda[2 * (n - 1) + 1] + vertical_force_from_symmetry(v, lambda));
+    // (The symmetry rows' multipliers are left out, moved into the vertical force above: the check
+    // is made without the symmetry.)
+    for (Index r = 2 * n; r < m - symmetric_pairs_; ++r) out_->multipliers[2 + (r - 2 * n)] = lambda[r];
     // Ipopt's Lagrangian is f + lambda^T g: n(L) = -lambda_end (the force the end constraint
     // applies to the rod). The gap multipliers give the contact forces -lambda grad g, so that
     // across the contacts n(0) = n(L) + sum (-lambda_k) grad g_k (n' = -f; eq. 63 for a wall).
@@ -249,7 +280,9 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
   std::vector<double> EI_;
   int N_;
   double h_, amplitude_;
+  int lobes_;
   std::vector<double> initial_theta_;
+  int symmetric_pairs_;  // rows holding the mirror symmetry (0: none)
   bool curved_ = false;
   DiscreteElasticaResult* out_;
 };
@@ -278,6 +311,9 @@ DiscreteElasticaResult solve_discrete_elastica(const DiscreteClampedElastica& ro
 DiscreteElasticaResult solve_discrete_elastica(const DiscreteClampedElastica& rod, int segments,
                                                const DiscreteSolveOptions& options) {
   if (!(rod.L > 0)) throw std::invalid_argument("discrete Elastica: L must be > 0");
+  if (options.mirror_symmetric && segments % 2 != 0)
+    throw std::invalid_argument("discrete Elastica: a mirror-symmetric rod needs an even number of segments");
+  if (options.lobes < 1) throw std::invalid_argument("discrete Elastica: lobes must be >= 1");
   double EI_max = 0.0;
   for (int k = 0; k <= 20; ++k) {
     const double EI = rod.EI(rod.L * k / 20);

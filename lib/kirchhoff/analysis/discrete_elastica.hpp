@@ -122,6 +122,18 @@ struct DiscreteElasticaResult {
 
 struct DiscreteSolveOptions {
   double amplitude = 0.05;  // of the first mode in the starting point (its sign: the side)
+  // Lobes of the starting shape y = (A/2)(1 - cos(2 pi lobes s / L)) across the chord: 1 the
+  // first clamped-clamped mode; 2 two bumps with the middle back on the chord, the way to a
+  // rod touching an obstacle twice (the wall's hanging fold, which Ipopt from one lobe leaves for
+  // the lower asymmetric contact).
+  int lobes = 1;
+  // Minimise over the rods symmetric under the reflection across the chord's perpendicular
+  // bisector only (theta_i + theta_N-1-i = twice the chord's angle; N even). A minimiser left free
+  // breaks a symmetric start's symmetry for a lower asymmetric minimum; held to it, it reaches
+  // the symmetric local minimum, which is an equilibrium of the whole problem where the problem
+  // is symmetric (symmetric criticality) and fails the KKT check, made without the symmetry, where
+  // it is not.
+  bool mirror_symmetric = false;
   // Start from these segment angles instead (size N; e.g. a coarser solution interpolated).
   std::vector<double> initial_theta;
   // Ipopt's starting value of every gap constraint's multiplier, i.e. the contact force each

@@ -91,10 +91,16 @@ void read_contacts(const std::vector<double>& force, const std::vector<double>& 
 }  // namespace
 
 DiscreteSeed seed_from_discrete_energy(const ProblemDefinition& d, int segments, double amplitude) {
+  DiscreteSolveOptions options;
+  options.amplitude = amplitude;
+  return seed_from_discrete_energy(d, segments, options);
+}
+
+DiscreteSeed seed_from_discrete_energy(const ProblemDefinition& d, int segments, const DiscreteSolveOptions& options) {
   const ShootingProblem problem(d);
   const DiscreteClampedElastica rod = discrete_rod(d, problem);
   DiscreteSeed seed;
-  seed.discrete = solve_discrete_elastica(rod, segments, amplitude);
+  seed.discrete = solve_discrete_elastica(rod, segments, options);
   // converged: Ipopt succeeded and its solution passed the library's own KKT check (stationarity,
   // end constraints, no penetration, no pulling force, complementarity); anything else is refused
   // rather than read off. (The seed needs no refinement check: the shooting solve that starts from
@@ -129,7 +135,14 @@ DiscreteSeed seed_from_discrete_energy(const ProblemDefinition& d, int segments,
 
 ContactSolveResult solve_from_discrete_seed(const ProblemDefinition& definition, int segments, double amplitude,
                                             DiscreteSeed* seed_out) {
-  DiscreteSeed seed = seed_from_discrete_energy(definition, segments, amplitude);
+  DiscreteSolveOptions options;
+  options.amplitude = amplitude;
+  return solve_from_discrete_seed(definition, segments, options, seed_out);
+}
+
+ContactSolveResult solve_from_discrete_seed(const ProblemDefinition& definition, int segments,
+                                            const DiscreteSolveOptions& options, DiscreteSeed* seed_out) {
+  DiscreteSeed seed = seed_from_discrete_energy(definition, segments, options);
   ProblemDefinition seeded = definition;
   seeded.contacts = seed.contacts;
   ContactSolveResult out = solve_with_contacts(seeded, seed.start);

@@ -38,14 +38,19 @@ struct DiscreteSeed {
   std::string summary;                 // one line: segments, energy, contacts found
 };
 
-// `amplitude` picks the side the discrete rod buckles to first (see solve_discrete_elastica).
-// Throws std::invalid_argument for a definition outside the scope above and std::runtime_error
-// when Ipopt does not converge or its solution fails the KKT check (DiscreteElasticaResult::kkt).
+// `amplitude` picks the side the discrete rod buckles to first (see solve_discrete_elastica;
+// `options` also the starting shape and the symmetry held). Throws std::invalid_argument for a
+// definition outside the scope above and std::runtime_error when Ipopt does not converge or its
+// solution fails the KKT check (DiscreteElasticaResult::kkt).
 DiscreteSeed seed_from_discrete_energy(const ProblemDefinition& definition, int segments = 200,
                                        double amplitude = 0.05);
+DiscreteSeed seed_from_discrete_energy(const ProblemDefinition& definition, int segments,
+                                       const DiscreteSolveOptions& options);
 
 // seed_from_discrete_energy, then solve_with_contacts from the seed.
 ContactSolveResult solve_from_discrete_seed(const ProblemDefinition& definition, int segments = 200,
                                             double amplitude = 0.05, DiscreteSeed* seed = nullptr);
+ContactSolveResult solve_from_discrete_seed(const ProblemDefinition& definition, int segments,
+                                            const DiscreteSolveOptions& options, DiscreteSeed* seed = nullptr);
 
 }  // namespace kirchhoff

@@ -58,7 +58,7 @@ RodContinuationOptions path_options(const ShootingProblem& problem, const std::s
   o.target = 1.0;
   o.max_points = options.max_points;
   o.deadline = options.deadline;
-  o.stop_at_fold = true;
+  o.stop_at_fold = !options.through_folds;
   o.compute_invariants = false;
   const bool large = problem.size() > options.branch_point_unknown_limit;
   o.detect_branch_points = !large;

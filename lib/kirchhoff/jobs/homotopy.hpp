@@ -10,8 +10,9 @@
 // equilibrium reached at t = 1 is then polished by Newton at exactly b.
 //
 // What the path meets is reported, never jumped over:
-//   - a fold in t: the branch turns back before b, so no equilibrium at b lies on it (the
-//     homotopy stops there, with the values at the fold);
+//   - a fold in t: the branch turns back before b, so no equilibrium at b lies on it this side
+//     of the fold (the homotopy stops there, with the values at the fold; with through_folds it
+//     goes on, and may turn again towards b);
 //   - a simple branch point: the branch goes on smoothly through it and so does the path (it is
 //     listed; the equilibrium's stability changes there, see stability.hpp);
 //   - a contact set that changes (contacts appear, lift off, flatten), as continuation reports.
@@ -40,6 +41,11 @@ struct HomotopyOptions {
   // plectoneme sweeps follow theirs: branch points are not looked for (an SVD of the bordered
   // matrix per point; the path says so), and the corrector keeps its matrix (modified Newton).
   int branch_point_unknown_limit = 400;
+  // Follow the branch through folds in t instead of stopping at the first (`equilibria`'s carried
+  // paths): a branch that turns back may turn again and reach b, with an equilibrium there that
+  // no starting point at b reaches (the wall's hanging fold at Delta = 0.05, past the fold at
+  // 0.0466 from the file's 0.026). The path then ends at b, or at max_points or the deadline.
+  bool through_folds = false;
 };
 
 struct HomotopyResult {
