@@ -3,12 +3,15 @@
 // different stiffness is never stepped across unseen.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <vector>
 
 #include "kirchhoff/continuation/rod_continuation.hpp"
 #include "kirchhoff/jobs/case_file.hpp"
 #include "kirchhoff/jobs/case_solve.hpp"
+#include "kirchhoff/jobs/equilibria.hpp"
+#include "kirchhoff/analysis/vibration.hpp"
 #include "kirchhoff/model/detail/profile_jumps.hpp"
 #include "kirchhoff/shooting/shooting.hpp"
 #include "test_support.hpp"
@@ -150,6 +153,119 @@ TEST(PiecewiseRod, AJumpOnAProfileSampleKeepsTheEndConditions) {
   EXPECT_NEAR(tip.m.x(), 0.0, 1e-9);
   EXPECT_NEAR(tip.m.y(), 0.2, 1e-9);
   EXPECT_NEAR(tip.m.z(), 0.3, 1e-9);
+}
+
+// The column stepped to a fifth of its stiffness at mid-span, shot in two segments whose node is
+// the jump (a probe's: 2.985331 and 16.199424 against 2.9946520 and 16.2233911 exactly; one
+// segment was exact). The segments start and end on the jump's sides now.
+TEST(PiecewiseRod, AJumpOnASegmentNodeKeepsTheCriticalLoads) {
+  std::string text = testing::case_text("euler_column.toml");
+  const std::string uniform = "B = \"EI\"";
+  text.replace(text.find(uniform), uniform.size(), "B = \"EI*(s < 0.5 ? 1 : 0.2)\"");
+  Case c = load_case_text(text, "stepped.toml", {{"P", 1.0}, {"theta_guess", 0.0}});
+  c.definition.options.segments = 2;
+  const ShootingProblem problem(c.definition);
+  RodContinuationOptions o;
+  o.parameter = "P";
+  o.target = 40.0;
+  o.initial_step = 0.5;
+  o.max_step = 5.0;
+  o.samples = 21;
+  RodContinuation run(problem, o);
+  const ContinuationResult r = run.run(problem.initial_unknowns(c.start_guess));
+  std::vector<double> branch_points;
+  for (const auto& p : r.points)
+    if (p.type == PointType::BranchPoint) branch_points.push_back(p.parameter);
+  const std::vector<double> exact = critical_loads({{1.0, 0.5}, {0.2, 0.5}}, 40.0);
+  ASSERT_EQ(exact.size(), 3u);  // 2.9947, 16.223, 35.349
+  ASSERT_EQ(branch_points.size(), exact.size());
+  for (size_t k = 0; k < exact.size(); ++k) EXPECT_NEAR(branch_points[k] / exact[k], 1.0, 1e-8);
+}
+
+// The pinned-pinned beam under a compression P with EI_i on consecutive stretches:
+// EI w'''' + P w'' = rho omega^2 w, carried as (w, w', M = EI w'', V = M' + P w'), all continuous
+// across a jump, by classical RK4 on fine fixed steps (independent of the library's integrator).
+// Returns det [w(L), M(L)] of the two fields with w = M = 0 at s = 0.
+double pinned_beam_determinant(double omega2, double P, const std::vector<std::pair<double, double>>& stretches) {
+  using State = std::array<double, 4>;
+  std::array<State, 2> y{State{0.0, 1.0, 0.0, 0.0}, State{0.0, 0.0, 0.0, 1.0}};
+  for (const auto& [EI, h] : stretches) {
+    const double stiffness = EI;
+    const auto rhs = [&](const State& q) {
+      return State{q[1], q[2] / stiffness, q[3] - P * q[1], omega2 * q[0]};
+    };
+    const int steps = static_cast<int>(std::ceil(h * 4000));
+    const double dt = h / steps;
+    for (State& q : y)
+      for (int k = 0; k < steps; ++k) {
+        const State k1 = rhs(q);
+        State a, b, c;
+        for (int i = 0; i < 4; ++i) a[i] = q[i] + 0.5 * dt * k1[i];
+        const State k2 = rhs(a);
+        for (int i = 0; i < 4; ++i) b[i] = q[i] + 0.5 * dt * k2[i];
+        const State k3 = rhs(b);
+        for (int i = 0; i < 4; ++i) c[i] = q[i] + dt * k3[i];
+        const State k4 = rhs(c);
+        for (int i = 0; i < 4; ++i) q[i] += dt / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+      }
+  }
+  return y[0][0] * y[1][2] - y[1][0] * y[0][2];
+}
+
+// vibrate matches the fields shot from both ends at mid-span: with the jump there its shots
+// started on the wrong side (a probe's: omega^2 = 506.068 and -21.748 against 507.539 and
+// -21.640).
+TEST(PiecewiseRod, VibrationsWithAJumpAtMidSpanMatchATransferComputation) {
+  std::string text = testing::case_text("euler_column.toml");
+  const std::string uniform = "B = \"EI\"";
+  text.replace(text.find(uniform), uniform.size(), "B = \"EI*(s < 0.5 ? 1 : 0.2)\"");
+  const Case c = load_case_text(text, "stepped.toml", {{"P", 5.0}, {"theta_guess", 0.0}});
+  const CaseSolve straight = kirchhoff::solve_case(c);
+  ASSERT_TRUE(straight.converged()) << straight.message;
+  VibrationOptions options;
+  options.modes = 2;
+  const VibrationProblem vib(*straight.solved.problem, straight.solved.result.x, options);
+  const std::vector<std::pair<double, double>> beam{{1.0, 0.5}, {0.2, 0.5}};
+  std::vector<double> omega2;
+  for (double w : vib.frequencies()) omega2.push_back(w * w);
+  for (double w2 : vib.negative_omega2()) omega2.push_back(w2);
+  ASSERT_EQ(omega2.size(), 3u);
+  for (double w2 : omega2) {
+    // A root of the independent determinant: it changes sign within 1e-6 relative of omega^2
+    // (RK4 at 4000 steps per unit length: ~1e-10).
+    const double d = 1e-6 * std::abs(w2);
+    EXPECT_LT(pinned_beam_determinant(w2 - d, 5.0, beam) * pinned_beam_determinant(w2 + d, 5.0, beam), 0.0)
+        << "omega^2 = " << w2;
+  }
+}
+
+// The energy across a jump: a cantilever under an end couple M bends with curvature M / B(s), and
+// its total potential energy is integral M^2 / (2 B) - M theta(L) = -M^2 I / 2, I = integral ds / B,
+// in closed form (B = 1 on [0, 0.3], 0.2 after: I = 3.8). Simpson across the jump erred by its
+// spacing times the jump (a probe's stepped column: 1e-4 relative).
+TEST(PiecewiseRod, TheEnergyOfACantileverUnderACoupleIsItsClosedForm) {
+  const std::string text = R"(model = "planar"
+[parameters]
+M = 1.0
+[rod]
+length = 1.0
+B = "s < 0.3 ? 1 : 0.2"
+[start]
+type = "clamped"
+position = [0, 0]
+[end]
+type = "loaded"
+force = [0, 0]
+moment = [0, 0, "M"]
+[guess]
+force = [0, 0]
+moment = [0, 0, "-M"]
+)";
+  const Case c = load_case_text(text, "couple.toml");
+  const CaseSolve solved = kirchhoff::solve_case(c);
+  ASSERT_TRUE(solved.converged()) << solved.message;
+  const double I = 0.3 + 0.7 / 0.2;
+  EXPECT_NEAR(total_potential_energy(*solved.solved.problem, solved.solved.result.x), -0.5 * I, 1e-10);
 }
 
 }  // namespace

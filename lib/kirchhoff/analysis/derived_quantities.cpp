@@ -2,6 +2,7 @@
 // the plectoneme's family. derived_catalogue() and derived_values() both read that table.
 #include "kirchhoff/analysis/detail/derived_quantities.hpp"
 
+#include <algorithm>
 #include <boost/math/tools/minima.hpp>
 #include <cmath>
 #include <functional>
@@ -78,16 +79,30 @@ double refined_maximum(const DerivedInputs& in, const PointFunction& f) {
 // Composite Simpson on a fine sampling (one integration pass): a soft wall's potential is peaked
 // over a width ~sqrt(gap / kappa) ~ 1e-2 at b = 1e-6, which 4000 intervals resolve to ~1e-7
 // relative; smooth integrands (the elastic energy) come out to ~1e-12.
-double integral_along(const DerivedInputs& in, const PointFunction& f) {
+// Where a property jumps (RodModel::jumps) the integrand does too, and Simpson across it errs by
+// its spacing times the jump (a probe's stepped column: 1e-4 of the energy); each stretch between
+// jumps is integrated on its own, sampled just inside so that it is read from its own side.
+double integral_along(DerivedInputs& in, const PointFunction& f) {
   constexpr int kIntervals = 4000;
   const double L = in.end().s;
-  std::vector<double> s(kIntervals + 1);
-  for (int i = 0; i <= kIntervals; ++i) s[i] = L * i / kIntervals;
-  s.back() = L;
-  const auto points = in.problem.sample(in.x(), s);
-  double sum = 0.0;
-  for (int i = 0; i <= kIntervals; ++i) sum += (i == 0 || i == kIntervals ? 1.0 : (i % 2 ? 4.0 : 2.0)) * f(points[i]);
-  return sum * (L / kIntervals) / 3.0;
+  std::vector<double> breaks{0.0};
+  for (const ProfileJump& j : in.model().jumps()) breaks.push_back(j.before);
+  breaks.push_back(L);
+  const double inset = breaks.size() > 2 ? 1e-12 * L : 0.0;
+  double total = 0.0;
+  for (size_t k = 0; k + 1 < breaks.size(); ++k) {
+    const double a = breaks[k] + (k == 0 ? 0.0 : inset), b = breaks[k + 1] - (k + 2 == breaks.size() ? 0.0 : inset);
+    if (!(b > a)) continue;
+    const int n = std::max(2, 2 * static_cast<int>(std::ceil(0.5 * kIntervals * (b - a) / L)));
+    std::vector<double> s(n + 1);
+    for (int i = 0; i <= n; ++i) s[i] = a + (b - a) * i / n;
+    s.back() = b;
+    const auto points = in.problem.sample(in.x(), s);
+    double sum = 0.0;
+    for (int i = 0; i <= n; ++i) sum += (i == 0 || i == n ? 1.0 : (i % 2 ? 4.0 : 2.0)) * f(points[i]);
+    total += sum * ((b - a) / n) / 3.0;
+  }
+  return total;
 }
 
 // The smallest of a per-contact quantity, over the contacts where it is defined (NaN elsewhere);
