@@ -88,15 +88,20 @@ std::vector<double> critical_loads(const std::vector<std::pair<double, double>>&
   return loads;
 }
 
-// The Euler column with a stretch of a hundredth of its stiffness 1e-3 long (a probe's case):
-// before the jumps were located the integrator stepped across it and every branch point was the
-// uniform column's (9.8696 = pi^2, where this column buckles at 8.2975), converged.
-TEST(PiecewiseRod, ColumnWithAShortSoftStretchBucklesAtItsTransferMatrixLoads) {
+// euler_column.toml with its stiffness `B` (an expression of s), straight from P = 1, in
+// `segments` shooting segments.
+Case stepped_column(const std::string& B, int segments = 1) {
   std::string text = testing::case_text("euler_column.toml");
   const std::string uniform = "B = \"EI\"";
-  ASSERT_NE(text.find(uniform), std::string::npos);
-  text.replace(text.find(uniform), uniform.size(), "B = \"EI*(1 - 0.99*(s > 0.4013 && s < 0.4023))\"");
-  const Case c = load_case_text(text, "soft_stretch.toml", {{"P", 1.0}, {"theta_guess", 0.0}});
+  EXPECT_NE(text.find(uniform), std::string::npos);
+  text.replace(text.find(uniform), uniform.size(), "B = \"" + B + "\"");
+  Case c = load_case_text(text, "stepped.toml", {{"P", 1.0}, {"theta_guess", 0.0}});
+  c.definition.options.segments = segments;
+  return c;
+}
+
+// The straight column continued in P to 40, its index at every point.
+ContinuationResult continued_to_40(const Case& c) {
   const ShootingProblem problem(c.definition);
   RodContinuationOptions o;
   o.parameter = "P";
@@ -106,15 +111,27 @@ TEST(PiecewiseRod, ColumnWithAShortSoftStretchBucklesAtItsTransferMatrixLoads) {
   o.samples = 21;
   o.compute_stability = true;
   RodContinuation run(problem, o);
-  const ContinuationResult r = run.run(problem.initial_unknowns(c.start_guess));
-  std::vector<ContinuationPoint> branch_points;
+  return run.run(problem.initial_unknowns(c.start_guess));
+}
+
+std::vector<double> branch_points_of(const ContinuationResult& r) {
+  std::vector<double> out;
   for (const auto& p : r.points)
-    if (p.type == PointType::BranchPoint) branch_points.push_back(p);
+    if (p.type == PointType::BranchPoint) out.push_back(p.parameter);
+  return out;
+}
+
+// The Euler column with a stretch of a hundredth of its stiffness 1e-3 long (a probe's case):
+// before the jumps were located the integrator stepped across it and every branch point was the
+// uniform column's (9.8696 = pi^2, where this column buckles at 8.2975), converged.
+TEST(PiecewiseRod, ColumnWithAShortSoftStretchBucklesAtItsTransferMatrixLoads) {
+  const ContinuationResult r = continued_to_40(stepped_column("EI*(1 - 0.99*(s > 0.4013 && s < 0.4023))"));
+  const std::vector<double> branch_points = branch_points_of(r);
   const std::vector<double> exact = critical_loads({{1.0, 0.4013}, {0.01, 0.001}, {1.0, 1.0 - 0.4023}}, 40.0);
   ASSERT_EQ(exact.size(), 2u);  // 8.2975 and 37.159
   ASSERT_EQ(branch_points.size(), exact.size());
   // The branch points are located to the continuation's 1e-8 (continuation_test's kLocated).
-  for (size_t k = 0; k < exact.size(); ++k) EXPECT_NEAR(branch_points[k].parameter / exact[k], 1.0, 1e-8);
+  for (size_t k = 0; k < exact.size(); ++k) EXPECT_NEAR(branch_points[k] / exact[k], 1.0, 1e-8);
   // The straight column is stable below the first load and has index 1 past it.
   for (const auto& p : r.points) {
     if (!p.stability_index || p.type == PointType::BranchPoint) continue;
@@ -159,23 +176,7 @@ TEST(PiecewiseRod, AJumpOnAProfileSampleKeepsTheEndConditions) {
 // the jump (a probe's: 2.985331 and 16.199424 against 2.9946520 and 16.2233911 exactly; one
 // segment was exact). The segments start and end on the jump's sides now.
 TEST(PiecewiseRod, AJumpOnASegmentNodeKeepsTheCriticalLoads) {
-  std::string text = testing::case_text("euler_column.toml");
-  const std::string uniform = "B = \"EI\"";
-  text.replace(text.find(uniform), uniform.size(), "B = \"EI*(s < 0.5 ? 1 : 0.2)\"");
-  Case c = load_case_text(text, "stepped.toml", {{"P", 1.0}, {"theta_guess", 0.0}});
-  c.definition.options.segments = 2;
-  const ShootingProblem problem(c.definition);
-  RodContinuationOptions o;
-  o.parameter = "P";
-  o.target = 40.0;
-  o.initial_step = 0.5;
-  o.max_step = 5.0;
-  o.samples = 21;
-  RodContinuation run(problem, o);
-  const ContinuationResult r = run.run(problem.initial_unknowns(c.start_guess));
-  std::vector<double> branch_points;
-  for (const auto& p : r.points)
-    if (p.type == PointType::BranchPoint) branch_points.push_back(p.parameter);
+  const std::vector<double> branch_points = branch_points_of(continued_to_40(stepped_column("EI*(s < 0.5 ? 1 : 0.2)", 2)));
   const std::vector<double> exact = critical_loads({{1.0, 0.5}, {0.2, 0.5}}, 40.0);
   ASSERT_EQ(exact.size(), 3u);  // 2.9947, 16.223, 35.349
   ASSERT_EQ(branch_points.size(), exact.size());
@@ -216,11 +217,7 @@ double pinned_beam_determinant(double omega2, double P, const std::vector<std::p
 // started on the wrong side (a probe's: omega^2 = 506.068 and -21.748 against 507.539 and
 // -21.640).
 TEST(PiecewiseRod, VibrationsWithAJumpAtMidSpanMatchATransferComputation) {
-  std::string text = testing::case_text("euler_column.toml");
-  const std::string uniform = "B = \"EI\"";
-  text.replace(text.find(uniform), uniform.size(), "B = \"EI*(s < 0.5 ? 1 : 0.2)\"");
-  const Case c = load_case_text(text, "stepped.toml", {{"P", 5.0}, {"theta_guess", 0.0}});
-  const CaseSolve straight = kirchhoff::solve_case(c);
+  const CaseSolve straight = kirchhoff::solve_case(reload_case(stepped_column("EI*(s < 0.5 ? 1 : 0.2)"), {{"P", 5.0}, {"theta_guess", 0.0}}));
   ASSERT_TRUE(straight.converged()) << straight.message;
   VibrationOptions options;
   options.modes = 2;
