@@ -1,5 +1,7 @@
 // kirchhoff: equilibria of elastic rods by shooting, checked against Noether's invariants.
 #include <CLI/CLI.hpp>
+#include <cstdlib>
+#include <sstream>
 #include <iostream>
 #include <string>
 
@@ -16,6 +18,21 @@
 namespace {
 
 using namespace kirchhoff::cli;
+
+// A number above `bound` (or at it, with `inclusive`), refused in words that say so.
+CLI::Validator at_least(const std::string& option, double bound, bool inclusive) {
+  return CLI::Validator(
+      [=](const std::string& text) {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        const bool number = !text.empty() && end == text.c_str() + text.size();
+        if (number && (inclusive ? v >= bound : v > bound)) return std::string();
+        std::ostringstream why;
+        why << option << " must be " << (inclusive ? ">= " : "> ") << bound << ", got " << text;
+        return why.str();
+      },
+      "");
+}
 
 // --seed, --seed-segments, --seed-amplitude (solve and continue).
 void add_seed_options(CLI::App* command, std::string* choice, kirchhoff::StartSeed* seed) {
@@ -226,12 +243,13 @@ CLI::App* add_vibrate_command(CLI::App& app, VibrateArguments* args) {
       "  kirchhoff vibrate cases/simply_supported.toml --set theta0=1 --modes 4 --out vib.json --profiles modes/\n"
       "  kirchhoff vibrate cases/heavy_cantilever.toml --set w=0 --rho-s 2 --json");
   add_case_options(command, args, "Case file (TOML) of a planar rod");
-  command->add_option("--modes", args->modes, "Number of lowest frequencies to find")
+  // (CLI11's PositiveNumber refused 0 saying "not in range 0 to 1.8e308": the bound said here.)
+  command->add_option("--modes", args->modes, "Number of lowest frequencies to find (>= 1)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  command->add_option("--rho-s", args->rho_s, "Mass per unit length rho S (uniform)")
+      ->check(at_least("--modes", 1.0, true));
+  command->add_option("--rho-s", args->rho_s, "Mass per unit length rho S (uniform, > 0)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(at_least("--rho-s", 0.0, false));
   command->add_option("--out", args->out_path,
                       "Write JSON {\"frequencies\": [...], \"modes\": [{\"omega\", \"H_vib_spread\", ...}]}");
   command->add_option("--profiles", args->profiles_dir,

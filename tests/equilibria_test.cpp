@@ -561,6 +561,19 @@ TEST(Equilibria, TheWallsHangingFoldAndItsMidSpanContactAreListed) {
   }
   EXPECT_EQ(hanging, 1);
   EXPECT_EQ(mid_span, 1);
+  // With --max 8 the eight equilibria carried from the file's values filled the list and the
+  // search stopped before Ipopt's minimisers: neither stable contact (s = 0.3646 and its mirror,
+  // energy 3.709783794 by a probe's own shooting) was listed. They are considered whatever --max
+  // says, and the 8 lowest kept.
+  options.max_equilibria = 8;
+  const EquilibriaSearch eight = find_case_equilibria(c, c.samples, options);
+  ASSERT_EQ(eight.equilibria.size(), 8u);
+  const auto stable_contact = std::find_if(eight.equilibria.begin(), eight.equilibria.end(), [](const Equilibrium& e) {
+    return e.solution.contacts.size() == 1 && std::abs(e.energy - 3.709783794) < 1e-8;
+  });
+  ASSERT_NE(stable_contact, eight.equilibria.end());
+  ASSERT_TRUE(stable_contact->stability.index);
+  EXPECT_EQ(*stable_contact->stability.index, 0);
 }
 
 // --max N holds for the equilibria carried from the file's values and the Ipopt seeds too (the

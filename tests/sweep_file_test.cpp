@@ -58,6 +58,17 @@ TEST(SweepFile, LinearRangesRunTheDecimalsMeant) {
   for (int k = 0; k < 7; ++k) EXPECT_EQ(spec.jobs[3 + k].values[0].second, meant[k]) << k;
 }
 
+// A name that is another table's job id ("x-001" beside "x" of two points): one folder and row
+// stood for two jobs, the second's result under the first's values, and --resume refused the file
+// (a probe's). Refused up front, at the name.
+TEST(SweepFile, AJobIdMadeTwiceIsRefused) {
+  const std::string text = head() +
+                           "[[jobs]]\nname = \"x\"\nkind = \"solve\"\nlist = [{ theta0 = 1 }, { theta0 = 2 }]\n"
+                           "[[jobs]]\nname = \"x-001\"\nkind = \"solve\"\n";
+  EXPECT_EQ(error_of(text).rfind("bad.toml:7: key 'jobs[2].name': its job id 'x-001' is another table's job id too", 0), 0u)
+      << error_of(text);
+}
+
 TEST(SweepFile, ErrorsNameFileLineKeyAndReason) {
   EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\ngrid = { theta0 = [1, 2], thetaX = 3 }\n"),
             "bad.toml:4: key 'jobs[1].grid.thetaX': no parameter 'thetaX' in " + kCases +

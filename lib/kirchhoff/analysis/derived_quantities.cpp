@@ -81,13 +81,21 @@ double refined_maximum(const DerivedInputs& in, const PointFunction& f) {
 // relative; smooth integrands (the elastic energy) come out to ~1e-12.
 // Where a property jumps (RodModel::jumps) the integrand does too, and Simpson across it errs by
 // its spacing times the jump (a probe's stepped column: 1e-4 of the energy); each stretch between
-// jumps is integrated on its own, sampled just inside so that it is read from its own side.
+// jumps and contacts is integrated on its own, sampled just inside so that it is read from its
+// own side.
 double integral_along(DerivedInputs& in, const PointFunction& f) {
   constexpr int kIntervals = 4000;
   const double L = in.end().s;
-  std::vector<double> breaks{0.0};
+  std::vector<double> breaks{0.0, L};
   for (const ProfileJump& j : in.model().jumps()) breaks.push_back(j.before);
-  breaks.push_back(L);
+  // (And at the contacts, where the density has a kink: Simpson across one erred by 1e-7 on a
+  // stepped rod against a wall, a probe's.)
+  for (const auto& c : in.problem.contacts_at(in.x())) {
+    breaks.push_back(std::clamp(c.s, 0.0, L));
+    if (c.extended) breaks.push_back(std::clamp(c.s_end, 0.0, L));
+  }
+  std::sort(breaks.begin(), breaks.end());
+  breaks.erase(std::unique(breaks.begin(), breaks.end()), breaks.end());
   const double inset = breaks.size() > 2 ? 1e-12 * L : 0.0;
   double total = 0.0;
   for (size_t k = 0; k + 1 < breaks.size(); ++k) {

@@ -15,9 +15,10 @@ namespace {
 constexpr double kFileValuesShare = 0.25;
 constexpr int kFileValuesMaxEquilibria = 8;
 // A carried path is followed through folds (HomotopyOptions::through_folds) for at most this many
-// points: one that turns away from the requested values for good ends there. The wall's path from
-// Delta = 0.026 to 0.05 reaches its hanging fold past the fold at 0.0466 (the eight carried paths
-// there take 1.7 s together).
+// points: one that turns away from the requested values for good ends there. On the wall from
+// Delta = 0.026 to 0.05 one path turns at 0.0477 and again, and reaches a rod touching twice
+// (index 1) that no starting point at 0.05 reached, and whose neighbours lead to the stable
+// hanging fold (the eight carried paths there take 2 s together).
 constexpr int kCarriedPathPoints = 600;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {

@@ -335,6 +335,9 @@ class Search {
       push_mirrors(guess_, "guess");
       push_half_turn(guess_, "guess", -INFINITY);
     }
+    // Ipopt's minimisers too, whatever --max says: minima of the energy, they bring the stable
+    // equilibria a search stopped at N may not reach (the wall at Delta = 0.05 with --max 8: eight
+    // carried equilibria filled the list, its stable contacts left out).
     if (options_.discrete_seeds) push_discrete_seeds();
     while (!seeds_.empty() && !should_stop()) {
       const auto next = std::min_element(seeds_.begin(), seeds_.end(),
@@ -365,6 +368,11 @@ class Search {
     const double L = model.length;
     const double B = std::max(model.B[0](0.0), model.B[1](0.0));
     return std::max(B / (L * L), guess_.n.norm());
+  }
+
+  // The time or Newton runs spent (should_stop without --max).
+  bool past_budget() const {
+    return std::chrono::steady_clock::now() > deadline_ || out_.newton_runs >= options_.max_newton_runs;
   }
 
   bool should_stop() {
@@ -467,7 +475,7 @@ class Search {
   void push_discrete_seeds() {
     for (const bool symmetric : {false, true})
       for (const double amplitude : {0.05, -0.05}) {
-        if (should_stop()) return;  // (max_equilibria may be reached by the known roots already)
+        if (past_budget()) return;  // (not --max: these are considered as the known roots are)
         const std::string label = std::string("Ipopt seed, ") + (symmetric ? "mirror symmetric, " : "") + "buckled " +
                                   (amplitude > 0 ? "up" : "down");
         DiscreteSolveOptions options;
@@ -540,7 +548,9 @@ class Search {
   // Other active sets next to x's: each point contact that may lie flat on its obstacle, made an
   // extended contact over kSpread L around it (a rod pressed further lies on the wall: the flat
   // contact coexists with point contacts), and each extended contact made a point contact at its
-  // middle. The active-set loop corrects them.
+  // middle, and two at its ends (its middle lifted off, as a flat part pressed past its Euler
+  // load buckles: the wall's hanging fold at Delta = 0.05, touching at s = 0.3036 and 0.6964, lies
+  // next to its flat contact over [0.3198, 0.6802]). The active-set loop corrects them.
   void push_contact_variants(const ShootingProblem& problem, const Eigen::VectorXd& x, const std::string& of,
                              double priority) {
     constexpr double kSpread = 0.05;
@@ -564,7 +574,18 @@ class Search {
         c.force_end = c.force = 0.5 * c.force;
       }
       push_start(start, variant, std::string(c.extended ? "flat" : "point") + " contact variant of " + of, priority);
+      if (contacts[k].extended) push_start(start, lifted_middle(contacts, k), "lifted flat contact of " + of, priority);
     }
+  }
+
+  // `contacts` with the k-th (extended) made point contacts at its two ends, each with its end's force.
+  static std::vector<PointContact> lifted_middle(std::vector<PointContact> contacts, size_t k) {
+    PointContact second = contacts[k];
+    contacts[k].extended = second.extended = false;
+    second.s = second.s_end;
+    second.force = second.force_end;
+    contacts.insert(contacts.begin() + static_cast<std::ptrdiff_t>(k) + 1, second);
+    return contacts;
   }
 
   // Why x is not an admissible equilibrium of its family's problem, or "".

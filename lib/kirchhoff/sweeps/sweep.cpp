@@ -492,6 +492,15 @@ void expand_jobs(const Reader& r, const Group& g, const std::vector<ParameterOve
   for (std::size_t k = 0; k < group_points.size(); ++k) {
     SweepJob job = g.prototype;
     job.id = group_points.size() == 1 ? g.name : g.name + "-" + padded(k + 1, group_points.size());
+    // Names are unique, but a name can be another table's id ("x-001" beside a table "x" of two
+    // points): one job's folder and row would stand for both, and --resume refuse the file.
+    for (const SweepJob& other : spec->jobs)
+      if (other.id == job.id) {
+        const Value* name = Reader::find(g.table, "name");
+        r.fail(name ? *name : g.table, g.key + ".name",
+               "its job id '" + job.id + "' is another table's job id too: give a name that no other table's "
+               "ids (NAME-001, NAME-002, ...) repeat");
+      }
     job.order = static_cast<int>(spec->jobs.size());
     job.values = group_points[k];
     for (const auto& entry : job.values)
