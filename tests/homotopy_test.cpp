@@ -65,6 +65,20 @@ TEST(Homotopy, MovesEveryChangedParameterTogether) {
   EXPECT_NEAR(solved_load(s) / exact.load(), 1.0, kLoadTolerance);
 }
 
+// EI down 69 times and L up 3 times at once: P falls from 11.2 to 0.0169, and a step of 1.03 whose
+// corrector moved the point 0.21 from its prediction (the steps before: at most 0.024 of theirs)
+// landed on the third mode lying beside the first (P = 0.15218 = 9 times, index 2), with no fold or
+// branch point to report (a probe's sweep, one row in 70). Such a step is now taken again, shorter.
+TEST(Homotopy, DoesNotJumpToAModeLyingBesideItsOwn) {
+  const CaseSolve s = solve_at("simply_supported.toml", {{"EI", 0.014491376746189442}, {"theta0", 0.7}, {"L", 3.0}});
+  ASSERT_TRUE(s.failure.empty()) << s.message;
+  ASSERT_TRUE(s.solved.result.summary.converged());
+  const analytic::PinnedElastica exact{3.0, 0.014491376746189442, 0.7};  // L, EI, theta0
+  EXPECT_NEAR(solved_load(s) / exact.load(), 1.0, kLoadTolerance);
+  ASSERT_TRUE(s.stability && s.stability->index);
+  EXPECT_EQ(*s.stability->index, 0);
+}
+
 // The shallow arch under its weight snaps through at a fold: asked for a weight beyond it, the
 // homotopy stops there and says where, instead of returning an equilibrium of another branch.
 TEST(Homotopy, StopsAtAFoldAndSaysWhere) {

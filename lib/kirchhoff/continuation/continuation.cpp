@@ -23,6 +23,10 @@
 namespace kirchhoff {
 namespace {
 
+// The largest distance a march's corrector may move a point from its prediction, as a fraction of
+// the step (Continuation::step_from): with the quadratic predictor, and with the tangent alone.
+constexpr double kMovedQuadratic = 0.1;
+constexpr double kMovedTangent = 0.3;
 // Step growth and shrink factors: the usual choices for predictor-corrector continuation.
 constexpr double kGrow = 1.5, kShrink = 0.5;
 // Location (Illinois, the kinked minimum) stops when the step interval is this small relative to the step.
@@ -393,6 +397,23 @@ std::optional<ContinuationPoint> Continuation::step_from(const ContinuationPoint
     z = z_pred;
     own.reset();
     if (!correct(z, z_pred, from.tangent, &iterations)) return std::nullopt;
+  }
+  // A march's corrector that moved the point far from its prediction may have converged on another
+  // branch lying beside this one, where the tangent does not turn to show it: the simply supported
+  // Elastica carried from EI = 1, L = 1 to EI = 0.0145, L = 3 went from its first mode to its third
+  // in one step of 1.03 whose corrector moved 0.21 (8 iterations), where the steps before it moved
+  // at most 0.024 of theirs. Such a step is taken again, shorter (as a failed corrector is). The
+  // quadratic predictor's error is O(h^3), the tangent's ~kappa h^2 / 2, at most ~0.18 h within
+  // max_tangent_angle: the bounds below leave both room.
+  if (march) {
+    const double moved = (z - z_pred).norm(), limit = (curvature ? kMovedQuadratic : kMovedTangent) * std::abs(h);
+    if (moved > limit) {
+      std::ostringstream why;
+      why << "the corrector moved the point " << moved << " from its prediction on a step of " << std::abs(h)
+          << " (another branch nearby?)";
+      last_corrector_failure_ = why.str();
+      return std::nullopt;
+    }
   }
   // A corrector that converged quickly on the previous matrix shows that matrix still serves:
   // the new point keeps it for its tangent and the next chord instead of paying for its own.
