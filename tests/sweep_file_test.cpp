@@ -69,6 +69,18 @@ TEST(SweepFile, AJobIdMadeTwiceIsRefused) {
       << error_of(text);
 }
 
+// The file's own `set` and `solver` are named where they are refused (a probe's: both were
+// reported at line 1, key 'case').
+TEST(SweepFile, TheFilesSetAndSolverAreNamedWhereTheyAreRefused) {
+  const std::string job = "[[jobs]]\nkind = \"solve\"\n";
+  EXPECT_EQ(error_of(head() + "set = { Q = 1 }\n" + job),
+            "bad.toml:2: key 'set.Q': no parameter 'Q' in " + kCases + "/simply_supported.toml (have: theta0, L, EI, P)");
+  EXPECT_EQ(error_of(head() + "solver = { tolerence = 1e-3 }\n" + job).rfind("bad.toml:2: key 'solver'", 0), 0u)
+      << error_of(head() + "solver = { tolerence = 1e-3 }\n" + job);
+  EXPECT_EQ(error_of(head() + job + "set = { Q = 1 }\n").rfind("bad.toml:4: key 'jobs[1].set.Q'", 0), 0u)
+      << error_of(head() + job + "set = { Q = 1 }\n");
+}
+
 TEST(SweepFile, ErrorsNameFileLineKeyAndReason) {
   EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\ngrid = { theta0 = [1, 2], thetaX = 3 }\n"),
             "bad.toml:4: key 'jobs[1].grid.thetaX': no parameter 'thetaX' in " + kCases +
@@ -91,7 +103,8 @@ TEST(SweepFile, ErrorsNameFileLineKeyAndReason) {
             "plectonemes)");
   EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\nmax_equilibria = 3\n"),
             "bad.toml:4: key 'jobs[1].max_equilibria': only equilibria jobs take it");
-  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\nset = { nope = 1 }\n").rfind("bad.toml:4: key 'jobs[1].set': ", 0),
+  EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\nset = { nope = 1 }\n")
+                .rfind("bad.toml:4: key 'jobs[1].set.nope': no parameter 'nope'", 0),
             0u);
   EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"continue\"\n"),
             "bad.toml:2: key 'jobs[1].param': missing: the parameter a continue job follows its branch in");

@@ -289,6 +289,8 @@ struct SweepTop {
   const Value* case_value = nullptr;
   ParameterOverrides set;
   SolverOverrides solver;
+  const Value* set_value = nullptr;     // where the file gives them, if it does
+  const Value* solver_value = nullptr;
   const Value* jobs = nullptr;  // a non-empty array
 };
 
@@ -298,8 +300,10 @@ SweepTop read_top(const Reader& r, const Value& root, SweepSpec* spec) {
   if (const Value* v = Reader::find(root, "title")) spec->title = r.string(*v, "title");
   top.case_value = Reader::find(root, "case");
   if (top.case_value) top.case_text = r.string(*top.case_value, "case");
-  if (const Value* v = Reader::find(root, "set")) top.set = r.overrides(*v, "set");
-  if (const Value* v = Reader::find(root, "solver")) top.solver = r.solver(*v, "solver");
+  top.set_value = Reader::find(root, "set");
+  top.solver_value = Reader::find(root, "solver");
+  if (top.set_value) top.set = r.overrides(*top.set_value, "set");
+  if (top.solver_value) top.solver = r.solver(*top.solver_value, "solver");
   top.jobs = Reader::find(root, "jobs");
   if (!top.jobs) r.fail("jobs", "no [[jobs]] tables: nothing to run");
   if (!top.jobs->is_array() || top.jobs->as_array().empty())
@@ -427,15 +431,44 @@ void read_continue_keys(const Reader& r, Group* g) {
 
 using SweptKeys = std::map<std::string, std::pair<const Value*, std::string>>;  // name -> (value, key)
 
-// The group's case loaded with its overrides: a case that does not load is reported at the key
-// that names it (the group's set, else its case). Adds the case's derived names to the columns.
-Case load_group_case(const Reader& r, const Group& g, SweepSpec* spec) {
+// The group's case loaded with its overrides. What refuses it is reported at the key that gives
+// it: the case itself at its `case`; an override at the `set` (the group's, else the file's) that
+// gives it, an unknown name as that table's NAME key; a [solver] key at its `solver` table (a
+// probe's `set = { Q = 1 }` on line 2 was reported at line 1, key 'case'). Adds the case's
+// derived names to the columns.
+Case load_group_case(const Reader& r, const SweepTop& top, const Group& g, SweepSpec* spec) {
+  const auto fail_at = [&](const Value* group_value, const Value* top_value, const std::string& key,
+                           const std::string& why) {
+    if (group_value) r.fail(*group_value, g.key + "." + key, why);
+    if (top_value) r.fail(*top_value, key, why);
+    r.fail(g.case_value ? *g.case_value : g.table, g.case_key, why);
+  };
+  const Value* group_set = Reader::find(g.table, "set");
+  const Value* group_solver = Reader::find(g.table, "solver");
+  Case plain;
+  try {
+    plain = load_case(g.prototype.case_path);
+  } catch (const CaseError& e) {
+    r.fail(g.case_value ? *g.case_value : g.table, g.case_key, e.what());
+  }
+  for (const auto& [name, value] : g.prototype.set)
+    if (!plain.file_parameters.contains(name)) {
+      std::string have;
+      for (const auto& n : plain.file_parameters.names()) have += (have.empty() ? "" : ", ") + n;
+      const Value* in_group = group_set ? Reader::find(*group_set, name) : nullptr;
+      fail_at(in_group, in_group || !top.set_value ? nullptr : Reader::find(*top.set_value, name), "set." + name,
+              "no parameter '" + name + "' in " + g.prototype.case_path + " (have: " + have + ")");
+    }
   Case c;
+  try {
+    c = load_case(g.prototype.case_path, g.prototype.set);
+  } catch (const CaseError& e) {
+    fail_at(group_set, top.set_value, "set", e.what());
+  }
   try {
     c = load_case(g.prototype.case_path, g.prototype.set, "", g.prototype.solver);
   } catch (const CaseError& e) {
-    const Value* at = Reader::find(g.table, "set") ? Reader::find(g.table, "set") : g.case_value;
-    r.fail(at ? *at : g.table, at == g.case_value ? g.case_key : g.key + ".set", e.what());
+    fail_at(group_solver, top.solver_value, "solver", e.what());
   }
   for (const auto& d : c.derived)
     if (std::find(spec->derived_columns.begin(), spec->derived_columns.end(), d) == spec->derived_columns.end())
@@ -528,7 +561,7 @@ void read_group(const Reader& r, const SweepTop& top, std::size_t index, std::se
   // The case, loaded once with the group's overrides, then with its first point: a case that
   // does not load, unknown or computed parameters and refused values are reported before any
   // job runs, at the key that names them.
-  const Case c = load_group_case(r, g, spec);
+  const Case c = load_group_case(r, top, g, spec);
   check_parameters(r, g, c, where);
   check_points(r, g, group_points);
   expand_jobs(r, g, group_points, spec);
