@@ -81,6 +81,15 @@ TEST(SweepFile, TheFilesSetAndSolverAreNamedWhereTheyAreRefused) {
       << error_of(head() + job + "set = { Q = 1 }\n");
 }
 
+// A continue job's steps that `continue` would refuse are refused with the file (a probe's
+// min_step = 1, max_step = 0.1 ran and became a bad_input row, exit 0).
+TEST(SweepFile, AContinueJobsStepsAreCheckedWithTheFile) {
+  const std::string text = head() +
+                           "[[jobs]]\nkind = \"continue\"\nparam = \"theta0\"\nto = 1.5\nmin_step = 1\nmax_step = 0.1\n";
+  EXPECT_EQ(error_of(text).rfind("bad.toml:6: key 'jobs[1].min_step': min_step (1) must not exceed max_step (0.1)", 0), 0u)
+      << error_of(text);
+}
+
 TEST(SweepFile, ErrorsNameFileLineKeyAndReason) {
   EXPECT_EQ(error_of(head() + "[[jobs]]\nkind = \"solve\"\ngrid = { theta0 = [1, 2], thetaX = 3 }\n"),
             "bad.toml:4: key 'jobs[1].grid.thetaX': no parameter 'thetaX' in " + kCases +

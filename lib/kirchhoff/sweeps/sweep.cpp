@@ -425,6 +425,14 @@ void read_continue_keys(const Reader& r, Group* g) {
       *field = r.number(*v, key + "." + k);
       if (!(*field > 0)) r.fail(*v, key + "." + k, "must be > 0");
     }
+  // (Checked here with the file, as `continue` checks it: a job refused when it ran was a
+  // bad_input row of a sweep that had said the file was sound, a probe's.)
+  if (!(job.min_step <= job.max_step)) {
+    const Value* at = Reader::find(g->table, "min_step") ? Reader::find(g->table, "min_step") : Reader::find(g->table, "max_step");
+    std::ostringstream why;
+    why << "min_step (" << job.min_step << ") must not exceed max_step (" << job.max_step << ")";
+    r.fail(at ? *at : g->table, key + (Reader::find(g->table, "min_step") ? ".min_step" : ".max_step"), why.str());
+  }
   if (const Value* v = Reader::find(g->table, "branch_points")) job.branch_points = r.boolean(*v, key + ".branch_points");
   if (const Value* v = Reader::find(g->table, "stability")) job.stability = r.boolean(*v, key + ".stability");
 }
