@@ -469,9 +469,9 @@ class Search {
 
   // Ipopt's minima from the first mode buckled either way, then the same held mirror symmetric:
   // a minimiser left free leaves a symmetric start for a lower asymmetric minimum, and the wall's
-  // hanging fold (contacts at s = 0.30 and 0.70 at Delta = 0.05, index 0, energy 6.356) was
-  // reached by no starting point (a probe's). On a problem without the symmetry the symmetric
-  // minimiser fails its KKT check and is logged, not used.
+  // symmetric rod touching at mid-span (Delta = 0.05, index 1, energy 4.6412) was reached by no
+  // starting point (a probe's). On a problem without the symmetry the symmetric minimiser fails
+  // its KKT check and is logged, not used.
   void push_discrete_seeds() {
     for (const bool symmetric : {false, true})
       for (const double amplitude : {0.05, -0.05}) {
