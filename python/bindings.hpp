@@ -118,6 +118,9 @@ py::dict stats_dict(const InvariantStats& s);
 
 // None, a mapping (its items()) or an iterable of (name, value) pairs.
 std::vector<std::pair<std::string, double>> named_values(const py::object& obj);
+// The Ipopt seed of solve() and continue_() from their seed= ('guess' or 'ipopt', else CaseError),
+// seed_segments= and seed_amplitude= (checked by the library, as the CLI's --seed options are).
+StartSeed start_seed(const std::string& seed, int segments, double amplitude);
 
 py::dict parameters_dict(const Parameters& p);
 

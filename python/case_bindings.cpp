@@ -38,7 +38,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
   if (samples < 2 || samples > 100000)  // as a case file's [output] samples
     throw CaseError("samples must be in [2, 100000] (got " + std::to_string(samples) + ")");
-  if (seed != "guess" && seed != "ipopt") throw CaseError("seed must be 'guess' or 'ipopt' (got '" + seed + "')");
+  const StartSeed start = start_seed(seed, seed_segments, seed_amplitude);
   std::string seed_refused;  // raised as ValueError once the GIL is back
 
   PySolution out;
@@ -52,9 +52,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
       // start, or a path that stopped short, is a failure with the CLI's status word.
       CaseSolveOptions options;
       options.direct = direct;
-      options.seed.ipopt = seed == "ipopt";
-      options.seed.segments = seed_segments;
-      options.seed.amplitude = seed_amplitude;
+      options.seed = start;
       options.samples = samples;
       solved = solve_case(c, options);
     } catch (const std::invalid_argument& e) {  // a case the Ipopt seed does not model

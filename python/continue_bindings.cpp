@@ -29,7 +29,7 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
                      const py::object& state, bool resume, const py::object& start_from,
                      const std::string& start_param, const std::string& seed, int seed_segments,
                      double seed_amplitude, double checkpoint) {
-  if (seed != "guess" && seed != "ipopt") throw CaseError("seed must be 'guess' or 'ipopt' (got '" + seed + "')");
+  const StartSeed start = start_seed(seed, seed_segments, seed_amplitude);
   if (!(checkpoint >= 0 && checkpoint <= 1e6)) throw CaseError("checkpoint must be in [0, 1e6] seconds");
   ContinueRequest request;
   request.parameter = parameter;
@@ -50,9 +50,7 @@ PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::o
   request.deflate = deflate;
   request.deflate_max = deflate_max;
   request.max_seconds = max_seconds;
-  request.seed.ipopt = seed == "ipopt";
-  request.seed.segments = seed_segments;
-  request.seed.amplitude = seed_amplitude;
+  request.seed = start;
   const std::string state_path = path_text(state), from = path_text(start_from);
   if (deflate && !state_path.empty()) throw CaseError("state: a deflate run is not resumable, so it saves no state");
   RunPlanInputs inputs;  // the case loaded again where the run's parameter values differ from pc's

@@ -25,6 +25,15 @@ std::vector<std::pair<std::string, double>> named_values(const py::object& obj) 
   return out;
 }
 
+StartSeed start_seed(const std::string& seed, int segments, double amplitude) {
+  if (seed != "guess" && seed != "ipopt") throw CaseError("seed must be 'guess' or 'ipopt' (got '" + seed + "')");
+  StartSeed out;
+  out.ipopt = seed == "ipopt";
+  out.segments = segments;
+  out.amplitude = amplitude;
+  return out;
+}
+
 py::dict parameters_dict(const Parameters& p) {
   py::dict d;
   for (int i = 0; i < p.size(); ++i) d[py::str(p.names()[i])] = p.values()[i];

@@ -11,6 +11,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "kirchhoff/analysis/detail/integral_along_rod.hpp"
 #include "kirchhoff/contact/closest_approach.hpp"
 #include "kirchhoff/contact/plectoneme.hpp"
 #include "kirchhoff/equations/invariants.hpp"
@@ -76,41 +77,12 @@ double refined_maximum(const DerivedInputs& in, const PointFunction& f) {
   return std::max(-value, f(profile[best]));
 }
 
-// Composite Simpson on a fine sampling (one integration pass): a soft wall's potential is peaked
-// over a width ~sqrt(gap / kappa) ~ 1e-2 at b = 1e-6, which 4000 intervals resolve to ~1e-7
-// relative; smooth integrands (the elastic energy) come out to ~1e-12.
-// Where a property jumps (RodModel::jumps) the integrand does too, and Simpson across it errs by
-// its spacing times the jump (a probe's stepped column: 1e-4 of the energy); each stretch between
-// jumps and contacts is integrated on its own, sampled just inside so that it is read from its
-// own side.
+// A soft wall's potential is peaked over a width ~sqrt(gap / kappa) ~ 1e-2 at b = 1e-6, which
+// 4000 Simpson intervals resolve to ~1e-7 relative; smooth integrands (the elastic energy) come
+// out to ~1e-12 (integral_along_rod.hpp: the stretches between jumps and contacts on their own).
 double integral_along(DerivedInputs& in, const PointFunction& f) {
   constexpr int kIntervals = 4000;
-  const double L = in.end().s;
-  std::vector<double> breaks{0.0, L};
-  for (const ProfileJump& j : in.model().jumps()) breaks.push_back(j.before);
-  // (And at the contacts, where the density has a kink: Simpson across one erred by 1e-7 on a
-  // stepped rod against a wall, a probe's.)
-  for (const auto& c : in.problem.contacts_at(in.x())) {
-    breaks.push_back(std::clamp(c.s, 0.0, L));
-    if (c.extended) breaks.push_back(std::clamp(c.s_end, 0.0, L));
-  }
-  std::sort(breaks.begin(), breaks.end());
-  breaks.erase(std::unique(breaks.begin(), breaks.end()), breaks.end());
-  const double inset = breaks.size() > 2 ? 1e-12 * L : 0.0;
-  double total = 0.0;
-  for (size_t k = 0; k + 1 < breaks.size(); ++k) {
-    const double a = breaks[k] + (k == 0 ? 0.0 : inset), b = breaks[k + 1] - (k + 2 == breaks.size() ? 0.0 : inset);
-    if (!(b > a)) continue;
-    const int n = std::max(2, 2 * static_cast<int>(std::ceil(0.5 * kIntervals * (b - a) / L)));
-    std::vector<double> s(n + 1);
-    for (int i = 0; i <= n; ++i) s[i] = a + (b - a) * i / n;
-    s.back() = b;
-    const auto points = in.problem.sample(in.x(), s);
-    double sum = 0.0;
-    for (int i = 0; i <= n; ++i) sum += (i == 0 || i == n ? 1.0 : (i % 2 ? 4.0 : 2.0)) * f(points[i]);
-    total += sum * ((b - a) / n) / 3.0;
-  }
-  return total;
+  return integral_along_rod(in.problem, in.x(), in.model(), kIntervals, f);
 }
 
 // The smallest of a per-contact quantity, over the contacts where it is defined (NaN elsewhere);

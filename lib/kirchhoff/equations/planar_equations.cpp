@@ -26,7 +26,9 @@ constexpr int kStateSize = kPlanarStateSize;
 class PlanarEquations final : public RodEquations {
  public:
   explicit PlanarEquations(RodModel model)
-      : model_(std::move(model)), compliances_(model_), jumps_(std::make_shared<const std::vector<ProfileJump>>(model_.jumps())) {}
+      : model_(std::move(model)),
+        compliances_(model_),
+        jumps_(std::make_shared<const std::vector<ProfileJump>>(model_.jumps())) {}
 
   int state_size() const override { return kStateSize; }
   const RodModel& model() const override { return model_; }
@@ -64,7 +66,7 @@ class PlanarEquations final : public RodEquations {
 
   void flow_into(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities, const IntegratorOptions& given,
                  SegmentFlow* out) const override {
-    const IntegratorOptions options = with_jumps(given);
+    const IntegratorOptions options = detail::with_jumps(given, jumps_);
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     if (!sensitivities) return detail::flow_state_into<kStateSize>(f, y0, s0, s1, options, out);
     if (model_.field) {
@@ -82,7 +84,7 @@ class PlanarEquations final : public RodEquations {
 
   DirectionalFlow flow_directions(const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions, double s0, double s1,
                                   const IntegratorOptions& given, CarriedSteps* carried) const override {
-    const IntegratorOptions options = with_jumps(given);
+    const IntegratorOptions options = detail::with_jumps(given, jumps_);
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     // The seeds of flow(): all of them with a field, else those x(s0), y(s0) do not enter.
     static const std::vector<int> kAll{kX, kY, kTheta, kNx, kNy, kMoment};
@@ -93,7 +95,7 @@ class PlanarEquations final : public RodEquations {
 
   std::vector<Eigen::VectorXd> sample(const Eigen::VectorXd& y0, const std::vector<double>& s,
                                       const IntegratorOptions& given) const override {
-    const IntegratorOptions options = with_jumps(given);
+    const IntegratorOptions options = detail::with_jumps(given, jumps_);
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     return detail::sample_states<kStateSize>(f, y0, s, options);
   }
@@ -241,13 +243,6 @@ class PlanarEquations final : public RodEquations {
     for (int r = 0; r < kRows; ++r)
       for (int j = 0; j < kColumns; ++j) out->Phi(kRowOf[r], kColumnOf[j]) = x[kStateSize + r * kColumns + j];
     out->dy_dunfolding.resize(0);
-  }
-
-  // The caller's options with this rod's jumps (IntegratorOptions::jumps).
-  IntegratorOptions with_jumps(const IntegratorOptions& given) const {
-    IntegratorOptions options = given;
-    if (!jumps_->empty()) options.jumps = jumps_;
-    return options;
   }
 
   RodModel model_;

@@ -44,7 +44,10 @@ Eigen::Vector4d quaternion_from_rotation(const Mat3& R) {
 class SpatialEquations final : public RodEquations {
  public:
   explicit SpatialEquations(RodModel model, std::optional<CylinderSupport> support = std::nullopt)
-      : model_(std::move(model)), compliances_(model_), jumps_(std::make_shared<const std::vector<ProfileJump>>(model_.jumps())), support_(std::move(support)),
+      : model_(std::move(model)),
+        compliances_(model_),
+        jumps_(std::make_shared<const std::vector<ProfileJump>>(model_.jumps())),
+        support_(std::move(support)),
         tangent_stiffness_(model_.field && !support_ && model_.field->has_tangent_stiffness()) {}
 
   int state_size() const override { return kStateSize; }
@@ -110,7 +113,7 @@ class SpatialEquations final : public RodEquations {
 
   void flow_into(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities, const IntegratorOptions& given,
                  SegmentFlow* out) const override {
-    const IntegratorOptions options = with_jumps(given);
+    const IntegratorOptions options = detail::with_jumps(given, jumps_);
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     if (!sensitivities) return detail::flow_state_into<kStateSize>(f, y0, s0, s1, options, out);
     // A rod without field or cylinder: the variational equations written out
@@ -133,7 +136,7 @@ class SpatialEquations final : public RodEquations {
 
   DirectionalFlow flow_directions(const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions, double s0, double s1,
                                   const IntegratorOptions& given, CarriedSteps* carried) const override {
-    const IntegratorOptions options = with_jumps(given);
+    const IntegratorOptions options = detail::with_jumps(given, jumps_);
     if (detail::has_written_out_variations(model_, support_.has_value())) {
       auto state_rhs = [this](const double* y, double* dy, double s) { rhs(y, dy, s); };
       return detail::written_out_directional_flow<3, 4, 5, 6, 8, 10>(model_, compliances_, state_rhs, y0, directions,
@@ -150,7 +153,7 @@ class SpatialEquations final : public RodEquations {
 
   std::vector<Eigen::VectorXd> sample(const Eigen::VectorXd& y0, const std::vector<double>& s,
                                       const IntegratorOptions& given) const override {
-    const IntegratorOptions options = with_jumps(given);
+    const IntegratorOptions options = detail::with_jumps(given, jumps_);
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     return detail::sample_states<kStateSize>(f, y0, s, options);
   }
@@ -276,13 +279,6 @@ class SpatialEquations final : public RodEquations {
   LabDirections admissible_directions(Slot) const override { return LabDirections::Identity(3, 3); }
 
  private:
-  // The caller's options with this rod's jumps (IntegratorOptions::jumps).
-  IntegratorOptions with_jumps(const IntegratorOptions& given) const {
-    IntegratorOptions options = given;
-    if (!jumps_->empty()) options.jumps = jumps_;
-    return options;
-  }
-
   RodModel model_;
   detail::Compliances compliances_;         // of model_ (declared after it: built from it)
   std::shared_ptr<const std::vector<ProfileJump>> jumps_;  // of model_: where its properties jump

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "kirchhoff/analysis/detail/integral_along_rod.hpp"
 #include "kirchhoff/analysis/discrete_seed.hpp"
 #include "kirchhoff/analysis/discrete_stability.hpp"
 #include "kirchhoff/contact/closest_approach.hpp"
@@ -24,35 +25,6 @@ namespace kirchhoff {
 // Energy
 
 namespace {
-
-// Composite Simpson over [a, b] with an even number of intervals, sampled by one integration.
-double simpson(const ShootingProblem& problem, const Eigen::VectorXd& x, const RodModel& model, double a, double b,
-               int intervals) {
-  std::vector<double> s(intervals + 1);
-  for (int i = 0; i <= intervals; ++i) s[i] = a + (b - a) * i / intervals;
-  s.back() = b;
-  const auto points = problem.sample(x, s);
-  double sum = 0.0;
-  for (int i = 0; i <= intervals; ++i)
-    sum += (i == 0 || i == intervals ? 1.0 : (i % 2 ? 4.0 : 2.0)) * energy_density(model, points[i]);
-  return sum * (b - a) / intervals / 3.0;
-}
-
-// Where the energy density may have a kink (the shear force jumps at a contact) or a jump (a
-// property given piecewise: Simpson across it erred by 1e-4 of a stepped column's energy, a
-// probe's): the pieces are integrated separately so that Simpson keeps its h^4 error.
-std::vector<double> energy_breakpoints(const ShootingProblem& problem, const Eigen::VectorXd& x, const RodModel& model) {
-  const double L = model.length;
-  std::vector<double> b{0.0, L};
-  for (const ProfileJump& j : model.jumps()) b.push_back(j.before);
-  for (const auto& c : problem.contacts_at(x)) {
-    b.push_back(std::clamp(c.s, 0.0, L));
-    if (c.extended) b.push_back(std::clamp(c.s_end, 0.0, L));
-  }
-  std::sort(b.begin(), b.end());
-  b.erase(std::unique(b.begin(), b.end()), b.end());
-  return b;
-}
 
 // The work of the loads an end condition gives, at the end state p; NaN for a dead couple on a
 // spatial end (not a potential in general).
@@ -88,16 +60,8 @@ double total_potential_energy(const ShootingProblem& problem, const Eigen::Vecto
   // 2000 intervals over the rod: Simpson's h^4 error is ~(1/2000)^4 ~ 6e-14 of the energy's
   // scale for a density as smooth as the elastic energy of a resolved rod.
   constexpr int kIntervals = 2000;
-  const std::vector<double> breaks = energy_breakpoints(problem, x, model);
-  // Sampled just inside each piece, so that a jump at a contact is read from the piece's own side.
-  const double inset = 1e-12 * L;
-  double energy = 0.0;
-  for (size_t i = 0; i + 1 < breaks.size(); ++i) {
-    const double a = breaks[i], b = breaks[i + 1];
-    if (b - a <= 2 * inset) continue;
-    const int n = std::max(2, 2 * static_cast<int>(std::ceil(0.5 * kIntervals * (b - a) / L)));
-    energy += simpson(problem, x, model, i == 0 ? a : a + inset, i + 2 == breaks.size() ? b : b - inset, n);
-  }
+  const double energy =
+      integral_along_rod(problem, x, model, kIntervals, [&](const RodPoint& p) { return energy_density(model, p); });
   const auto ends = problem.sample(x, {0.0, L});
   return energy - end_load_work(definition.start, *eq, params, ends.front()) -
          end_load_work(definition.end, *eq, params, ends.back());

@@ -439,12 +439,10 @@ void read_continue_keys(const Reader& r, Group* g) {
 
 using SweptKeys = std::map<std::string, std::pair<const Value*, std::string>>;  // name -> (value, key)
 
-// The group's case loaded with its overrides. What refuses it is reported at the key that gives
-// it: the case itself at its `case`; an override at the `set` (the group's, else the file's) that
-// gives it, an unknown name as that table's NAME key; a [solver] key at its `solver` table (a
-// probe's `set = { Q = 1 }` on line 2 was reported at line 1, key 'case'). Adds the case's
-// derived names to the columns.
-Case load_group_case(const Reader& r, const SweepTop& top, const Group& g, SweepSpec* spec) {
+// Why the group's case did not load with its overrides, reported at the key that refuses it,
+// found by loading the case with less: the case alone, then with the overrides, then with the
+// [solver] keys.
+[[noreturn]] void fail_where_refused(const Reader& r, const SweepTop& top, const Group& g) {
   const auto fail_at = [&](const Value* group_value, const Value* top_value, const std::string& key,
                            const std::string& why) {
     if (group_value) r.fail(*group_value, g.key + "." + key, why);
@@ -452,7 +450,6 @@ Case load_group_case(const Reader& r, const SweepTop& top, const Group& g, Sweep
     r.fail(g.case_value ? *g.case_value : g.table, g.case_key, why);
   };
   const Value* group_set = Reader::find(g.table, "set");
-  const Value* group_solver = Reader::find(g.table, "solver");
   Case plain;
   try {
     plain = load_case(g.prototype.case_path);
@@ -467,16 +464,28 @@ Case load_group_case(const Reader& r, const SweepTop& top, const Group& g, Sweep
       fail_at(in_group, in_group || !top.set_value ? nullptr : Reader::find(*top.set_value, name), "set." + name,
               "no parameter '" + name + "' in " + g.prototype.case_path + " (have: " + have + ")");
     }
-  Case c;
   try {
-    c = load_case(g.prototype.case_path, g.prototype.set);
+    load_case(g.prototype.case_path, g.prototype.set);
   } catch (const CaseError& e) {
     fail_at(group_set, top.set_value, "set", e.what());
   }
   try {
-    c = load_case(g.prototype.case_path, g.prototype.set, "", g.prototype.solver);
+    load_case(g.prototype.case_path, g.prototype.set, "", g.prototype.solver);
   } catch (const CaseError& e) {
-    fail_at(group_solver, top.solver_value, "solver", e.what());
+    fail_at(Reader::find(g.table, "solver"), top.solver_value, "solver", e.what());
+  }
+  throw std::logic_error("sweep: a case refused with its overrides loaded with them");
+}
+
+// The group's case loaded with its overrides (once, where the file is sound); what refuses it is
+// reported at the key that gives it (fail_where_refused: a probe's `set = { Q = 1 }` on line 2 was
+// reported at line 1, key 'case'). Adds the case's derived names to the columns.
+Case load_group_case(const Reader& r, const SweepTop& top, const Group& g, SweepSpec* spec) {
+  Case c;
+  try {
+    c = load_case(g.prototype.case_path, g.prototype.set, "", g.prototype.solver);
+  } catch (const CaseError&) {
+    fail_where_refused(r, top, g);
   }
   for (const auto& d : c.derived)
     if (std::find(spec->derived_columns.begin(), spec->derived_columns.end(), d) == spec->derived_columns.end())

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <memory>
 #include <boost/numeric/odeint.hpp>
 #include <cmath>
 #include <stdexcept>
@@ -52,6 +53,14 @@ long march_stretch(State& x, double s0, double s1, const System& system, const I
   for (double v : x)
     if (!std::isfinite(v)) throw IntegrationError("non-finite state");
   return steps;
+}
+
+// The caller's options with a rod's jumps (IntegratorOptions::jumps), which the equations hold.
+inline IntegratorOptions with_jumps(const IntegratorOptions& given,
+                                    const std::shared_ptr<const std::vector<ProfileJump>>& jumps) {
+  IntegratorOptions options = given;
+  if (!jumps->empty()) options.jumps = jumps;
+  return options;
 }
 
 // march_stretch over [s0, s1] (either way round), the stretch between two jumps of the right-hand
