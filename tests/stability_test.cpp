@@ -509,6 +509,57 @@ derived = ["tip_x"]
   }
 }
 
+// The same strip far stiffer in its plane (a ruler: B1 / B2 up to 1e10): Prandtl's critical tip
+// load is 4.0126 sqrt(B2 C) / L^2 (a probe's shooting of C phi'' + P^2 (L - s)^2 phi / B2 = 0),
+// and the index is 0 below it and 1 past it. The fields' scale came from a bound on |m| through H,
+// sqrt(B_max 2 (H + |n|)), 2.8e4 at B1 = 1e8 where |m| is at most |m(0)| + |n| L = 8: the soft
+// directions' momenta were 1e-5 of their rotations and the end form's crossing eigenvalue
+// (+-1e-6) fell within the zero tolerance, "stable, 1 zero mode" up to 1.7 % past the load
+// (B1 = 1e8) and 4.7 % (B2 = 1e-4). The loads below are 0.5 % from it at least.
+TEST(Stability, AStripAMillionTimesStifferInItsPlaneBucklesAtPrandtlsLoad) {
+  const std::string tip = R"(model = "spatial"
+[parameters]
+P = 1.0
+B1 = 1e4
+B2 = 1.0
+[rod]
+length = 1.0
+B1 = "B1"
+B2 = "B2"
+B3 = 1.0
+[start]
+type = "clamped"
+position = [0, 0, 0]
+[end]
+type = "loaded"
+force = [0, "-P", 0]
+moment = [0, 0, 0]
+[guess]
+force = [0, "P", 0]
+moment = ["-P", 0, 0]
+)";
+  struct Row {
+    double B1, B2, P;
+    int index;
+  };
+  const double critical = 4.012599;  // sqrt(B2 C) / L^2 = 1
+  const Row rows[] = {{1e6, 1.0, 0.995 * critical, 0},   {1e6, 1.0, 1.005 * critical, 1},
+                      {1e8, 1.0, 0.995 * critical, 0},   {1e8, 1.0, 1.017 * critical, 1},
+                      {1e10, 1.0, 1.005 * critical, 1},  {1e4, 1e-4, 0.0097 * critical, 0},
+                      {1e4, 1e-4, 0.0105 * critical, 1}, {1e8, 1.0, 10.3, 2}};
+  for (const Row& row : rows) {
+    SCOPED_TRACE("B1 = " + std::to_string(row.B1) + ", B2 = " + std::to_string(row.B2) + ", P = " + std::to_string(row.P));
+    const Case c = load_case_text(tip, "ruler.toml", {{"B1", row.B1}, {"B2", row.B2}, {"P", row.P}});
+    ShootingProblem problem(c.definition);
+    const ShootingResult solved = solve(problem, problem.initial_unknowns(c.start_guess));
+    ASSERT_TRUE(solved.summary.converged());
+    const StabilityReport r = analyse_stability(problem, solved.x);
+    ASSERT_TRUE(r.defined()) << r.reason;
+    EXPECT_EQ(*r.index, row.index);
+    EXPECT_EQ(r.zero_modes, 0);
+  }
+}
+
 // An anisotropic twisted rod (twisted_clamped.toml with B1 = 3, B2 = 1, C = 2) under a
 // compression of 3, straight, twisted to phi = 33.9 and 39: a branch's looser fields (1e-8) leave
 // the isoperimetric correction unresolved there (D's eigenvalue -0.022 within a resolution of
