@@ -130,7 +130,7 @@ CLI::App* add_continue_command(CLI::App& app, ContinueArguments* args, std::stri
   command->add_option("--direction", args->direction,
                       "Which way the parameter goes first when there is no --to: 1 (up) or -1 (down)")
       ->capture_default_str();
-  command->add_option("--step", args->step, "Initial pseudo-arclength step")->capture_default_str();
+  command->add_option("--step", args->step, "Initial pseudo-arclength step (at most --max-step)")->capture_default_str();
   command->add_option("--min-step", args->min_step, "Smallest step before giving up")->capture_default_str();
   command->add_option("--max-step", args->max_step, "Largest step")->capture_default_str();
   command->add_option("--max-points", args->max_points, "Largest number of points of each branch (a switched branch counts its own)")->capture_default_str();

@@ -95,9 +95,9 @@ void bind_case_continuation(py::class_<PyCase>& cls) {
           py::arg("step") = 0.05, py::arg("min_step") = 1e-7, py::arg("max_step") = 0.5,
           py::arg("max_points") = 500, py::arg("events") = py::none(), py::arg("record") = py::none(),
           py::arg("switch_at_bp") = 0, py::arg("side") = 1.0, py::arg("samples") = 101,
-          py::arg("direction") = 1.0, py::arg("branch_points") = true, py::arg("stability") = true,
-          py::arg("deflate") = false, py::arg("deflate_max") = 16, py::arg("max_seconds") = 0.0,
-          py::arg("state") = py::none(), py::arg("resume") = false, py::arg("start_from") = py::none(),
+          py::arg("direction") = 1.0, py::arg("branch_points").noconvert() = true, py::arg("stability").noconvert() = true,
+          py::arg("deflate").noconvert() = false, py::arg("deflate_max") = 16, py::arg("max_seconds") = 0.0,
+          py::arg("state") = py::none(), py::arg("resume").noconvert() = false, py::arg("start_from") = py::none(),
           py::arg("start_param") = "", py::arg("seed") = "guess", py::arg("seed_segments") = 200,
           py::arg("seed_amplitude") = 0.05, py::arg("checkpoint") = 0.0,
           R"doc(Pseudo-arclength continuation in one parameter (the CLI's `continue`).
@@ -106,7 +106,8 @@ Args:
     param (str): the continued parameter; its value in the case is the starting one.
     to (float, optional): stop on reaching this value on the starting branch (None: no target, go
         along `direction`); a branch switched onto runs to an event or `max_points`.
-    step, min_step, max_step (float): initial, smallest and largest pseudo-arclength step.
+    step, min_step, max_step (float): initial, smallest and largest pseudo-arclength step (the
+        first step is `step` within [min_step, max_step]).
     max_points (int): points per branch.
     events (dict name -> value): stop when a derived quantity crosses the value.
     record (dict name -> value): record such crossings without stopping.

@@ -348,6 +348,19 @@ TEST(SingularPointIndex, IsTheNeighboursLowerIndexWhereTheZeroModesExplainTheCha
   EXPECT_EQ(zero_modes(counted(std::nullopt, 0), counted(3, 1), counted(1, 1)), 3);
   EXPECT_EQ(settled(counted(std::nullopt, 0), counted(1, 0), counted(1, 0)), std::nullopt);
   EXPECT_EQ(settled(counted(2, 1), counted(std::nullopt, 0), counted(1, 0)), 2);
+  // The reason goes with an empty index only: settled, the degenerate count's reason is cleared (a
+  // probe: the run's note said row 138 of the clamped column had no index where its CSV row had
+  // 0); made empty here, the row gets one.
+  auto reason = [](PointRecord p, const PointRecord& a, const PointRecord& b) {
+    detail::settle_singular_point_index(&p, a, b);
+    return p.stability_reason;
+  };
+  PointRecord degenerate = counted(std::nullopt, 0);
+  degenerate.stability_reason = "a degenerate constraint";
+  EXPECT_EQ(reason(degenerate, counted(0, 0), counted(1, 0)), "");
+  EXPECT_EQ(reason(degenerate, counted(1, 0), counted(1, 0)), "a degenerate constraint");
+  EXPECT_NE(reason(counted(1, 0), counted(1, 0), counted(1, 0)), "");
+  EXPECT_NE(reason(counted(2, 0), counted(0, 0), counted(1, 0)), "");
 }
 
 TEST(BroydenSteps, SolveALinearSystemInAtMostTwiceItsSizeSteps) {

@@ -64,6 +64,23 @@ TEST(EulerColumn, BranchPointsAtTheEulerLoads) {
   EXPECT_TRUE(of_type(run.result, PointType::Fold).empty());
 }
 
+// No step longer than max_step, the first included: an initial step of 0.05 under a max_step of
+// 0.01 went five times as far as the run allows (a probe); the first point is at the largest step
+// allowed. The straight column's branch is P itself, so each step is its change in P.
+TEST(EulerColumn, TheFirstStepIsNoLongerThanMaxStep) {
+  RodContinuationOptions o = euler_options();
+  o.target = 1.2;
+  o.initial_step = 0.05;
+  o.max_step = 0.01;
+  o.compute_stability = false;
+  const BranchRun run = continue_case("euler_column.toml", {{"P", 1.0}, {"theta_guess", 0.0}}, o);
+  EXPECT_EQ(run.result.reason, StopReason::ReachedTarget);
+  ASSERT_GE(run.result.points.size(), 3u);
+  EXPECT_NEAR(run.result.points[1].arclength, 0.01, 1e-12);
+  for (size_t i = 1; i < run.result.points.size(); ++i)
+    EXPECT_LE(run.result.points[i].arclength - run.result.points[i - 1].arclength, 0.01 * (1 + 1e-9)) << i;
+}
+
 TEST(EulerColumn, MultipleShootingContinuesTheSameWay) {
   Case c = load_case(testing::case_path("euler_column.toml"), {{"P", 1.0}, {"theta_guess", 0.0}});
   c.definition.options.segments = 3;

@@ -8,6 +8,7 @@
 // zero modes against 1e-2 instead of 1e-6 fails on the Euler column at its branch points.)
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 #include <string>
 #include <vector>
@@ -104,6 +105,39 @@ TEST(StabilityAlongBranches, ClampedClampedRodUnderEndShortening) {
   r.direction = -1.0;
   const std::set<int> seen = expect_same_indices("clamped_clamped.toml", {{"s_mode", 1.0}}, r);
   EXPECT_TRUE(seen.count(1)) << "the S-shaped mode";
+}
+
+// The straight column at P = 20 continued in EI down to 0.05 and 0.04: a branch point at each
+// EI = 20 / (k pi)^2, index k - 1 there with one zero mode. The last step of each run overshoots
+// its target past several branch points (its candidate at EI = 0.0247, index 9); the branch point
+// before the target was settled against that candidate instead of the target's point, and got
+// four zero modes (0.05) and seven (0.04), from a probe.
+struct KeepBranchPoints : ContinueSink {
+  std::vector<std::pair<double, std::pair<std::optional<int>, int>>> rows;  // EI, (index, zero modes)
+  void point(const RunPoint& p) override {
+    if (p.point->type == PointType::BranchPoint)
+      rows.push_back({p.point->parameter, {p.point->stability_index, p.point->zero_modes}});
+  }
+};
+
+TEST(StabilityAlongBranches, ABranchPointBeforeTheTargetIsSettledAgainstTheTargetsPoint) {
+  for (const double target : {0.05, 0.04}) {
+    SCOPED_TRACE(target);
+    const Case c = load_case(testing::case_path("euler_column.toml"), {{"P", 20.0}, {"theta_guess", 0.0}});
+    ContinueRequest r;
+    r.parameter = "EI";
+    r.target = target;
+    r.samples = 21;
+    KeepBranchPoints keep;
+    ASSERT_TRUE(continue_case(c, r, {&keep}).ok);
+    ASSERT_GE(keep.rows.size(), 5u);
+    for (const auto& [EI, count] : keep.rows) {
+      const double k = std::sqrt(20.0 / EI) / M_PI;  // whole at a branch point
+      EXPECT_NEAR(k, std::round(k), 1e-6) << EI;
+      EXPECT_EQ(count.first, static_cast<int>(std::round(k)) - 1) << EI;
+      EXPECT_EQ(count.second, 1) << EI;
+    }
+  }
 }
 
 }  // namespace

@@ -23,6 +23,13 @@
 namespace kirchhoff {
 namespace {
 
+// The first step of a run or a branch: initial_step, within [min_step, max_step] (a first step
+// of 0.05 under --max-step 0.01 went five times as far as the run allows any).
+double first_step(const StepControl& o) { return std::clamp(o.initial_step, o.min_step, o.max_step); }
+
+// How many times the first step from a branch point is halved before the switch gives up.
+constexpr int kFirstStepHalvings = 6;
+
 // The largest distance a march's corrector may move a point from its prediction, as a fraction of
 // the step (Continuation::step_from): with the quadratic predictor, and with the tangent alone.
 constexpr double kMovedQuadratic = 0.1;
@@ -543,7 +550,7 @@ ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink&
                      (start ? ": " + start->check_failure : "");
     return result;
   }
-  start->step = options_.initial_step;
+  start->step = first_step(options_);
   MarchState state;
   state.current = std::move(*start);
   return march(std::move(state), sink);
@@ -586,7 +593,7 @@ ContinuationResult Continuation::resume(const MarchState& saved, const PointSink
 ContinuationResult Continuation::resume(const ContinuationPoint& last, const PointSink& sink) {
   MarchState state;
   state.current = last;
-  if (!(state.current.step > 0)) state.current.step = options_.initial_step;
+  if (!(state.current.step > 0)) state.current.step = first_step(options_);
   return resume(state, sink);
 }
 
@@ -639,16 +646,24 @@ ContinuationResult Continuation::run_along(const Eigen::VectorXd& x, double lamb
   origin.tangent = d;
   origin.type = start_type;
   describe(&origin);
-  const Eigen::VectorXd z_pred = z_bp + options_.initial_step * d;
-  Eigen::VectorXd z = z_pred;
-  int iterations = 0;
+  // The first point a step along d, corrected on the plane normal to d; where the corrector
+  // fails, the step is halved (kFirstStepHalvings times at most, not below min_step), as a
+  // march's would be: the shallow arch's asymmetric branch from its branch point at w = 39.26
+  // was reached on one side (--side -1) and not on the other at the first step, 0.05.
   std::optional<ContinuationPoint> first;
-  if (correct(z, z_pred, d, &iterations))
-    first = point_at(z, d, PointType::Regular, 1, (z - z_bp).norm(), iterations);
+  double h = first_step(options_);
+  for (int halving = 0; !first && halving <= kFirstStepHalvings && h >= options_.min_step; ++halving, h *= 0.5) {
+    const Eigen::VectorXd z_pred = z_bp + h * d;
+    Eigen::VectorXd z = z_pred;
+    int iterations = 0;
+    if (correct(z, z_pred, d, &iterations))
+      first = point_at(z, d, PointType::Regular, 1, (z - z_bp).norm(), iterations);
+  }
   if (first) describe(&*first);
   if (!first) {
     result.reason = failed_start_reason(options_.deadline);
-    result.message = "no solution along the switching direction";
+    result.message = "no solution along the switching direction (the first step halved down to " + std::to_string(2 * h) +
+                     "); the other side (--side -1, or side=-1 in Python) may be reachable";
     return result;
   }
   record(&origin);
@@ -659,7 +674,7 @@ ContinuationResult Continuation::run_along(const Eigen::VectorXd& x, double lamb
     origin.zero_modes = known->zero_modes;
   }
   if (sink) sink(origin);
-  first->step = options_.initial_step;
+  first->step = first_step(options_);
   MarchState state;
   state.current = std::move(*first);
   state.points = 2;  // the origin, reported, counts against max_points as a run's start does
@@ -694,7 +709,7 @@ struct Continuation::Marcher {
         previous_h(state.previous_step),
         just_reported_branch_point(state.just_reported_branch_point),
         points_before(state.points - 1),
-        ds(current.step > 0 ? current.step : engine.options_.initial_step) {
+        ds(current.step > 0 ? current.step : first_step(engine.options_)) {
     counters.branch_points_found = state.branch_points_found;
     result.refused_steps = state.refused_steps;
   }
@@ -881,8 +896,9 @@ struct Continuation::Marcher {
     just_reported_branch_point = std::any_of(found.begin(), found.end(), [](const detail::Detection& d) {
       return d.point.type == PointType::BranchPoint;
     });
+    const ContinuationPoint* after = singular ? settling_neighbour(&found, candidate, step_stop) : nullptr;
     for (auto& d : found) {
-      accept(d.point, d.recorded, singular ? candidate : nullptr);
+      accept(d.point, d.recorded, after);
       const ContinuationPoint& p = result.points.back();
       if (auto s = d.detector->act(p, &counters)) return s;
       // An end point stops with its own reason: a contact leg's stopping event found beyond the
@@ -894,6 +910,29 @@ struct Continuation::Marcher {
       if (!has_room()) return detail::Stop{StopReason::MaxPoints, ""};
     }
     return std::nullopt;
+  }
+
+  // The regular point after the step's singular points that settles their index: the candidate,
+  // or the point where the run ends inside the step (its target, a stopping event), recorded
+  // here. Beyond that point the candidate is off the reported branch and may lie past more
+  // singular points: the Euler column continued in EI to 0.05 settled its branch point at
+  // 0.0563 against the candidate at 0.0247, four branch points on, and gave it four zero modes.
+  const ContinuationPoint* settling_neighbour(std::vector<detail::Detection>* found, const ContinuationPoint* candidate,
+                                             std::optional<StopReason> step_stop) {
+    const double s0 = current.arclength;
+    double last_singular = -std::numeric_limits<double>::infinity();
+    for (const auto& d : *found)
+      if (d.point.type == PointType::Fold || d.point.type == PointType::BranchPoint)
+        last_singular = std::max(last_singular, d.point.arclength - s0);
+    for (auto& d : *found) {
+      const bool ends_run =
+          d.point.type == PointType::Endpoint || (d.point.type == PointType::Event && step_stop == StopReason::EventStop);
+      if (!ends_run || !(d.point.arclength - s0 > last_singular)) continue;
+      if (!d.recorded) c.record(&d.point);
+      d.recorded = true;
+      return &d.point;
+    }
+    return candidate;
   }
 
   // The candidate on the branch as the new current point. The next step is decided before the

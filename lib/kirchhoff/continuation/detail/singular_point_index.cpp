@@ -1,6 +1,7 @@
 #include "kirchhoff/continuation/detail/singular_point_index.hpp"
 
 #include <algorithm>
+#include <string>
 
 namespace kirchhoff::detail {
 
@@ -16,6 +17,7 @@ void settle_singular_point_index(PointRecord* singular, const PointRecord& befor
     if (lower == upper) return;
     singular->stability_index = lower;
     singular->zero_modes = common + (upper - lower);
+    singular->stability_reason.clear();  // settled: no longer why it is empty
     return;
   }
   // Equal neighbours: the zero eigenvalue may touch zero from either side without crossing, and
@@ -25,6 +27,9 @@ void settle_singular_point_index(PointRecord* singular, const PointRecord& befor
     if (singular->zero_modes > common) return;
     singular->stability_index.reset();
     singular->zero_modes = common + 1;
+    singular->stability_reason =
+        "an eigenvalue touches zero at this fold or branch point without crossing (both neighbours have index " +
+        std::to_string(lower) + "), and the point's own count took it for nonzero: its sign is not known";
     return;
   }
   const int own = *singular->stability_index;
@@ -35,6 +40,9 @@ void settle_singular_point_index(PointRecord* singular, const PointRecord& befor
   const bool explained = (own >= lower && own <= upper) || singular->zero_modes - common >= crossing;
   if (!explained) {
     singular->stability_index.reset();
+    singular->stability_reason = "the point's own count (" + std::to_string(own) +
+                                 ") is outside its neighbours' indices (" + std::to_string(lower) + " and " +
+                                 std::to_string(upper) + ") and its zero modes do not explain it";
     return;
   }
   singular->stability_index = lower;
