@@ -76,7 +76,8 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   out.converged = r.summary.converged();
   out.iterations = r.summary.iterations;
   out.residual = r.summary.residual_norm;
-  out.message = r.summary.message;
+  // As the CLI's: why it did not converge, Newton's report where it gave no message of its own.
+  out.message = !out.converged && r.summary.message.empty() ? r.summary.brief_report() : r.summary.message;
   out.used_fallback_search = r.summary.used_fallback_search;
   out.history = r.summary.history;
   out.rhs_evaluations = problem ? problem->rhs_evaluations() : 0;  // none when the guess failed
@@ -297,7 +298,7 @@ Attributes:
       .def_readonly("phase_condition", &PyCase::phase_condition);
   cls.def("solve", &py_solve, py::arg("samples") = py::none(), py::kw_only(), py::arg("seed") = "guess",
           py::arg("seed_segments") = 200, py::arg("seed_amplitude") = 0.05,
-          py::arg("max_seconds") = kDefaultSolveSeconds, py::arg("direct") = false,
+          py::arg("max_seconds") = kDefaultSolveSeconds, py::arg("direct").noconvert() = false,
           R"doc(Solves the case by shooting.
 
 Parameters changed from the file's values (load(..., set=...)) are reached by continuation from

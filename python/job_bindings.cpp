@@ -130,7 +130,7 @@ Returns:
 Raises:
     CaseError (ValueError): the file cannot be used; the message names the key and the reason.)doc");
 
-  m.def("reproduce", &py_reproduce, py::arg("out"), py::arg("full") = false, py::kw_only(), py::arg("cases") = py::none(),
+  m.def("reproduce", &py_reproduce, py::arg("out"), py::arg("full").noconvert() = false, py::kw_only(), py::arg("cases") = py::none(),
         R"doc(Recompute the reference paper's results (the CLI's `kirchhoff reproduce`, the same files).
 
 Writes out/report.md, out/report.json and the figure data in out/profiles/ (and with full=True
@@ -150,11 +150,11 @@ Raises:
     CaseError (ValueError): a case file missing from `cases` or refused (the CLI's exit 2).
     RuntimeError: a result that could not be computed (the report is then not written).)doc");
 
-  m.def("sweep", &py_sweep, py::arg("spec"), py::arg("out"), py::kw_only(), py::arg("resume") = false,
+  m.def("sweep", &py_sweep, py::arg("spec"), py::arg("out"), py::kw_only(), py::arg("resume").noconvert() = false,
         R"doc(Runs a sweep file serially (the CLI's `kirchhoff sweep SPEC --out OUT`, the same files:
 OUT/jobs/<id>/, OUT/index.csv, OUT/times.csv; docs/sweeps.md) and returns the index as columns:
 {"job": [...], "kind": [...], <each swept parameter>: [float], "status", "reason",
-"contact_state", "stable_states": [str], "stability_index", "equilibria", "energy", <derived>:
+"contact_state", "stable_states": [str], "stability_index", "zero_modes", "equilibria", "energy", <derived>:
 [float, NaN where not defined]}. A failing job is a row with its status, not an exception.
 
 Args:
@@ -168,7 +168,7 @@ Raises:
   m.def("plectonemes", &py_plectonemes, py::arg("out"), py::arg("slenderness") = std::vector<double>{100},
         py::arg("turns") = std::vector<double>{10}, py::kw_only(), py::arg("case") = py::none(),
         py::arg("from_ply") = std::vector<double>{}, py::arg("turns_min") = 4.0, py::arg("hard_from") = 0.0,
-        py::arg("resume") = false, py::arg("sensitivity_tol") = kPlectonemeSensitivityTol,
+        py::arg("resume").noconvert() = false, py::arg("sensitivity_tol") = kPlectonemeSensitivityTol,
         R"doc(The Fig. 11 sweep of cases/plectoneme.toml (the CLI's `kirchhoff plectonemes`, the same
 files into `out`; progress on stderr, a line per slenderness on stdout).
 

@@ -174,7 +174,7 @@ void bind_system_continuation(py::module_& m) {
   m.def("continue_system", &continue_system, py::arg("F"), py::arg("J"), py::arg("x0"), py::arg("parameter"),
         py::arg("to") = py::none(), py::kw_only(), py::arg("step") = 0.05, py::arg("min_step") = 1e-7,
         py::arg("max_step") = 0.5, py::arg("max_points") = 500, py::arg("direction") = 1.0,
-        py::arg("branch_points") = true, py::arg("events") = py::none(), py::arg("switch_at_bp") = 0,
+        py::arg("branch_points").noconvert() = true, py::arg("events") = py::none(), py::arg("switch_at_bp") = 0,
         py::arg("side") = 1.0, py::arg("tolerance") = 1e-10,
         R"doc(Pseudo-arclength continuation of any system F(x, lambda) = 0 (the engine of Case.continue_()).
 

@@ -457,6 +457,20 @@ TEST_F(CaseFileTest, UnknownVariableIsACaseErrorWherever) {
   }
 }
 
+// A planar rod's field acts in its plane: gravity with up = [0, 0, 1] was accepted and did
+// nothing (a probe); in-plane directions are normalised, not refused.
+TEST_F(CaseFileTest, AFieldAcrossAPlanarRodsPlaneIsRefused) {
+  for (const char* field : {"gravity = { weight = 1.0, up = [0, 0, 1] }", "gravity = { weight = 1.0, up = [0, 1, 0.5] }",
+                            "barrier = { b = 0.01, a = 0.2, normal = [0, 0, 1] }"}) {
+    SCOPED_TRACE(field);
+    const std::string text = replaced(kBase, "B = \"EI\"", std::string("B = \"EI\"\n") + field);
+    const std::string key = std::string(field).rfind("gravity", 0) == 0 ? "rod.gravity.up" : "rod.barrier.normal";
+    expect_refused(text, key, {"the z component must be 0"}, line_of(text, field));
+  }
+  EXPECT_NO_THROW(load_case_text(replaced(kBase, "B = \"EI\"", "B = \"EI\"\ngravity = { weight = 1.0, up = [1, 1, 0] }"),
+                                 "tilted.toml"));
+}
+
 TEST_F(CaseFileTest, ExpressionWithSyntaxError) {
   const std::string text = replaced(kBase, "length = \"L\"", "length = \"L*\"");
   expect_refused(text, "rod.length", {"cannot read expression 'L*'"}, line_of(text, "length = "));

@@ -314,6 +314,11 @@ TEST_F(CliTest, NotConvergedExitsOneWithStatus) {
   ASSERT_TRUE(j.contains("iterations")) << r.out;
   EXPECT_LE(j["iterations"].get<int>(), 1);
   EXPECT_EQ(j["parameters"]["theta0"].get<double>(), 2.5);
+  // Why, in the JSON as on stderr, also where Newton gave no message of its own (out of
+  // iterations: the message was empty, from a probe).
+  const CliRun direct = run(args + " --json --direct");
+  EXPECT_EQ(direct.status, 1) << direct.out << direct.err;
+  EXPECT_THAT(parse(direct)["message"].get<std::string>(), HasSubstr("iterations, residual"));
 
   // The same copy converges with enough iterations: the failure above is the iteration cap.
   const std::string relaxed = variant("simply_supported.toml", "unknowns = [\"P\"]",

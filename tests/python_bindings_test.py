@@ -334,6 +334,8 @@ class SolveTest(unittest.TestCase):
         self.assertEqual(sol.derived, {})
         self.assertEqual(sol.profile, {})
         self.assertEqual(sol.parameters["theta0"], 2.5)
+        # Why, as the CLI's JSON says it (Newton gave no message of its own: out of iterations).
+        self.assertIn("after 1 iterations, residual", sol.message)
 
 
 class CheckedResultTest(unittest.TestCase):
@@ -625,6 +627,11 @@ class ContinuationTest(unittest.TestCase):
         self.assertIn("not_derived", str(cm.exception))
         with self.assertRaises(ValueError):
             case.continue_("P", to=13.0, step=-1.0)
+        # A flag is True or False: None or 0 turned the stability columns off silently (a probe).
+        for flag in ("stability", "branch_points", "resume", "deflate"):
+            for value in (None, 0, 2, "yes"):
+                with self.assertRaises(TypeError, msg=f"{flag}={value!r}"):
+                    case.continue_("P", to=13.0, **{flag: value})
 
     def test_branch_points_can_be_skipped(self):
         case = kirchhoff.load_case(case_path("euler_column.toml"), set={"P": 1.0, "theta_guess": 0.0})
@@ -983,6 +990,7 @@ class SweepTest(unittest.TestCase):
             self.assertEqual(index["status"], ["ok"] * 3)
             self.assertEqual(index["contact_state"], ["none"] * 3)
             self.assertEqual(index["stability_index"], [0.0] * 3)
+            self.assertEqual(index["zero_modes"], [0.0] * 3)
             self.assertAlmostEqual(index["P"][2], 17.4295934848, places=8)  # Fig. 3, README
             self.assertTrue((pathlib.Path(out) / "jobs" / "solve-002" / "profile.csv").exists())
             with self.assertRaises(kirchhoff.CaseError):  # results there already, no resume

@@ -65,13 +65,13 @@ TEST_F(SweepRunTest, IndexHasOneRowPerJobInJobOrder) {
   ASSERT_EQ(testing::run_to_end(sweep(spec, dir_ / "a"), dir_ / "a.log"), 0);
   const auto rows = testing::lines_of(dir_ / "a" / "index.csv");
   ASSERT_EQ(rows.size(), 17u);
-  EXPECT_EQ(rows[0].rfind("job,kind,theta0,P,slenderness,turns,status,reason,contact_state,stable_states,stability_index,equilibria,"
+  EXPECT_EQ(rows[0].rfind("job,kind,theta0,P,slenderness,turns,status,reason,contact_state,stable_states,stability_index,zero_modes,equilibria,"
                           "energy,derived_P,y_max,kappa_max,end_to_end,derived_theta0",
                           0),
             0u)
       << rows[0];
-  EXPECT_EQ(rows[1].rfind("fig3-001,solve,0.25,,,,ok,,none,none,0,1,", 0), 0u) << rows[1];
-  EXPECT_EQ(rows[13].rfind("column-001,equilibria,,5.0,,,ok,,none,none,0,3,", 0), 0u) << rows[13];
+  EXPECT_EQ(rows[1].rfind("fig3-001,solve,0.25,,,,ok,,none,none,0,0,1,", 0), 0u) << rows[1];
+  EXPECT_EQ(rows[13].rfind("column-001,equilibria,,5.0,,,ok,,none,none,0,0,3,", 0), 0u) << rows[13];
   EXPECT_TRUE(fs::exists(dir_ / "a" / "jobs" / "fig3-012" / "profile.csv"));
   EXPECT_TRUE(fs::exists(dir_ / "a" / "jobs" / "column-002" / "equilibrium_3.csv"));
   EXPECT_EQ(rows[15].rfind("branch,continue,,5.0,,,ok,", 0), 0u) << rows[15];
@@ -99,7 +99,7 @@ TEST_F(SweepRunTest, ASolveJobTakesTheDiscretisedIndexAsSolveDoes) {
   ASSERT_EQ(testing::run_to_end(sweep(spec, dir_ / "m"), dir_ / "m.log"), 0);
   const auto rows = testing::lines_of(dir_ / "m" / "index.csv");
   ASSERT_EQ(rows.size(), 2u);
-  EXPECT_EQ(rows[1].rfind("meet,solve,1e-05,ok,,none,none,0,1,", 0), 0u) << rows[1];
+  EXPECT_EQ(rows[1].rfind("meet,solve,1e-05,ok,,none,none,0,0,1,", 0), 0u) << rows[1];
   std::ifstream in(dir_ / "m" / "jobs" / "meet" / "result.json");
   const std::string result((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(result.find("\"stability_method\": \"discretised_energy\""), std::string::npos) << result;

@@ -113,14 +113,26 @@ void note_field_parameters(const Expression& e, std::set<std::string>* field_par
   for (const auto& n : e.used_parameters()) field_parameters->insert(n);
 }
 
-// [rod.gravity]: a uniform weight per unit length along -up.
-FieldAdder add_gravity(const Reader& reader, const Value& g, FieldAdder prev, std::set<std::string>* field_parameters) {
+// A field's direction on a planar rod lies in its plane (x, y): a z component would be taken by
+// the plane in silence (gravity with up = [0, 0, 1] left the rod as it was).
+void refuse_out_of_plane_direction(const Reader& reader, const Value& v, const std::string& key, const Vec3& direction,
+                                   RodKind kind) {
+  if (kind == RodKind::Planar && direction.z() != 0.0)
+    reader.fail(v, key,
+                "a planar rod's field acts in its plane (x, y): the z component must be 0 (use model = \"spatial\" "
+                "for a field across it)");
+}
+
+// [rod.gravity]: a uniform weight per unit length along -up (up normalised: its direction counts).
+FieldAdder add_gravity(const Reader& reader, const Value& g, RodKind kind, FieldAdder prev,
+                       std::set<std::string>* field_parameters) {
   reader.allow_keys(g, "rod.gravity", {"weight", "up"});
   const Value* w = Reader::find(g, "weight");
   if (!w) reader.fail(g, "rod.gravity.weight", "missing (weight per unit length)");
   const Expression weight = reader.expression(*w, "rod.gravity.weight");
   const Value* up_value = Reader::find(g, "up");
   const Vec3 up = up_value ? reader.unit_vector(*up_value, "rod.gravity.up") : Vec3::UnitY();
+  if (up_value) refuse_out_of_plane_direction(reader, *up_value, "rod.gravity.up", up, kind);
   note_field_parameters(weight, field_parameters);
   return [prev = std::move(prev), weight, up](const Parameters& p, double length, FieldSum* f) {
     prev(p, length, f);
@@ -129,8 +141,8 @@ FieldAdder add_gravity(const Reader& reader, const Value& g, FieldAdder prev, st
 }
 
 // [rod.barrier]: a soft wall of range b and height a, normal to `normal`.
-FieldAdder add_barrier(const Reader& reader, const Value& bw, const Parameters& parameters, FieldAdder prev,
-                       std::set<std::string>* field_parameters) {
+FieldAdder add_barrier(const Reader& reader, const Value& bw, RodKind kind, const Parameters& parameters,
+                       FieldAdder prev, std::set<std::string>* field_parameters) {
   reader.allow_keys(bw, "rod.barrier", {"b", "a", "normal"});
   const Value* b = Reader::find(bw, "b");
   const Value* a = Reader::find(bw, "a");
@@ -138,6 +150,7 @@ FieldAdder add_barrier(const Reader& reader, const Value& bw, const Parameters& 
   const Expression range = reader.expression(*b, "rod.barrier.b"), height = reader.expression(*a, "rod.barrier.a");
   const Value* normal_value = Reader::find(bw, "normal");
   const Vec3 normal = normal_value ? reader.unit_vector(*normal_value, "rod.barrier.normal") : Vec3::UnitY();
+  if (normal_value) refuse_out_of_plane_direction(reader, *normal_value, "rod.barrier.normal", normal, kind);
   if (!(range(parameters) > 0)) reader.fail(*b, "rod.barrier.b", "must be > 0");
   for (const auto& e : {range, height}) note_field_parameters(e, field_parameters);
   return [prev = std::move(prev), range, height, normal](const Parameters& p, double length, FieldSum* f) {
@@ -189,9 +202,10 @@ FieldAdder add_self_contact(const Reader& reader, const Value& sc, RodKind kind,
 FieldAdder read_fields(const Reader& reader, const Value& rod, RodKind kind, const Parameters& parameters,
                        const Expression& bend, std::set<std::string>* field_parameters) {
   FieldAdder add_fields = [](const Parameters&, double, FieldSum*) {};
-  if (const Value* g = Reader::find(rod, "gravity")) add_fields = add_gravity(reader, *g, add_fields, field_parameters);
+  if (const Value* g = Reader::find(rod, "gravity"))
+    add_fields = add_gravity(reader, *g, kind, add_fields, field_parameters);
   if (const Value* bw = Reader::find(rod, "barrier"))
-    add_fields = add_barrier(reader, *bw, parameters, add_fields, field_parameters);
+    add_fields = add_barrier(reader, *bw, kind, parameters, add_fields, field_parameters);
   if (const Value* sc = Reader::find(rod, "self_contact"))
     add_fields = add_self_contact(reader, *sc, kind, parameters, bend, add_fields, field_parameters);
   return add_fields;

@@ -58,6 +58,8 @@ json derived_json(const Solution& sol) {
 }
 
 json stability_index(const StabilityReport& s) { return s.index ? json(*s.index) : json(); }
+// Beside the index (a straight column at P = pi^2 is index 0 with one zero mode): null with it.
+json zero_modes(const StabilityReport& s) { return s.index ? json(s.zero_modes) : json(); }
 
 // Writes `text` to `path` through a temporary file renamed over it (atomic on POSIX).
 void write_atomically(const fs::path& path, const std::string& text) {
@@ -109,6 +111,7 @@ void run_solve(const SweepJob& job, const Case& c, const fs::path& folder, json*
   (*result)["contact_state"] = state;
   (*result)["stable_states"] = stability.stable() ? state : "";
   (*result)["stability_index"] = stability_index(stability);
+  (*result)["zero_modes"] = zero_modes(stability);
   (*result)["stability_reason"] = stability.reason;
   (*result)["stability_method"] = stability.method;
   (*result)["equilibria"] = 1;
@@ -153,6 +156,7 @@ void run_equilibria(const SweepJob& job, const Case& c, const fs::path& folder, 
                     {"energy", number(e.energy)},
                     {"contact_state", state},
                     {"stability_index", stability_index(e.stability)},
+                    {"zero_modes", zero_modes(e.stability)},
                     {"stability_reason", e.stability.reason},
                     {"derived", derived_json(e.solution)},
                     {"contacts", contacts_json(*e.problem, e.solution)},
@@ -175,6 +179,7 @@ void run_equilibria(const SweepJob& job, const Case& c, const fs::path& folder, 
   (*result)["contact_state"] = joined(states);
   (*result)["stable_states"] = joined(stable_states);
   (*result)["stability_index"] = stability_index(lowest.stability);
+  (*result)["zero_modes"] = zero_modes(lowest.stability);
   (*result)["energy"] = number(lowest.energy);
   (*result)["derived"] = derived_json(lowest.solution);
   (*result)["list"] = std::move(list);
@@ -408,7 +413,7 @@ SweepIndex write_sweep_index(const SweepSpec& spec, const std::string& dir) {
   column("kind", false);
   for (const auto& p : spec.parameter_columns) column(p, true);
   for (const char* name : {"status", "reason", "contact_state", "stable_states"}) column(name, false);
-  for (const char* name : {"stability_index", "equilibria", "energy"}) column(name, true);
+  for (const char* name : {"stability_index", "zero_modes", "equilibria", "energy"}) column(name, true);
   // A derived quantity named like a column before it (a parameter P and the derived P) is
   // derived_<name>.
   for (const auto& d : spec.derived_columns)
@@ -428,8 +433,8 @@ SweepIndex write_sweep_index(const SweepSpec& spec, const std::string& dir) {
     const fs::path result = jobs / job.id / "result.json";
     if (fs::exists(result)) j = json::parse(read_file(result));
     else j = {{"status", "not_run"}};
-    for (const char* name : {"status", "reason", "contact_state", "stable_states", "stability_index", "equilibria",
-                             "energy"})
+    for (const char* name : {"status", "reason", "contact_state", "stable_states", "stability_index", "zero_modes",
+                             "equilibria", "energy"})
       row.push_back(j.contains(name) ? cell(j[name]) : "");
     for (const auto& d : spec.derived_columns) {
       const json* derived = j.contains("derived") ? &j["derived"] : nullptr;
