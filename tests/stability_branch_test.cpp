@@ -140,5 +140,32 @@ TEST(StabilityAlongBranches, ABranchPointBeforeTheTargetIsSettledAgainstTheTarge
   }
 }
 
+// The shallow arch's symmetric branch meets the asymmetric one at w = 39.2597 (a pitchfork: its
+// two sides are mirror images, index 1). The first step along the switching direction, 0.05,
+// failed its corrector on one side (start_failed, "no solution along the switching direction")
+// and not on the other (a probe); it is halved now, as a march's step is, and both sides start.
+struct KeepBranches : ContinueSink {
+  std::vector<std::pair<int, std::optional<int>>> rows;  // branch, index
+  void point(const RunPoint& p) override { rows.push_back({p.branch, p.point->stability_index}); }
+};
+
+TEST(StabilityAlongBranches, BothSidesOfTheShallowArchsPitchforkAreReached) {
+  for (const double side : {1.0, -1.0}) {
+    SCOPED_TRACE(side);
+    const Case c = load_case(testing::case_path("shallow_arch.toml"));
+    ContinueRequest r = towards("w", 200.0, 0.5);
+    r.switch_at_bp = 1;
+    r.switch_side = side;
+    r.max_points = 140;
+    KeepBranches keep;
+    const ContinueRunResult result = continue_case(c, r, {&keep});
+    EXPECT_NE(result.status, "start_failed") << result.message;
+    int on_branch = 0;
+    for (const auto& [branch, index] : keep.rows)
+      if (branch == 1 && on_branch++ > 0) EXPECT_EQ(index, 1);  // past its origin (the branch point)
+    EXPECT_GT(on_branch, 5);
+  }
+}
+
 }  // namespace
 }  // namespace kirchhoff
