@@ -64,3 +64,50 @@ TEST(EulerColumn, BuckledGuessConvergesToTheBuckledElastica) {
 
 }  // namespace
 }  // namespace kirchhoff
+
+namespace kirchhoff {
+namespace {
+
+// A rod of natural curvature 2 pi, both ends pinned at the origin and no force: its unstressed
+// circle, theta linear in s. RKF78's error estimate vanishes there (stages 12 and 13 repeat 1 and
+// 11 where the right-hand side depends on s alone), and a residual's single march took steps of
+// 0.01, 0.05, 0.25 and the rest of the rod: the ring's closure came out 6.7e-5 (a probe; the same
+// march with the variational equations, whose errors it sees, 5e-15), and `solve` reported a
+// singular Jacobian at residual 6.7e-5 instead of the circle. The planar equations bound the step
+// by the turn of theta (IntegratorOptions::max_step). 1e-12: the state's tolerance, on a rod of
+// unit length whose closure is a sum of ~20 steps' errors.
+TEST(NaturallyCurvedRing, ClosesInOneMarchWithoutForce) {
+  const std::string text = R"(model = "planar"
+[parameters]
+k0 = 6.283185307179586
+fx = 0.0
+[rod]
+length = 1.0
+B = 1.0
+u_hat = [0, "k0", 0]
+[start]
+type = "pinned"
+position = [0, 0]
+[end]
+type = "pinned"
+position = [0, 0]
+[guess]
+orientation = { axis = [0, 0, 1], angle = 1.5707963267948966 }
+force = ["fx", 0]
+)";
+  const Case c = load_case_text(text, "ring.toml");
+  ShootingProblem problem(c.definition);
+  const Eigen::VectorXd x = problem.initial_unknowns(c.start_guess);
+  Eigen::VectorXd F;
+  std::string failure;
+  ASSERT_TRUE(problem.evaluate(x, &F, nullptr, &failure)) << failure;
+  EXPECT_LT(F.lpNorm<Eigen::Infinity>(), 1e-12) << F.transpose();
+  // Five turns of a tighter ring (k0 = 10 pi): the bound is on the turn, not the length.
+  const Case tight = load_case_text(text, "ring5.toml", {{"k0", 10 * M_PI}});
+  ShootingProblem five(tight.definition);
+  ASSERT_TRUE(five.evaluate(five.initial_unknowns(tight.start_guess), &F, nullptr, &failure)) << failure;
+  EXPECT_LT(F.lpNorm<Eigen::Infinity>(), 1e-12) << F.transpose();
+}
+
+}  // namespace
+}  // namespace kirchhoff

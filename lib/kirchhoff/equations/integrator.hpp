@@ -40,6 +40,13 @@ struct IntegratorOptions {
   // from RodModel::jumps, not the caller): every integration ends a stretch on a jump's `before`
   // and goes on from its `after`, so that no step straddles it. Null: none.
   std::shared_ptr<const std::vector<ProfileJump>> jumps;
+  // The longest step (arclength); 0: none. RKF78's error estimate is h 41/840 (k1 + k11 - k12 -
+  // k13), stages 12 and 13 taken where 1 and 11 are: it vanishes where the right-hand side
+  // depends on s alone along the step, and then nothing holds the step back. A planar rod
+  // without force whose curvature is constant is such a case (theta linear in s, the position
+  // a quadrature of it): a ring closed by pinning both ends at one point had its closure off by
+  // 6.7e-5 in a residual. The planar equations set it from the rotation rate (planar_equations.cpp).
+  double max_step = 0.0;
 
   // Returns an empty string when valid, else the reason.
   std::string validate() const;

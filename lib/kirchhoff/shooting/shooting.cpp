@@ -45,6 +45,7 @@ std::string IntegratorOptions::validate() const {
   if (!(sensitivity_tol >= 0)) return "sensitivity_tol must be >= 0 (0: the state's tolerances)";
   if (!(initial_step > 0) || initial_step > 1) return "initial_step must be in (0, 1]";
   if (max_steps < 1) return "max_steps must be >= 1";
+  if (!(max_step >= 0)) return "max_step must be >= 0 (0: none)";
   return {};
 }
 

@@ -46,10 +46,13 @@ long march_stretch(State& x, double s0, double s1, const System& system, const I
         throw IntegrationError("step size underflow near s = " + std::to_string(s));
     }
   };
+  // (A step longer than max_step is refused by the controller, at no cost, and retried at it;
+  // odeint's 0 is no limit.)
+  const double max_step = opt.max_step > 0 ? opt.max_step : 0.0;
   if (opt.stepper == IntegratorOptions::Stepper::Dopri5)
-    advance(odeint::make_controlled(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_dopri5<State>()));
+    advance(odeint::make_controlled(opt.abs_tol, opt.rel_tol, max_step, odeint::runge_kutta_dopri5<State>()));
   else
-    advance(odeint::make_controlled(opt.abs_tol, opt.rel_tol, odeint::runge_kutta_fehlberg78<State>()));
+    advance(odeint::make_controlled(opt.abs_tol, opt.rel_tol, max_step, odeint::runge_kutta_fehlberg78<State>()));
   for (double v : x)
     if (!std::isfinite(v)) throw IntegrationError("non-finite state");
   return steps;
