@@ -542,12 +542,18 @@ ContinuationResult Continuation::run(const Eigen::VectorXd& x0, const PointSink&
   int iterations = 0;
   const double direction = std::isnan(options_.target) ? sign_of(options_.direction) : sign_of(options_.target - lambda0);
   std::optional<ContinuationPoint> start;
-  if (correct(z, z, e, &iterations)) start = point_at(z, direction * e, PointType::Start, 0, 0.0, iterations);
+  const bool corrected = correct(z, z, e, &iterations);
+  if (corrected) start = point_at(z, direction * e, PointType::Start, 0, 0.0, iterations);
   if (start) describe(&*start);
   if (!start || !start->check_failure.empty()) {
+    // Which of the three: the start converged at fixed lambda above, and each says something else.
+    const std::string why = start       ? "the starting point fails its checks: " + start->check_failure
+                            : corrected ? "the starting point has no tangent (its matrix [F_x F_lambda], bordered, is "
+                                          "singular or not finite; parameters or unknowns decades apart make it so: "
+                                          "give the case in units that make them of order 1)"
+                                        : "the starting point does not converge: " + last_corrector_failure_;
     result.reason = failed_start_reason(options_.deadline);
-    result.message = "the starting point does not converge at " + options_.parameter + " = " + std::to_string(lambda0) +
-                     (start ? ": " + start->check_failure : "");
+    result.message = why + " at " + options_.parameter + " = " + std::to_string(lambda0);
     return result;
   }
   start->step = first_step(options_);
