@@ -92,6 +92,40 @@ TEST(Summary, ASingularSingleShootingSaysMoreSegmentsHelp) {
   EXPECT_EQ(solved.summary.message.find("segments"), std::string::npos);
 }
 
+// A heavy standing column in units far from 1 (EI = 1e6, weight 7.8e6 per length, q L^3 / EI =
+// 7.8, just below Greenhill's 7.8373): its Jacobian is singular to the solver at a residual of
+// 3.5e-9, 4e-16 of its forces. The failure said that more segments help, which they do not; it
+// says the units are the cause (the same column with EI = 1 and q = 7.8 solves, stable).
+TEST(Summary, ASingularSolveFarFromUnitScaleSaysSo) {
+  const std::string text = R"(model = "planar"
+[parameters]
+EI = 1e6
+q = 7.8e6
+[rod]
+length = 1.0
+B = "EI"
+gravity = { weight = "q", up = [0, 1, 0] }
+[start]
+type = "clamped"
+position = [0, 0]
+orientation = { axis = [0, 0, 1], angle = "pi/2" }
+[end]
+type = "free"
+[guess]
+orientation = { axis = [0, 0, 1], angle = "pi/2" }
+force = [0, "-q"]
+)";
+  const Case c = load_case_text(text, "heavy_column.toml");
+  const ShootingProblem problem(c.definition);
+  const ShootingResult r = solve(problem, problem.initial_unknowns(c.start_guess));
+  if (r.summary.converged()) GTEST_SKIP() << "converged here: no failure to describe";
+  EXPECT_NE(r.summary.message.find("far from unit scale"), std::string::npos) << r.summary.message;
+  EXPECT_EQ(r.summary.message.find("more segments"), std::string::npos) << r.summary.message;
+  const Case unit = load_case_text(text, "heavy_column.toml", {{"EI", 1.0}, {"q", 7.8}});
+  const ShootingProblem scaled(unit.definition);
+  EXPECT_TRUE(solve(scaled, scaled.initial_unknowns(unit.start_guess)).summary.converged());
+}
+
 TEST(Summary, MaxIterationsIsReportedWithTheBestResidual) {
   Case c = load_case(testing::case_path("simply_supported.toml"), {{"theta0", 2.0}, {"P", 12.0}});
   const ShootingProblem problem(c.definition);

@@ -759,11 +759,31 @@ bool singular_at_solution(const ShootingProblem& problem, const Eigen::VectorXd&
 // is most often a shooting problem too ill-conditioned for one segment: the fields grow like
 // exp(sqrt(P) L) along a rod in tension (the Euler column in tension at P = 1000: singular at one
 // segment, converged in 2 iterations at 8). The failure says what would help.
-void note_single_shooting(const ShootingProblem& problem, NewtonSummary* summary) {
+// A case whose length or bending stiffness lies decades from 1 is ill-conditioned by its
+// units alone, and its residual tolerance (absolute) means something else there: a heavy column
+// with EI = 1e6 and weight 7.8e6 came out singular at a residual of 3.5e-9 (4e-16 of its forces),
+// where more segments do not help and units of order 1 do.
+constexpr double kUnitScaleDecades = 3.0;
+std::string scale_hint(const ShootingProblem& problem, const Eigen::VectorXd& x) {  // x: where it stopped
+  const RodModel& model = problem.equations(problem.parameters_at(x))->model();
+  // (Loads large against B / L^2 are the rod's own state - a tension that more segments help -
+  // not its units.)
+  const double length = model.length, bending = model.B[1](0.0);
+  const auto decades = [](double v) { return v > 0 ? std::abs(std::log10(v)) : 0.0; };
+  if (decades(length) <= kUnitScaleDecades && decades(bending) <= kUnitScaleDecades) return "";
+  std::ostringstream os;
+  os << "the case is far from unit scale (length " << length << ", bending stiffness " << bending
+     << ") and the residual tolerance is absolute: give lengths, stiffnesses and loads in units that make them of "
+     << "order 1";
+  return os.str();
+}
+
+void note_single_shooting(const ShootingProblem& problem, const Eigen::VectorXd& x, NewtonSummary* summary) {
   const SolverStatus status = summary->status;
   if (problem.segments() != 1 || (status != SolverStatus::SingularJacobian && status != SolverStatus::LineSearchFailed))
     return;
-  const std::string hint = single_segment_hint();
+  std::string hint = scale_hint(problem, x);
+  if (hint.empty()) hint = single_segment_hint();
   summary->message = summary->message.empty() ? hint : summary->message + "; " + hint;
 }
 
@@ -789,7 +809,7 @@ ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) 
   result.x = x0;
   result.summary = solve_with_fallback(problem, result.x, problem.definition().options.newton);
   result.parameters = problem.parameters_at(result.x);
-  note_single_shooting(problem, &result.summary);
+  note_single_shooting(problem, result.x, &result.summary);
   if (result.summary.converged()) mark_check_failure(&result, unknowns_failure(problem, result));
   if (result.summary.converged()) mark_check_failure(&result, zero_iteration_failure(problem, result));
   if (!result.summary.converged() || !result.parameters.contains(kUnfoldingParameter)) return result;
