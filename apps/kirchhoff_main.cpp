@@ -193,7 +193,7 @@ CLI::App* add_equilibria_command(CLI::App& app, EquilibriaArguments* args) {
       "with stability index, contact set, derived quantities and invariants");
   command->footer(
       "Starts from the case's guess, its mirror images, perturbations along the low modes of every\n"
-      "equilibrium found and, for planar rods clamped at both ends, Ipopt's discretised minimisers;\n"
+      "equilibrium found and, for planar rods clamped or pinned at both ends, Ipopt's discretised minimisers;\n"
       "deflation keeps Newton from converging to an equilibrium already found. Equilibria are\n"
       "compared by their profiles relative to L; every one listed has converged and, with obstacles,\n"
       "satisfies 0 <= gap perp force >= 0. The energy is the elastic energy plus the potential of the\n"

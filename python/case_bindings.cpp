@@ -231,7 +231,7 @@ void bind_case_equilibria_and_vibrations(py::class_<PyCase>& cls) {
           R"doc(The distinct equilibria at the case's parameters (the CLI's `equilibria`), by deflated Newton.
 
 Starts from the case's guess, its mirror images, the low modes of every equilibrium found and,
-for planar rods clamped at both ends, Ipopt's discretised minimisers (docs/equilibria.md).
+for planar rods clamped or pinned at both ends, Ipopt's discretised minimisers (docs/equilibria.md).
 
 Args:
     max (int): stop once this many distinct equilibria are found.

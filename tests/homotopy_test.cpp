@@ -104,6 +104,35 @@ TEST(Homotopy, StopsAtAFoldAndSaysWhere) {
   EXPECT_TRUE(below.failure.empty()) << below.message;
 }
 
+// A ring of natural curvature 2 pi pinned at one point is one of a family (it turns about its
+// pin): the homotopy in its curvature cannot leave it, and stopped at "a fold at k0 = 6.28
+// (homotopy fraction -1.6e-13) before reaching the requested values" (a probe). It says that the
+// case's own solution is singular, as on a family, and what to do.
+TEST(Homotopy, AStartOnAContinuousFamilySaysSo) {
+  const std::string text = R"(model = "planar"
+[parameters]
+k0 = 6.283185307179586
+[rod]
+length = 1.0
+B = 1.0
+u_hat = [0, "k0", 0]
+[start]
+type = "pinned"
+position = [0, 0]
+[end]
+type = "pinned"
+position = [0, 0]
+[guess]
+orientation = { axis = [0, 0, 1], angle = 0.0 }
+force = [0, 0]
+)";
+  const CaseSolve s = solve_case(load_case_text(text, "ring.toml", {{"k0", 5.0}}));
+  ASSERT_FALSE(s.converged());
+  if (s.failure != "fold") GTEST_SKIP() << "not stopped as a fold here: " << s.failure << ": " << s.message;
+  EXPECT_NE(s.message.find("cannot leave the case's solution"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("continuous family"), std::string::npos) << s.message;
+}
+
 // The Euler column's first mode followed from the file's P = 12 to 500 on one shooting segment:
 // past P ~ 450 the fields grow like exp(sqrt(P) L) ~ 1e9 and the corrector's best residual sits
 // at 1.5e-10, above the tolerance 1e-10, down to the minimum step. The failure says that more

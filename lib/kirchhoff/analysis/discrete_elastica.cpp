@@ -13,6 +13,16 @@
 namespace kirchhoff {
 namespace {
 
+// The half cell at an end: a clamp at the angle `clamp` holds its end segment's angle through half
+// a cell (stiffness 2 EI / h); a pinned end (`clamp` NaN: free to turn, no moment) has none.
+double clamp_energy(double EI, double h, double theta, double clamp) {
+  return std::isfinite(clamp) ? EI / h * (theta - clamp) * (theta - clamp) : 0.0;
+}
+double clamp_moment(double EI, double h, double theta, double clamp) {  // d clamp_energy / d theta
+  return std::isfinite(clamp) ? 2.0 * EI / h * (theta - clamp) : 0.0;
+}
+double clamp_stiffness(double EI, double clamp) { return std::isfinite(clamp) ? 2.0 * EI : 0.0; }  // times 1 / h
+
 using Ipopt::Index;
 using Ipopt::Number;
 
@@ -104,7 +114,9 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
       const double along = std::atan2(chord.y(), chord.x());
       for (int i = 0; i < N_; ++i) {
         const double s = (i + 0.5) * h_, t = s / rod_.L;
-        v[i] = along + (1 - t) * (rod_.start_angle - along) + t * (rod_.end_angle - along) +
+        const double start_turn = std::isfinite(rod_.start_angle) ? rod_.start_angle - along : 0.0;
+        const double end_turn = std::isfinite(rod_.end_angle) ? rod_.end_angle - along : 0.0;
+        v[i] = along + (1 - t) * start_turn + t * end_turn +
                amplitude_ * M_PI * lobes_ / rod_.L * std::sin(2 * M_PI * lobes_ * t);
       }
     }
@@ -119,15 +131,15 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
   }
 
   bool eval_f(Index, const Number* t, bool, Number& f) override {
-    f = EI_[0] / h_ * std::pow(t[0] - rod_.start_angle, 2) + EI_[N_] / h_ * std::pow(t[N_ - 1] - rod_.end_angle, 2);
+    f = clamp_energy(EI_[0], h_, t[0], rod_.start_angle) + clamp_energy(EI_[N_], h_, t[N_ - 1], rod_.end_angle);
     for (int k = 1; k < N_; ++k) f += 0.5 * EI_[k] / h_ * (t[k] - t[k - 1]) * (t[k] - t[k - 1]);
     return true;
   }
 
   bool eval_grad_f(Index n, const Number* t, bool, Number* g) override {
     for (Index i = 0; i < n; ++i) g[i] = 0.0;
-    g[0] += 2 * EI_[0] / h_ * (t[0] - rod_.start_angle);
-    g[N_ - 1] += 2 * EI_[N_] / h_ * (t[N_ - 1] - rod_.end_angle);
+    g[0] += clamp_moment(EI_[0], h_, t[0], rod_.start_angle);
+    g[N_ - 1] += clamp_moment(EI_[N_], h_, t[N_ - 1], rod_.end_angle);
     for (int k = 1; k < N_; ++k) {
       const double d = EI_[k] / h_ * (t[k] - t[k - 1]);
       g[k] += d;
@@ -201,8 +213,8 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
       if (i > 0) entry(i, i - 1, values ? -obj_factor * EI_[i] / h_ : 0.0);
       double diagonal = 0.0;
       if (values) {
-        diagonal = obj_factor / h_ * (i > 0 ? EI_[i] : 2.0 * EI_[0]) +
-                   obj_factor / h_ * (i + 1 < N_ ? EI_[i + 1] : 2.0 * EI_[N_]);
+        diagonal = obj_factor / h_ * (i > 0 ? EI_[i] : clamp_stiffness(EI_[0], rod_.start_angle)) +
+                   obj_factor / h_ * (i + 1 < N_ ? EI_[i + 1] : clamp_stiffness(EI_[N_], rod_.end_angle));
         // d2/dtheta2 of -h cos theta and -h sin theta.
         diagonal += lambda[2 * i] * h_ * std::cos(v[i]) + lambda[2 * i + 1] * h_ * std::sin(v[i]);
       }
@@ -272,7 +284,7 @@ class ClampedElasticaNLP : public Ipopt::TNLP {
       }
     out_->n_y = n_start.y();
     out_->n_start = n_start;
-    out_->m_start = EI_[0] * (v[0] - rod_.start_angle) / (0.5 * h_);
+    out_->m_start = clamp_moment(EI_[0], h_, v[0], rod_.start_angle);  // 0 at a pinned start
   }
 
  private:
@@ -388,8 +400,8 @@ DiscreteKktCheck check_discrete_elastica(const DiscreteClampedElastica& rod, con
   // dL/dtheta_i: the energy's gradient, plus the multipliers times the constraints' gradients
   // (every constraint of node k >= i + 1 depends on theta_i through r_k, d r_k / d theta_i = a_i).
   std::vector<double> dL(N, 0.0);
-  dL[0] += 2 * EI[0] / h * (t[0] - rod.start_angle);
-  dL[N - 1] += 2 * EI[N] / h * (t[N - 1] - rod.end_angle);
+  dL[0] += clamp_moment(EI[0], h, t[0], rod.start_angle);
+  dL[N - 1] += clamp_moment(EI[N], h, t[N - 1], rod.end_angle);
   for (int k = 1; k < N; ++k) {
     const double d = EI[k] / h * (t[k] - t[k - 1]);
     dL[k] += d;

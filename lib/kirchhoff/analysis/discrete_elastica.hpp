@@ -35,7 +35,8 @@
 namespace kirchhoff {
 
 // A clamped-clamped planar rod: ends at `start` and `end` with tangent angles `start_angle` and
-// `end_angle` (from e_x), bending stiffness EI(s), clear of the obstacles.
+// `end_angle` (from e_x), bending stiffness EI(s), clear of the obstacles. An angle that is NaN
+// leaves its end free to turn (pinned: position held, no moment), its half cell out of the energy.
 struct DiscreteClampedElastica {
   double L = 1.0;
   std::function<double(double)> EI = [](double) { return 1.0; };
@@ -106,7 +107,7 @@ struct DiscreteElasticaResult {
   double P = 0.0;              // compressive end load, -n_x(L) (the x-constraint's multiplier)
   double n_y = 0.0;            // n_y at s = 0
   Vec3 n_start = Vec3::Zero(); // n(0)
-  double m_start = 0.0;        // the clamp's moment at s = 0, EI (theta_0 - start_angle) / (h / 2)
+  double m_start = 0.0;        // the clamp's moment at s = 0, EI (theta_0 - start_angle) / (h / 2); 0 pinned
   double contact_force = 0.0;  // sum of the contact forces' magnitudes
   double energy = 0.0;
   double min_gap = 0.0;

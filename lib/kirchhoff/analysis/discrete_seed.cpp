@@ -9,7 +9,8 @@ namespace kirchhoff {
 namespace {
 
 [[noreturn]] void out_of_scope(const std::string& why) {
-  throw std::invalid_argument("the Ipopt seed handles planar clamped-clamped Kirchhoff rods only: " + why);
+  throw std::invalid_argument("the Ipopt seed handles planar Kirchhoff rods clamped or pinned at both ends only: " +
+                              why);
 }
 
 // Whether an end is clamped: position and frame imposed in every direction, nothing else.
@@ -25,11 +26,30 @@ bool is_clamped(const EndCondition& end) {
   return position && orientation;
 }
 
-// The clamp's position and tangent angle.
-std::pair<Vec3, double> clamp(const RodEquations& eq, const EndCondition& end, bool at_start, const Parameters& p) {
+// Whether an end is pinned without a couple: position imposed in every direction, the moment
+// imposed zero, nothing else.
+bool is_pinned(const RodEquations& eq, const EndCondition& end, bool at_start, const Parameters& p) {
+  if (end.extra_count() != 0) return false;
+  bool position = false, moment = false;
+  for (const auto& c : end.conditions()) {
+    if (c.directions != Directions::All) return false;
+    if (c.slot == Slot::Position) position = true;
+    else if (c.slot == Slot::Moment) moment = true;
+    else return false;
+  }
+  if (!position || !moment) return false;
   RodPoint point;
   point.R = planar_reference_frame();
   end.impose_on(eq, at_start, p, &point);
+  return point.m.norm() == 0.0;
+}
+
+// The end's position and, for a clamp, its tangent angle (NaN where the end is pinned: free to turn).
+std::pair<Vec3, double> held_end(const RodEquations& eq, const EndCondition& end, bool at_start, const Parameters& p) {
+  RodPoint point;
+  point.R = planar_reference_frame();
+  end.impose_on(eq, at_start, p, &point);
+  if (!is_clamped(end)) return {point.r, NAN};
   const Vec3 t = point.R.col(2);
   return {point.r, std::atan2(t.y(), t.x())};
 }
@@ -37,8 +57,12 @@ std::pair<Vec3, double> clamp(const RodEquations& eq, const EndCondition& end, b
 DiscreteClampedElastica discrete_rod(const ProblemDefinition& d, const ShootingProblem& problem) {
   if (d.kind != RodKind::Planar) out_of_scope("the case is spatial");
   if (!d.unknown_parameters.empty()) out_of_scope("the case solves for parameters");
-  if (!is_clamped(d.start) || !is_clamped(d.end)) out_of_scope("both ends must be clamped");
   const auto eq = problem.equations(d.parameters);
+  for (const bool at_start : {true, false}) {
+    const EndCondition& end = at_start ? d.start : d.end;
+    if (!is_clamped(end) && !is_pinned(*eq, end, at_start, d.parameters))
+      out_of_scope(std::string(at_start ? "the start" : "the end") + " is neither clamped nor pinned without a couple");
+  }
   const RodModel& model = eq->model();
   if (model.extensible) out_of_scope("the rod is extensible or shearable");
   if (model.field) out_of_scope("the rod carries an external field");
@@ -47,8 +71,8 @@ DiscreteClampedElastica discrete_rod(const ProblemDefinition& d, const ShootingP
   DiscreteClampedElastica rod;
   rod.L = model.length;
   rod.EI = [B = model.B[1]](double s) { return B(s); };
-  std::tie(rod.start, rod.start_angle) = clamp(*eq, d.start, true, d.parameters);
-  std::tie(rod.end, rod.end_angle) = clamp(*eq, d.end, false, d.parameters);
+  std::tie(rod.start, rod.start_angle) = held_end(*eq, d.start, true, d.parameters);
+  std::tie(rod.end, rod.end_angle) = held_end(*eq, d.end, false, d.parameters);
   rod.obstacles = problem.obstacles(d.parameters);
   return rod;
 }
@@ -115,7 +139,11 @@ DiscreteSeed seed_from_discrete_energy(const ProblemDefinition& d, int segments,
                   rod.obstacles[o].is_flat(), h, rod.L, force_scale, &seed.contacts);
   std::sort(seed.contacts.begin(), seed.contacts.end(), [](const auto& a, const auto& b) { return a.s < b.s; });
   seed.start.r = rod.start;
-  seed.start.R = Eigen::AngleAxisd(rod.start_angle, Vec3::UnitZ()).toRotationMatrix() * planar_reference_frame();
+  // A pinned start's tangent: the first two segments' angles (at h/2 and 3h/2) extrapolated to 0.
+  const std::vector<double>& theta = seed.discrete.theta;
+  const double start_angle =
+      std::isfinite(rod.start_angle) ? rod.start_angle : 1.5 * theta[0] - 0.5 * theta[1];
+  seed.start.R = Eigen::AngleAxisd(start_angle, Vec3::UnitZ()).toRotationMatrix() * planar_reference_frame();
   seed.start.n = seed.discrete.n_start;
   seed.start.m = Vec3(0.0, 0.0, seed.discrete.m_start);
   std::ostringstream summary;

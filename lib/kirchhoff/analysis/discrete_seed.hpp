@@ -11,6 +11,8 @@
 // What is read off (segments N, h = L / N):
 //   - the state at s = 0: the clamp's position and frame, n(0) from the multipliers, and
 //     m(0) = EI (theta_0 - clamp angle) / (h / 2) - first-order accurate, which Newton corrects;
+//     at a pinned start m(0) = 0 and the frame's angle 1.5 theta_0 - 0.5 theta_1 (the first two
+//     segments' angles extrapolated to s = 0);
 //   - the contacts: per obstacle, runs of interior nodes that touch (gap < 1e-9 L) or carry a
 //     force (> 1e-6 of |n(0)| + EI / L^2). A run longer than two segments on a plane is an extended
 //     contact over it (the rod lies flat there; its end forces are the multipliers of the run's
@@ -19,7 +21,8 @@
 // Then solve_with_contacts starts from both and corrects the set if needed.
 //
 // Scope: what the discrete model describes - planar, inextensible and unshearable rods without
-// natural curvature or external fields, clamped at both ends, with no unknown parameters. Other
+// natural curvature or external fields, each end clamped or pinned without a couple, with no
+// unknown parameters. Other
 // definitions are refused with the reason (std::invalid_argument).
 #pragma once
 

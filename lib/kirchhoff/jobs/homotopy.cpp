@@ -90,11 +90,22 @@ std::string stop_word(StopReason reason) {
 }
 
 // Why the path ended short of t = 1, for the user.
+// A fold located within this of the path's start (in t) is the start itself.
+constexpr double kAtTheStart = 1e-8;
+
 std::string stop_message(const HomotopyResult& h, const std::vector<ParameterChange>& changes,
                          const std::string& detail) {
   std::ostringstream m;
   m.precision(10);
-  if (h.stop == "fold") {
+  if (h.stop == "fold" && std::abs(h.fraction) < kAtTheStart) {
+    // A "fold" where the path starts: the case's own solution is singular, most often one of a
+    // continuous family (a naturally curved ring pinned at one point turns about its pin: the
+    // homotopy in its curvature stopped at fraction -1.6e-13, a probe's).
+    m << "the homotopy cannot leave the case's solution at its file's values (a fold at homotopy fraction "
+      << h.fraction << "): its Jacobian is singular there, as at a fold or on a continuous family of equilibria "
+      << "(a symmetry the case leaves free, e.g. a ring that can turn about its pin); fix the symmetry in the case "
+         "or solve directly";
+  } else if (h.stop == "fold") {
     // The detail only repeats the fold's place in t.
     m << "the branch the case's solution lies on turns back at a fold at " << describe_values(changes, h.fraction)
       << " (homotopy fraction " << h.fraction << ") before reaching the requested values";
