@@ -120,9 +120,8 @@ int load_and_solve(const std::string& case_path, const std::vector<std::string>&
 int report_not_converged(const Case& c, const NewtonSummary& summary, bool json) {
   std::cerr << "error: " << c.path << ": not converged: " << summary.brief_report() << "\n";
   if (json)
-    // (The message says why; where Newton gave none, e.g. out of iterations, its report does.)
     std::cout << failure_json(c, to_string(summary.status), summary.iterations, summary.residual_norm,
-                              summary.message.empty() ? summary.brief_report() : summary.message)
+                              summary.why_stopped())
                      .dump(2)
               << "\n";
   return kExitNotConverged;

@@ -76,8 +76,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   out.converged = r.summary.converged();
   out.iterations = r.summary.iterations;
   out.residual = r.summary.residual_norm;
-  // As the CLI's: why it did not converge, Newton's report where it gave no message of its own.
-  out.message = !out.converged && r.summary.message.empty() ? r.summary.brief_report() : r.summary.message;
+  out.message = out.converged ? r.summary.message : r.summary.why_stopped();  // as the CLI's JSON
   out.used_fallback_search = r.summary.used_fallback_search;
   out.history = r.summary.history;
   out.rhs_evaluations = problem ? problem->rhs_evaluations() : 0;  // none when the guess failed

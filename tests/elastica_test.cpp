@@ -77,24 +77,7 @@ namespace {
 // by the turn of theta (IntegratorOptions::max_step). 1e-12: the state's tolerance, on a rod of
 // unit length whose closure is a sum of ~20 steps' errors.
 TEST(NaturallyCurvedRing, ClosesInOneMarchWithoutForce) {
-  const std::string text = R"(model = "planar"
-[parameters]
-k0 = 6.283185307179586
-fx = 0.0
-[rod]
-length = 1.0
-B = 1.0
-u_hat = [0, "k0", 0]
-[start]
-type = "pinned"
-position = [0, 0]
-[end]
-type = "pinned"
-position = [0, 0]
-[guess]
-orientation = { axis = [0, 0, 1], angle = 1.5707963267948966 }
-force = ["fx", 0]
-)";
+  const std::string text = testing::kNaturalRingPinnedAtOnePoint;
   const Case c = load_case_text(text, "ring.toml");
   ShootingProblem problem(c.definition);
   const Eigen::VectorXd x = problem.initial_unknowns(c.start_guess);

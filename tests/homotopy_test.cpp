@@ -109,24 +109,7 @@ TEST(Homotopy, StopsAtAFoldAndSaysWhere) {
 // (homotopy fraction -1.6e-13) before reaching the requested values" (a probe). It says that the
 // case's own solution is singular, as on a family, and what to do.
 TEST(Homotopy, AStartOnAContinuousFamilySaysSo) {
-  const std::string text = R"(model = "planar"
-[parameters]
-k0 = 6.283185307179586
-[rod]
-length = 1.0
-B = 1.0
-u_hat = [0, "k0", 0]
-[start]
-type = "pinned"
-position = [0, 0]
-[end]
-type = "pinned"
-position = [0, 0]
-[guess]
-orientation = { axis = [0, 0, 1], angle = 0.0 }
-force = [0, 0]
-)";
-  const CaseSolve s = solve_case(load_case_text(text, "ring.toml", {{"k0", 5.0}}));
+  const CaseSolve s = solve_case(load_case_text(testing::kNaturalRingPinnedAtOnePoint, "ring.toml", {{"k0", 5.0}}));
   ASSERT_FALSE(s.converged());
   if (s.failure != "fold") GTEST_SKIP() << "not stopped as a fold here: " << s.failure << ": " << s.message;
   EXPECT_NE(s.message.find("cannot leave the case's solution"), std::string::npos) << s.message;

@@ -38,6 +38,26 @@ inline std::string case_text(const std::string& name) {
 // both parts inside are straight and unloaded (H = 0 there), so the length outside, ell, slides.
 // Equilibria at ell = 1.1132 (index 0) and 1.9572 (index 1). Used by the sliding-length stability
 // tests and their discretised-energy check.
+// A rod of natural curvature k0 (2 pi: its unstressed circle), both ends pinned at the origin:
+// without force, theta linear in s; one of a family (the ring turns about its pin).
+inline constexpr const char* kNaturalRingPinnedAtOnePoint = R"(model = "planar"
+[parameters]
+k0 = 6.283185307179586
+[rod]
+length = 1.0
+B = 1.0
+u_hat = [0, "k0", 0]
+[start]
+type = "pinned"
+position = [0, 0]
+[end]
+type = "pinned"
+position = [0, 0]
+[guess]
+orientation = { axis = [0, 0, 1], angle = 1.5707963267948966 }
+force = [0, 0]
+)";
+
 inline constexpr const char* kTwoSleeveRodCase = R"(
 title = "A rod between two sliding sleeves"
 model = "planar"

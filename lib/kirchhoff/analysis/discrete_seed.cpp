@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -13,31 +14,35 @@ namespace {
                               why);
 }
 
+// The slots an end imposes (position, orientation, moment), each in every direction and nothing
+// else; empty where it imposes anything other (a direction, a load, an unknown).
+struct HeldSlots {
+  bool position = false, orientation = false, moment = false;
+};
+std::optional<HeldSlots> held_slots(const EndCondition& end) {
+  if (end.extra_count() != 0) return std::nullopt;
+  HeldSlots held;
+  for (const auto& c : end.conditions()) {
+    if (c.directions != Directions::All) return std::nullopt;
+    if (c.slot == Slot::Position) held.position = true;
+    else if (c.slot == Slot::Orientation) held.orientation = true;
+    else if (c.slot == Slot::Moment) held.moment = true;
+    else return std::nullopt;
+  }
+  return held;
+}
+
 // Whether an end is clamped: position and frame imposed in every direction, nothing else.
 bool is_clamped(const EndCondition& end) {
-  if (end.extra_count() != 0) return false;
-  bool position = false, orientation = false;
-  for (const auto& c : end.conditions()) {
-    if (c.directions != Directions::All) return false;
-    if (c.slot == Slot::Position) position = true;
-    else if (c.slot == Slot::Orientation) orientation = true;
-    else return false;
-  }
-  return position && orientation;
+  const auto held = held_slots(end);
+  return held && held->position && held->orientation && !held->moment;
 }
 
 // Whether an end is pinned without a couple: position imposed in every direction, the moment
 // imposed zero, nothing else.
 bool is_pinned(const RodEquations& eq, const EndCondition& end, bool at_start, const Parameters& p) {
-  if (end.extra_count() != 0) return false;
-  bool position = false, moment = false;
-  for (const auto& c : end.conditions()) {
-    if (c.directions != Directions::All) return false;
-    if (c.slot == Slot::Position) position = true;
-    else if (c.slot == Slot::Moment) moment = true;
-    else return false;
-  }
-  if (!position || !moment) return false;
+  const auto held = held_slots(end);
+  if (!held || !held->position || !held->moment || held->orientation) return false;
   RodPoint point;
   point.R = planar_reference_frame();
   end.impose_on(eq, at_start, p, &point);

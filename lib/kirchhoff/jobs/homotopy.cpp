@@ -89,10 +89,10 @@ std::string stop_word(StopReason reason) {
   }
 }
 
-// Why the path ended short of t = 1, for the user.
 // A fold located within this of the path's start (in t) is the start itself.
 constexpr double kAtTheStart = 1e-8;
 
+// Why the path ended short of t = 1, for the user.
 std::string stop_message(const HomotopyResult& h, const std::vector<ParameterChange>& changes,
                          const std::string& detail) {
   std::ostringstream m;

@@ -134,6 +134,9 @@ struct NewtonSummary {
 
   bool converged() const { return status == SolverStatus::Converged; }
   std::string brief_report() const;
+  // Why it stopped, for a user: its message, or its brief report where it gave none (out of
+  // iterations).
+  std::string why_stopped() const { return message.empty() ? brief_report() : message; }
 };
 
 // Solves F(x) = 0 starting from x; on return x holds the best iterate found.

@@ -755,22 +755,16 @@ bool singular_at_solution(const ShootingProblem& problem, const Eigen::VectorXd&
   return problem.evaluate(x, &F, &J, &failure) && !(JacobianLU(J).reciprocal_condition() > threshold);
 }
 
-// A single segment whose Jacobian is singular to the solver, or whose residual no step lowers,
-// is most often a shooting problem too ill-conditioned for one segment: the fields grow like
-// exp(sqrt(P) L) along a rod in tension (the Euler column in tension at P = 1000: singular at one
-// segment, converged in 2 iterations at 8). The failure says what would help.
-// A case whose length or bending stiffness lies decades from 1 is ill-conditioned by its
-// units alone, and its residual tolerance (absolute) means something else there: a heavy column
-// with EI = 1e6 and weight 7.8e6 came out singular at a residual of 3.5e-9 (4e-16 of its forces),
-// where more segments do not help and units of order 1 do.
-constexpr double kUnitScaleDecades = 3.0;
-std::string scale_hint(const ShootingProblem& problem, const Eigen::VectorXd& x) {  // x: where it stopped
+// A case whose length or bending stiffness lies decades from 1 (of_unit_scale) is ill-conditioned
+// by its units alone, and its residual tolerance (absolute) means something else there: a heavy
+// column with EI = 1e6 and weight 7.8e6 came out singular at a residual of 3.5e-9 (4e-16 of its
+// forces), where more segments do not help and units of order 1 do. Loads large against B / L^2
+// are the rod's own state (a tension, which more segments help), not its units. x: where the
+// solve stopped.
+std::string scale_hint(const ShootingProblem& problem, const Eigen::VectorXd& x) {
   const RodModel& model = problem.equations(problem.parameters_at(x))->model();
-  // (Loads large against B / L^2 are the rod's own state - a tension that more segments help -
-  // not its units.)
   const double length = model.length, bending = model.B[1](0.0);
-  const auto decades = [](double v) { return v > 0 ? std::abs(std::log10(v)) : 0.0; };
-  if (decades(length) <= kUnitScaleDecades && decades(bending) <= kUnitScaleDecades) return "";
+  if (of_unit_scale(length, bending)) return "";
   std::ostringstream os;
   os << "the case is far from unit scale (length " << length << ", bending stiffness " << bending
      << ") and the residual tolerance is absolute: give lengths, stiffnesses and loads in units that make them of "
@@ -778,6 +772,11 @@ std::string scale_hint(const ShootingProblem& problem, const Eigen::VectorXd& x)
   return os.str();
 }
 
+// A single segment whose Jacobian is singular to the solver, or whose residual no step lowers,
+// is most often a shooting problem too ill-conditioned for one segment: the fields grow like
+// exp(sqrt(P) L) along a rod in tension (the Euler column in tension at P = 1000: singular at one
+// segment, converged in 2 iterations at 8), or one whose units are far from 1 (scale_hint). The
+// failure says what would help.
 void note_single_shooting(const ShootingProblem& problem, const Eigen::VectorXd& x, NewtonSummary* summary) {
   const SolverStatus status = summary->status;
   if (problem.segments() != 1 || (status != SolverStatus::SingularJacobian && status != SolverStatus::LineSearchFailed))

@@ -89,13 +89,11 @@ constexpr double kNearlySingular = 1e-6;
 // Decades from 1 within which a case's length and stiffness count as of unit scale.
 constexpr double kUnitScale = 3.0;
 
-// Length and bending stiffness within kUnitScale of 1, either way.
-bool of_unit_scale(const RodModel& model) {
-  const double length = model.length, bending = model.B[0](0.0);
+}  // namespace
+
+bool of_unit_scale(double length, double bending) {
   return std::abs(std::log10(length)) <= kUnitScale && std::abs(std::log10(bending)) <= kUnitScale;
 }
-
-}  // namespace
 
 std::string zero_iteration_failure(const ShootingProblem& problem, const ShootingResult& result) {
   if (result.summary.iterations > 0) return {};
@@ -122,7 +120,8 @@ std::string zero_iteration_failure(const ShootingProblem& problem, const Shootin
   // equilibria there are not isolated (a continuous family the case does not fix) or branch. On a
   // case far from unit scale the matrix is singular to round-off by its scale alone (a rod 1e-100
   // long), so that is said there.
-  if (rcond < kNearlySingular && of_unit_scale(problem.equations(problem.parameters_at(result.x))->model()))
+  const RodModel& model = problem.equations(problem.parameters_at(result.x))->model();
+  if (rcond < kNearlySingular && of_unit_scale(model.length, model.B[0](0.0)))
     os << ": the Jacobian is nearly singular there (reciprocal condition " << rcond
        << ", rows and columns equilibrated), so the equilibrium is not isolated: a continuous family of equilibria (a symmetry "
        << "the case leaves free, e.g. turning an isotropic ring about its centreline) or a branch point; fix the "

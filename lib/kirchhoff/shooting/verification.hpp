@@ -26,6 +26,11 @@ std::string unknowns_failure(const ShootingProblem& problem, const ShootingResul
 // a step, the step itself shows the scale).
 std::string zero_iteration_failure(const ShootingProblem& problem, const ShootingResult& result);
 
+// Whether a case's length and bending stiffness lie within three decades of 1, either way: where
+// they do not, its absolute residual tolerance means something else and its matrices are
+// ill-conditioned by its units alone (zero_iteration_failure's and a singular solve's messages).
+bool of_unit_scale(double length, double bending);
+
 // A correction below 1e-4 of the unknowns' size is far above what a converged residual gives (|F|
 // <= 1e-10 through a Jacobian even as ill-conditioned as 1e-5 near a fold: 1e-5), and far below
 // what a residual that is small only by scale gives (orders of magnitude beyond the unknowns).
