@@ -99,9 +99,11 @@ TEST(DiscreteSeed, RefusesWhatTheDiscreteModelDoesNotDescribe) {
 // Pinned ends (position held, no couple): the end segments' angles are free. A pinned-pinned rod
 // held at D = 0.7 (L = EI = 1) buckles into the first-mode Elastica, energy 3.211755985 (the
 // elliptic closed form 8 EI K (E - (1 - m) K) / L, a probe's); the discrete energy converges to it
-// at second order (N = 200: within 10 h^2 relative), and the shooting solve from the seed to 1e-9.
+// at second order (N = 200: within 10 h^2 relative), and the shooting solve from the seed to 1e-8
+// (the closed form is quoted to ten digits; the solve's energy is good to ~1e-10).
 // Under a wall at y = 0.2 the rod buckled towards it rests on it at one point (energy 12.2722,
-// stable, a probe's discretised energy: 12.2699 at N = 120), which `equilibria` did not list
+// stable; 12.2722219 is the shooting solution's, checked here to 1e-6 as a regression value, and a
+// probe's discretised energy agrees to its O(h^2): 12.2699 at N = 120), which `equilibria` did not list
 // while the seeds were made for clamped ends only.
 TEST(DiscreteSeed, PinnedEndsTurnFreely) {
   std::string text = R"(model = "planar"
