@@ -22,6 +22,8 @@
 //       max step equal, no growth), over the same branch: what the step control buys.
 //   (5) the branches (1) and (2) with the tangent predictor (StepControl::Predictor::Tangent)
 //       instead of the default quadratic one: what the predictor buys.
+//   (6) the branch (1) with its flows marched by RKF78 (IntegratorOptions::closed_form off):
+//       what the closed-form flow of a planar rod under end loads buys.
 // Goals (issue 24): >= 10x AUTO-07p's points per second, stated there as >= 35,000 planar and
 // >= 2,500 3D points/s on the project's 2-core machine. AUTO-07p is not run by this program
 // unless --auto-euler DIR / --auto-twist DIR name prepared AUTO run directories (an executable
@@ -140,11 +142,13 @@ struct EulerSetup {
   std::string error;
 };
 
-const EulerSetup& euler_setup() {
-  static EulerSetup s = [] {
+// marched: the same column with its flows marched by RKF78 (IntegratorOptions::closed_form off),
+// the baseline the closed-form flow is measured against in this process.
+EulerSetup make_euler_setup(bool marched) {
     EulerSetup s;
     try {
       s.c = load_case(case_path("euler_column.toml"), {{"P", 1.0}, {"theta_guess", 0.0}});
+      s.c.definition.options.integrator.closed_form = !marched;
       s.problem = std::make_unique<ShootingProblem>(s.c.definition);
       RodContinuationOptions o;
       o.parameter = "P";
@@ -164,8 +168,11 @@ const EulerSetup& euler_setup() {
       s.error = std::string("Euler set-up failed: ") + e.what();
     }
     return s;
-  }();
-  return s;
+}
+
+const EulerSetup& euler_setup(bool marched = false) {
+  static EulerSetup closed_form = make_euler_setup(false), march = make_euler_setup(true);
+  return marched ? march : closed_form;
 }
 
 struct TwistSetup {
@@ -279,8 +286,9 @@ void fix_step(RodContinuationOptions& o, double fixed_step) {
 
 using Predictor = StepControl::Predictor;
 
-Run euler_branch(bool invariants, double fixed_step = 0, Predictor predictor = Predictor::Quadratic) {
-  const EulerSetup& s = euler_setup();
+Run euler_branch(bool invariants, double fixed_step = 0, Predictor predictor = Predictor::Quadratic,
+                 bool marched = false) {
+  const EulerSetup& s = euler_setup(marched);
   if (!s.error.empty()) {
     Run run;
     run.error = s.error;
@@ -966,6 +974,9 @@ int run_table(int reps) {
   print_branch("euler buckled, invariants on, 101 samples", e_inv, kPlanarGoalIssue);
   const BranchStats e_tangent = time_branch(reps, [] { return euler_branch(false, 0, Predictor::Tangent); });
   print_branch("euler buckled, tangent predictor", e_tangent, kPlanarGoalIssue);
+  const BranchStats e_marched =
+      time_branch(reps, [] { return euler_branch(false, 0, Predictor::Quadratic, true); });
+  print_branch("euler buckled, flows marched (RKF78)", e_marched, kPlanarGoalIssue);
 
   // (3a) naive Euler
   NaiveStats n_euler;
@@ -1079,6 +1090,10 @@ int run_table(int reps) {
     std::printf("  planar: tangent / quadratic predictor = %.2f in time for the branch (%.1f / %.1f ms; %d / %d points)\n",
                 e_tangent.median_cpu / e_fast.median_cpu, 1e3 * e_tangent.median_cpu, 1e3 * e_fast.median_cpu,
                 e_tangent.points, e_fast.points);
+  if (e_fast.ok && e_marched.ok)
+    std::printf("  planar: closed-form flows / marched (RKF78) = %.2f in points/s (%.0f / %.0f; %d / %d points)\n",
+                e_fast.points_per_s / e_marched.points_per_s, e_fast.points_per_s, e_marched.points_per_s, e_fast.points,
+                e_marched.points);
   if (t_inv.ok && t_tangent.ok)
     std::printf("  3D:     tangent / quadratic predictor = %.2f in time for the branch (%.1f / %.1f ms; %d / %d points)\n",
                 t_tangent.median_cpu / t_inv.median_cpu, 1e3 * t_tangent.median_cpu, 1e3 * t_inv.median_cpu,

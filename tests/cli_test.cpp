@@ -396,7 +396,9 @@ TEST_F(CliTest, TheDiscretisedEnergyDecidesWhereTheConjugatePointsDoNot) {
 }
 
 TEST_F(CliTest, Dopri5StepperGivesTheElastica) {
-  const std::string path = variant("simply_supported.toml", "[solver]", "[solver]\nstepper = \"dopri5\"");
+  // (Marched: the Elastica's closed-form flow would take no steps of either stepper.)
+  const std::string path =
+      variant("simply_supported.toml", "[solver]", "[solver]\nstepper = \"dopri5\"\nclosed_form = false");
   const CliRun r = run("solve " + quoted(path) + " --json");
   ASSERT_EQ(r.status, 0) << r.out << r.err;
   const json j = parse(r);
@@ -405,12 +407,13 @@ TEST_F(CliTest, Dopri5StepperGivesTheElastica) {
   EXPECT_NEAR(j["derived"]["y_max"].get<double>(), 0.286225241775, 1e-8);
 }
 
-// A solve that cannot converge (theta0 = 1e6 spends ~35 s in Newton and the NLopt search) ends at
-// its wall-clock limit with status time_limit, exit 1, the best residual reported.
+// A solve that cannot converge (theta0 = 1e6, its flows marched, spends ~35 s in Newton and the
+// NLopt search; in closed form it converges to a high mode in milliseconds) ends at its
+// wall-clock limit with status time_limit, exit 1, the best residual reported.
 TEST_F(CliTest, MaxSecondsEndsASolveWithTimeLimit) {
   const auto start = std::chrono::steady_clock::now();
-  const CliRun r =
-      run("solve " + quoted(case_path("simply_supported.toml")) + " --set theta0=1e6 --max-seconds 1 --json --direct");
+  const CliRun r = run("solve " + quoted(case_path("simply_supported.toml")) +
+                       " --set theta0=1e6 --solver closed_form=false --max-seconds 1 --json --direct");
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_EQ(r.status, 1) << r.out << r.err;
   const json j = parse(r);

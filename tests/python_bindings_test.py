@@ -192,6 +192,19 @@ class CaseOptionsTest(unittest.TestCase):
             kirchhoff.load_case(case_path("simply_supported.toml"), solver={"stepper": "rk4"})
         self.assertIn("'rk4' is not 'rk78' or 'dopri5'", str(cm.exception))
 
+    def test_closed_form_and_march_give_the_same_elastica(self):
+        # The Elastica of Fig. 3 at theta0 = 2.8 flows in closed form by default (no right-hand
+        # sides); marched, the same rod to the march's accuracy (P to 1e-9 of itself, the residual
+        # 1e-10 and the integrator's 1e-12 amplified by the shooting's conditioning there).
+        closed = kirchhoff.load_case(case_path("simply_supported.toml"), set={"theta0": 2.8}).solve()
+        marched = kirchhoff.load_case(case_path("simply_supported.toml"), set={"theta0": 2.8},
+                                      solver={"closed_form": False}).solve()
+        self.assertTrue(closed.converged, closed.message)
+        self.assertTrue(marched.converged, marched.message)
+        self.assertAlmostEqual(closed.derived["P"] / marched.derived["P"], 1.0, delta=1e-9)
+        with self.assertRaises(kirchhoff.CaseError):
+            kirchhoff.load_case(case_path("simply_supported.toml"), solver={"closed_form": "yes"})
+
     def test_computed_parameter_follows_its_inputs(self):
         text = pathlib.Path(case_path("simply_supported.toml")).read_text()
         self.assertIn("\nEI = 1.0", text)
@@ -343,7 +356,8 @@ class CheckedResultTest(unittest.TestCase):
 
     def test_dopri5_gives_the_elastica(self):
         text = pathlib.Path(case_path("simply_supported.toml")).read_text()
-        text = text.replace("[solver]\n", "[solver]\nstepper = \"dopri5\"\n")
+        # (Marched: the Elastica's closed-form flow would take no steps of either stepper.)
+        text = text.replace("[solver]\n", "[solver]\nstepper = \"dopri5\"\nclosed_form = false\n")
         with tempfile.TemporaryDirectory() as tmp:
             path = pathlib.Path(tmp) / "dopri5.toml"
             path.write_text(text)

@@ -318,6 +318,49 @@ TEST(Stability, EveryShippedCaseHasAnIndexOrAReason) {
   }
 }
 
+// The planar rods' closed-form flows (IntegratorOptions::closed_form) carry the Jacobi fields as
+// the march does: on every shipped planar case and on equilibria whose phases turn fast or pass
+// several conjugate points, the same index and zero modes, the conjugate points within 1e-5 (each
+// is located to ~1e-7 L either way). And the closed form must have been taken somewhere, or this
+// would compare the march with itself: fewer right-hand sides on the Euler column.
+TEST(Stability, ClosedFormFlowsCountAsMarchedOnes) {
+  std::vector<std::pair<std::string, DefinitionSolve>> equilibria;
+  auto add = [&](const std::string& name, const ParameterOverrides& set) {
+    const Case c = load_case(testing::case_path(name), set);
+    if (c.definition.kind != RodKind::Planar) return;
+    try {
+      DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
+      if (solved.result.summary.converged()) equilibria.emplace_back(name, std::move(solved));
+    } catch (const std::exception&) {
+      // a case solved elsewhere by continuation
+    }
+  };
+  for (const auto& entry : std::filesystem::directory_iterator(KIRCHHOFF_CASES_DIR))
+    if (entry.path().extension() == ".toml") add(entry.path().filename().string(), {});
+  add("euler_column.toml", {{"P", 200.0}, {"theta_guess", 0.0}});
+  add("euler_column.toml", {{"P", 100.0}, {"theta_guess", 1.5}});
+  add("clamped_clamped.toml", {{"s_mode", 1.0}});
+  ASSERT_GT(equilibria.size(), 10u);
+  long saved = 0;
+  for (const auto& [name, solved] : equilibria) {
+    SCOPED_TRACE(name);
+    ProblemDefinition marched_definition = solved.problem->definition();
+    marched_definition.options.integrator.closed_form = false;
+    const ShootingProblem marched(marched_definition);
+    const StabilityReport a = analyse_stability(*solved.problem, solved.result.x);
+    const StabilityReport b = analyse_stability(marched, solved.result.x);
+    ASSERT_EQ(a.defined(), b.defined()) << a.reason << " / " << b.reason;
+    if (!a.defined()) continue;
+    EXPECT_EQ(*a.index, *b.index);
+    EXPECT_EQ(a.zero_modes, b.zero_modes);
+    ASSERT_EQ(a.conjugate_points.size(), b.conjugate_points.size());
+    for (size_t j = 0; j < a.conjugate_points.size(); ++j)
+      EXPECT_NEAR(a.conjugate_points[j], b.conjugate_points[j], 1e-5);
+    if (name == "euler_column.toml") saved += b.rhs_evaluations - a.rhs_evaluations;
+  }
+  EXPECT_GT(saved, 0);
+}
+
 // Observing the eigenphases on the integration's interpolant (StabilityOptions::
 // interpolated_observations) must count exactly as observing every one on an exact integration:
 // on every shipped case and on equilibria whose phases turn fast or pass several conjugate points,

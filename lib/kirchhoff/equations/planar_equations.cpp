@@ -9,8 +9,10 @@
 // State layout (6): x, y, theta, n_x, n_y, m. theta tracks whole turns by itself.
 #include <array>
 #include <cmath>
+#include <optional>
 
 #include "kirchhoff/equations/detail/compliances.hpp"
+#include "kirchhoff/equations/detail/elastica_flow.hpp"
 #include "kirchhoff/equations/detail/field_eval.hpp"
 #include "kirchhoff/equations/detail/integrator_impl.hpp"
 #include "kirchhoff/equations/detail/planar_state.hpp"
@@ -32,7 +34,8 @@ class PlanarEquations final : public RodEquations {
   explicit PlanarEquations(RodModel model)
       : model_(std::move(model)),
         compliances_(model_),
-        jumps_(std::make_shared<const std::vector<ProfileJump>>(model_.jumps())) {}
+        jumps_(std::make_shared<const std::vector<ProfileJump>>(model_.jumps())),
+        pendulum_(pendulum_of(model_)) {}
 
   int state_size() const override { return kStateSize; }
   const RodModel& model() const override { return model_; }
@@ -83,8 +86,30 @@ class PlanarEquations final : public RodEquations {
     return options;
   }
 
+  // The state in closed form wherever its limits allow (detail::kStateLimits), Phi too where its
+  // own do (kMatrixLimits), else by the march's variational equations beside the closed-form
+  // state: F is then the same number with or without Phi, and as accurate near the separatrix.
   void flow_into(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities, const IntegratorOptions& given,
                  SegmentFlow* out) const override {
+    std::array<double, kStateSize> y1;
+    if (!given.closed_form || !closed_form_state(y0, s1 - s0, detail::kStateLimits, &y1))
+      return march_into(y0, s0, s1, sensitivities, given, out);
+    if (!sensitivities) {
+      out->Phi.resize(0, 0);
+    } else if (!closed_form_matrix(y0, s1 - s0, detail::kMatrixLimits, &out->Phi)) {
+      march_into(y0, s0, s1, true, given, out);
+      out->y = Eigen::Map<const Eigen::Matrix<double, kStateSize, 1>>(y1.data());
+      return;
+    }
+    out->y = Eigen::Map<const Eigen::Matrix<double, kStateSize, 1>>(y1.data());
+    out->dy_dunfolding.resize(0);
+    out->rhs_evaluations = 0;  // (no right-hand side is evaluated)
+    out->steps = 1;
+  }
+
+  // The flow by the march (the stepper of `given`), Phi from the variational equations.
+  void march_into(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities, const IntegratorOptions& given,
+                  SegmentFlow* out) const {
     const IntegratorOptions options = options_from(given, y0, s0);
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     if (!sensitivities) return detail::flow_state_into<kStateSize>(f, y0, s0, s1, options, out);
@@ -103,6 +128,18 @@ class PlanarEquations final : public RodEquations {
 
   DirectionalFlow flow_directions(const Eigen::VectorXd& y0, const Eigen::MatrixXd& directions, double s0, double s1,
                                   const IntegratorOptions& given, CarriedSteps* carried) const override {
+    // In closed form: Phi directions, Phi at the interval's end (the carried step sizes are the
+    // march's, left as they are for the next interval that needs one).
+    std::array<double, kStateSize> y1;
+    Eigen::MatrixXd Phi;
+    if (given.closed_form && closed_form_state(y0, s1 - s0, detail::kStateLimits, &y1) &&
+        closed_form_matrix(y0, s1 - s0, detail::kFieldLimits, &Phi)) {
+      DirectionalFlow out;
+      out.y = Eigen::Map<const Eigen::Matrix<double, kStateSize, 1>>(y1.data());
+      out.directions = Phi * directions;
+      out.steps = 1;
+      return out;
+    }
     const IntegratorOptions options = options_from(given, y0, s0);
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     // The seeds of flow(): all of them with a field, else those x(s0), y(s0) do not enter.
@@ -114,6 +151,10 @@ class PlanarEquations final : public RodEquations {
 
   std::vector<Eigen::VectorXd> sample(const Eigen::VectorXd& y0, const std::vector<double>& s,
                                       const IntegratorOptions& given) const override {
+    if (given.closed_form && pendulum_) {
+      std::vector<Eigen::VectorXd> states;
+      if (closed_form_samples(y0, s, &states)) return states;
+    }
     const IntegratorOptions options = options_from(given, y0, s.empty() ? 0.0 : s.front());
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
     return detail::sample_states<kStateSize>(f, y0, s, options);
@@ -188,6 +229,61 @@ class PlanarEquations final : public RodEquations {
   }
 
  private:
+  // The pendulum this rod's moment obeys, where its flow is closed form (detail/elastica_flow.hpp):
+  // no field, inextensible, and every property that enters constant (then nothing jumps either).
+  static std::optional<detail::ElasticaConstants> pendulum_of(const RodModel& m) {
+    if (m.field || m.extensible) return std::nullopt;
+    for (const Profile* p : {&m.B[1], &m.u_hat[1], &m.v_hat[0], &m.v_hat[2]})
+      if (!p->is_constant()) return std::nullopt;
+    return detail::ElasticaConstants{m.B[1](0.0), m.u_hat[1](0.0), m.v_hat[0](0.0), m.v_hat[2](0.0)};
+  }
+
+  // The state at s0 + ds in closed form into *y1; false where `limits` do not allow it (no
+  // pendulum, an orbit outside the oscillating regime, too near the separatrix, too short a phase).
+  bool closed_form_state(const Eigen::VectorXd& y0, double ds, const detail::ClosedFormLimits& limits,
+                         std::array<double, kStateSize>* y1) const {
+    return pendulum_ && detail::elastica_flow(y0.data(), ds, *pendulum_, y1->data(), limits) && all_finite(*y1);
+  }
+
+  // Phi over ds by the same formulas on dual numbers seeded with theta, n_x, n_y and m (x, y
+  // enter nothing) into *Phi; false where `limits` do not allow it. (The state is closed_form_state's,
+  // on double: the dual numbers' divisions round otherwise.)
+  bool closed_form_matrix(const Eigen::VectorXd& y0, double ds, const detail::ClosedFormLimits& limits,
+                          Eigen::MatrixXd* Phi) const {
+    using D = Dual<4>;
+    constexpr std::array<int, 4> kSeeds{kTheta, kNx, kNy, kMoment};
+    std::array<D, kStateSize> x0, x1;
+    for (int i = 0; i < kStateSize; ++i) x0[i] = D(y0[i]);
+    for (int j = 0; j < 4; ++j) x0[kSeeds[j]].d[j] = 1.0;
+    if (!pendulum_ || !detail::elastica_flow(x0.data(), ds, *pendulum_, x1.data(), limits)) return false;
+    Phi->setIdentity(kStateSize, kStateSize);
+    for (int i = 0; i < kStateSize; ++i)
+      for (int j = 0; j < 4; ++j) (*Phi)(i, kSeeds[j]) = x1[i].d[j];
+    return Phi->allFinite();
+  }
+
+  // The states at s (sorted) in closed form, interval by interval; false where an interval is
+  // outside the state's limits (the caller marches the whole then).
+  bool closed_form_samples(const Eigen::VectorXd& y0, const std::vector<double>& s,
+                           std::vector<Eigen::VectorXd>* states) const {
+    states->clear();
+    if (s.empty()) return true;
+    states->reserve(s.size());
+    states->push_back(y0);
+    std::array<double, kStateSize> y1;
+    for (size_t i = 1; i < s.size(); ++i) {
+      if (!closed_form_state(states->back(), s[i] - s[i - 1], detail::kStateLimits, &y1)) return false;
+      states->push_back(Eigen::Map<const Eigen::Matrix<double, kStateSize, 1>>(y1.data()));
+    }
+    return true;
+  }
+
+  static bool all_finite(const std::array<double, kStateSize>& y) {
+    for (double v : y)
+      if (!std::isfinite(v)) return false;
+    return true;
+  }
+
   // Without a field nothing depends on x(s0), y(s0), and n is constant: the columns x, y of Phi
   // are unit vectors and its rows n_x, n_y those of the identity. The variational equations of
   // the other columns (theta, n_x, n_y, m) are written out for the rows x, y, theta and m: 16
@@ -267,6 +363,7 @@ class PlanarEquations final : public RodEquations {
   RodModel model_;
   detail::Compliances compliances_;  // of model_ (declared after it: built from it)
   std::shared_ptr<const std::vector<ProfileJump>> jumps_;  // of model_: where its properties jump
+  std::optional<detail::ElasticaConstants> pendulum_;       // of model_: where its flow is closed form
 };
 
 }  // namespace

@@ -93,7 +93,7 @@ void read_solver(const Reader& reader, const Value& s, const Parameters& paramet
                  ProblemDefinition* d) {
   reader.allow_keys(s, "solver", {"unknowns", "segments", "stepper", "abs_tol", "rel_tol", "sensitivity_tol",
                                   "tolerance", "max_iterations", "jacobian", "fallback_search", "phase_condition",
-                                  "threads", "coarse_tolerance"});
+                                  "threads", "coarse_tolerance", "closed_form"});
   ShootingOptions& o = d->options;
   if (const Value* v = Reader::find(s, "unknowns")) d->unknown_parameters = read_unknowns(reader, *v, parameters, dependents);
   if (const Value* v = Reader::find(s, "segments")) o.segments = read_segments(reader, *v, *d);
@@ -130,6 +130,7 @@ void read_solver(const Reader& reader, const Value& s, const Parameters& paramet
     if (name == "finite_differences") o.newton.finite_difference_jacobian = true;
     else if (name != "variational") reader.fail(*v, "solver.jacobian", "'" + name + "' is not 'variational' or 'finite_differences'");
   }
+  if (const Value* v = Reader::find(s, "closed_form")) o.integrator.closed_form = reader.boolean(*v, "solver.closed_form");
   if (const Value* v = Reader::find(s, "fallback_search")) o.newton.fallback_search = reader.boolean(*v, "solver.fallback_search");
   if (const Value* v = Reader::find(s, "phase_condition"); v && phase_condition.empty())
     apply_phase_condition(reader, v, reader.string(*v, "solver.phase_condition"), *d);

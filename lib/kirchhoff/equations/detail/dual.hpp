@@ -71,6 +71,21 @@ template <int N> Dual<N> cos(const Dual<N>& a) {
   return r;
 }
 
+template <int N> Dual<N> asin(const Dual<N>& a) {
+  Dual<N> r;
+  r.v = std::asin(a.v);
+  const double k = 1.0 / std::sqrt(1.0 - a.v * a.v);
+  for (int i = 0; i < N; ++i) r.d[i] = k * a.d[i];
+  return r;
+}
+template <int N> Dual<N> atan2(const Dual<N>& y, const Dual<N>& x) {
+  Dual<N> r;
+  r.v = std::atan2(y.v, x.v);
+  const double inv = 1.0 / (x.v * x.v + y.v * y.v);
+  for (int i = 0; i < N; ++i) r.d[i] = (x.v * y.d[i] - y.v * x.d[i]) * inv;
+  return r;
+}
+
 inline double value(double x) { return x; }
 template <int N> double value(const Dual<N>& x) { return x.v; }
 
