@@ -318,16 +318,13 @@ TEST(Stability, EveryShippedCaseHasAnIndexOrAReason) {
   }
 }
 
-// The planar rods' closed-form flows (IntegratorOptions::closed_form) carry the Jacobi fields as
-// the march does: on every shipped planar case and on equilibria whose phases turn fast or pass
-// several conjugate points, the same index and zero modes, the conjugate points within 1e-5 (each
-// is located to ~1e-7 L either way). And the closed form must have been taken somewhere, or this
-// would compare the march with itself: fewer right-hand sides on the Euler column.
-TEST(Stability, ClosedFormFlowsCountAsMarchedOnes) {
+// Every shipped case that solves from its file, and equilibria whose phases turn fast or pass
+// several conjugate points (with the twisted rod's two when `spatial`), by name.
+std::vector<std::pair<std::string, DefinitionSolve>> solved_equilibria(bool spatial) {
   std::vector<std::pair<std::string, DefinitionSolve>> equilibria;
   auto add = [&](const std::string& name, const ParameterOverrides& set) {
     const Case c = load_case(testing::case_path(name), set);
-    if (c.definition.kind != RodKind::Planar) return;
+    if (!spatial && c.definition.kind != RodKind::Planar) return;
     try {
       DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
       if (solved.result.summary.converged()) equilibria.emplace_back(name, std::move(solved));
@@ -339,7 +336,32 @@ TEST(Stability, ClosedFormFlowsCountAsMarchedOnes) {
     if (entry.path().extension() == ".toml") add(entry.path().filename().string(), {});
   add("euler_column.toml", {{"P", 200.0}, {"theta_guess", 0.0}});
   add("euler_column.toml", {{"P", 100.0}, {"theta_guess", 1.5}});
+  if (spatial) {
+    add("twisted_clamped.toml", {{"phi", 12.0}});
+    add("twisted_clamped.toml", {{"phi", 30.0}, {"tension", -20.0}});
+  }
   add("clamped_clamped.toml", {{"s_mode", 1.0}});
+  return equilibria;
+}
+
+// The same count from two computations of one equilibrium's index: defined alike, the same index
+// and zero modes, the conjugate points within 1e-5 (each is located to ~1e-7 L).
+void expect_same_count(const StabilityReport& a, const StabilityReport& b) {
+  ASSERT_EQ(a.defined(), b.defined()) << a.reason << " / " << b.reason;
+  if (!a.defined()) return;
+  EXPECT_EQ(*a.index, *b.index);
+  EXPECT_EQ(a.zero_modes, b.zero_modes);
+  ASSERT_EQ(a.conjugate_points.size(), b.conjugate_points.size());
+  for (size_t j = 0; j < a.conjugate_points.size(); ++j) EXPECT_NEAR(a.conjugate_points[j], b.conjugate_points[j], 1e-5);
+}
+
+// The planar rods' closed-form flows (IntegratorOptions::closed_form) carry the Jacobi fields as
+// the march does: on every shipped planar case and on equilibria whose phases turn fast or pass
+// several conjugate points, the same index and zero modes, the conjugate points within 1e-5 (each
+// is located to ~1e-7 L either way). And the closed form must have been taken somewhere, or this
+// would compare the march with itself: fewer right-hand sides on the Euler column.
+TEST(Stability, ClosedFormFlowsCountAsMarchedOnes) {
+  const auto equilibria = solved_equilibria(false);
   ASSERT_GT(equilibria.size(), 10u);
   long saved = 0;
   for (const auto& [name, solved] : equilibria) {
@@ -349,13 +371,7 @@ TEST(Stability, ClosedFormFlowsCountAsMarchedOnes) {
     const ShootingProblem marched(marched_definition);
     const StabilityReport a = analyse_stability(*solved.problem, solved.result.x);
     const StabilityReport b = analyse_stability(marched, solved.result.x);
-    ASSERT_EQ(a.defined(), b.defined()) << a.reason << " / " << b.reason;
-    if (!a.defined()) continue;
-    EXPECT_EQ(*a.index, *b.index);
-    EXPECT_EQ(a.zero_modes, b.zero_modes);
-    ASSERT_EQ(a.conjugate_points.size(), b.conjugate_points.size());
-    for (size_t j = 0; j < a.conjugate_points.size(); ++j)
-      EXPECT_NEAR(a.conjugate_points[j], b.conjugate_points[j], 1e-5);
+    expect_same_count(a, b);
     if (name == "euler_column.toml") saved += b.rhs_evaluations - a.rhs_evaluations;
   }
   EXPECT_GT(saved, 0);
@@ -369,47 +385,22 @@ TEST(Stability, ClosedFormFlowsCountAsMarchedOnes) {
 // somewhere, or this test would compare a path with itself: on the straight twisted rod, whose
 // phases turn slowly along most of it, it takes fewer right-hand sides.
 TEST(Stability, InterpolatedObservationsCountAsExactOnes) {
-  struct Equilibrium {
-    std::string name;
-    DefinitionSolve solved;
-  };
-  std::vector<Equilibrium> equilibria;
-  auto add = [&](const std::string& name, const ParameterOverrides& set) {
-    const Case c = load_case(testing::case_path(name), set);
-    try {
-      DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
-      if (solved.result.summary.converged()) equilibria.push_back({name, std::move(solved)});
-    } catch (const std::exception&) {
-      // a case solved elsewhere by continuation
-    }
-  };
-  for (const auto& entry : std::filesystem::directory_iterator(KIRCHHOFF_CASES_DIR))
-    if (entry.path().extension() == ".toml") add(entry.path().filename().string(), {});
-  add("euler_column.toml", {{"P", 200.0}, {"theta_guess", 0.0}});
-  add("euler_column.toml", {{"P", 100.0}, {"theta_guess", 1.5}});
-  add("twisted_clamped.toml", {{"phi", 12.0}});
-  add("twisted_clamped.toml", {{"phi", 30.0}, {"tension", -20.0}});
-  add("clamped_clamped.toml", {{"s_mode", 1.0}});
+  const auto equilibria = solved_equilibria(true);
   ASSERT_GT(equilibria.size(), 20u);
   long saved_on_the_twisted_rod = 0;
   for (const double tolerance : {0.0, 1e-8}) {
-    for (const Equilibrium& e : equilibria) {
-      SCOPED_TRACE(e.name + " at field tolerance " + std::to_string(tolerance));
+    for (const auto& [name, solved] : equilibria) {
+      SCOPED_TRACE(name + " at field tolerance " + std::to_string(tolerance));
       StabilityOptions interpolated, exact;
       interpolated.field_tolerance = exact.field_tolerance = tolerance;
       exact.interpolated_observations = false;
-      const Eigen::VectorXd& x = e.solved.result.x;
-      const StabilityReport a = analyse_stability(*e.solved.problem, x, interpolated);
-      const StabilityReport b = analyse_stability(*e.solved.problem, x, exact);
-      ASSERT_EQ(a.defined(), b.defined()) << a.reason << " / " << b.reason;
+      const Eigen::VectorXd& x = solved.result.x;
+      const StabilityReport a = analyse_stability(*solved.problem, x, interpolated);
+      const StabilityReport b = analyse_stability(*solved.problem, x, exact);
       EXPECT_EQ(a.reason, b.reason);
+      expect_same_count(a, b);
       if (!a.defined()) continue;
-      EXPECT_EQ(*a.index, *b.index);
-      EXPECT_EQ(a.zero_modes, b.zero_modes);
-      ASSERT_EQ(a.conjugate_points.size(), b.conjugate_points.size());
-      for (size_t j = 0; j < a.conjugate_points.size(); ++j)
-        EXPECT_NEAR(a.conjugate_points[j], b.conjugate_points[j], 1e-5);
-      if (e.name == "twisted_clamped.toml" && *a.index == 2 && tolerance > 0)
+      if (name == "twisted_clamped.toml" && *a.index == 2 && tolerance > 0)
         saved_on_the_twisted_rod = b.rhs_evaluations - a.rhs_evaluations;
     }
   }
