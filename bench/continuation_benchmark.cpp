@@ -171,8 +171,12 @@ EulerSetup make_euler_setup(bool marched) {
 }
 
 const EulerSetup& euler_setup(bool marched = false) {
-  static EulerSetup closed_form = make_euler_setup(false), march = make_euler_setup(true);
-  return marched ? march : closed_form;
+  if (marched) {
+    static const EulerSetup march = make_euler_setup(true);
+    return march;
+  }
+  static const EulerSetup closed_form = make_euler_setup(false);
+  return closed_form;
 }
 
 struct TwistSetup {

@@ -50,8 +50,9 @@ struct IntegratorOptions {
 
   // A planar rod whose only load is the force at its ends (uniform, inextensible, no field,
   // constant natural curvature) is flowed in closed form, Jacobi's elliptic functions of the
-  // pendulum its moment obeys (detail/elastica_flow.hpp), where its orbit oscillates: exact to
-  // round-off, whatever the tolerances above, and some forty times cheaper than a march. False:
+  // pendulum its moment obeys (detail/elastica_flow.hpp), where its orbit oscillates and within
+  // the limits there: the state to about 1e-13 of its size whatever the tolerances above, and
+  // some forty times cheaper than a march. A ShootingProblem with obstacles sets it false. False:
   // always march (the stepper above), as a baseline or a cross-check.
   bool closed_form = true;
 

@@ -97,7 +97,10 @@ class PlanarEquations final : public RodEquations {
     if (!sensitivities) {
       out->Phi.resize(0, 0);
     } else if (!closed_form_matrix(y0, s1 - s0, detail::kMatrixLimits, &out->Phi)) {
-      march_into(y0, s0, s1, true, given, out);
+      // (Phi's pass alone: the march's own state pass would only be replaced.)
+      IntegratorOptions phi_only = given;
+      phi_only.sensitivities_only = true;
+      march_into(y0, s0, s1, true, phi_only, out);
       out->y = Eigen::Map<const Eigen::Matrix<double, kStateSize, 1>>(y1.data());
       return;
     }
