@@ -143,18 +143,71 @@ TEST(ElasticaFlow, TurningOverOrUnloadedRodsAreMarched) {
 }
 
 // A profile in closed form is the flow's own end, sample by sample.
+// A profile's samples (ShootingProblem::sample) start with the segment's start repeated, and may
+// hold intervals shorter than the closed form's least phase. Neither may send the profile to the
+// march: composed interval by interval, the closed form agrees with its one-interval flow to
+// round-off (measured 1.4e-15 here), where the march agrees to its tolerance (2.6e-13).
 TEST(ElasticaFlow, SamplesAreTheFlowsStates) {
   const auto eq = make_planar_equations(RodModel{});
   Eigen::VectorXd y0(6);
   y0 << 0, 0, 0.2, -12, 1, 3;
-  const std::vector<Eigen::VectorXd> states = eq->sample(y0, {0.0, 0.25, 0.5, 1.0}, IntegratorOptions{});
+  const std::vector<double> s{0.0, 0.0, 0.25, 0.5, 0.5 + 1e-12, 1.0};
+  const std::vector<Eigen::VectorXd> states = eq->sample(y0, s, IntegratorOptions{});
   const SegmentFlow whole = eq->flow(y0, 0.0, 1.0, false, IntegratorOptions{});
-  ASSERT_EQ(states.size(), 4u);
-  EXPECT_LT((states.back() - whole.y).norm(), 1e-13 * whole.y.norm());
+  ASSERT_EQ(states.size(), s.size());
+  EXPECT_EQ(states[1], y0);
+  EXPECT_LT((states.back() - whole.y).norm(), 2e-15 * whole.y.norm());
   IntegratorOptions march;
   march.closed_form = false;
-  const std::vector<Eigen::VectorXd> marched = eq->sample(y0, {0.0, 0.25, 0.5, 1.0}, march);
-  for (size_t i = 0; i < 4; ++i) EXPECT_LT((states[i] - marched[i]).norm(), 1e-10 * (1 + marched[i].norm()));
+  const std::vector<Eigen::VectorXd> marched = eq->sample(y0, s, march);
+  for (size_t i = 0; i < s.size(); ++i) EXPECT_LT((states[i] - marched[i]).norm(), 1e-10 * (1 + marched[i].norm()));
+}
+
+// A profile's equal intervals share their Jacobi functions (JacobiMemo): along an orbit m is
+// invariant and v = lambda ds the same, so of 100 intervals one forms them (m drifts by round-off
+// from state to state, within the memo's bound away from the separatrix; at 1 - m = 1.2e-4 it
+// drifts further and most intervals form their own: 93 measured). The states agree with flows
+// that each form their own to 1e-13 of a state of size 20 (measured 1.4e-13 at theta0 = 2.9, where
+// both differ from the one-interval flow by 1e-13 and 5e-14). A change of orbit recomputes.
+TEST(ElasticaFlow, EqualIntervalsShareTheirJacobiFunctions) {
+  const detail::ElasticaConstants rod;
+  for (const double theta0 : {0.3, 2.9, 3.12}) {  // 1 - m from 0.98 to 1.2e-4 (the state's limit: 1e-4)
+    std::array<double, 6> y{0, 0, theta0, -20, 0, 0}, alone = y, next{};
+    detail::JacobiMemo memo;
+    const double ds = 0.01;
+    for (int i = 0; i < 100; ++i) {
+      ASSERT_TRUE(detail::elastica_flow(y.data(), ds, rod, next.data(), detail::kStateLimits, &memo));
+      y = next;
+      ASSERT_TRUE(detail::elastica_flow(alone.data(), ds, rod, next.data(), detail::kStateLimits));
+      alone = next;
+    }
+    if (theta0 < 3) EXPECT_EQ(memo.evaluations, 1) << "theta0 " << theta0;
+    for (int k = 0; k < 6; ++k) EXPECT_NEAR(y[k], alone[k], 1e-13 * 20) << "theta0 " << theta0 << " k " << k;
+    std::array<double, 6> other{0, 0, theta0, -30, 0, 0};
+    const int before = memo.evaluations;
+    ASSERT_TRUE(detail::elastica_flow(other.data(), ds, rod, next.data(), detail::kStateLimits, &memo));
+    EXPECT_EQ(memo.evaluations, before + 1);
+  }
+}
+
+// Near the separatrix, off an equilibrium (a Newton iterate), the flow over a long phase: the
+// addition theorems' denominator 1 - S0^2 sn^2 is formed as D0^2 + S0^2 cn^2, without the
+// cancellation to 1 - m that cost 1.7e-9 and 5.4e-9 of these states (size 20 to 50). Against a
+// march at 1e-15 (which agrees with one at 1e-12 to 4e-11 here): measured 7e-12 to 6e-11.
+TEST(ElasticaFlow, LongPhasesNearTheSeparatrixKeepTheirDigits) {
+  const auto eq = make_planar_equations(RodModel{});
+  IntegratorOptions tight;
+  tight.closed_form = false;
+  tight.abs_tol = tight.rel_tol = 1e-15;
+  for (const double theta0 : {3.1, 3.12})
+    for (const double P : {20.0, 50.0}) {
+      Eigen::VectorXd y0(6);
+      y0 << 0, 0, theta0, -P, 0, 0;
+      const SegmentFlow closed = eq->flow(y0, 0.0, 1.0, false, IntegratorOptions{});
+      ASSERT_EQ(closed.rhs_evaluations, 0);
+      const SegmentFlow marched = eq->flow(y0, 0.0, 1.0, false, tight);
+      EXPECT_LT((closed.y - marched.y).norm(), 3e-10) << "theta0 " << theta0 << " P " << P;
+    }
 }
 
 // The march towards smaller s under a step bound (a naturally curved ring: the planar equations

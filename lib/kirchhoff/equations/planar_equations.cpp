@@ -133,10 +133,11 @@ class PlanarEquations final : public RodEquations {
                                   const IntegratorOptions& given, CarriedSteps* carried) const override {
     // In closed form: Phi directions, Phi at the interval's end (the carried step sizes are the
     // march's, left as they are for the next interval that needs one).
+    // The state is the dual numbers' values (the fields' limits are inside the state's): their
+    // rounding, a few ulps, is nothing to the fields, and a second pass on double costs a third.
     std::array<double, kStateSize> y1;
     Eigen::MatrixXd Phi;
-    if (given.closed_form && closed_form_state(y0, s1 - s0, detail::kStateLimits, &y1) &&
-        closed_form_matrix(y0, s1 - s0, detail::kFieldLimits, &Phi)) {
+    if (given.closed_form && closed_form_matrix(y0, s1 - s0, detail::kFieldLimits, &Phi, &y1)) {
       DirectionalFlow out;
       out.y = Eigen::Map<const Eigen::Matrix<double, kStateSize, 1>>(y1.data());
       out.directions = Phi * directions;
@@ -156,7 +157,7 @@ class PlanarEquations final : public RodEquations {
                                       const IntegratorOptions& given) const override {
     if (given.closed_form && pendulum_) {
       std::vector<Eigen::VectorXd> states;
-      if (closed_form_samples(y0, s, &states)) return states;
+      if (closed_form_samples(y0, s, given, &states)) return states;
     }
     const IntegratorOptions options = options_from(given, y0, s.empty() ? 0.0 : s.front());
     auto f = [this](const auto* y, auto* dy, double s) { rhs(y, dy, s); };
@@ -244,15 +245,17 @@ class PlanarEquations final : public RodEquations {
   // The state at s0 + ds in closed form into *y1; false where `limits` do not allow it (no
   // pendulum, an orbit outside the oscillating regime, too near the separatrix, too short a phase).
   bool closed_form_state(const Eigen::VectorXd& y0, double ds, const detail::ClosedFormLimits& limits,
-                         std::array<double, kStateSize>* y1) const {
-    return pendulum_ && detail::elastica_flow(y0.data(), ds, *pendulum_, y1->data(), limits) && all_finite(*y1);
+                         std::array<double, kStateSize>* y1, detail::JacobiMemo* memo = nullptr) const {
+    return pendulum_ && detail::elastica_flow(y0.data(), ds, *pendulum_, y1->data(), limits, memo) &&
+           all_finite(*y1);
   }
 
   // Phi over ds by the same formulas on dual numbers seeded with theta, n_x, n_y and m (x, y
-  // enter nothing) into *Phi; false where `limits` do not allow it. (The state is closed_form_state's,
-  // on double: the dual numbers' divisions round otherwise.)
+  // enter nothing) into *Phi, and their values into *values if asked; false where `limits` do not
+  // allow it. (Shooting's state is closed_form_state's, on double: the dual numbers' divisions
+  // round otherwise, and F must be the same number with or without Phi.)
   bool closed_form_matrix(const Eigen::VectorXd& y0, double ds, const detail::ClosedFormLimits& limits,
-                          Eigen::MatrixXd* Phi) const {
+                          Eigen::MatrixXd* Phi, std::array<double, kStateSize>* values = nullptr) const {
     using D = Dual<4>;
     constexpr std::array<int, 4> kSeeds{kTheta, kNx, kNy, kMoment};
     std::array<D, kStateSize> x0, x1;
@@ -262,21 +265,38 @@ class PlanarEquations final : public RodEquations {
     Phi->setIdentity(kStateSize, kStateSize);
     for (int i = 0; i < kStateSize; ++i)
       for (int j = 0; j < 4; ++j) (*Phi)(i, kSeeds[j]) = x1[i].d[j];
-    return Phi->allFinite();
+    if (values)
+      for (int i = 0; i < kStateSize; ++i) (*values)[i] = x1[i].v;
+    return Phi->allFinite() && (!values || all_finite(*values));
   }
 
-  // The states at s (sorted) in closed form, interval by interval; false where an interval is
-  // outside the state's limits (the caller marches the whole then).
-  bool closed_form_samples(const Eigen::VectorXd& y0, const std::vector<double>& s,
+  // The states at s (sorted) in closed form, interval by interval; false where an orbit is outside
+  // the state's limits (the caller marches the whole then). An interval of no length (a profile's
+  // first sample is its start) keeps the state, and one too short a phase for the closed form
+  // (detail::kStateLimits) is marched alone: neither says anything about the orbit.
+  bool closed_form_samples(const Eigen::VectorXd& y0, const std::vector<double>& s, const IntegratorOptions& given,
                            std::vector<Eigen::VectorXd>* states) const {
     states->clear();
     if (s.empty()) return true;
     states->reserve(s.size());
     states->push_back(y0);
+    constexpr detail::ClosedFormLimits kAnyPhase{detail::kStateLimits.separatrix_margin, 0.0};
     std::array<double, kStateSize> y1;
+    detail::JacobiMemo memo;  // (equal intervals share their Jacobi functions)
     for (size_t i = 1; i < s.size(); ++i) {
-      if (!closed_form_state(states->back(), s[i] - s[i - 1], detail::kStateLimits, &y1)) return false;
-      states->push_back(Eigen::Map<const Eigen::Matrix<double, kStateSize, 1>>(y1.data()));
+      const Eigen::VectorXd& y = states->back();
+      const double ds = s[i] - s[i - 1];
+      if (ds == 0.0) {
+        states->push_back(Eigen::VectorXd(y));
+      } else if (closed_form_state(y, ds, detail::kStateLimits, &y1, &memo)) {
+        states->push_back(Eigen::Map<const Eigen::Matrix<double, kStateSize, 1>>(y1.data()));
+      } else if (closed_form_state(y, ds, kAnyPhase, &y1)) {
+        SegmentFlow short_interval;
+        march_into(y, s[i - 1], s[i], false, given, &short_interval);
+        states->push_back(short_interval.y);
+      } else {
+        return false;
+      }
     }
     return true;
   }

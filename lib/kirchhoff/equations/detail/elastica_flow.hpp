@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cmath>
+#include <type_traits>
 
 #include "kirchhoff/equations/detail/jacobi_elliptic.hpp"
 #include "kirchhoff/equations/detail/planar_state.hpp"
@@ -54,10 +55,46 @@ constexpr ClosedFormLimits kMatrixLimits{1e-3, 0.1};
 // Phi for the stability analysis' Jacobi fields, integrated to ~1e-10 otherwise.
 constexpr ClosedFormLimits kFieldLimits{1e-3, 0.02};
 
-// y1 = the state at s0 + ds from y0 (planar layout), or false (y1 untouched) where the rod is not
-// in the oscillating regime the closed form covers, within `limits`.
+// The Jacobi functions of the last flow, for the next one over the same phase on the same orbit
+// (a profile's equal intervals: one AGM instead of one per sample). Reused where v agrees to
+// 2e-15 of itself and m to 1e-12 of 1 - m: m, formed from each state, drifts by round-off along
+// the orbit (by up to 1e-13 a step near the separatrix, where little is reused), and over 10 to
+// 1000 steps the states then agree with flows that form their own functions to 1e-13 of a state
+// of size 20 (tests/elastica_flow_test.cpp).
+struct JacobiMemo {
+  bool filled = false;
+  double v = 0.0, m = 0.0;
+  JacobiValues<double> values;
+  int evaluations = 0;  // of jacobi_elliptic (the tests count them)
+
+  const JacobiValues<double>& at(double v_now, double m_now, double complement) {
+    const double tolerance = 1e-12;
+    if (!filled || !(std::abs(v_now - v) <= 2e-15 * std::abs(v)) ||
+        !(std::abs(m_now - m) <= tolerance * complement)) {
+      values = jacobi_elliptic(v_now, m_now, complement);
+      v = v_now;
+      m = m_now;
+      filled = true;
+      ++evaluations;
+    }
+    return values;
+  }
+};
+
 template <class T>
-bool elastica_flow(const T* y0, double ds, const ElasticaConstants& rod, T* y1, const ClosedFormLimits& limits) {
+JacobiValues<T> jacobi_of_phase(const T& v, const T& m, const T& complement, JacobiMemo* memo) {
+  if constexpr (std::is_same_v<T, double>) {
+    if (memo) return memo->at(v, m, complement);
+  }
+  return jacobi_elliptic(v, m, complement);
+}
+
+// y1 = the state at s0 + ds from y0 (planar layout), or false (y1 untouched) where the rod is not
+// in the oscillating regime the closed form covers, within `limits`. `memo` (double only, may be
+// null) carries the Jacobi functions from one call to the next (JacobiMemo).
+template <class T>
+bool elastica_flow(const T* y0, double ds, const ElasticaConstants& rod, T* y1, const ClosedFormLimits& limits,
+                   JacobiMemo* memo = nullptr) {
   using std::atan2;
   using std::cos;
   using std::sin;
@@ -82,8 +119,10 @@ bool elastica_flow(const T* y0, double ds, const ElasticaConstants& rod, T* y1, 
   const T m = s0 * s0 + c0 * c0;
   const T v = lambda * ds;
   if (!(std::abs(value(v)) >= limits.least_phase)) return false;
-  const JacobiValues<T> j = jacobi_elliptic(v, m, complement);
-  const T den = 1.0 - s0 * s0 * j.sn * j.sn;
+  const JacobiValues<T> j = jacobi_of_phase(v, m, complement, memo);
+  // 1 - S0^2 sn^2 as D0^2 + S0^2 cn^2: two terms of one sign, where the difference cancels to
+  // 1 - m near the separatrix (1e-9 of the state lost at 1 - m = 2e-3 on long phases).
+  const T den = d0_squared + s0 * s0 * j.cn * j.cn;
   const T s1 = (s0 * j.cn * j.dn + c0 * d0 * j.sn) / den;
   const T d1 = (d0 * j.dn - s0 * c0 * j.sn * j.cn) / den;
   // 1 - cn without cancellation on either side of cn = 0.
