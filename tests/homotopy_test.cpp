@@ -79,6 +79,22 @@ TEST(Homotopy, DoesNotJumpToAModeLyingBesideItsOwn) {
   EXPECT_EQ(*s.stability->index, 0);
 }
 
+// Values far above the file's (EI = 1e4 from 1, P = 3e4 from 12, L = 2 from 1): the force moves by
+// 3e4 along the path, which took more than the 5000 points allowed in steps of the start's size
+// (stopped at a third of the way). The steps now grow with the unknowns (measured 62 points).
+// The straight column at P L^2 / EI = 12 lies between pi^2 and 4 pi^2: index 1, and its path
+// crosses the branch point where P L^2 / EI passes pi^2 again.
+TEST(Homotopy, ReachesValuesFarAboveTheFilesInTensOfPoints) {
+  const CaseSolve s = solve_at("euler_column.toml", {{"EI", 1e4}, {"L", 2.0}, {"P", 3e4}, {"theta_guess", 0.5}});
+  ASSERT_TRUE(s.failure.empty()) << s.failure << ": " << s.message;
+  EXPECT_EQ(s.path.homotopy.stop, "reached");
+  EXPECT_LT(s.path.homotopy.points, 500);
+  ASSERT_TRUE(s.stability && s.stability->index);
+  EXPECT_EQ(*s.stability->index, 1);
+  const auto& derived = s.solution->derived;
+  EXPECT_NEAR(derived.at("end_to_end"), 2.0, 1e-9);  // straight
+}
+
 // The shallow arch under its weight snaps through at a fold: asked for a weight beyond it, the
 // homotopy stops there and says where, instead of returning an equilibrium of another branch.
 TEST(Homotopy, StopsAtAFoldAndSaysWhere) {
@@ -116,16 +132,18 @@ TEST(Homotopy, AStartOnAContinuousFamilySaysSo) {
   EXPECT_NE(s.message.find("continuous family"), std::string::npos) << s.message;
 }
 
-// The Euler column's first mode followed from the file's P = 12 to 500 on one shooting segment:
-// past P ~ 450 the fields grow like exp(sqrt(P) L) ~ 1e9 and the corrector's best residual sits
-// at 1.5e-10, above the tolerance 1e-10, down to the minimum step. The failure says that more
-// segments help, and with 8 the same request reaches the Elastica: theta0 = 3.14148108804982883,
+// The Euler column's first mode followed from the file's P = 12 to 1000 on one shooting segment:
+// past P ~ 520 the fields grow like exp(sqrt(P) L) ~ 1e10 and the corrector's best residual sits
+// above the tolerance 1e-10, down to the minimum step. The failure says that more segments help,
+// and with 8 the request P = 500 reaches the Elastica: theta0 = 3.14148108804982883,
 // the root of 4 K(sin(theta0/2))^2 = 500 (EI = L = 1; bisection in mpmath at 50 digits). Within
 // 1e-9: near pi theta0 is ill-conditioned by about 10 against the residual's 1e-10 (with 8, 16
 // and 32 segments it comes out 4.7e-10, 2.7e-10 and 1.9e-10 below; P = 4 K^2 from it is 1e-6 off,
 // as dP/dtheta0 ~ 1e6 there).
 TEST(Homotopy, AStepTooSmallOnOneSegmentSaysMoreSegmentsHelp) {
-  const CaseSolve one = solve_at("euler_column.toml", {{"P", 500.0}});
+  // (P = 500 itself is reached on one segment since the path's steps grow with its unknowns: it
+  // passes the ill-conditioned stretch in fewer, longer steps; residual 9.4e-11.)
+  const CaseSolve one = solve_at("euler_column.toml", {{"P", 1000.0}});
   EXPECT_EQ(one.failure, "step_too_small");
   EXPECT_NE(one.message.find("more segments condition it better"), std::string::npos) << one.message;
   const Case c = load_case(testing::case_path("euler_column.toml"), {{"P", 500.0}}, "", {{"segments", "8"}});

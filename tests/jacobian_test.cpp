@@ -224,5 +224,30 @@ force = [-2.0, 0.5, 1.0]
   }
 }
 
+// dF/d(parameter) where one side of the central difference is no rod: at EI = 5e-7 the step
+// h = 1e-6 (1 + EI) probes EI - h < 0 (as a homotopy from EI = 1 to 2e11 probes its start at
+// t - h). That failed the derivative, and with it the homotopy's start; it is now the forward
+// difference, (F(EI + h) - F(EI)) / h, the same numbers as formed here from two residuals.
+TEST(ParameterDerivative, OneSidedWhereTheOtherSideIsNoRod) {
+  const double EI = 5e-7, h = 1e-6 * (1.0 + EI);
+  const Case c = load_case(testing::case_path("simply_supported.toml"), {{"EI", EI}});
+  ShootingProblem problem(c.definition);
+  const Eigen::VectorXd x = perturbed_guess(problem, c, 0.01);
+  Eigen::VectorXd dF, F0, Fp;
+  std::string failure;
+  ASSERT_TRUE(problem.parameter_derivative(x, "EI", &dF, &failure)) << failure;
+  ASSERT_TRUE(problem.evaluate(x, &F0, nullptr, &failure)) << failure;
+  ShootingProblem plus = problem;
+  plus.set_parameter("EI", EI + h);
+  ASSERT_TRUE(plus.evaluate(x, &Fp, nullptr, &failure)) << failure;
+  const Eigen::VectorXd forward = (Fp - F0) / h;
+  EXPECT_LE((dF - forward).cwiseAbs().maxCoeff(), 1e-12 * std::max(1.0, forward.cwiseAbs().maxCoeff()));
+  // And where both sides are rods, the central difference as before.
+  ShootingProblem stiff = problem;
+  stiff.set_parameter("EI", 1.0);
+  ASSERT_TRUE(stiff.parameter_derivative(x, "EI", &dF, &failure)) << failure;
+  EXPECT_TRUE(dF.allFinite());
+}
+
 }  // namespace
 }  // namespace kirchhoff

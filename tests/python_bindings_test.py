@@ -76,6 +76,17 @@ class HomotopyTest(unittest.TestCase):
         self.assertEqual(direct.path["method"], "direct")
         self.assertGreater(abs(direct.parameters["P"] / exact - 1.0), 1e-3)
 
+    def test_values_far_above_the_files_are_reached_in_tens_of_points(self):
+        # Fig. 3 in units far from 1 (EI = 2e4, L = 3 from 1 and 1): P = 4 K(k)^2 EI / L^2 = 3.9e4.
+        # The path's steps grow with its unknowns (as tests/homotopy_test.cpp; measured 73 points).
+        sol = kirchhoff.load_case(case_path("simply_supported.toml"),
+                                  set={"EI": 2e4, "L": 3.0, "theta0": 2.0}).solve()
+        self.assertEqual(sol.status, "converged", sol.message)
+        exact = kirchhoff.analytic_pinned_load(3.0, 2e4, 2.0)
+        self.assertLess(abs(sol.parameters["P"] / exact - 1.0), 1e-9)
+        self.assertEqual(sol.path["stop"], "reached")
+        self.assertLess(sol.path["points"], 500)
+
     def test_a_fold_on_the_way_is_a_status_with_where(self):
         sol = kirchhoff.load_case(case_path("shallow_arch.toml"), set={"w": 150.0}).solve()
         self.assertFalse(sol.converged)

@@ -27,6 +27,12 @@ namespace {
 // of 0.05 under --max-step 0.01 went five times as far as the run allows any).
 double first_step(const StepControl& o) { return std::clamp(o.initial_step, o.min_step, o.max_step); }
 
+// The longest step from a point with unknowns x (StepControl::max_step_reference_size).
+double longest_step(const StepControl& o, const Eigen::VectorXd& x) {
+  if (!(o.max_step_reference_size > 0)) return o.max_step;
+  return o.max_step * std::max(1.0, x.norm() / o.max_step_reference_size);
+}
+
 // How many times the first step from a branch point is halved before the switch gives up.
 constexpr int kFirstStepHalvings = 6;
 
@@ -131,6 +137,7 @@ std::string ContinuationRange::validate() const {
 
 std::string StepControl::validate() const {
   if (!(initial_step > 0) || !(min_step > 0) || !(max_step >= min_step)) return "steps must satisfy 0 < min_step <= max_step, initial_step > 0";
+  if (!(max_step_reference_size >= 0)) return "max_step_reference_size must be >= 0";
   if (!(0 <= grow_iterations && grow_iterations < shrink_iterations))
     return "grow_iterations must be >= 0 and below shrink_iterations";
   return {};
@@ -947,7 +954,7 @@ struct Continuation::Marcher {
     const int iterations = candidate.newton_iterations;
     before = std::move(current);
     previous_h = ds;
-    if (iterations <= o.grow_iterations) ds = std::min(ds * kGrow, o.max_step);
+    if (iterations <= o.grow_iterations) ds = std::min(ds * kGrow, longest_step(o, candidate.x));
     if (iterations >= o.shrink_iterations) ds = std::max(ds * kShrink, o.min_step);
     accept(std::move(candidate), candidate_recorded);
     candidate_recorded = false;

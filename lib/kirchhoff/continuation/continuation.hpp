@@ -83,6 +83,11 @@ struct StepControl {
   double initial_step = 0.05;       // pseudo-arclength step
   double min_step = 1e-7;           // below this the run stops (step_too_small)
   double max_step = 0.5;
+  // > 0: max_step is meant for unknowns of this size (|x|), and where they are larger the bound
+  // grows with them, max_step |x| / max_step_reference_size: a path whose unknowns grow by
+  // orders of magnitude (a homotopy to a load of 3e4 from 12, or to a stiffness of 2e11 from 1)
+  // then takes steps of its own scale, not thousands of the start's. 0: max_step alone.
+  double max_step_reference_size = 0.0;
   double max_tangent_angle = 0.35;  // rad; a step turning the tangent more is retried shorter
   // A corrector that needed at most grow_iterations lets the step grow, at least
   // shrink_iterations shrink it (chord iterations contract linearly, so a good step takes three

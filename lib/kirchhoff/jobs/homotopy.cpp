@@ -1,5 +1,6 @@
 #include "kirchhoff/jobs/homotopy.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -55,6 +56,14 @@ RodContinuationOptions path_options(const ShootingProblem& problem, const std::s
   const double scale = std::sqrt(1.0 + x_start.norm());
   o.initial_step *= scale;
   o.max_step *= scale;
+  // Values far above the file's (EI = 1e4, P = 3e4 from 1 and 12) carry the unknowns over orders
+  // of magnitude: the steps grow with them (in proportion to |x| beyond its size at the start), as
+  // the corrector's convergence allows. Not with obstacles: their paths change contact sets
+  // along the way, and longer steps there reached other equilibria (the indenter at rise 0.3663
+  // ended where Newton could not polish it; the cavity reached an equilibrium of index 2).
+  const ProblemDefinition& d = problem.definition();
+  if (d.obstacles.empty() && !d.moving_obstacles && d.contacts.empty())
+    o.max_step_reference_size = std::max(1.0, x_start.norm());
   o.target = 1.0;
   o.max_points = options.max_points;
   o.deadline = options.deadline;
@@ -192,8 +201,12 @@ HomotopyResult follow_homotopy(const ProblemDefinition& start, const Eigen::Vect
     // A corrector that failed down to the minimum step on one segment has most often met the
     // residual's floor of an ill-conditioned shooting (the Euler column's first mode at P = 454:
     // best residual 1.5e-10 against the tolerance 1e-10; with 8 segments P = 500 converges).
-    const bool ill_conditioned = run.reason == StopReason::StepTooSmall && problem.segments() == 1;
-    h.message = stop_message(h, changes, ill_conditioned ? run.message + "; " + single_segment_hint() : run.message);
+    std::string why = run.message;
+    if (run.reason == StopReason::StepTooSmall) {
+      if (problem.segments() == 1) why += "; " + single_segment_hint();
+      if (const std::string units = scale_hint(problem, run.points.back().x); !units.empty()) why += "; " + units;
+    }
+    h.message = stop_message(h, changes, why);
     return h;
   }
   polish(start, changes, contacts, run.points.back().x, &h);

@@ -345,10 +345,22 @@ bool ShootingProblem::parameter_derivative(const Eigen::VectorXd& x, const std::
   complete(&plus, definition_.dependent_parameters);
   complete(&minus, definition_.dependent_parameters);
   if (definition_.model_parameters.count(name) || definition_.obstacle_parameters.count(name)) {
-    Eigen::VectorXd Fp, Fm;
-    if (!residual(x, plus, &Fp, nullptr, failure) || !residual(x, minus, &Fm, nullptr, failure)) return false;
-    *dF = (Fp - Fm) / (2.0 * h);
-    return true;
+    Eigen::VectorXd Fp, Fm, F0;
+    std::string plus_failure, minus_failure;
+    const bool has_plus = residual(x, plus, &Fp, nullptr, &plus_failure);
+    const bool has_minus = residual(x, minus, &Fm, nullptr, &minus_failure);
+    if (has_plus && has_minus) {
+      *dF = (Fp - Fm) / (2.0 * h);
+      return true;
+    }
+    // One side outside the model's domain (a homotopy from EI = 1 to 2e11 probes EI = 1 - 2e5 h
+    // < 0 at its start): the one-sided difference, O(h) where the central one is O(h^2).
+    if (has_plus != has_minus && residual(x, parameters_at(x), &F0, nullptr, failure)) {
+      *dF = has_plus ? Eigen::VectorXd((Fp - F0) / h) : Eigen::VectorXd((F0 - Fm) / h);
+      return true;
+    }
+    if (failure) *failure = has_plus ? minus_failure : plus_failure;
+    return false;
   }
   Eigen::VectorXd end_state;
   if (!y_end) {
@@ -762,22 +774,6 @@ bool singular_at_solution(const ShootingProblem& problem, const Eigen::VectorXd&
   return problem.evaluate(x, &F, &J, &failure) && !(JacobianLU(J).reciprocal_condition() > threshold);
 }
 
-// A case whose length or bending stiffness lies decades from 1 (of_unit_scale) is ill-conditioned
-// by its units alone, and its residual tolerance (absolute) means something else there: a heavy
-// column with EI = 1e6 and weight 7.8e6 came out singular at a residual of 3.5e-9 (4e-16 of its
-// forces), where more segments do not help and units of order 1 do. Loads large against B / L^2
-// are the rod's own state (a tension, which more segments help), not its units. x: where the
-// solve stopped.
-std::string scale_hint(const ShootingProblem& problem, const Eigen::VectorXd& x) {
-  const RodModel& model = problem.equations(problem.parameters_at(x))->model();
-  const double length = model.length, bending = model.B[1](0.0);
-  if (of_unit_scale(length, bending)) return "";
-  std::ostringstream os;
-  os << "the case is far from unit scale (length " << length << ", bending stiffness " << bending
-     << ") and the residual tolerance is absolute: give lengths, stiffnesses and loads in units that make them of "
-     << "order 1";
-  return os.str();
-}
 
 // A single segment whose Jacobian is singular to the solver, or whose residual no step lowers,
 // is most often a shooting problem too ill-conditioned for one segment: the fields grow like
@@ -794,6 +790,23 @@ void note_single_shooting(const ShootingProblem& problem, const Eigen::VectorXd&
 }
 
 }  // namespace
+
+// A case whose length or bending stiffness lies decades from 1 (of_unit_scale) is ill-conditioned
+// by its units alone, and its residual tolerance (absolute) means something else there: a heavy
+// column with EI = 1e6 and weight 7.8e6 came out singular at a residual of 3.5e-9 (4e-16 of its
+// forces), where more segments do not help and units of order 1 do. Loads large against B / L^2
+// are the rod's own state (a tension, which more segments help), not its units. x: where the
+// solve stopped.
+std::string scale_hint(const ShootingProblem& problem, const Eigen::VectorXd& x) {
+  const RodModel& model = problem.equations(problem.parameters_at(x))->model();
+  const double length = model.length, bending = model.B[1](0.0);
+  if (of_unit_scale(length, bending)) return "";
+  std::ostringstream os;
+  os << "the case is far from unit scale (length " << length << ", bending stiffness " << bending
+     << ") and the residual tolerance is absolute: give lengths, stiffnesses and loads in units that make them of "
+     << "order 1";
+  return os.str();
+}
 
 std::string single_segment_hint() {
   return "with a single shooting segment; where the rod is long or under a large tension its shooting is "

@@ -348,5 +348,8 @@ ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0);
 
 // What a failure on one shooting segment adds: more segments condition an ill-conditioned shooting.
 std::string single_segment_hint();
+// What to do where a case's length or bending stiffness lies decades from 1 at x (its units make
+// the absolute residual tolerance mean something else); "" for a case of unit scale.
+std::string scale_hint(const ShootingProblem& problem, const Eigen::VectorXd& x);
 
 }  // namespace kirchhoff
