@@ -21,6 +21,7 @@
 #include <cmath>
 #include <type_traits>
 
+#include "kirchhoff/equations/detail/dual.hpp"
 #include "kirchhoff/equations/detail/jacobi_elliptic.hpp"
 #include "kirchhoff/equations/detail/planar_state.hpp"
 
@@ -81,10 +82,36 @@ struct JacobiMemo {
   }
 };
 
+// The functions of v and m on dual numbers of N > 2 directions by the chain rule through two: they
+// depend on the state through v and m alone, so the mean runs on Dual<2> (d/dv, d/dm) and each
+// result's N derivatives are d/dv dv + d/dm dm (the complement's derivative is -dm). The same
+// numbers to round-off at a third of the operations on Dual<4> (Phi, the stability fields).
+template <int N>
+JacobiValues<Dual<N>> jacobi_through_v_and_m(const Dual<N>& v, const Dual<N>& m, const Dual<N>& complement) {
+  Dual<2> v2(v.v), m2(m.v), complement2(complement.v);
+  v2.d[0] = 1.0;
+  m2.d[1] = 1.0;
+  complement2.d[1] = -1.0;
+  const JacobiValues<Dual<2>> j = jacobi_elliptic(v2, m2, complement2);
+  auto chained = [&](const Dual<2>& x) {
+    Dual<N> out(x.v);
+    for (int k = 0; k < N; ++k) out.d[k] = x.d[0] * v.d[k] + x.d[1] * m.d[k];
+    return out;
+  };
+  return {chained(j.sn), chained(j.cn), chained(j.dn), chained(j.epsilon_minus_u_over_m)};
+}
+
+template <class T>
+struct DualDirections : std::integral_constant<int, 0> {};
+template <int N>
+struct DualDirections<Dual<N>> : std::integral_constant<int, N> {};
+
 template <class T>
 JacobiValues<T> jacobi_of_phase(const T& v, const T& m, const T& complement, JacobiMemo* memo) {
   if constexpr (std::is_same_v<T, double>) {
     if (memo) return memo->at(v, m, complement);
+  } else if constexpr (DualDirections<T>::value > 2) {
+    return jacobi_through_v_and_m(v, m, complement);
   }
   return jacobi_elliptic(v, m, complement);
 }
