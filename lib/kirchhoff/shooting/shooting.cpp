@@ -774,7 +774,6 @@ bool singular_at_solution(const ShootingProblem& problem, const Eigen::VectorXd&
   return problem.evaluate(x, &F, &J, &failure) && !(JacobianLU(J).reciprocal_condition() > threshold);
 }
 
-
 // A single segment whose Jacobian is singular to the solver, or whose residual no step lowers,
 // is most often a shooting problem too ill-conditioned for one segment: the fields grow like
 // exp(sqrt(P) L) along a rod in tension (the Euler column in tension at P = 1000: singular at one
