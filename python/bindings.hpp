@@ -50,6 +50,8 @@
 #include "kirchhoff/sweeps/plectoneme_sweep.hpp"
 #include "kirchhoff/sweeps/sweep_run.hpp"
 
+#include "count_argument.hpp"
+
 namespace kirchhoff::python_bindings {
 
 namespace py = pybind11;

@@ -26,7 +26,14 @@ PyCase py_load_case(const std::string& path, const py::object& set, const std::s
 
 namespace {
 
-PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::string& seed, int seed_segments,
+// An optional count given as a Python object (None: the case's own), refusing a bool as Count does.
+int samples_or(const py::object& samples, int fallback) {
+  if (samples.is_none()) return fallback;
+  if (py::isinstance<py::bool_>(samples)) throw py::type_error("samples must be an int, not a bool");
+  return samples.cast<int>();
+}
+
+PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::string& seed, Count seed_segments,
                     double seed_amplitude, double max_seconds, bool direct) {
   Case c = pc.c;
   // Bad arguments are CaseError (a ValueError), as the module's other bad input.
@@ -35,7 +42,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
   } catch (const std::invalid_argument& e) {
     throw CaseError(std::string("max_seconds: ") + e.what());
   }
-  const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
+  const int samples = samples_or(samples_arg, c.samples);
   if (samples < 2 || samples > 100000)  // as a case file's [output] samples
     throw CaseError("samples must be in [2, 100000] (got " + std::to_string(samples) + ")");
   const StartSeed start = start_seed(seed, seed_segments, seed_amplitude);
@@ -112,7 +119,7 @@ PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::
 }
 
 // Vibrations about the case's equilibrium (the CLI's `vibrate`).
-py::dict py_vibrate(const PyCase& pc, int modes, double rho_s, int samples) {
+py::dict py_vibrate(const PyCase& pc, Count modes, double rho_s, Count samples) {
   Case c = pc.c;
   VibrationOptions options;
   options.modes = modes;
@@ -198,9 +205,9 @@ PySolution equilibrium_solution(const Case& c, const Equilibrium& e) {
 }
 
 // The CLI's `equilibria`: distinct equilibria at the case's parameters, by increasing energy.
-py::list py_equilibria(const PyCase& pc, int max, double max_seconds, const py::object& samples_arg) {
+py::list py_equilibria(const PyCase& pc, Count max, double max_seconds, const py::object& samples_arg) {
   const Case& c = pc.c;
-  const int samples = samples_arg.is_none() ? c.samples : samples_arg.cast<int>();
+  const int samples = samples_or(samples_arg, c.samples);
   if (samples < 2 || samples > 100000) throw CaseError("samples must be in [2, 100000]");
   EquilibriaOptions options;
   options.max_equilibria = max;

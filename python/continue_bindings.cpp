@@ -23,11 +23,11 @@ class CollectingSink : public ContinueSink {
 
 // The CLI's `continue` (continue_case: the same statuses and messages), its points in memory.
 PyBranch py_continue(const PyCase& pc, const std::string& parameter, const py::object& to, double step,
-                     double min_step, double max_step, int max_points, const py::object& events,
-                     const py::object& record, int switch_at_bp, double side, int samples, double direction,
-                     bool branch_points, bool stability, bool deflate, int deflate_max, double max_seconds,
+                     double min_step, double max_step, Count max_points, const py::object& events,
+                     const py::object& record, Count switch_at_bp, double side, Count samples, double direction,
+                     bool branch_points, bool stability, bool deflate, Count deflate_max, double max_seconds,
                      const py::object& state, bool resume, const py::object& start_from,
-                     const std::string& start_param, const std::string& seed, int seed_segments,
+                     const std::string& start_param, const std::string& seed, Count seed_segments,
                      double seed_amplitude, double checkpoint) {
   const StartSeed start = start_seed(seed, seed_segments, seed_amplitude);
   if (!(checkpoint >= 0 && checkpoint <= 1e6)) throw CaseError("checkpoint must be in [0, 1e6] seconds");

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "count_argument.hpp"
 #include "kirchhoff/continuation/continuation.hpp"
 
 namespace py = pybind11;
@@ -119,8 +120,9 @@ py::dict branch_dict(const std::vector<ContinuationPoint>& points, const std::ve
 }
 
 py::dict continue_system(py::function F, py::function J, const Eigen::VectorXd& x0, double lambda0, py::object to,
-                         double step, double min_step, double max_step, int max_points, double direction,
-                         bool branch_points, py::object events, int switch_at_bp, double side, double tolerance) {
+                         double step, double min_step, double max_step, python_bindings::Count max_points,
+                         double direction, bool branch_points, py::object events,
+                         python_bindings::Count switch_at_bp, double side, double tolerance) {
   const int n = static_cast<int>(x0.size());
   if (n == 0) throw py::value_error("x0 is empty");
   if (side != 1.0 && side != -1.0) throw py::value_error("side must be 1 or -1");

@@ -421,6 +421,23 @@ class CheckedResultTest(unittest.TestCase):
         self.assertEqual(sol.status, "check_failed")
         self.assertIn("whole turns", sol.message)
 
+    def test_counts_refuse_bools_and_floats(self):
+        # bool is an int in Python: max_points=True used to run one point, samples=True asked
+        # for 1 sample. Counts are ints (numpy's too); a bool or a float is a TypeError.
+        case = kirchhoff.load_case(case_path("simply_supported.toml"))
+        for bad in ({"max_points": True}, {"max_points": 3.5}, {"samples": False}, {"switch_at_bp": True}):
+            with self.assertRaises(TypeError, msg=str(bad)):
+                case.continue_(param="theta0", to=1.2, **bad)
+        with self.assertRaises(TypeError):
+            case.solve(samples=True)
+        with self.assertRaises(TypeError):
+            case.vibrate(modes=True)
+        with self.assertRaises(TypeError):
+            case.equilibria(max=True)
+        branch = case.continue_(param="theta0", to=1.2, max_points=np.int64(5))
+        self.assertEqual(len(branch.points["parameter"]), 5)
+        self.assertEqual(branch.reason, "max_points")
+
     def test_max_seconds_ends_the_solve(self):
         # As the CLI's test: Newton from the guess at theta0 = 1e6 with the flows marched takes
         # ~3.4 s without a limit. (The homotopy there now stops sooner, its step too small near
