@@ -26,11 +26,12 @@ PyCase py_load_case(const std::string& path, const py::object& set, const std::s
 
 namespace {
 
-// An optional count given as a Python object (None: the case's own), refusing a bool as Count does.
+// An optional count given as a Python object (None: the case's own), by Count's rule.
 int samples_or(const py::object& samples, int fallback) {
   if (samples.is_none()) return fallback;
-  if (py::isinstance<py::bool_>(samples)) throw py::type_error("samples must be an int, not a bool");
-  return samples.cast<int>();
+  py::detail::make_caster<Count> count;
+  if (!count.load(samples, true)) throw py::type_error("samples must be an int, not a bool or a float");
+  return py::detail::cast_op<Count>(count);
 }
 
 PySolution py_solve(const PyCase& pc, const py::object& samples_arg, const std::string& seed, Count seed_segments,

@@ -35,4 +35,3 @@ struct type_caster<kirchhoff::python_bindings::Count> {
   }
 };
 }  // namespace pybind11::detail
-

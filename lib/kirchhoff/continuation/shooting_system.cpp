@@ -4,15 +4,6 @@
 #include <stdexcept>
 
 namespace kirchhoff {
-namespace {
-
-// Obstacles or contacts: their events and energy differences follow Newton's last iterates to
-// better than the looser matrices' 1e-9 (RodContinuationOptions::march_sensitivity_tol).
-bool has_contact(const ProblemDefinition& d) {
-  return !d.obstacles.empty() || d.moving_obstacles || !d.contacts.empty();
-}
-
-}  // namespace
 
 ShootingSystem::ShootingSystem(const ShootingProblem& problem, std::string parameter, double march_sensitivity_tol)
     : problem_(problem), parameter_(std::move(parameter)) {
@@ -23,7 +14,9 @@ ShootingSystem::ShootingSystem(const ShootingProblem& problem, std::string param
     if (u == parameter_)
       throw std::invalid_argument("'" + parameter_ + "' is solved for (an unknown); continue in another parameter");
   const double own = std::max(d.options.integrator.sensitivity_tol, d.options.integrator.abs_tol);
-  if (!has_contact(d) && march_sensitivity_tol > own) {
+  // (Not with obstacles or contacts: their events and energy differences follow Newton's last
+  // iterates to better than the looser matrices' 1e-9, RodContinuationOptions::march_sensitivity_tol.)
+  if (problem_.without_obstacles() && march_sensitivity_tol > own) {
     ProblemDefinition loose = d;
     loose.options.integrator.sensitivity_tol = march_sensitivity_tol;
     march_problem_.emplace(std::move(loose));

@@ -61,9 +61,7 @@ RodContinuationOptions path_options(const ShootingProblem& problem, const std::s
   // the corrector's convergence allows. Not with obstacles: their paths change contact sets
   // along the way, and longer steps there reached other equilibria (the indenter at rise 0.3663
   // ended where Newton could not polish it; the cavity reached an equilibrium of index 2).
-  const ProblemDefinition& d = problem.definition();
-  if (d.obstacles.empty() && !d.moving_obstacles && d.contacts.empty())
-    o.max_step_reference_size = std::max(1.0, x_start.norm());
+  if (problem.without_obstacles()) o.max_step_reference_size = std::max(1.0, x_start.norm());
   o.target = 1.0;
   o.max_points = options.max_points;
   o.deadline = options.deadline;

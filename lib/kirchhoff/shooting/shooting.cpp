@@ -57,8 +57,7 @@ ShootingProblem::ShootingProblem(ProblemDefinition definition) : definition_(std
   // buckles into a hanging fold, the fold's direction is a combination of two null vectors
   // (contact.cpp, fold_direction), and with the closed form's flows `continue cavity.toml` took
   // another branch than the one docs/contact.md gives.
-  if (!definition_.obstacles.empty() || definition_.moving_obstacles || !definition_.contacts.empty())
-    definition_.options.integrator.closed_form = false;
+  if (!without_obstacles()) definition_.options.integrator.closed_form = false;
   adopt_dependent_parameters();
   const auto eq = equations(definition_.parameters);
   state_size_ = eq->state_size();

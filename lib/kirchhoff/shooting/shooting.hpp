@@ -218,11 +218,12 @@ class ShootingProblem final : public NonlinearSystem {
   // Residual, Jacobian and the state at s = L in one integration.
   bool evaluate_with_end(const Eigen::VectorXd& x, Eigen::VectorXd* F, Eigen::MatrixXd* J, Eigen::VectorXd* y_end,
                          std::string* failure) const;
+  // No obstacle (fixed or moving) and no contact: where Newton's step and coarse evaluations are
+  // offered (an active-set decision or an event follows every iterate, which they leave as they
+  // were), where flows may be closed form, and where a homotopy's steps may grow.
+  bool without_obstacles() const;
 
  private:
-  // No obstacle and no contact: where Newton's step and coarse evaluations are offered (an
-  // active-set decision or an event follows every iterate, which they leave as they were).
-  bool without_obstacles() const;
   // `integrator`: the options of the flows without contacts (null: the definition's).
   bool residual(const Eigen::VectorXd& x, const Parameters& p, Eigen::VectorXd* F, Eigen::MatrixXd* J,
                 std::string* failure, Eigen::VectorXd* y_end = nullptr,

@@ -68,10 +68,12 @@ struct JacobiMemo {
   JacobiValues<double> values;
   int evaluations = 0;  // of jacobi_elliptic (the tests count them)
 
+  static constexpr double kSamePhase = 2e-15;  // of v
+  static constexpr double kSameOrbit = 1e-12;  // of 1 - m
+
   const JacobiValues<double>& at(double v_now, double m_now, double complement) {
-    const double tolerance = 1e-12;
-    if (!filled || !(std::abs(v_now - v) <= 2e-15 * std::abs(v)) ||
-        !(std::abs(m_now - m) <= tolerance * complement)) {
+    if (!filled || !(std::abs(v_now - v) <= kSamePhase * std::abs(v)) ||
+        !(std::abs(m_now - m) <= kSameOrbit * complement)) {
       values = jacobi_elliptic(v_now, m_now, complement);
       v = v_now;
       m = m_now;
