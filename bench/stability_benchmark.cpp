@@ -158,22 +158,36 @@ int measure_branch(const std::string& name, int runs) {
   std::printf("branch %s: %d points; CPU time, median of %d alternating runs: %.3f s with the index, %.3f s "
               "without (+%.0f %%)\n",
               name.c_str(), points, runs, median(with), median(without), 100 * (median(with) / median(without) - 1));
-  // The index of each point alone: with the continuation's options (point_record.cpp), and with
-  // its fields at the state's tolerance.
+  // The index of each point alone: with the continuation's options (point_record.cpp), with the
+  // estimate's step control where the phase speed's bound would serve (the baseline of
+  // StabilityOptions::bounded_observations), and with the fields at the state's tolerance.
   const double points_kept = static_cast<double>(std::max<size_t>(1, keep.points.size()));
-  for (const double field_tolerance : {RodRecordOptions{}.stability_field_tolerance, 0.0}) {
+  struct Variant {
+    double field_tolerance;
+    bool bounded;
+    const char* label;
+  };
+  const Variant variants[] = {
+      {RodRecordOptions{}.stability_field_tolerance, true, "fields at 1e-8 (as continuation)"},
+      {RodRecordOptions{}.stability_field_tolerance, false, "fields at 1e-8, no phase-speed bound"},
+      {0.0, true, "fields at the state's tolerance"}};
+  for (const Variant& v : variants) {
     StabilityOptions options;
     options.extended_contacts = false;
-    options.field_tolerance = field_tolerance;
-    long rhs = 0;
+    options.field_tolerance = v.field_tolerance;
+    options.bounded_observations = v.bounded;
+    long rhs = 0, flows = 0;
     const double t0 = process_cpu_seconds();
-    for (const auto& [problem, x] : keep.points) rhs += analyse_stability(problem, x, options).rhs_evaluations;
+    for (const auto& [problem, x] : keep.points) {
+      const StabilityReport report = analyse_stability(problem, x, options);
+      rhs += report.rhs_evaluations;
+      flows += report.field_flows;
+    }
     const double index = process_cpu_seconds() - t0;
-    std::printf("  the index of each of its %zu points alone, fields at %s: %.3f s (%.0f us and %.0f rhs per "
-                "point) against %.3f s for the branch without it (+%.0f %%)\n",
-                keep.points.size(), field_tolerance > 0 ? "1e-8 (as continuation)" : "the state's tolerance",
-                index, 1e6 * index / points_kept, static_cast<double>(rhs) / points_kept, branch,
-                100 * index / branch);
+    std::printf("  the index of each of its %zu points alone, %s: %.3f s (%.0f us, %.0f rhs and %.1f field "
+                "flows per point) against %.3f s for the branch without it (+%.0f %%)\n",
+                keep.points.size(), v.label, index, 1e6 * index / points_kept, static_cast<double>(rhs) / points_kept,
+                static_cast<double>(flows) / points_kept, branch, 100 * index / branch);
   }
   return 0;
 }

@@ -407,6 +407,67 @@ TEST(Stability, InterpolatedObservationsCountAsExactOnes) {
   EXPECT_GT(saved_on_the_twisted_rod, 0);
 }
 
+// Observation steps spaced by the proved bound on the eigenphase's speed (StabilityOptions::
+// bounded_observations: planar rods under a constant force) must count exactly as those the
+// estimate's step control takes: on every shipped case, at both tolerances, and on columns whose
+// phase turns fast (P = 1000: 10 conjugate points) with a stiffness, length, natural curvature and
+// natural strains (|v_hat| = 1.43 enters the bound) away from 1, where a bound too small would let
+// turns pass unseen and lose conjugate points. The conjugate points within 1e-5 (each is located to
+// ~1e-7 L). And the bound must be taken somewhere, or this would compare a path with itself: fewer
+// integrations of the fields on the Euler column.
+TEST(Stability, BoundedObservationsCountAsEstimatedOnes) {
+  auto equilibria = solved_equilibria(true);
+  const std::string natural = R"(
+model = "planar"
+[parameters]
+P = 300.0
+[rod]
+length = 2.5
+B = 0.3
+u_hat = [0, 0.4, 0]
+v_hat = [0.5, 0, 1.34]
+[start]
+type = "pinned"
+position = [0, 0]
+[end]
+type = "sliding"
+axis = [1, 0, 0]
+position = [0, 0]
+force = ["-P", 0]
+[guess]
+orientation = { axis = [0, 0, 1], angle = 0.2 }
+force = ["-P", 0]
+)";
+  for (const double P : {3.0, 40.0, 300.0}) {
+    const Case c = load_case_text(natural, "natural.toml", {{"P", P}});
+    DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
+    ASSERT_TRUE(solved.result.summary.converged()) << "P = " << P;
+    equilibria.emplace_back("natural strains, P = " + std::to_string(P), std::move(solved));
+  }
+  for (const double P : {1000.0, 200.0}) {
+    const Case c = load_case(testing::case_path("euler_column.toml"), {{"P", P}, {"theta_guess", P > 500 ? 0.0 : 2.5}});
+    DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
+    ASSERT_TRUE(solved.result.summary.converged()) << "P = " << P;
+    equilibria.emplace_back("euler_column.toml, P = " + std::to_string(P), std::move(solved));
+  }
+  long saved_on_the_column = 0;
+  for (const double tolerance : {0.0, 1e-8}) {
+    for (const auto& [name, solved] : equilibria) {
+      SCOPED_TRACE(name + " at field tolerance " + std::to_string(tolerance));
+      StabilityOptions bounded, estimated;
+      bounded.field_tolerance = estimated.field_tolerance = tolerance;
+      estimated.bounded_observations = false;
+      const Eigen::VectorXd& x = solved.result.x;
+      const StabilityReport a = analyse_stability(*solved.problem, x, bounded);
+      const StabilityReport b = analyse_stability(*solved.problem, x, estimated);
+      EXPECT_EQ(a.reason, b.reason);
+      expect_same_count(a, b);
+      if (name.rfind("euler_column.toml", 0) == 0) saved_on_the_column += b.field_flows - a.field_flows;
+    }
+  }
+  EXPECT_GT(saved_on_the_column, 0);
+}
+
 // A pinned column on a stiff Winkler foundation k = 1e6 (a soft wall b / (a - y) balanced by a
 // uniform weight b / a^2 towards it; k = 2 b / a^3): its sine modes diagonalise the second
 // variation, mode j critical at P_j = (j pi)^2 + k / (j pi)^2, so the index at P is the number of

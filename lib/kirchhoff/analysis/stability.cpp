@@ -29,6 +29,10 @@ constexpr double kPassageMargin = 0.03;  // rad
 // Observation steps aim at eigenphase moves of this fraction of max_phase_step (observation_step
 // and the interpolant's sub-steps): beyond max_phase_step a step is halved.
 constexpr double kAimedPhaseMove = 0.7;
+// Where the eigenphase's speed is bounded (StabilityOptions::bounded_observations) it moves at
+// most this much over an observation step: below pi, so that the move read from the step's ends
+// is the move itself (no turn unseen, no passage paired wrongly), with 0.64 rad to spare.
+constexpr double kBoundedPhaseMove = 2.5;
 // A load-controlled mode is an exact zero mode of the isoperimetric correction where its share of
 // D is this many times the rest (its sign then decides, as the exact count assumes), or where its
 // singular value is below this fraction of the largest (round-off: the decomposition drops it).
@@ -150,8 +154,14 @@ CanonicalMap canonical_map(const RodEquations& eq, const Coordinates& c, const S
 }
 
 // Orthonormal basis of the column space of A (columns below `tol` times the largest dropped).
+// (One column: its singular value is its norm, and it is its own direction - a planar frame's
+// blocks, most of a planar index's bases, without the decomposition.)
 Eigen::MatrixXd column_basis(const Eigen::MatrixXd& A, double tol = 1e-10) {
   if (A.cols() == 0 || A.rows() == 0) return Eigen::MatrixXd(A.rows(), 0);
+  if (A.cols() == 1) {
+    const double norm = A.norm();
+    return norm > tol ? Eigen::MatrixXd(A / norm) : Eigen::MatrixXd(A.rows(), 0);
+  }
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU);
   int rank = 0;
   for (int i = 0; i < svd.singularValues().size(); ++i)
@@ -170,6 +180,7 @@ Eigen::MatrixXd complement(const Eigen::MatrixXd& C, int n) {
 // Orthonormal basis of the null space of A (singular values below tol), as columns.
 Eigen::MatrixXd null_space(const Eigen::MatrixXd& A, int cols, double tol) {
   if (A.rows() == 0) return Eigen::MatrixXd::Identity(cols, cols);
+  if (cols == 1) return A.norm() > tol ? Eigen::MatrixXd(1, 0) : Eigen::MatrixXd::Identity(1, 1);
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
   int rank = 0;
   for (int i = 0; i < svd.singularValues().size(); ++i)
@@ -422,6 +433,8 @@ class StabilityAnalysis {
   void flowed(const Frame& f, double s1, CarriedSteps* steps, bool frame_only, Frame* next);
   void march(Frame* f, double end, double longest, double observed, PhaseTrack* track);
   void march_observed(Frame* f, double end, double longest, PhaseTrack* track);
+  std::optional<double> phase_speed_bound(const std::vector<PointContact>& contacts) const;
+  void march_bounded(Frame* f, double end, PhaseTrack* track);
   bool interpolated_step(Frame* f, double s1, double observed, PhaseTrack* track);
   bool near_passage(const Eigen::VectorXd& from, const Eigen::VectorXd& to) const;
   // A passage of an eigenphase past an odd multiple of pi seen between two observations on an
@@ -474,6 +487,9 @@ class StabilityAnalysis {
   std::vector<RodPoint> profile_;
   std::optional<double> moment_bound_;
   long rhs_ = 0;
+  long flows_ = 0;  // integrations of the fields (flowed)
+  // The bound on the eigenphase's speed where one is proved (phase_speed_bound), else empty.
+  std::optional<double> phase_speed_bound_;
   IntegratorOptions field_integrator_;  // the state's, or looser (StabilityOptions::field_tolerance)
   bool reversed_ = false;
   CarriedSteps steps_;  // the step sizes the fields' integration proposes next (flowed)
@@ -794,6 +810,7 @@ void StabilityAnalysis::flowed(const Frame& f, double s1, CarriedSteps* steps, b
   DirectionalFlow flow =
       eq_->flow_directions(f.y, directions_, f.s, s1, field_integrator_, steps);
   rhs_ += flow.rhs_evaluations;
+  ++flows_;
   next->y.swap(flow.y);
   next->s = s1;
   next->slope_at = std::numeric_limits<double>::quiet_NaN();
@@ -840,6 +857,34 @@ void StabilityAnalysis::march_observed(Frame* f, double end, double longest, Pha
     if (steps_.directions > 0) h = std::min(h, steps_.directions);
     advance(f, step_end(f->s, end, h), track, 0);
   }
+}
+
+// The bound on the eigenphase's speed (per unit arclength) where it is proved, else empty: a
+// planar rod (one eigenphase: the frame holds the rotation alone) whose force is the same all
+// along it - uniform, inextensible, no field, no contact, so that n is its value at s = 0. With
+// u the rotation's perturbation and p = dm L / (B_s rate) (Scales; B_s = scales_.bending),
+//   u' = dm / B = (B_s rate / (L B)) p,   p' = -c (L / (B_s rate)) u,
+// where c = dm'/dtheta = -(n x dr'/dtheta).e_z, |c| <= |n| |v_hat| (r' = R v_hat). So u + ip turns
+// at most at the larger coefficient, and W = (u + ip) / (u - ip) at twice that.
+std::optional<double> StabilityAnalysis::phase_speed_bound(const std::vector<PointContact>& contacts) const {
+  const RodModel& model = eq_->model();
+  if (!options_.bounded_observations || !eq_->is_planar() || full_ || mU_ != 1 || !contacts.empty() || barrier_eq_ ||
+      model.field || model.extensible || !model.is_uniform() || profile_.empty())
+    return std::nullopt;
+  const double B = model.B[1](0.0), L = scales_.length, Bs = scales_.bending, rate = scales_.rate;
+  const double v_hat = std::hypot(model.v_hat[0](0.0), model.v_hat[2](0.0));
+  const double c = profile_.front().n.norm() * v_hat;
+  return 2.0 * std::max(Bs * rate / (L * B), c * L / (Bs * rate));
+}
+
+// Marches the frame to `end` in equal observation steps over which the eigenphase moves at most
+// kBoundedPhaseMove (phase_speed_bound): each observed on an exact frame, the passages located on
+// exact frames too (record).
+void StabilityAnalysis::march_bounded(Frame* f, double end, PhaseTrack* track) {
+  const double sliver = 1e-12 * scales_.length;
+  const double h = kBoundedPhaseMove / (*phase_speed_bound_ * options_.observation_density);
+  if (!(steps_.directions > 0)) steps_.directions = h;
+  while (end - f->s > sliver) advance(f, step_end(f->s, end, h), track, 0);
 }
 
 // Whether an eigenphase moving from `from` to `to` (lifted) passes an odd multiple of pi or
@@ -996,13 +1041,24 @@ double StabilityAnalysis::observation_step(double longest) const {
   return std::clamp(grown, 0.25 * longest, 2.0 * longest);
 }
 
+// det A, written out up to 3 x 3 (the rotation blocks of planar and spatial rods), where the
+// dynamic-size LU would allocate at every observation.
+double small_determinant(const Eigen::MatrixXd& A) {
+  switch (A.rows()) {
+    case 1: return A(0, 0);
+    case 2: return A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
+    case 3: return A.topLeftCorner<3, 3>().determinant();
+    default: return A.determinant();
+  }
+}
+
 // Whether det U changed sign from frame `from` to `to`, the fields carried from it (to's U before
 // it is orthonormalised: the columns are then the same fields, continuous in s in between).
 // U(s) is singular exactly at conjugate points, so its determinant changes sign an odd number of
 // times where an odd number of eigenphases pass odd multiples of pi, counted with multiplicity.
 bool StabilityAnalysis::determinant_flipped(const Frame& from, const Frame& to) {
   if (from.U.size() == 0) return false;
-  return (from.U.determinant() < 0) != (to.U.determinant() < 0);
+  return (small_determinant(from.U) < 0) != (small_determinant(to.U) < 0);
 }
 
 // Whether the passages of the lifted eigenphases from `from` to `to` contradict the parity of det
@@ -1567,7 +1623,8 @@ std::string StabilityAnalysis::carry_across(Frame* f, const std::vector<PointCon
     for (double h = 0.25 * scales_.length / (1.0 + shear); shear > 0 && h < observed; h *= 2)
       advance(f, breaks[i] + h, track, 0);
     shear = 0.0;
-    march(f, breaks[i + 1], longest, observed, track);
+    if (phase_speed_bound_) march_bounded(f, breaks[i + 1], track);
+    else march(f, breaks[i + 1], longest, observed, track);
     for (size_t c = 0; c < contacts.size(); ++c) {
       if (std::abs(contacts[c].s - breaks[i + 1]) > 1e-12 * scales_.length) continue;
       if (std::string why = pass_contact(f, contacts[c], static_cast<int>(c), track, &shear); !why.empty()) return why;
@@ -1639,6 +1696,9 @@ StabilityReport StabilityAnalysis::run() {
   const std::vector<PointContact> contacts = problem_.contacts_at(x_);
   scales_.rate = field_rate();
   if (full_) scales_.force_rate = scales_.rate;
+  phase_speed_bound_ = phase_speed_bound(contacts);
+  // (advance halves a step whose move passes this: never, where the bound holds, but for round-off)
+  if (phase_speed_bound_) max_phase_step_ = std::max(max_phase_step_, 1.01 * kBoundedPhaseMove);
 
   Frame f = start_frame(start, start_multipliers, static_cast<int>(contacts.size()),
                         full_ ? static_cast<int>(end.position.cols()) : 0);
@@ -1656,6 +1716,7 @@ StabilityReport StabilityAnalysis::run() {
     return report;
   }
   report.rhs_evaluations = rhs_;
+  report.field_flows = flows_;
   reversed_ = track.reversed || track.unresolved;
   count_at_end(f, track, start_phases, start, scales_.stiffness_min > 0 ? held_at(end_, multipliers, f.y, f.s) : end,
                constraints, &report);
@@ -1675,6 +1736,7 @@ StabilityReport whole_rod(const StabilityReport& symmetric, const StabilityRepor
       out.reason = std::string(part == &symmetric ? "symmetric" : "antisymmetric") +
                    " perturbations of the half-turn symmetric rod: " + part->reason;
       out.rhs_evaluations = symmetric.rhs_evaluations + antisymmetric.rhs_evaluations;
+      out.field_flows = symmetric.field_flows + antisymmetric.field_flows;
       return out;
     }
   StabilityReport out;
@@ -1692,16 +1754,19 @@ StabilityReport whole_rod(const StabilityReport& symmetric, const StabilityRepor
   out.constraint_count = symmetric.constraint_count + antisymmetric.constraint_count;
   out.constraint_correction = symmetric.constraint_correction + antisymmetric.constraint_correction;
   out.rhs_evaluations = symmetric.rhs_evaluations + antisymmetric.rhs_evaluations;
+  out.field_flows = symmetric.field_flows + antisymmetric.field_flows;
   return out;
 }
 
 // Where the sliding contact partners are not defined (stability_symmetric.hpp), the whole rod's
 // index is not; the symmetric half's is given.
-StabilityReport sliding_undefined(const std::string& reason, const StabilityReport& symmetric, long rhs_evaluations) {
+StabilityReport sliding_undefined(const std::string& reason, const StabilityReport& symmetric,
+                                  const StabilityReport& antisymmetric) {
   StabilityReport out;
   out.reason = reason + "; the symmetric perturbations' index is given";
   out.symmetric_index = symmetric.index;
-  out.rhs_evaluations = symmetric.rhs_evaluations + rhs_evaluations;
+  out.rhs_evaluations = symmetric.rhs_evaluations + antisymmetric.rhs_evaluations;
+  out.field_flows = symmetric.field_flows + antisymmetric.field_flows;
   return out;
 }
 
@@ -1733,7 +1798,7 @@ bool same_count(const StabilityReport& a, const StabilityReport& b) {
 template <class Run>
 StabilityReport run_resolved(const StabilityOptions& options, bool confirm, const Run& run) {
   StabilityOptions o = options;
-  long rhs_before = 0;
+  long rhs_before = 0, flows_before = 0;
   std::vector<StabilityReport> counted;  // the runs without a reversal, in the order made
   StabilityReport last;
   for (int refinement = 0; refinement <= kRefinements; ++refinement) {
@@ -1741,6 +1806,8 @@ StabilityReport run_resolved(const StabilityOptions& options, bool confirm, cons
     last = run(o, &reversed);
     last.rhs_evaluations += rhs_before;
     rhs_before = last.rhs_evaluations;
+    last.field_flows += flows_before;
+    flows_before = last.field_flows;
     if (!reversed) {
       if (!confirm || (!counted.empty() && same_count(counted.back(), last))) return last;
       counted.push_back(last);
@@ -1750,6 +1817,7 @@ StabilityReport run_resolved(const StabilityOptions& options, bool confirm, cons
   if (counted.empty()) return last;  // a reversal at every density: the index is undefined
   StabilityReport out = counted.back();
   out.rhs_evaluations = rhs_before;
+  out.field_flows = flows_before;
   if (counted.size() == 1) return out;
   std::ostringstream why;
   why << "the count is not settled by denser observations of the Jacobi fields (index";
@@ -1829,7 +1897,7 @@ StabilityReport analyse_at_field_tolerance(const ShootingProblem& problem, const
       return report;
     };
     const StabilityReport antisymmetric = run_resolved(options, confirm, run_antisymmetric);
-    if (!sliding.empty()) return sliding_undefined(sliding, symmetric, antisymmetric.rhs_evaluations);
+    if (!sliding.empty()) return sliding_undefined(sliding, symmetric, antisymmetric);
     return whole_rod(symmetric, antisymmetric);
   } catch (const IntegrationError& e) {
     StabilityReport report;
@@ -1856,6 +1924,7 @@ StabilityReport analyse_stability(const ShootingProblem& problem, const Eigen::V
   exact.field_tolerance = 0.0;
   StabilityReport again = analyse_at_field_tolerance(problem, x, exact);
   again.rhs_evaluations += report.rhs_evaluations;
+  again.field_flows += report.field_flows;
   return again;
 }
 

@@ -97,6 +97,13 @@ struct StabilityOptions {
   // exact observations near a conjugate point: fewer integration steps, the same count. false:
   // every observation on an exact integration (tests compare the two).
   bool interpolated_observations = true;
+  // Where the eigenphase's speed has a proved bound - a planar rod whose force is constant along
+  // it (uniform, inextensible, no field, no contact: the Elastica) has one eigenphase, turning at
+  // most at 2 max(rate, |n| |v_hat| L^2 / (B rate)) / L in the canonical scales - the
+  // observations are spaced by that bound alone, the phase moving at most 2.5 rad (< pi) over
+  // each, so that no turn can pass unseen: a quarter of the observations the step control above
+  // takes there. false: that step control everywhere (tests compare the two).
+  bool bounded_observations = true;
   // Observations this many times denser than min_steps and max_phase_step say, on integration
   // steps as long as at 1 where they are observed on the interpolant: how a count in a field
   // that stiffens the perturbations is confirmed (analyse_stability runs it again so).
@@ -150,6 +157,9 @@ struct StabilityReport {
   std::optional<int> fixed_length_index;
   std::optional<double> reduced_energy_curvature;
   long rhs_evaluations = 0;
+  // Integrations of the Jacobi fields (observation steps, trial steps locating conjugate points):
+  // what an index costs in the fields' own count, whatever the machine.
+  long field_flows = 0;
   // No index, but unstable all the same (reason says why): a part lying on an obstacle with zero
   // contact force lifts off with lower energy, where the lowering perturbations form a cone, not
   // a space (detail/stability_extended_contact.hpp).

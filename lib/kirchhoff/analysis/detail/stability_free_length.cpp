@@ -158,6 +158,7 @@ FreeLengthStability undefined(FreeLengthStability out, const std::string& reason
   out.report.method = kMethod;
   out.report.reason = reason;
   out.report.rhs_evaluations = out.fixed_length.rhs_evaluations;
+  out.report.field_flows = out.fixed_length.field_flows;
   return out;
 }
 
