@@ -1086,6 +1086,31 @@ class EquilibriaTest(unittest.TestCase):
         self.assertAlmostEqual(energies[0], energies[1], delta=1e-8 * energies[0])
         self.assertNotAlmostEqual(eqs[0].profile["y"][100], eqs[1].profile["y"][100], places=3)
 
+    def test_a_rod_lying_flat_on_the_wall_is_listed(self):
+        # A pinned-pinned rod held at 0.7 under a wall at y = 0.2 (tests/discrete_seed_test.cpp):
+        # the mirror-symmetric Ipopt seed brings it lying flat on the wall, energy 11.620963 (the
+        # discretised energy's at 100, 200 and 400 segments, extrapolated: 1e-5 leaves ten times
+        # its error), index 1 by the discretised energy, its profile at the wall's height between
+        # the flat contacts' outer ends (to the solve's 1e-10).
+        with tempfile.TemporaryDirectory() as d:
+            path = pathlib.Path(d) / "pinned_wall.toml"
+            path.write_text('model = "planar"\n[parameters]\nD = 0.7\n[rod]\nlength = 1.0\nB = 1.0\n'
+                            '[start]\ntype = "pinned"\nposition = [0, 0]\n[end]\ntype = "pinned"\n'
+                            'position = ["D", 0]\n[guess]\norientation = { axis = [0, 0, 1], angle = 1.2 }\n'
+                            'force = [-15, 0]\n[[obstacles]]\ntype = "plane"\nname = "wall"\npoint = [0, 0.2]\n'
+                            'normal = [0, -1, 0]\n')
+            eqs = kirchhoff.load_case(str(path)).equilibria(max=4)
+        flat = [e for e in eqs if any(c["extended"] for c in e.contacts)]
+        self.assertEqual(len(flat), 1)
+        self.assertAlmostEqual(flat[0].energy, 11.620963, delta=1e-5)
+        self.assertEqual(flat[0].stability["index"], 1)
+        first = min(c["s"] for c in flat[0].contacts)
+        last = max(c["s_end"] for c in flat[0].contacts)
+        on_wall = [y for s, y in zip(flat[0].profile["s"], flat[0].profile["y"]) if first <= s <= last]
+        self.assertGreater(len(on_wall), 10)
+        for y in on_wall:
+            self.assertAlmostEqual(y, 0.2, delta=1e-10)
+
     def test_points_of_a_continuous_family_share_its_number(self):
         # A rod pinned at both ends at one point: every closed Elastica is a circle of equilibria
         # (turned about the pin), of which the search finds several points (the CLI's JSON

@@ -82,6 +82,26 @@ DiscreteClampedElastica discrete_rod(const ProblemDefinition& d, const ShootingP
   return rod;
 }
 
+// The stationarity a mirror-symmetric seed needs: it only starts Newton, whose solution is checked
+// on its own. Held symmetric, the discrete rod's vertical force is carried by rows made redundant
+// by the symmetry, whose multipliers Ipopt leaves undetermined; the check recovers the force from
+// them by least squares (vertical_force_from_symmetry), which leaves the stationarity at 1e-5 ..
+// 1e-4 where the minimiser itself is right: 3.5e-5 on clamped_clamped.toml, and on the
+// pinned-pinned rod lying flat under a wall (discrete_seed_test.cpp) 1.5e-5, 2.5e-4 and 4.7e-8 at
+// 100, 200 and 400 segments, its energies converging at second order to the shooting solution's
+// all the same. 1e-3 takes such a minimiser as a seed; its constraints (ends, penetration, pulling
+// forces, complementarity) must still hold to the check's tolerance.
+constexpr double kSymmetricSeedStationarity = 1e-3;
+
+bool usable_as_seed(const DiscreteElasticaResult& r, bool mirror_symmetric) {
+  if (r.converged) return true;
+  if (!mirror_symmetric) return false;
+  const DiscreteKktCheck& k = r.kkt;
+  return r.ipopt_status == "success" && k.stationarity <= kSymmetricSeedStationarity &&
+         k.end_error <= kDiscreteKktTolerance && k.penetration <= kDiscreteKktTolerance &&
+         k.negative_force <= kDiscreteKktTolerance && k.complementarity <= kDiscreteKktTolerance;
+}
+
 // The contacts of one obstacle from the nodes' forces and gaps (see the header).
 void read_contacts(const std::vector<double>& force, const std::vector<double>& gap, int obstacle, bool flat,
                    double h, double L, double force_scale, std::vector<PointContact>* out) {
@@ -130,11 +150,12 @@ DiscreteSeed seed_from_discrete_energy(const ProblemDefinition& d, int segments,
   const DiscreteClampedElastica rod = discrete_rod(d, problem);
   DiscreteSeed seed;
   seed.discrete = solve_discrete_elastica(rod, segments, options);
-  // converged: Ipopt succeeded and its solution passed the library's own KKT check (stationarity,
-  // end constraints, no penetration, no pulling force, complementarity); anything else is refused
-  // rather than read off. (The seed needs no refinement check: the shooting solve that starts from
+  // Ipopt succeeded and its solution passed the library's own KKT check (stationarity, end
+  // constraints, no penetration, no pulling force, complementarity), a mirror-symmetric one's
+  // stationarity to a seed's accuracy (usable_as_seed); anything else is refused rather than read
+  // off. (The seed needs no refinement check: the shooting solve that starts from
   // it is checked by its own residual and complementarity.)
-  if (!seed.discrete.converged)
+  if (!usable_as_seed(seed.discrete, options.mirror_symmetric))
     throw std::runtime_error("the Ipopt seed did not converge (" + seed.discrete.status + ")");
   const double h = rod.L / segments;
   // Forces: the end reaction, or the Euler load's scale EI / L^2 when that is smaller.
@@ -153,7 +174,8 @@ DiscreteSeed seed_from_discrete_energy(const ProblemDefinition& d, int segments,
   seed.start.m = Vec3(0.0, 0.0, seed.discrete.m_start);
   std::ostringstream summary;
   summary << "Ipopt on " << segments << " segments (" << seed.discrete.iterations << " iterations, energy "
-          << seed.discrete.energy << ", KKT checked: stationarity " << seed.discrete.kkt.stationarity
+          << seed.discrete.energy << ", KKT checked" << (seed.discrete.converged ? "" : " to a seed's accuracy")
+          << ": stationarity " << seed.discrete.kkt.stationarity
           << ", complementarity " << seed.discrete.kkt.complementarity << "): " << seed.contacts.size() << " contact(s)";
   for (const auto& c : seed.contacts) {
     summary << (&c == &seed.contacts.front() ? ": " : ", ");

@@ -453,6 +453,13 @@ class Search {
             continue;
           }
           Family& f = family(r.definition.contacts);
+          // A seed that lands on a root deflated already (the minimiser held symmetric reaching
+          // the free one's symmetric rod) leaves the search as it was: deflated twice, the root's
+          // factor squared would steer the deflated runs after it differently, for nothing.
+          if (f.deflation.nearest_root_distance(r.result.x) <= deflated_.known_root_distance) {
+            out_.log.push_back(label + ": again a root found before");
+            continue;
+          }
           consider(f, r.result.x, label);
         } catch (const std::invalid_argument& e) {
           out_.log.push_back(std::string("Ipopt seeds not used: ") + e.what());
