@@ -377,6 +377,31 @@ TEST(Stability, ClosedFormFlowsCountAsMarchedOnes) {
   EXPECT_GT(saved, 0);
 }
 
+// Every equilibrium's index with default options and with `baseline` changing them, at the state's
+// tolerance (solve) and at a branch's (1e-8): the same reason, count and conjugate points
+// (expect_same_count). `saved(name, tolerance, default_report, baseline_report)` adds up what the
+// default saves where the caller looks for it; its sum is returned.
+template <class Baseline, class Saved>
+long compare_with_baseline(const std::vector<std::pair<std::string, DefinitionSolve>>& equilibria,
+                           const Baseline& baseline, const Saved& saved) {
+  long total = 0;
+  for (const double tolerance : {0.0, 1e-8}) {
+    for (const auto& [name, solved] : equilibria) {
+      SCOPED_TRACE(name + " at field tolerance " + std::to_string(tolerance));
+      StabilityOptions defaults, other;
+      defaults.field_tolerance = other.field_tolerance = tolerance;
+      baseline(&other);
+      const Eigen::VectorXd& x = solved.result.x;
+      const StabilityReport a = analyse_stability(*solved.problem, x, defaults);
+      const StabilityReport b = analyse_stability(*solved.problem, x, other);
+      EXPECT_EQ(a.reason, b.reason);
+      expect_same_count(a, b);
+      total += saved(name, tolerance, a, b);
+    }
+  }
+  return total;
+}
+
 // Observing the eigenphases on the integration's interpolant (StabilityOptions::
 // interpolated_observations) must count exactly as observing every one on an exact integration:
 // on every shipped case and on equilibria whose phases turn fast or pass several conjugate points,
@@ -387,23 +412,12 @@ TEST(Stability, ClosedFormFlowsCountAsMarchedOnes) {
 TEST(Stability, InterpolatedObservationsCountAsExactOnes) {
   const auto equilibria = solved_equilibria(true);
   ASSERT_GT(equilibria.size(), 20u);
-  long saved_on_the_twisted_rod = 0;
-  for (const double tolerance : {0.0, 1e-8}) {
-    for (const auto& [name, solved] : equilibria) {
-      SCOPED_TRACE(name + " at field tolerance " + std::to_string(tolerance));
-      StabilityOptions interpolated, exact;
-      interpolated.field_tolerance = exact.field_tolerance = tolerance;
-      exact.interpolated_observations = false;
-      const Eigen::VectorXd& x = solved.result.x;
-      const StabilityReport a = analyse_stability(*solved.problem, x, interpolated);
-      const StabilityReport b = analyse_stability(*solved.problem, x, exact);
-      EXPECT_EQ(a.reason, b.reason);
-      expect_same_count(a, b);
-      if (!a.defined()) continue;
-      if (name == "twisted_clamped.toml" && *a.index == 2 && tolerance > 0)
-        saved_on_the_twisted_rod = b.rhs_evaluations - a.rhs_evaluations;
-    }
-  }
+  const long saved_on_the_twisted_rod = compare_with_baseline(
+      equilibria, [](StabilityOptions* exact) { exact->interpolated_observations = false; },
+      [](const std::string& name, double tolerance, const StabilityReport& a, const StabilityReport& b) {
+        const bool straight_twisted = name == "twisted_clamped.toml" && a.defined() && *a.index == 2;
+        return straight_twisted && tolerance > 0 ? b.rhs_evaluations - a.rhs_evaluations : 0L;
+      });
   EXPECT_GT(saved_on_the_twisted_rod, 0);
 }
 
@@ -417,29 +431,12 @@ TEST(Stability, InterpolatedObservationsCountAsExactOnes) {
 // integrations of the fields on the Euler column.
 TEST(Stability, BoundedObservationsCountAsEstimatedOnes) {
   auto equilibria = solved_equilibria(true);
-  const std::string natural = R"(
-model = "planar"
-[parameters]
-P = 300.0
-[rod]
-length = 2.5
-B = 0.3
-u_hat = [0, 0.4, 0]
-v_hat = [0.5, 0, 1.34]
-[start]
-type = "pinned"
-position = [0, 0]
-[end]
-type = "sliding"
-axis = [1, 0, 0]
-position = [0, 0]
-force = ["-P", 0]
-[guess]
-orientation = { axis = [0, 0, 1], angle = 0.2 }
-force = ["-P", 0]
-)";
+  // euler_column.toml with a natural curvature and natural strains (inextensible).
+  std::string natural = testing::case_text("euler_column.toml");
+  const std::string rod = "[rod]\n";
+  natural.replace(natural.find(rod), rod.size(), rod + "u_hat = [0, 0.4, 0]\nv_hat = [0.5, 0, 1.34]\n");
   for (const double P : {3.0, 40.0, 300.0}) {
-    const Case c = load_case_text(natural, "natural.toml", {{"P", P}});
+    const Case c = load_case_text(natural, "natural.toml", {{"P", P}, {"L", 2.5}, {"EI", 0.3}, {"theta_guess", 0.2}});
     DefinitionSolve solved = solve_definition(c.definition, c.start_guess);
     ASSERT_TRUE(solved.result.summary.converged()) << "P = " << P;
     equilibria.emplace_back("natural strains, P = " + std::to_string(P), std::move(solved));
@@ -450,21 +447,11 @@ force = ["-P", 0]
     ASSERT_TRUE(solved.result.summary.converged()) << "P = " << P;
     equilibria.emplace_back("euler_column.toml, P = " + std::to_string(P), std::move(solved));
   }
-  long saved_on_the_column = 0;
-  for (const double tolerance : {0.0, 1e-8}) {
-    for (const auto& [name, solved] : equilibria) {
-      SCOPED_TRACE(name + " at field tolerance " + std::to_string(tolerance));
-      StabilityOptions bounded, estimated;
-      bounded.field_tolerance = estimated.field_tolerance = tolerance;
-      estimated.bounded_observations = false;
-      const Eigen::VectorXd& x = solved.result.x;
-      const StabilityReport a = analyse_stability(*solved.problem, x, bounded);
-      const StabilityReport b = analyse_stability(*solved.problem, x, estimated);
-      EXPECT_EQ(a.reason, b.reason);
-      expect_same_count(a, b);
-      if (name.rfind("euler_column.toml", 0) == 0) saved_on_the_column += b.field_flows - a.field_flows;
-    }
-  }
+  const long saved_on_the_column = compare_with_baseline(
+      equilibria, [](StabilityOptions* estimated) { estimated->bounded_observations = false; },
+      [](const std::string& name, double, const StabilityReport& a, const StabilityReport& b) {
+        return name.rfind("euler_column.toml", 0) == 0 ? b.field_flows - a.field_flows : 0L;
+      });
   EXPECT_GT(saved_on_the_column, 0);
 }
 
