@@ -153,8 +153,8 @@ DiscreteSeed seed_from_discrete_energy(const ProblemDefinition& d, int segments,
   // Ipopt succeeded and its solution passed the library's own KKT check (stationarity, end
   // constraints, no penetration, no pulling force, complementarity), a mirror-symmetric one's
   // stationarity to a seed's accuracy (usable_as_seed); anything else is refused rather than read
-  // off. (The seed needs no refinement check: the shooting solve that starts from
-  // it is checked by its own residual and complementarity.)
+  // off. (The seed needs no refinement check: the shooting solve that starts from it is checked
+  // by its own residual and complementarity.)
   if (!usable_as_seed(seed.discrete, options.mirror_symmetric))
     throw std::runtime_error("the Ipopt seed did not converge (" + seed.discrete.status + ")");
   const double h = rod.L / segments;
