@@ -238,6 +238,16 @@ TEST(Greenhill, ZeroTensionIsTwiceFirstTanRoot) {
   EXPECT_NEAR(clamped_twisted_critical_moment(1.0, -1e-9, 1.0), 8.98681891581813, 1e-8);
 }
 
+TEST(MichellRing, CriticalTwistsAreSqrtNSquaredMinusOne) {
+  // C tau R / B = sqrt(n^2 - 1): sqrt(3) for the first pair (Michell's), sqrt(8) and sqrt(15) next.
+  EXPECT_DOUBLE_EQ(michell_ring_critical_twist(1.0, 1.0, 1.0), std::sqrt(3.0));
+  EXPECT_DOUBLE_EQ(michell_ring_critical_twist(2.0, 0.5, 1.5, 3) * 0.5 * 1.5 / 2.0, std::sqrt(8.0));
+  EXPECT_DOUBLE_EQ(michell_ring_critical_twist(1.0, 1.0, 1.0, 4), std::sqrt(15.0));
+  EXPECT_THROW(michell_ring_critical_twist(1.0, 1.0, 1.0, 1), std::invalid_argument);  // a rigid turn
+  EXPECT_THROW(michell_ring_critical_twist(1.0, 0.0, 1.0), std::invalid_argument);
+  EXPECT_THROW(michell_ring_critical_twist(1.0, 1.0, -1.0), std::invalid_argument);
+}
+
 TEST(Greenhill, RootsSolveTheBoundaryDeterminant) {
   const double B = 1.0, L = 1.0;
   for (double t : {-39.0, -20.0, -1.0, 0.5, 5.0, 50.0, 1e3}) {

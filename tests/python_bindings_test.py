@@ -284,6 +284,23 @@ class SolveTest(unittest.TestCase):
         self.assertIsNone(couple.stability["zero_modes"])
         self.assertIn("not conservative", couple.stability["reason"])
 
+    def test_michells_ring_turns_unstable_at_michells_twist(self):
+        # A twisted ring is stable while C tau R < sqrt(3) B (Michell), then two modes at once; the
+        # ring's turn about its tangent at the weld is a zero mode throughout. Here R = 1.2, C = B:
+        # the branch point at sqrt(3) / 1.2 to the continuation's location (1e-10; 1e-8 allowed).
+        def ring(tau):
+            return kirchhoff.load_case(case_path("michell_ring.toml"), set={"R": 1.2, "C": 1.0, "tau": tau})
+        tau_c = np.sqrt(3.0) / 1.2
+        below = ring(0.97 * tau_c).solve().stability
+        above = ring(1.03 * tau_c).solve().stability
+        self.assertEqual((below["index"], below["zero_modes"]), (0, 1))
+        self.assertEqual((above["index"], above["zero_modes"]), (2, 1))
+        branch = ring(0.5).continue_("tau", to=1.8, max_step=0.2)
+        self.assertEqual(branch.reason, "reached_target")
+        at = [t for t, kind in zip(branch.points["parameter"], branch.points["type"]) if kind == "branch_point"]
+        self.assertEqual(len(at), 1)
+        self.assertLess(abs(at[0] - tau_c), 1e-8)
+
     def test_the_discretised_energy_decides_where_the_conjugate_points_do_not(self):
         # A pinned column on a stiff Winkler foundation (k = 1e6: a soft wall balanced by a uniform
         # weight towards it): the conjugate points call its held end degenerate, the discretised

@@ -112,6 +112,16 @@ void heavy_cantilever(const Shipped& s) {
   EXPECT_NEAR(std::abs(s.derived("m_start")) / moment, 1.0, 1e-5);
 }
 
+void michell_ring(const Shipped& s) {
+  // tau = 1.5 on the unit ring: the twisted circle (closed, m3 = C tau, |m| = sqrt(B^2 + (C tau)^2)),
+  // below Michell's twist sqrt(3) B / (C R) = 2.2517, so the stable ring the description names.
+  const double C = 0.769230769230769, tau = 1.5;
+  EXPECT_NEAR(s.derived("end_to_end"), 0.0, 1e-10);
+  EXPECT_NEAR(s.derived("m_start"), std::hypot(1.0, C * tau), 1e-10);
+  EXPECT_NEAR(s.sol.invariants.m3.mean, C * tau, 1e-10);
+  EXPECT_LT(tau, analytic::michell_ring_critical_twist(1.0, C, 1.0));
+}
+
 void indenter(const Shipped& s) {
   const auto exact = analytic::three_point_bending(1.0, 1.0, kSupportSlope);
   ASSERT_EQ(s.sol.contacts.size(), 1u);
@@ -280,6 +290,7 @@ const std::map<std::string, std::function<void(const Shipped&)>>& checks() {
       {"euler_column.toml", euler_column},
       {"heavy_cantilever.toml", heavy_cantilever},
       {"indenter.toml", indenter},
+      {"michell_ring.toml", michell_ring},
       {"plectoneme.toml", plectoneme},
       {"reissner.toml", reissner},
       {"shallow_arch.toml", shallow_arch},

@@ -708,4 +708,14 @@ WrappedThreePointBending three_point_bending_wrapped(double L, double EI, double
   return out;
 }
 
+double michell_ring_critical_twist(double B, double C, double R, int mode) {
+  const char* where = "michell_ring_critical_twist";
+  require_positive(where, "B", B);
+  require_positive(where, "C", C);
+  require_positive(where, "R", R);
+  if (mode < 2) reject(where, "mode", "must be >= 2 (mode 1 is a rigid turn of the ring), got " + std::to_string(mode));
+  const double n = mode;
+  return std::sqrt(n * n - 1.0) * B / (C * R);
+}
+
 }  // namespace kirchhoff::analytic

@@ -124,6 +124,16 @@ struct StraightTwistedRod {
 // at that load the straight rod buckles with no twist at all). The derivation is in analytic.cpp.
 double clamped_twisted_critical_moment(double B, double T, double L);
 
+// Michell's twisted ring (Michell 1889-90; rederived, with the higher modes, by Goriely 2006,
+// "Twisted elastic rings and the rediscoveries of Michell's instability", J. Elasticity 84): a
+// closed isotropic ring of radius R, bending stiffness B and twist stiffness C, its material
+// twisted uniformly by tau per length, is stable while C tau R < sqrt(3) B. Its out-of-plane
+// perturbations of wavenumber `mode` (n >= 2 around the ring; n = 1 is a rigid turn) have a zero
+// eigenvalue at C tau R / B = sqrt(n^2 - 1), each a double one (the mode and its quarter-period
+// shift): the twist at which the n-th pair turns unstable, the index then 2 (n - 1).
+// Domain: B, C, R > 0, mode >= 2.
+double michell_ring_critical_twist(double B, double C, double R, int mode = 2);
+
 // The symmetric single-arch Elastica pressed against a hard wall (Fig. 12 in the hard-wall
 // limit): clamped-clamped, length L, end shortening Delta, frictionless point contact with the
 // wall y = a at mid-span. The half rod [0, L/2] is a pendulum elastica,

@@ -1,5 +1,6 @@
 // `reproduce`'s continuation results (reproduce_steps.hpp): the Euler column's branch points, its
-// first buckled branch against the elliptic solution, and the twisted rod's double branch point.
+// first buckled branch against the elliptic solution, the twisted rod's double branch point and
+// Michell's ring's.
 #include <cmath>
 #include <fstream>
 #include <stdexcept>
@@ -55,20 +56,39 @@ void buckled_column(const Step& step, const ShootingProblem& problem, const Cont
                         "pseudo-arclength from the first branch point; the singular touching-ends point excluded"});
 }
 
-// The twisted clamped rod continued in phi: its first branch point against Greenhill's.
-void twisted_branch_point(const Step& step) {
-  const Case twisted = load_case((step.cases / "twisted_clamped.toml").string(), {{"phi", 6.0}});
-  const ShootingProblem rod(twisted.definition);
-  RodContinuation twist(rod, report_continuation("phi", 15.0, 1.0, ReportPoints::Located));
-  const ContinuationResult tr = twist.run(rod.initial_unknowns(twisted.start_guess));
+// A twisted rod's first double branch point along `parameter` (from `from` towards `to`), against
+// the closed form `exact`: a row labelled `id` and `quantity`.
+struct TwistedBranchPoint {
+  const char* file;
+  const char* parameter;
+  double from, to, max_step, exact;
+  const char* id;
+  const char* quantity;
+};
+
+void first_branch_point_row(const Step& step, const TwistedBranchPoint& t) {
+  const Case c = load_case((step.cases / t.file).string(), {{t.parameter, t.from}});
+  const ShootingProblem rod(c.definition);
+  RodContinuation twist(rod, report_continuation(t.parameter, t.to, t.max_step, ReportPoints::Located));
+  const ContinuationResult tr = twist.run(rod.initial_unknowns(c.start_guess));
   for (const auto& p : tr.points)
     if (p.type == PointType::BranchPoint) {
-      const double exact = analytic::clamped_twisted_critical_moment(1.0, 0.0, 1.0) / 0.769230769230769;
-      step.rows->push_back({"Twisted clamped rod (Greenhill)", "phi at the double branch point (M L/B = 8.9868)", {},
-                            exact, p.parameter, exact, 1e-6,
+      step.rows->push_back({t.id, t.quantity, {}, t.exact, p.parameter, t.exact, 1e-6,
                             "multiplicity " + std::to_string(p.multiplicity) + ", seen by the singular values"});
-      break;
+      return;
     }
+}
+
+// The twisted clamped rod continued in phi against Greenhill's; Michell's ring continued in its
+// twist against C tau R = sqrt(3) B.
+void twisted_branch_points(const Step& step) {
+  const double C = 0.769230769230769;  // both cases' twist stiffness, B / 1.3
+  first_branch_point_row(step, {"twisted_clamped.toml", "phi", 6.0, 15.0, 1.0,
+                                analytic::clamped_twisted_critical_moment(1.0, 0.0, 1.0) / C,
+                                "Twisted clamped rod (Greenhill)", "phi at the double branch point (M L/B = 8.9868)"});
+  first_branch_point_row(step, {"michell_ring.toml", "tau", 1.0, 3.0, 0.2,
+                                analytic::michell_ring_critical_twist(1.0, C, 1.0), "Michell's twisted ring",
+                                "tau at the double branch point (C tau R / B = sqrt(3))"});
 }
 
 }  // namespace
@@ -79,7 +99,7 @@ void continuation(const Step& step) {
   const RodContinuationOptions o = report_continuation("P", 100.0, 5.0, ReportPoints::Located, {"theta0"});
   const std::vector<ContinuationPoint> bps = column_branch_points(problem, column, o, step.rows);
   buckled_column(step, problem, bps[0]);
-  twisted_branch_point(step);
+  twisted_branch_points(step);
 }
 
 }  // namespace kirchhoff::reproduce_steps

@@ -1,6 +1,6 @@
 // `reproduce`'s stability indices (reproduce_steps.hpp, stability.hpp) of classical equilibria,
 // against what is known of them independently (Euler's loads, the modes of the clamped rod,
-// Greenhill). A row passes when the index is the expected integer.
+// Greenhill, Michell's ring). A row passes when the index is the expected integer.
 #include <cmath>
 
 #include "kirchhoff/analysis/analytic.hpp"
@@ -52,6 +52,13 @@ void stability(const Step& step) {
                             solve_for_report(twisted, {{"phi", phi_c - 0.5}}, 41), ""));
   rows->push_back(index_row("Stability: twisted straight rod above the Greenhill point", "index", 2,
                             solve_for_report(twisted, {{"phi", phi_c + 0.5}}, 41), "double branch point"));
+  const double tau_c = analytic::michell_ring_critical_twist(1.0, 0.769230769230769, 1.0);
+  const fs::path ring = step.cases / "michell_ring.toml";
+  rows->push_back(index_row("Stability: Michell's twisted ring below C tau R = sqrt(3) B", "index", 0,
+                            solve_for_report(ring, {{"tau", 0.97 * tau_c}}, 41), "tau = 0.97 of Michell's"));
+  rows->push_back(index_row("Stability: Michell's twisted ring above C tau R = sqrt(3) B", "index", 2,
+                            solve_for_report(ring, {{"tau", 1.03 * tau_c}}, 41),
+                            "tau = 1.03 of Michell's; two out-of-plane modes at once"));
 }
 
 }  // namespace kirchhoff::reproduce_steps

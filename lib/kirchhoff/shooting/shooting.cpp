@@ -826,6 +826,9 @@ ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) 
   result.x = x0;
   result.summary = solve_with_fallback(problem, result.x, problem.definition().options.newton);
   result.parameters = problem.parameters_at(result.x);
+  if (!result.summary.converged())
+    if (const std::string turns = turn_count_hint(problem, result.x); !turns.empty())
+      result.summary.message = result.summary.message.empty() ? turns : result.summary.message + "; " + turns;
   note_single_shooting(problem, result.x, &result.summary);
   if (result.summary.converged()) mark_check_failure(&result, unknowns_failure(problem, result));
   if (result.summary.converged()) mark_check_failure(&result, zero_iteration_failure(problem, result));

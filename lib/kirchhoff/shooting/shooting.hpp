@@ -343,8 +343,9 @@ struct ShootingResult {
   Parameters parameters;
 };
 
-// Newton (with the NLopt fallback when enabled) from the unknowns x0. A single segment that is
-// singular to the solver, or whose line search fails, adds single_segment_hint() to the message.
+// Newton (with the NLopt fallback when enabled) from the unknowns x0. A failure adds
+// turn_count_hint() to the message where it applies; a single segment that is singular to the
+// solver, or whose line search fails, adds single_segment_hint().
 ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0);
 
 // What a failure on one shooting segment adds: more segments condition an ill-conditioned shooting.
@@ -352,5 +353,9 @@ std::string single_segment_hint();
 // What to do where a case's length or bending stiffness lies decades from 1 at x (its units make
 // the absolute residual tolerance mean something else); "" for a case of unit scale.
 std::string scale_hint(const ShootingProblem& problem, const Eigen::VectorXd& x);
+// Where the rod's tangent at x comes within a few degrees of -e3 (a ring closed on itself) and an
+// end counts whole turns about e3 (track_turns) or the stepper is dopri5, what to do: the frame's
+// turn angle about e3 is undefined there (turn_count_hint.cpp); "" otherwise.
+std::string turn_count_hint(const ShootingProblem& problem, const Eigen::VectorXd& x);
 
 }  // namespace kirchhoff
