@@ -5,9 +5,14 @@
 //   1. in this process with continue_case and no outputs (the mathematics alone),
 //   2. in this process with the CLI's outputs: the branch CSV and the state file (checkpointed),
 //   3. as the CLI itself, a child process (process start, case loading, terminal lines included),
+//   4. as 2, in a child process of its own: this benchmark started again with --library-once,
+//      which runs 2 once and exits,
 // alternately, `--reps` times each. Times are CPU time (this process's for 1-2, the child's user +
-// system time for 3, from wait4) beside the wall time; the ratios are points per second of 3 and
-// 2 against 1, from medians. Issue 24's goal: the CLI within 20 % of the library (ratio >= 0.8).
+// system time for 3-4, from wait4) beside the wall time; the ratios are points per second of 2, 3
+// and 4 against 1, from medians. Issue 24's goal: the CLI within 20 % of the library (ratio >= 0.8).
+// 4 tells what any process pays to run the library once - starting, loading its libraries,
+// faulting in its pages, caches and branch predictors cold - from what the CLI adds to it (3
+// against 4).
 //
 //   cli_benchmark [--reps N] [--checkpoint SECONDS] [--stability on|off] [--out DIR]
 //
@@ -46,6 +51,7 @@ namespace fs = std::filesystem;
 using namespace kirchhoff;
 
 struct Options {
+  bool library_once = false;  // variant 4's child: run the library with outputs once, then exit
   int reps = 5;
   double checkpoint = 1.0;  // the CLI's default --checkpoint
   bool stability = true;    // the CLI's default
@@ -117,15 +123,11 @@ int csv_rows(const fs::path& csv) {
   return std::max(0, lines - 1);  // the header
 }
 
-// 3: the CLI as a child process, its terminal output discarded.
-Timing run_cli(const Options& o, const fs::path& csv) {
+// `args` as a child process, its terminal output discarded: its CPU and wall time, and the CSV
+// rows it wrote to `csv`.
+Timing run_child(std::vector<std::string> args, const fs::path& csv) {
   fs::remove(csv);
   fs::remove(csv.string() + ".state.json");
-  std::vector<std::string> args = {KIRCHHOFF_CLI, "continue", case_path(), "--param", "P", "--to", "12",
-                                   "--set", "P=1", "--set", "theta_guess=0", "--switch-at-bp", "1",
-                                   "--event", "theta0=3", "--max-step", "1", "--checkpoint",
-                                   std::to_string(o.checkpoint), "--out", csv.string()};
-  if (!o.stability) args.push_back("--no-stability");
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -137,16 +139,34 @@ Timing run_cli(const Options& o, const fs::path& csv) {
   pid_t pid = 0;
   const int spawned = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
-  if (spawned != 0) throw std::runtime_error(std::string("cannot start the CLI: ") + std::strerror(spawned));
+  if (spawned != 0) throw std::runtime_error("cannot start " + args[0] + ": " + std::strerror(spawned));
   int status = 0;
   rusage usage{};
   if (wait4(pid, &status, 0, &usage) != pid) throw std::runtime_error("wait4 failed");
   Timing t;
   t.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) throw std::runtime_error("the CLI's run failed");
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) throw std::runtime_error(args[0] + "'s run failed");
   t.cpu_s = seconds(usage.ru_utime) + seconds(usage.ru_stime);
   t.points = csv_rows(csv);
   return t;
+}
+
+// 3: the CLI.
+Timing run_cli(const Options& o, const fs::path& csv) {
+  std::vector<std::string> args = {KIRCHHOFF_CLI, "continue", case_path(), "--param", "P", "--to", "12",
+                                   "--set", "P=1", "--set", "theta_guess=0", "--switch-at-bp", "1",
+                                   "--event", "theta0=3", "--max-step", "1", "--checkpoint",
+                                   std::to_string(o.checkpoint), "--out", csv.string()};
+  if (!o.stability) args.push_back("--no-stability");
+  return run_child(args, csv);
+}
+
+// 4: this benchmark, started again to run 2 once (`self`: its own path).
+Timing run_library_process(const Options& o, const std::string& self, const fs::path& csv) {
+  std::vector<std::string> args = {self, "--library-once", "--out", csv.parent_path().string(),
+                                   "--checkpoint", std::to_string(o.checkpoint), "--stability",
+                                   o.stability ? "on" : "off"};
+  return run_child(args, csv);
 }
 
 double median(std::vector<double> v) {
@@ -179,7 +199,8 @@ Options parse(int argc, char** argv) {
       if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
       return argv[++i];
     };
-    if (a == "--reps") o.reps = std::stoi(value());
+    if (a == "--library-once") o.library_once = true;
+    else if (a == "--reps") o.reps = std::stoi(value());
     else if (a == "--checkpoint") o.checkpoint = std::stod(value());
     else if (a == "--stability") o.stability = value() != "off";
     else if (a == "--out") o.out = value();
@@ -197,27 +218,39 @@ int main(int argc, char** argv) {
   kirchhoff::keep_freed_memory_for_reuse();  // as the CLI's main, so that the two run alike
   try {
     const Options o = parse(argc, argv);
-    Series library{"library, no outputs", {}}, outputs{"library + CSV + state file", {}}, cli{"CLI (child process)", {}};
+    if (o.library_once) {
+      run_library(o, true, o.out / "process.csv");
+      return 0;
+    }
+    Series library{"library, no outputs", {}}, outputs{"library + CSV + state file", {}}, cli{"CLI (child process)", {}},
+        process{"library + outputs, own process", {}};
     // Alternating, each round in another order, so that a load on the machine and the order of
-    // the runs (caches, a page cache warmed by the one before) hit all three alike.
+    // the runs (caches, a page cache warmed by the one before) hit all four alike.
     const std::function<void()> variants[] = {
         [&] { library.runs.push_back(run_library(o, false, {})); },
         [&] { outputs.runs.push_back(run_library(o, true, o.out / "library.csv")); },
-        [&] { cli.runs.push_back(run_cli(o, o.out / "cli.csv")); }};
+        [&] { cli.runs.push_back(run_cli(o, o.out / "cli.csv")); },
+        [&] { process.runs.push_back(run_library_process(o, fs::read_symlink("/proc/self/exe").string(), o.out / "process.csv")); }};
+    constexpr int kVariants = 4;
     for (int r = 0; r < o.reps; ++r)
-      for (int k = 0; k < 3; ++k) variants[(r + k) % 3]();
+      for (int k = 0; k < kVariants; ++k) variants[(r + k) % kVariants]();
     std::printf("Euler column, the README's continue command (branch point, switch, event theta0 = 3), stability %s,\n"
                 "--checkpoint %g s, outputs in %s; medians of %d alternating runs.\n\n",
                 o.stability ? "on" : "off", o.checkpoint, o.out.c_str(), o.reps);
     std::printf("%-30s %7s %9s %9s %11s %11s\n", "run", "points", "cpu_ms", "wall_ms", "points/s", "wall pts/s");
-    for (const Series* s : {&library, &outputs, &cli})
+    for (const Series* s : {&library, &outputs, &process, &cli})
       std::printf("%-30s %7d %9.1f %9.1f %11.0f %11.0f\n", s->name, s->points(), 1e3 * s->cpu(), 1e3 * s->wall(),
                   s->points() / s->cpu(), s->points() / s->wall());
-    if (cli.points() != library.points() || outputs.points() != library.points())
+    if (cli.points() != library.points() || outputs.points() != library.points() || process.points() != library.points())
       std::printf("\nwarning: the runs wrote different numbers of points\n");
     std::printf("\nRatios (points/s against the library without outputs; goal for the CLI >= 0.8):\n");
-    std::printf("  library + outputs  cpu %.3f  wall %.3f\n", library.cpu() / outputs.cpu(), library.wall() / outputs.wall());
-    std::printf("  CLI                cpu %.3f  wall %.3f\n", library.cpu() / cli.cpu(), library.wall() / cli.wall());
+    std::printf("  library + outputs                 cpu %.3f  wall %.3f\n", library.cpu() / outputs.cpu(), library.wall() / outputs.wall());
+    std::printf("  library + outputs, own process    cpu %.3f  wall %.3f\n", library.cpu() / process.cpu(),
+                library.wall() / process.wall());
+    std::printf("  CLI                               cpu %.3f  wall %.3f\n", library.cpu() / cli.cpu(), library.wall() / cli.wall());
+    std::printf("The CLI against the library + outputs in a process of its own (what the CLI adds to starting a\n"
+                "process that runs the library once): cpu %.3f  wall %.3f\n", process.cpu() / cli.cpu(),
+                process.wall() / cli.wall());
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
