@@ -51,9 +51,16 @@ double end_load_work(const EndCondition& end, const RodEquations& eq, const Para
 
 double total_potential_energy(const ShootingProblem& problem, const Eigen::VectorXd& x) {
   const ProblemDefinition& definition = problem.definition();
-  for (const auto& name : definition.unknown_parameters)
-    if (definition.model_parameters.count(name) || definition.obstacle_parameters.count(name)) return NAN;
   const Parameters params = problem.parameters_at(x);
+  // The axial phase condition's unfolding couple (add_axial_phase_condition) is zero at every
+  // equilibrium: where it is (unfolding_failure says not otherwise) the rod is the case's own and
+  // its energy defined (Michell's ring, which sets the condition, had every energy NaN).
+  const auto unfolded = [&](const std::string& name) {
+    return is_unfolding_parameter(name) && unfolding_failure(params).empty();
+  };
+  for (const auto& name : definition.unknown_parameters)
+    if ((definition.model_parameters.count(name) || definition.obstacle_parameters.count(name)) && !unfolded(name))
+      return NAN;
   const auto eq = problem.equations(params);
   const RodModel& model = eq->model();
   const double L = model.length;

@@ -140,7 +140,8 @@ EquilibriaSearch find_equilibria(const ProblemDefinition& definition, const RodP
 // error ~ h^4, ~1e-13 of the energy with 2000 intervals); NaN where the energy is not a potential:
 // a dead couple on a spatial end free to rotate, or an unknown parameter that changes the rod or
 // an obstacle (a sleeve's sliding length: the work the sleeve's load does as the rod slides is not
-// part of this energy, so comparing such equilibria by it would mislead).
+// part of this energy, so comparing such equilibria by it would mislead) - but the axial phase
+// condition's unfolding parameter where it is zero, as at every equilibrium.
 double total_potential_energy(const ShootingProblem& problem, const Eigen::VectorXd& x);
 
 // The scale-free distance between two solutions (see above) over `samples` points. Without
