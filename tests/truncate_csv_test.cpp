@@ -3,12 +3,19 @@
 // is refused rather than resumed with a gap.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
+#include <limits>
+#include <random>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "cli_run_support.hpp"
+#include "kirchhoff/jobs/detail/csv_number.hpp"
 #include "kirchhoff/jobs/run_state.hpp"
 
 namespace {
@@ -55,6 +62,27 @@ TEST_F(TruncateCsv, SomeIndicesMayHaveGapsButNotGoBack) {
   EXPECT_EQ(read_text(path), "index,a\n0,1\n4,2\n9,3\n");
   const fs::path back = write("index,a\n0,1\n4,2\n3,3\n");
   EXPECT_THROW(truncate_csv(back, 10, "", CsvRows::SomeIndices), std::runtime_error);
+}
+
+// The branch CSV's numbers are written by to_chars (detail/csv_number.hpp): the very text the
+// stream wrote them as before (setprecision(15), printf's %.15g), so that resumed runs append
+// rows identical to an uninterrupted run's and earlier CSVs compare equal.
+TEST(CsvNumber, WritesWhatTheStreamWrote) {
+  std::vector<double> values = {0.0, -0.0, 1.0, -1.0, 0.1, 1.0 / 3.0, 9.869604401089358, 1e-300, 5e-324,
+                                123456789012345678.0, 1e15, 1e16, 1e-5, 1e-4, 2.5e-7, 65.25036310,
+                                std::numeric_limits<double>::max(), std::numeric_limits<double>::quiet_NaN(),
+                                -std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+                                -std::numeric_limits<double>::infinity()};
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-40, 40);
+  for (int i = 0; i < 2000; ++i) values.push_back(std::ldexp(mantissa(random), exponent(random)));
+  for (double v : values) {
+    std::ostringstream by_stream, by_chars;
+    by_stream << std::setprecision(15) << v;
+    kirchhoff::detail::put_csv_number(by_chars, v);
+    EXPECT_EQ(by_chars.str(), by_stream.str()) << std::hexfloat << v;
+  }
 }
 
 }  // namespace

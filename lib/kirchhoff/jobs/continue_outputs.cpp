@@ -9,6 +9,7 @@
 
 #include "kirchhoff/analysis/point_record.hpp"
 #include "kirchhoff/analysis/solution.hpp"
+#include "kirchhoff/jobs/detail/csv_number.hpp"
 
 namespace kirchhoff {
 
@@ -62,7 +63,7 @@ void BranchCsvSink::begin(const std::string& parameter, const std::vector<std::s
   }
   out_.open(path_, append ? std::ios::app : std::ios::trunc);
   if (!out_) throw std::runtime_error("cannot write " + path_.string());
-  out_ << std::setprecision(15);
+  out_ << std::setprecision(detail::kCsvPrecision);  // (every double goes through put_csv_number)
   if (!append) {
     out_ << header << "\n";
     out_.flush();
@@ -71,16 +72,24 @@ void BranchCsvSink::begin(const std::string& parameter, const std::vector<std::s
 
 void BranchCsvSink::point(const RunPoint& rp) {
   const ContinuationPoint& p = *rp.point;
-  out_ << rp.row << ',' << rp.branch << ',' << p.parameter << ',' << p.arclength;
+  const auto cell = [this](double v) {
+    out_ << ',';
+    detail::put_csv_number(out_, v);
+  };
+  out_ << rp.row << ',' << rp.branch;
+  cell(p.parameter);
+  cell(p.arclength);
   for (const auto& d : columns_) {
     const auto it = p.derived.find(d);
-    out_ << ',' << (it != p.derived.end() ? it->second : NAN);
+    cell(it != p.derived.end() ? it->second : NAN);
   }
   const auto& inv = invariants_of(p);
   // + 0.0 prints a zero spread as 0, not -0.
-  out_ << ',' << inv.H.relative_spread() + 0.0 << ',' << inv.m3.relative_spread() + 0.0 << ','
-       << inv.n_dot_m.relative_spread() + 0.0 << ',' << (H_is_flat(p) ? 1 : 0) << ',' << to_string(p.type) << ','
-       << p.multiplicity << ',' << p.event << ',' << p.newton_iterations << ',';
+  cell(inv.H.relative_spread() + 0.0);
+  cell(inv.m3.relative_spread() + 0.0);
+  cell(inv.n_dot_m.relative_spread() + 0.0);
+  out_ << ',' << (H_is_flat(p) ? 1 : 0) << ',' << to_string(p.type) << ',' << p.multiplicity << ',' << p.event << ','
+       << p.newton_iterations << ',';
   // Both empty where the index is not defined (or not computed): never a guessed number.
   if (p.stability_index) out_ << *p.stability_index << ',' << p.zero_modes;
   else out_ << ',';
