@@ -140,20 +140,6 @@ TEST(MichellRing, CountingTurnsThroughAReversedTangentSaysWhyItFails) {
   EXPECT_NE(r.summary.message.find("set track_turns = false"), std::string::npos) << r.summary.message;
 }
 
-TEST(MichellRing, Dopri5SaysWhereItCannotPass) {
-  // The turn angle is carried with the state even where no end counts turns; it jumps where the
-  // tangent passes through -e3, and dopri5's step size underflows there. The failure says where
-  // and which stepper passes.
-  Case c = load_case(testing::case_path("michell_ring.toml"));
-  c.definition.options.integrator.stepper = IntegratorOptions::Stepper::Dopri5;
-  const ShootingProblem problem(c.definition);
-  const ShootingResult r = solve(problem, problem.initial_unknowns(c.start_guess));
-  ASSERT_FALSE(r.summary.converged());
-  EXPECT_NE(r.summary.message.find("the tangent reverses through -e3"), std::string::npos) << r.summary.message;
-  EXPECT_NE(r.summary.message.find("stepper = \"rk78\""), std::string::npos) << r.summary.message;
-  EXPECT_EQ(r.summary.message.find("track_turns = false"), std::string::npos) << r.summary.message;
-}
-
 TEST(MichellRing, NoTurnCountHintWhereTheTangentStaysAwayFromMinusE3) {
   // The twisted clamped rod counts its turns and never points its tangent backwards: a failure
   // there (one Newton iteration allowed from a far guess) must not blame the turn count.

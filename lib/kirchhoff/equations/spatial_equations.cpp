@@ -107,8 +107,9 @@ class SpatialEquations final : public RodEquations {
       dy[kM + 1] = dy[kM + 1] + mu * R[1][2];
       dy[kM + 2] = dy[kM + 2] - mu * (1.0 - R[2][2]);
     }
-    // chi = 2 atan2(qz, w)  =>  chi' = 2 (w qz' - qz w') / (w^2 + qz^2).
-    dy[kChi] = 2.0 * (w * dy[kQ + 3] - qz * dy[kQ]) / (w * w + qz * qz);
+    // chi = 2 atan2(qz, w)  =>  chi' = 2 (w qz' - qz w') / (w^2 + qz^2), the denominator held off
+    // zero where the tangent points along -e3 (turn_angle_denominator).
+    dy[kChi] = 2.0 * (w * dy[kQ + 3] - qz * dy[kQ]) / detail::turn_angle_denominator(w, qx, qy, qz);
   }
 
   void flow_into(const Eigen::VectorXd& y0, double s0, double s1, bool sensitivities, const IntegratorOptions& given,
@@ -259,7 +260,9 @@ class SpatialEquations final : public RodEquations {
     const Eigen::Vector4d q = y.segment<4>(kQ);
     GaugeRows g(2);
     g[0] = q.squaredNorm() - 1.0;
-    const double w = q[0], qz = q[3], d = w * w + qz * qz;
+    // (d held off zero as chi's equation holds it, turn_angle_denominator: a clamp pointing along
+    // -e3 has w = qz = 0, where the gauge's derivatives were infinite.)
+    const double w = q[0], qz = q[3], d = detail::turn_angle_denominator(w, q[1], q[2], qz);
     // chi(0) is the twist of R(0) up to whole turns: 2 atan2(qz, w) is it for q and -q alike
     // modulo 2 pi. The remainder keeps the residual continuous where the twist passes pi (w = 0):
     // a gauge in a fixed interval such as (-pi, pi] jumps by 2 pi there, and Newton could not

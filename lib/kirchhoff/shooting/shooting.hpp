@@ -353,9 +353,9 @@ std::string single_segment_hint();
 // What to do where a case's length or bending stiffness lies decades from 1 at x (its units make
 // the absolute residual tolerance mean something else); "" for a case of unit scale.
 std::string scale_hint(const ShootingProblem& problem, const Eigen::VectorXd& x);
-// Where the rod's tangent at x comes within a few degrees of -e3 (a ring closed on itself) and an
-// end counts whole turns about e3 (track_turns) or the stepper is dopri5, what to do: the frame's
-// turn angle about e3 is undefined there (turn_count_hint.cpp); "" otherwise.
+// Where an end counts whole turns about e3 (track_turns) and the rod's tangent at x comes within a
+// few degrees of -e3 - a ring closed on itself - what to do: the counted turn is undefined there
+// (turn_count_hint.cpp); "" otherwise.
 std::string turn_count_hint(const ShootingProblem& problem, const Eigen::VectorXd& x);
 
 }  // namespace kirchhoff

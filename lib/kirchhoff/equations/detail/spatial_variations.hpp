@@ -145,12 +145,15 @@ void rhs_with_written_out_variations(const RodModel& model, const Compliances& c
                                 n[i2] * d_dr[i1][j] + mu * (R[i][0] * omega[1][j] - R[i][1] * omega[0][j]);
     if (forced >= 0) dP[(kRowM + i) * C + forced] += R[i][2] - (i == 2 ? 1.0 : 0.0);
   }
-  // chi' = 2 N / D with N = w z' - z w', D = w^2 + z^2.
+  // chi' = 2 N / D with N = w z' - z w', D = w^2 + z^2, or where the tangent points along -e3 the
+  // constant floor (turn_angle_denominator, the same branch as the state's).
   const double w = q[0], z = q[3], w_prime = dy[kQ], z_prime = dy[kQ + 3];
-  const double D = w * w + z * z, N = w * z_prime - z * w_prime;
+  const double raw = w * w + z * z, floor = turn_angle_floor(w, q[1], q[2], z);
+  const bool floored = !(raw >= floor);
+  const double D = floored ? floor : raw, N = w * z_prime - z * w_prime;
   for (int j = 0; j < C; ++j) {
     const double dN = dq[0][j] * z_prime + w * dz[j] - dq[3][j] * w_prime - z * dw[j];
-    const double dD = 2.0 * (w * dq[0][j] + z * dq[3][j]);
+    const double dD = floored ? 0.0 : 2.0 * (w * dq[0][j] + z * dq[3][j]);
     dP[kRowChi * C + j] = 2.0 * (dN * D - N * dD) / (D * D);
   }
 }
