@@ -121,10 +121,10 @@ TEST(MichellRing, TheCliSaysTheRingPastMichellsTwistIsUnstable) {
 }
 
 TEST(MichellRing, CountingTurnsThroughAReversedTangentSaysWhyItFails) {
-  // With track_turns, the turn about e3 is counted by an angle whose equation is singular where
-  // the tangent points along -e3, as the ring's does at s = L / 2: Newton stalls on the
-  // integration's error there (at tau = 1: residual 1.2e-9 against 1e-10; at 1.5 it happens to
-  // converge). The failure says so and what to do, rather than only that the line search failed.
+  // With track_turns, the turn about e3 is counted by an angle that jumps by about pi where the
+  // tangent passes -e3, as the ring's does at s = L / 2, to one side or the other as the rod
+  // passes it: Newton stalls there (at tau = 1: residual 1.2e-9 against 1e-10; at 1.5 it happens
+  // to converge). The failure says so and what to do, rather than only that the line search failed.
   std::string text = testing::case_text("michell_ring.toml");
   const std::string end_frame = "orientation = { axis = [0, 0, 1], angle = \"tau*2*pi*R\" }";
   const size_t at = text.find(end_frame);
