@@ -226,11 +226,12 @@ int main(int argc, char** argv) {
         process{"library + outputs, own process", {}};
     // Alternating, each round in another order, so that a load on the machine and the order of
     // the runs (caches, a page cache warmed by the one before) hit all four alike.
+    const std::string self = fs::read_symlink("/proc/self/exe").string();  // variant 4's program
     const std::function<void()> variants[] = {
         [&] { library.runs.push_back(run_library(o, false, {})); },
         [&] { outputs.runs.push_back(run_library(o, true, o.out / "library.csv")); },
         [&] { cli.runs.push_back(run_cli(o, o.out / "cli.csv")); },
-        [&] { process.runs.push_back(run_library_process(o, fs::read_symlink("/proc/self/exe").string(), o.out / "process.csv")); }};
+        [&] { process.runs.push_back(run_library_process(o, self, o.out / "process.csv")); }};
     constexpr int kVariants = 4;
     for (int r = 0; r < o.reps; ++r)
       for (int k = 0; k < kVariants; ++k) variants[(r + k) % kVariants]();

@@ -196,9 +196,9 @@ bool has_hanging_fold(const std::vector<PointContact>& contacts) {
 namespace {
 
 // Appends `what` to a failed solve's message (once: the summary may already say it).
-void append_to_message(NewtonSummary* summary, const std::string& what) {
+void append_once_to_message(NewtonSummary* summary, const std::string& what) {
   if (summary->message.find(what) != std::string::npos) return;
-  summary->message = summary->message.empty() ? what : summary->message + "; " + what;
+  summary->append_to_message(what);
 }
 
 // The log line of a solve accepted by converged_at_round_off.
@@ -285,7 +285,7 @@ ContactSolveResult solve_with_contacts(ProblemDefinition d, const RodPoint& gues
       out.message = "solve with " + std::to_string(d.contacts.size()) + " contact(s) did not converge";
       if (const std::string why = stalled_flat_contact_reason(d, out.result.summary); !why.empty()) out.message += ": " + why;
       if (round > 0) out.message += " (round " + std::to_string(round + 1) + " of the active-set loop)";
-      append_to_message(&out.result.summary, out.message);
+      append_once_to_message(&out.result.summary, out.message);
       return out;
     }
     const auto solved = problem->contacts_at(out.result.x);

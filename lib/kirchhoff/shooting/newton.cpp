@@ -437,7 +437,7 @@ NewtonSummary solve_with_fallback(const NonlinearSystem& system, Eigen::VectorXd
   NewtonSummary& best = second.residual_norm < summary.residual_norm ? second : summary;
   if (&best == &second) x = candidate;
   best.evaluations = second.evaluations;
-  best.message = best.message.empty() ? tried.str() : best.message + "; " + tried.str();
+  best.append_to_message(tried.str());
   return best;
 }
 

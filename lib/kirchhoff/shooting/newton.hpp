@@ -137,6 +137,8 @@ struct NewtonSummary {
   // Why it stopped, for a user: its message, or its brief report where it gave none (out of
   // iterations).
   std::string why_stopped() const { return message.empty() ? brief_report() : message; }
+  // Adds a clause to the message, after a "; " where it already says something.
+  void append_to_message(const std::string& clause) { message = message.empty() ? clause : message + "; " + clause; }
 };
 
 // Solves F(x) = 0 starting from x; on return x holds the best iterate found.

@@ -784,7 +784,7 @@ void note_single_shooting(const ShootingProblem& problem, const Eigen::VectorXd&
     return;
   std::string hint = scale_hint(problem, x);
   if (hint.empty()) hint = single_segment_hint();
-  summary->message = summary->message.empty() ? hint : summary->message + "; " + hint;
+  summary->append_to_message(hint);
 }
 
 }  // namespace
@@ -828,7 +828,7 @@ ShootingResult solve(const ShootingProblem& problem, const Eigen::VectorXd& x0) 
   result.parameters = problem.parameters_at(result.x);
   if (!result.summary.converged())
     if (const std::string turns = turn_count_hint(problem, result.x); !turns.empty())
-      result.summary.message = result.summary.message.empty() ? turns : result.summary.message + "; " + turns;
+      result.summary.append_to_message(turns);
   note_single_shooting(problem, result.x, &result.summary);
   if (result.summary.converged()) mark_check_failure(&result, unknowns_failure(problem, result));
   if (result.summary.converged()) mark_check_failure(&result, zero_iteration_failure(problem, result));
